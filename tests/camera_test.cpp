@@ -1,0 +1,3 @@
+#include <gtest/gtest.h>
+#include "common/camera.h"
+TEST(Camera, Placeholder) { EXPECT_TRUE(true); }

@@ -1,0 +1,25 @@
+#include "tests/test_util.h"
+
+#include <cstdlib>
+
+namespace isowall::test {
+
+std::optional<std::filesystem::path> shared_data_dir() {
+    namespace fs = std::filesystem;
+    if (const char* env = std::getenv("ISOWALL_SHARED_DATA")) {
+        if (fs::is_directory(env)) return fs::path(env);
+    }
+    const fs::path beside = fs::path(ISOWALL_SOURCE_DIR).parent_path() / "shared" / "data";
+    if (fs::is_directory(beside)) return beside;
+    return std::nullopt;
+}
+
+std::filesystem::path scratch_dir(const std::string& name) {
+    namespace fs = std::filesystem;
+    fs::path dir = fs::current_path() / "scratch" / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+}  // namespace isowall::test
