@@ -1,1 +1,69 @@
-int main() { return 0; }
+// isowall: progressive view-dependent isosurfaces for display walls.
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "master/commands.h"
+
+int main(int argc, char** argv) {
+    using namespace isowall;
+    CLI::App app{"isowall: isosurfaces of large volumes on tiled display walls"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "isowall 0.1.0");
+
+    InfoOptions info;
+    auto* info_cmd = app.add_subcommand("info", "Print a volume's size, type, value range and octree");
+    add_volume_options(*info_cmd, info.volume);
+
+    ExtractOptions ex;
+    auto* ex_cmd = app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
+    add_volume_options(*ex_cmd, ex.volume);
+    ex_cmd->add_option("--iso", ex.iso, "Isovalue (default for the phantom: skin, 50)");
+    ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
+
+    RenderOptions re;
+    auto* re_cmd = app.add_subcommand("render", "Extract the isosurface and render one image");
+    add_volume_options(*re_cmd, re.volume);
+    re_cmd->add_option("--iso", re.iso, "Isovalue (default for the phantom: skin, 50)");
+    re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();
+    re_cmd->add_option("--out,-o", re.out, "Output image (PNG, or any format OpenImageIO writes)")
+        ->capture_default_str();
+    re_cmd->add_option("--depth-out", re.depth_out, "Also write window depth (EXR)");
+    re_cmd->add_option("--gl", re.gl, "OpenGL back end")
+        ->check(CLI::IsMember({"osmesa", "egl"}))
+        ->capture_default_str();
+    re_cmd->add_option("--projection", re.projection, "perspective or orthographic")
+        ->check(CLI::IsMember({"perspective", "orthographic"}))
+        ->capture_default_str();
+    re_cmd->add_option("--orbit", re.orbit, "Rotate the front view: YAW PITCH in degrees")->expected(2);
+    re_cmd->add_option("--zoom", re.zoom, "Zoom factor (>1 moves closer)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        // One line, then a pointer to --help (CLI11's own output spans several lines).
+        std::fprintf(stderr, "isowall: error: %s (see isowall --help)\n", e.what());
+        return 2;
+    }
+
+    try {
+        if (info_cmd->parsed()) return run_info(info);
+        if (ex_cmd->parsed()) return run_extract(ex);
+        if (re_cmd->parsed()) return run_render(re);
+    } catch (const std::exception& e) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "isowall: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,29 @@
+#pragma once
+// Read-only memory map of a whole file (RAII). Volumes and octree caches are read through it, so
+// ranks on one machine share one copy of the bytes through the page cache.
+#include <cstddef>
+#include <filesystem>
+#include <span>
+
+namespace isowall {
+
+class MappedFile {
+public:
+    MappedFile() = default;
+    // Throws std::runtime_error naming the file when it cannot be opened or mapped.
+    explicit MappedFile(const std::filesystem::path& path);
+    MappedFile(MappedFile&& other) noexcept;
+    MappedFile& operator=(MappedFile&& other) noexcept;
+    MappedFile(const MappedFile&) = delete;
+    MappedFile& operator=(const MappedFile&) = delete;
+    ~MappedFile();
+
+    std::span<const std::byte> bytes() const { return {data_, size_}; }
+    std::size_t size() const { return size_; }
+
+private:
+    const std::byte* data_ = nullptr;
+    std::size_t size_ = 0;
+};
+
+}  // namespace isowall

@@ -1,0 +1,32 @@
+#pragma once
+// Small helpers for programs: wall-clock stopwatch, peak memory, option value parsing.
+#include <chrono>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <glm/vec2.hpp>
+
+namespace isowall {
+
+class Stopwatch {
+public:
+    Stopwatch() : start_(std::chrono::steady_clock::now()) {}
+    double seconds() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    }
+    void restart() { start_ = std::chrono::steady_clock::now(); }
+
+private:
+    std::chrono::steady_clock::time_point start_;
+};
+
+// Peak resident set size of this process, in MiB (getrusage).
+double peak_rss_mib();
+// Current resident set size of this process, in MiB (/proc/self/statm).
+double current_rss_mib();
+
+// "1600x1200" -> (1600, 1200); nullopt unless two positive integers <= 32768.
+std::optional<glm::ivec2> parse_size(std::string_view s);
+
+}  // namespace isowall

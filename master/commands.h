@@ -1,0 +1,36 @@
+#pragma once
+// The subcommands of the isowall program. Each returns the process exit code.
+#include <string>
+#include <vector>
+
+#include "master/volume_options.h"
+
+namespace isowall {
+
+struct InfoOptions {
+    VolumeOptions volume;
+};
+
+struct ExtractOptions {
+    VolumeOptions volume;
+    std::optional<double> iso;
+    std::string out;
+};
+
+struct RenderOptions {
+    VolumeOptions volume;
+    std::optional<double> iso;
+    std::string size = "1600x1200";
+    std::string out = "isowall.png";
+    std::string depth_out;
+    std::string gl = "osmesa";
+    std::string projection = "perspective";
+    std::vector<float> orbit;  // yaw pitch in degrees
+    float zoom = 1.0f;
+};
+
+int run_info(const InfoOptions& o);
+int run_extract(const ExtractOptions& o);
+int run_render(const RenderOptions& o);
+
+}  // namespace isowall
