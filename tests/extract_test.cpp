@@ -66,7 +66,7 @@ TEST(Extract, SphereIsClosedWithTheRightArea) {
         auto s = sphere_field(d, spacing, c, r);
         auto o = MinMaxOctree<float>::build(s.view);
         const Mesh m = extract_full(s.view, o, 0.0, nullptr);
-        SCOPED_TRACE(::testing::Message() << "spacing " << spacing);
+        SCOPED_TRACE(::testing::Message() << "spacing " << spacing.x << " " << spacing.y << " " << spacing.z);
         ASSERT_GT(m.triangle_count(), 1000u);
         expect_closed_and_oriented(m);
         const double want = 4.0 * std::numbers::pi * r * r;
