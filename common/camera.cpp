@@ -60,13 +60,21 @@ Camera front_full_view(const Box3& bounds, float aspect, Projection projection) 
     c.projection = projection;
     c.target = bounds.center();
     c.up = glm::vec3(0, 0, 1);
-    const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-6f);
-    const float half_fovy = glm::radians(c.fovy_deg) * 0.5f;
-    const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
-    const float half_fov = std::min(half_fovy, half_fovx);
-    const float dist = radius / std::sin(half_fov);
+    const glm::vec3 half = 0.5f * bounds.extent();
+    // Looking along +y: x is screen-right, z is screen-up, y is depth. Place the eye at the
+    // smallest distance where all eight corners project inside the view, with a 4% margin.
+    const float tan_y = std::tan(glm::radians(c.fovy_deg) * 0.5f);
+    const float tan_x = tan_y * aspect;
+    float dist = 0;
+    float ortho_half_h = 0;
+    for (float sy : {-1.0f, 1.0f}) {
+        const float depth_offset = sy * half.y;  // corner depth relative to the target
+        dist = std::max({dist, half.x / tan_x - depth_offset, half.z / tan_y - depth_offset});
+        ortho_half_h = std::max({ortho_half_h, half.z, half.x / aspect});
+    }
+    dist = std::max(dist * 1.04f, half.y * 1.1f + 1e-3f);
     c.eye = c.target - glm::vec3(0, dist, 0);
-    c.ortho_height = 2.0f * radius * std::max(1.0f, 1.0f / aspect);
+    c.ortho_height = 2.0f * ortho_half_h * 1.04f;
     return fit_depth_range(c, bounds);
 }
 

@@ -47,8 +47,8 @@ struct Camera {
     float distance() const;
 };
 
-// Front full view: looking along +y of the volume (front of a head scan) with +z up, at a
-// distance where the whole bounding sphere fits the smaller of the two fields of view.
+// Front full view: looking along +y of the volume (front of a head scan) with +z up, at the
+// nearest distance where every corner of `bounds` is in view (4% margin).
 Camera front_full_view(const Box3& bounds, float aspect, Projection projection = Projection::perspective);
 
 // Rotate the eye around the target: yaw about the up vector, pitch about the right vector.

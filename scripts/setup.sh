@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs what isowall needs on Debian 12 (as root, with apt-get) and builds it in build/.
+# Safe to run again: packages already present are not reinstalled, the build is incremental.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+    build-essential cmake pkg-config
+    libglm-dev libteem-dev zlib1g-dev libtomlplusplus-dev libcli11-dev
+    libopenimageio-dev openimageio-tools
+    libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev
+    libopenmpi-dev openmpi-bin
+    libgtest-dev libgmock-dev libbenchmark-dev
+    python3 python3-numpy python3-matplotlib
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "setup: installing ${missing[*]}"
+    SUDO=""
+    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+BUILD_DIR=${ISOWALL_BUILD_DIR:-build}
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DISOWALL_WERROR=ON > /dev/null
+cmake --build "$BUILD_DIR" -j "$(nproc)"

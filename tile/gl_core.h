@@ -1,0 +1,62 @@
+#pragma once
+// The OpenGL 3.3 core work both back ends share: an off-screen framebuffer (RGBA8 colour and
+// 24-bit depth renderbuffers), the headlight shader, mesh upload, drawing and read-back. A back
+// end creates the context, makes it current and then forwards every call here; GlCore itself
+// never switches contexts.
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <glm/mat4x4.hpp>
+
+#include "common/image.h"
+#include "common/mesh.h"
+
+namespace isowall {
+
+struct GlFunctions;
+using GlProc = void (*)();
+using GlLoader = GlProc (*)(const char* name);
+
+class GlCore {
+  public:
+    // The back end's context must be current; `loader` fetches GL entry points from it and
+    // `backend` prefixes every RendererError.
+    GlCore(std::string_view backend, GlLoader loader);
+    // Frees the GL objects, so the context must still be current.
+    ~GlCore();
+    GlCore(const GlCore&) = delete;
+    GlCore& operator=(const GlCore&) = delete;
+
+    void resize(int width, int height);
+    void clear();
+    void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection);
+    void read_back(Image& out);
+
+  private:
+    [[noreturn]] void fail(std::string_view call, std::string_view detail) const;
+    // Throws naming `call` when GL has recorded an error since the last check.
+    void check(std::string_view call) const;
+    void require_size(std::string_view call) const;
+    unsigned compile_shader(unsigned type, const char* source);
+    void bind_frame();
+
+    std::string backend_;
+    std::unique_ptr<GlFunctions> gl_;
+    int width_ = 0;
+    int height_ = 0;
+    unsigned framebuffer_ = 0;
+    unsigned colour_buffer_ = 0;
+    unsigned depth_buffer_ = 0;
+    unsigned program_ = 0;
+    unsigned vertex_array_ = 0;
+    unsigned position_buffer_ = 0;
+    unsigned normal_buffer_ = 0;
+    unsigned index_buffer_ = 0;
+    int model_view_location_ = -1;
+    int projection_location_ = -1;
+    int normal_matrix_location_ = -1;
+    int orthographic_location_ = -1;
+};
+
+}  // namespace isowall

@@ -1,0 +1,42 @@
+#pragma once
+// The tile renderer: draws meshes into an off-screen frame and reads it back as an Image. Back
+// ends (OSMesa, EGL) hide behind this interface, so no caller ever sees a GL or EGL header.
+#include <memory>
+#include <stdexcept>
+#include <string_view>
+
+#include <glm/mat4x4.hpp>
+
+#include "common/image.h"
+#include "common/mesh.h"
+
+namespace isowall {
+
+// Every renderer failure: the message starts with the back end (or "make_renderer") and names the
+// failing call, e.g. "egl: eglInitialize failed (EGL_NOT_INITIALIZED)".
+class RendererError : public std::runtime_error {
+  public:
+    RendererError(std::string_view source, std::string_view message);
+};
+
+class Renderer {
+  public:
+    virtual ~Renderer() = default;
+
+    // Sets the frame size in pixels; the frame's contents are undefined until clear().
+    virtual void resize(int width, int height) = 0;
+    // Black background, depth 1 everywhere.
+    virtual void clear() = 0;
+    // Adds `mesh` to the current frame without clearing it, so a caller can draw only the groups
+    // that changed since the last frame.
+    virtual void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) = 0;
+    // Colour (RGBA8) and window depth of the frame, row 0 at the top.
+    virtual void read_back(Image& out) = 0;
+    virtual std::string_view name() const = 0;
+};
+
+// backend is "osmesa" or "egl". Throws RendererError when the back end is unknown or its context
+// cannot be created.
+std::unique_ptr<Renderer> make_renderer(std::string_view backend);
+
+}  // namespace isowall
