@@ -177,6 +177,10 @@ class EglRenderer final : public Renderer {
         make_current();
         core_->read_back(out);
     }
+    void finish() override {
+        make_current();
+        core_->finish();
+    }
     std::string_view name() const override { return kName; }
 
   private:

@@ -279,6 +279,11 @@ void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& proj
     check("glDrawElements");
 }
 
+void GlCore::finish() {
+    gl_->Finish();
+    check("glFinish");
+}
+
 void GlCore::read_back(Image& out) {
     require_size("read_back");
     bind_frame();

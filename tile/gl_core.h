@@ -32,6 +32,7 @@ class GlCore {
     void clear();
     void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection);
     void read_back(Image& out);
+    void finish();
 
   private:
     [[noreturn]] void fail(std::string_view call, std::string_view detail) const;

@@ -20,6 +20,7 @@ namespace isowall {
     X(PFNGLCLEARCOLORPROC, ClearColor)                           \
     X(PFNGLCLEARDEPTHPROC, ClearDepth)                           \
     X(PFNGLCLEARPROC, Clear)                                     \
+    X(PFNGLFINISHPROC, Finish)                                   \
     X(PFNGLENABLEPROC, Enable)                                   \
     X(PFNGLDISABLEPROC, Disable)                                 \
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                             \

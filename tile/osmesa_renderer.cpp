@@ -76,6 +76,10 @@ class OsmesaRenderer final : public Renderer {
         make_current();
         core_->read_back(out);
     }
+    void finish() override {
+        make_current();
+        core_->finish();
+    }
     std::string_view name() const override { return kName; }
 
   private:

@@ -32,6 +32,8 @@ class Renderer {
     virtual void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) = 0;
     // Colour (RGBA8) and window depth of the frame, row 0 at the top.
     virtual void read_back(Image& out) = 0;
+    // Waits until everything drawn so far is in the frame (for honest stage timings).
+    virtual void finish() = 0;
     virtual std::string_view name() const = 0;
 };
 

@@ -1,0 +1,239 @@
+// The progressive engine: after every ray its image is the full surface's; propagation keeps its
+// invariants; an interrupt stops a frame and the next frame is the new view only.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <tuple>
+
+#include "common/phantom.h"
+#include "common/volume.h"
+#include "tests/test_util.h"
+#include "tile/image_io.h"
+#include "tile/progressive_engine.h"
+
+namespace isowall {
+namespace {
+
+struct ImageMatch {
+    double mask_iou = 0;
+    double equal_share = 0;  // pixels whose colour differs by <= 1 in every channel
+};
+
+ImageMatch compare(const Image& a, const Image& b) {
+    std::size_t inter = 0, uni = 0, equal = 0;
+    for (std::size_t i = 0; i < a.pixel_count(); ++i) {
+        const bool ca = a.depth[i] < 1.0f, cb = b.depth[i] < 1.0f;
+        inter += ca && cb;
+        uni += ca || cb;
+        bool same = true;
+        for (int k = 0; k < 3; ++k)
+            same = same && std::abs(int(a.rgba[4 * i + k]) - int(b.rgba[4 * i + k])) <= 1;
+        equal += same;
+    }
+    return {uni ? double(inter) / double(uni) : 1.0, double(equal) / double(a.pixel_count())};
+}
+
+FrameView make_view(const Volume& v, int w, int h, double iso, float yaw = 0, float pitch = 0) {
+    FrameView fv;
+    fv.width = w;
+    fv.height = h;
+    fv.iso = iso;
+    fv.camera = fit_depth_range(orbit(front_full_view(v.bounds(), float(w) / float(h)), yaw, pitch), v.bounds());
+    fv.frustum = fv.camera.frustum(float(w) / float(h));
+    return fv;
+}
+
+Image full_surface_image(SurfaceExtractor& ex, Renderer& r, const FrameView& fv) {
+    const Mesh m = ex.extract_full(fv.iso);
+    Image img;
+    r.resize(fv.width, fv.height);
+    r.clear();
+    r.draw(m, fv.camera.view(), fv.frustum.matrix());
+    r.read_back(img);
+    return img;
+}
+
+using Combo = std::tuple<RayOrderKind, IntersectMode, PropagationMode>;
+
+std::string combo_name(const Combo& c) {
+    return std::string(to_string(std::get<0>(c))) +
+           (std::get<1>(c) == IntersectMode::exact ? "_exact" : "_approximate") +
+           (std::get<2>(c) == PropagationMode::max_count ? "_count" : "_angle");
+}
+
+class FinalImage : public ::testing::TestWithParam<Combo> {};
+
+void expect_final_matches_full(const Volume& volume, double iso, const Combo& combo, int w, int h,
+                               float yaw = 0) {
+    auto ex = make_surface_extractor(volume);
+    auto renderer = make_renderer("osmesa");
+    EngineOptions opt;
+    std::tie(opt.order, opt.intersect, opt.propagation.mode) = combo;
+    opt.propagation.max_count = 2000;
+    const FrameView fv = make_view(volume, w, h, iso, yaw, 10);
+    ProgressiveEngine engine(*ex, *renderer, opt);
+    FrameResult fr = engine.run(fv);
+    ASSERT_TRUE(fr.completed);
+    const Image full = full_surface_image(*ex, *renderer, fv);
+    const ImageMatch m = compare(fr.final_image, full);
+    if (m.mask_iou < 0.999 || m.equal_share < 0.999) {
+        // Leave the evidence: both images and a mask of the pixels that differ.
+        const auto dir = test::scratch_dir("final_" + combo_name(combo));
+        Image diff = full;
+        for (std::size_t i = 0; i < diff.pixel_count(); ++i) {
+            const bool a = fr.final_image.depth[i] < 1.0f, b = full.depth[i] < 1.0f;
+            diff.rgba[4 * i] = a && !b ? 255 : 0;      // red: only progressive
+            diff.rgba[4 * i + 1] = b && !a ? 255 : 0;  // green: only full
+            diff.rgba[4 * i + 2] = 0;
+        }
+        write_image(dir / "progressive.png", fr.final_image);
+        write_image(dir / "full.png", full);
+        write_image(dir / "diff.png", diff);
+        std::cout << "images in " << dir << "\n";
+    }
+    EXPECT_GE(m.mask_iou, 0.999) << combo_name(combo) << " iso " << iso;
+    EXPECT_GE(m.equal_share, 0.999) << combo_name(combo) << " iso " << iso;
+    // Every pixel of the screen box had its ray (and the approximate mode a second, exact one).
+    const std::size_t box = std::size_t(fr.screen_rect.width) * fr.screen_rect.height;
+    EXPECT_EQ(fr.rays_cast, std::get<1>(combo) == IntersectMode::exact ? box : 2 * box);
+    EXPECT_GT(fr.groups.size(), 0u);
+    std::cout << combo_name(combo) << " iso " << iso << ": IoU " << m.mask_iou << ", equal "
+              << m.equal_share * 100 << "%, " << fr.groups.size() << " groups, " << fr.rays_cast
+              << " rays, " << fr.elapsed_s << " s\n";
+}
+
+TEST_P(FinalImage, PhantomMatchesTheFullSurface) {
+    const Volume p = make_phantom();
+    for (double iso : {kPhantomSkinIso, kPhantomBoneIso}) expect_final_matches_full(p, iso, GetParam(), 240, 180, 25);
+}
+
+TEST_P(FinalImage, SharedCtHeadMatchesTheFullSurface) {
+    const auto data = test::shared_data_dir();
+    if (!data) GTEST_SKIP() << "../shared/data is absent: skipping the CT head";
+    const Volume v = load_nrrd(*data / "cthead.nhdr");
+    expect_final_matches_full(v, 600, GetParam(), 200, 150);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllOptions, FinalImage,
+    ::testing::Combine(::testing::Values(RayOrderKind::refining_grid, RayOrderKind::screen_readback,
+                                         RayOrderKind::dynamic_grid),
+                       ::testing::Values(IntersectMode::exact, IntersectMode::approximate),
+                       ::testing::Values(PropagationMode::max_count, PropagationMode::cutoff_angle)),
+    [](const auto& info) { return combo_name(info.param); });
+
+TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    for (PropagationMode mode : {PropagationMode::max_count, PropagationMode::cutoff_angle}) {
+        EngineOptions opt;
+        opt.propagation.mode = mode;
+        opt.propagation.max_count = 500;  // many small groups
+        ProgressiveEngine engine(*ex, *renderer, opt);
+        const FrameView fv = make_view(p, 160, 120, kPhantomBoneIso, 30, 20);
+        FrameResult fr = engine.run(fv);
+        ASSERT_TRUE(fr.completed);
+        const auto view = p.view<std::uint8_t>();
+        std::set<std::tuple<int, int, int>> seen;
+        std::size_t inactive = 0, twice = 0, wrong_group = 0;
+        for (const Group& g : fr.groups) {
+            EXPECT_LE(g.cells.size(), mode == PropagationMode::max_count ? 500u : g.cells.size());
+            for (const glm::ivec3 c : g.cells) {
+                double corner[8];
+                cell_corners(view, c, corner);
+                const int cs = cell_case(corner, fv.iso);
+                inactive += cs == 0 || cs == 255;
+                twice += !seen.insert({c.x, c.y, c.z}).second;
+                wrong_group += ex->group_of(c) != g.id;
+            }
+        }
+        EXPECT_EQ(inactive, 0u);
+        EXPECT_EQ(twice, 0u);
+        EXPECT_EQ(wrong_group, 0u);
+        EXPECT_EQ(seen.size(), ex->visited_count());
+        EXPECT_GT(fr.groups.size(), 5u);
+    }
+}
+
+// Triangles as sorted vertex-position triples, so indexed and unindexed meshes compare.
+std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> soup(const Mesh& m) {
+    std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> s;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
+                        c = m.positions[m.indices[3 * t + 2]];
+        s.insert({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
+    }
+    return s;
+}
+
+TEST(Propagation, InterpolantCacheGivesTheSameTriangles) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    const FrameView fv = make_view(p, 64, 48, kPhantomSkinIso);
+    const Ray ray = pixel_ray(glm::inverse(fv.camera.view()), fv.frustum, 64, 48, {32, 24});
+    PropagationParams cached, uncached;
+    cached.max_count = uncached.max_count = 3000;
+    uncached.interpolant_cache = false;
+    ex->begin_frame(fv.iso);
+    const RayHit hit = ex->cast(ray, IntersectMode::exact);
+    ASSERT_TRUE(hit.found);
+    const Group a = ex->propagate(hit.cell, 0, cached, ray);
+    ex->begin_frame(fv.iso);
+    const Group b = ex->propagate(hit.cell, 0, uncached, ray);
+    EXPECT_EQ(a.cells, b.cells);
+    EXPECT_EQ(soup(a.mesh), soup(b.mesh));
+    // Sharing: about one vertex per two triangles with the cache, three per triangle without.
+    EXPECT_LT(a.mesh.vertex_count() * 2, b.mesh.vertex_count());
+    EXPECT_EQ(b.mesh.vertex_count(), 3 * b.mesh.triangle_count());
+}
+
+TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    ProgressiveEngine engine(*ex, *renderer);
+    const FrameView first = make_view(p, 200, 150, kPhantomSkinIso);
+    std::size_t polls = 0;
+    FrameResult a = engine.run(first, [&] { return ++polls > 400; });
+    EXPECT_FALSE(a.completed);
+    EXPECT_LE(a.rays_cast, 400u);
+    EXPECT_EQ(a.final_image.pixel_count(), 0u);
+
+    // New view and new isovalue: nothing of the first frame may remain.
+    const FrameView second = make_view(p, 200, 150, kPhantomBoneIso, 60, -20);
+    FrameResult b = engine.run(second);
+    ASSERT_TRUE(b.completed);
+    const Image full = full_surface_image(*ex, *renderer, second);
+    const ImageMatch m = compare(b.final_image, full);
+    EXPECT_GE(m.mask_iou, 0.999);
+    EXPECT_GE(m.equal_share, 0.999);
+}
+
+TEST(Engine, TimelineIsMonotoneAndReachesFullCorrectness) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    ProgressiveEngine engine(*ex, *renderer);
+    const FrameView fv = make_view(p, 240, 180, kPhantomSkinIso);
+    FrameResult fr = engine.run(fv);
+    ASSERT_TRUE(fr.completed);
+    engine.measure(fr, fv);
+    ASSERT_GT(fr.timeline.size(), 5u);
+    for (std::size_t i = 1; i < fr.timeline.size(); ++i) {
+        EXPECT_GE(fr.timeline[i].time_s, fr.timeline[i - 1].time_s);
+        EXPECT_GE(fr.timeline[i].rays, fr.timeline[i - 1].rays);
+        EXPECT_GE(fr.timeline[i].triangles, fr.timeline[i - 1].triangles);
+    }
+    EXPECT_DOUBLE_EQ(fr.timeline.back().correctness.c, 1.0);
+    EXPECT_DOUBLE_EQ(fr.timeline.back().correctness.final_pixels, 1.0);
+    // The progressive promise: most of the image long before most of the rays.
+    for (const auto& s : fr.timeline)
+        if (s.correctness.c >= 0.9) {
+            EXPECT_LT(double(s.rays) / double(fr.rays_cast), 0.05);
+            break;
+        }
+}
+
+}  // namespace
+}  // namespace isowall

@@ -1,0 +1,420 @@
+// Ray-casting orders: every rect pixel exactly once, refining levels, read-back ordering, the
+// dynamic grid sized from the first surface piece.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/ray_order.h"
+
+namespace isowall {
+namespace {
+
+constexpr RayOrderKind kAllKinds[] = {RayOrderKind::refining_grid, RayOrderKind::screen_readback,
+                                      RayOrderKind::dynamic_grid};
+
+std::string rect_str(const PixelRect& r) {
+    return "rect{" + std::to_string(r.x) + ", " + std::to_string(r.y) + ", " +
+           std::to_string(r.width) + "x" + std::to_string(r.height) + "}";
+}
+
+struct Disk {
+    double cx, cy, radius;
+    bool contains(int x, int y) const {
+        const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
+        return dx * dx + dy * dy <= radius * radius;
+    }
+};
+
+// A synthetic screen: each disk is a piece of surface that is drawn whole as soon as a ray hits
+// one of its pixels, as propagation from a seed would draw it.
+class DiskScene {
+  public:
+    DiskScene(int width, int height, std::vector<Disk> disks)
+        : width_(width), height_(height), disks_(std::move(disks)), drawn_(disks_.size(), false) {}
+
+    void cast(const std::vector<glm::ivec2>& rays) {
+        for (glm::ivec2 p : rays)
+            for (std::size_t d = 0; d < disks_.size(); ++d)
+                if (disks_[d].contains(p.x, p.y)) drawn_[d] = true;
+    }
+
+    std::vector<std::uint8_t> coverage() const {
+        std::vector<std::uint8_t> covered(std::size_t(width_) * std::size_t(height_), 0);
+        for (std::size_t d = 0; d < disks_.size(); ++d) {
+            if (!drawn_[d]) continue;
+            const Disk& disk = disks_[d];
+            const int x0 = std::max(0, int(disk.cx - disk.radius) - 1);
+            const int x1 = std::min(width_, int(disk.cx + disk.radius) + 2);
+            const int y0 = std::max(0, int(disk.cy - disk.radius) - 1);
+            const int y1 = std::min(height_, int(disk.cy + disk.radius) + 2);
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x)
+                    if (disks_[d].contains(x, y)) covered[std::size_t(y) * width_ + x] = 1;
+        }
+        return covered;
+    }
+
+  private:
+    int width_, height_;
+    std::vector<Disk> disks_;
+    std::vector<bool> drawn_;
+};
+
+// A disk of a quarter of the rect's smaller side at its centre, and a smaller one near a corner.
+DiskScene scene_for(int screen_w, int screen_h, const PixelRect& r) {
+    const double small_side = std::min(r.width, r.height);
+    return DiskScene(
+        screen_w, screen_h,
+        {{r.x + r.width * 0.5, r.y + r.height * 0.5, std::max(1.0, small_side / 4)},
+         {r.x + r.width * 0.15, r.y + r.height * 0.8, std::max(1.0, small_side / 10)}});
+}
+
+// Runs an order to the end, feeding the scene's coverage whenever the order asks for it.
+std::vector<std::vector<glm::ivec2>> run_order(RayOrder& order, DiskScene* scene) {
+    std::vector<std::vector<glm::ivec2>> levels;
+    std::vector<glm::ivec2> rays;
+    while (true) {
+        if (order.wants_coverage()) {
+            EXPECT_NE(scene, nullptr) << "an order asked for coverage";
+            if (scene) order.set_coverage(scene->coverage());
+        }
+        if (!order.next_level(rays)) break;
+        EXPECT_FALSE(rays.empty()) << "level " << levels.size();
+        EXPECT_EQ(order.level(), int(levels.size()));
+        if (scene) scene->cast(rays);
+        levels.push_back(rays);
+    }
+    EXPECT_FALSE(order.wants_coverage()) << "after the last level";
+    return levels;
+}
+
+struct ScreenCase {
+    int screen_w, screen_h;
+    PixelRect rect;
+};
+
+const ScreenCase kCases[] = {
+    {1, 1, {0, 0, 1, 1}},         {7, 5, {0, 0, 7, 5}},         {64, 48, {0, 0, 64, 48}},
+    {200, 100, {37, 21, 90, 55}}, {200, 100, {199, 0, 1, 100}}, {1600, 1200, {0, 0, 1600, 1200}},
+};
+
+TEST(RayOrder, ParseAndToStringRoundTrip) {
+    for (RayOrderKind k : kAllKinds) EXPECT_EQ(parse_ray_order(to_string(k)), k) << to_string(k);
+    EXPECT_EQ(parse_ray_order("grid"), RayOrderKind::refining_grid);
+    EXPECT_EQ(parse_ray_order("refining"), RayOrderKind::refining_grid);
+    EXPECT_EQ(parse_ray_order("readback"), RayOrderKind::screen_readback);
+    EXPECT_EQ(parse_ray_order("dynamic"), RayOrderKind::dynamic_grid);
+    EXPECT_EQ(parse_ray_order(""), std::nullopt);
+    EXPECT_EQ(parse_ray_order("Dynamic"), std::nullopt);
+    EXPECT_EQ(parse_ray_order("dynamic_grid2"), std::nullopt);
+}
+
+TEST(RayOrder, EmptyRectGivesNoLevel) {
+    const PixelRect empties[] = {{0, 0, 0, 0}, {5, 5, 0, 10}, {5, 5, 10, -3}, {300, 10, 20, 20}};
+    for (RayOrderKind k : kAllKinds)
+        for (const PixelRect& r : empties) {
+            auto order = make_ray_order(k, 200, 100, r);
+            std::vector<glm::ivec2> rays{{1, 1}};
+            EXPECT_FALSE(order->wants_coverage()) << to_string(k) << " " << rect_str(r);
+            EXPECT_FALSE(order->next_level(rays)) << to_string(k) << " " << rect_str(r);
+            EXPECT_TRUE(rays.empty()) << to_string(k) << " " << rect_str(r);
+            EXPECT_EQ(order->level(), -1) << to_string(k) << " " << rect_str(r);
+            EXPECT_FALSE(order->wants_coverage()) << to_string(k) << " " << rect_str(r);
+        }
+}
+
+TEST(RayOrder, EveryRectPixelExactlyOnce) {
+    for (RayOrderKind k : kAllKinds)
+        for (const ScreenCase& c : kCases) {
+            DiskScene scene = scene_for(c.screen_w, c.screen_h, c.rect);
+            auto order = make_ray_order(k, c.screen_w, c.screen_h, c.rect);
+            const auto levels = run_order(*order, &scene);
+            std::vector<int> count(std::size_t(c.screen_w) * c.screen_h, 0);
+            for (const auto& level : levels)
+                for (glm::ivec2 p : level) {
+                    ASSERT_TRUE(p.x >= 0 && p.y >= 0 && p.x < c.screen_w && p.y < c.screen_h)
+                        << to_string(k) << " " << rect_str(c.rect) << " pixel " << p.x << ","
+                        << p.y;
+                    ++count[std::size_t(p.y) * c.screen_w + p.x];
+                }
+            int wrong = 0;
+            for (int y = 0; y < c.screen_h; ++y)
+                for (int x = 0; x < c.screen_w; ++x) {
+                    const bool inside = x >= c.rect.x && x < c.rect.x + c.rect.width &&
+                                        y >= c.rect.y && y < c.rect.y + c.rect.height;
+                    if (count[std::size_t(y) * c.screen_w + x] != (inside ? 1 : 0)) ++wrong;
+                }
+            EXPECT_EQ(wrong, 0) << to_string(k) << " " << rect_str(c.rect) << " on " << c.screen_w
+                                << "x" << c.screen_h << ", " << levels.size() << " levels";
+        }
+}
+
+TEST(RayOrder, RectIsClippedToTheScreen) {
+    for (RayOrderKind k : kAllKinds) {
+        auto order = make_ray_order(k, 50, 40, {-10, 30, 30, 30});
+        DiskScene blank(50, 40, {});
+        const auto levels = run_order(*order, &blank);
+        std::size_t total = 0;
+        for (const auto& level : levels)
+            for (glm::ivec2 p : level) {
+                EXPECT_TRUE(p.x >= 0 && p.x < 20 && p.y >= 30 && p.y < 40)
+                    << to_string(k) << " pixel " << p.x << "," << p.y;
+                ++total;
+            }
+        EXPECT_EQ(total, 20u * 10u) << to_string(k);
+    }
+}
+
+TEST(RayOrder, RefiningLevelsDoubleTheGrid) {
+    for (const ScreenCase& c : kCases) {
+        auto order = make_ray_order(RayOrderKind::refining_grid, c.screen_w, c.screen_h, c.rect);
+        EXPECT_FALSE(order->wants_coverage());
+        const auto levels = run_order(*order, nullptr);
+        ASSERT_FALSE(levels.empty()) << rect_str(c.rect);
+        // Level 0: the one pixel at the centre of the rect.
+        ASSERT_EQ(levels[0].size(), 1u) << rect_str(c.rect);
+        EXPECT_EQ(levels[0][0],
+                  glm::ivec2(c.rect.x + c.rect.width / 2, c.rect.y + c.rect.height / 2))
+            << rect_str(c.rect);
+        // Grid levels until a cell would be under 2 px on the larger side, then one fill level.
+        const int max_side = std::max(c.rect.width, c.rect.height);
+        int grid_levels = 1;
+        while (max_side >= (4 << (grid_levels - 1))) ++grid_levels;
+        const std::size_t area = std::size_t(c.rect.width) * c.rect.height;
+        EXPECT_EQ(levels.size(), std::size_t(grid_levels) + (area > 1 ? 1 : 0)) << rect_str(c.rect);
+        for (std::size_t k = 0; k < levels.size(); ++k) {
+            if (int(k) < grid_levels) {
+                EXPECT_LE(levels[k].size(), std::size_t(1) << (2 * k)) << rect_str(c.rect);
+            }
+            // Row-major within a level (by grid cell, which is row-major by pixel too).
+            EXPECT_TRUE(std::is_sorted(
+                levels[k].begin(), levels[k].end(),
+                [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; }))
+                << rect_str(c.rect) << " level " << k;
+        }
+    }
+    // A 64x48 rect: the cell centres never coincide, so the levels are full quad-tree levels.
+    auto order = make_ray_order(RayOrderKind::refining_grid, 64, 48, {0, 0, 64, 48});
+    const auto levels = run_order(*order, nullptr);
+    const std::vector<std::size_t> expected = {1, 4, 16, 64, 256, 1024, 64 * 48 - 1365};
+    ASSERT_EQ(levels.size(), expected.size());
+    for (std::size_t k = 0; k < levels.size(); ++k)
+        EXPECT_EQ(levels[k].size(), expected[k]) << "level " << k;
+    // Level 1 is the centres of the four quadrants.
+    EXPECT_EQ(levels[1], (std::vector<glm::ivec2>{{16, 12}, {48, 12}, {16, 36}, {48, 36}}));
+}
+
+TEST(RayOrder, ReadbackPutsUncoveredPixelsFirst) {
+    for (const ScreenCase& c : kCases) {
+        DiskScene scene = scene_for(c.screen_w, c.screen_h, c.rect);
+        auto readback =
+            make_ray_order(RayOrderKind::screen_readback, c.screen_w, c.screen_h, c.rect);
+        auto grid = make_ray_order(RayOrderKind::refining_grid, c.screen_w, c.screen_h, c.rect);
+        EXPECT_FALSE(readback->wants_coverage()) << "nothing drawn before the first level";
+        std::vector<glm::ivec2> rays, grid_rays;
+        std::vector<std::uint8_t> covered;
+        int covered_rays = 0;
+        while (readback->next_level(rays)) {
+            ASSERT_TRUE(grid->next_level(grid_rays)) << rect_str(c.rect);
+            // The same pixels as the refining grid's level; uncovered first, each group stable.
+            std::vector<glm::ivec2> expected;
+            for (bool want_covered : {false, true})
+                for (glm::ivec2 p : grid_rays) {
+                    const bool is_covered =
+                        !covered.empty() && covered[std::size_t(p.y) * c.screen_w + p.x] != 0;
+                    if (is_covered == want_covered) expected.push_back(p);
+                    covered_rays += is_covered && want_covered;
+                }
+            EXPECT_EQ(rays, expected) << rect_str(c.rect) << " level " << readback->level();
+            scene.cast(rays);
+            if (readback->wants_coverage()) {
+                covered = scene.coverage();
+                readback->set_coverage(covered);
+            } else {
+                EXPECT_FALSE(grid->next_level(grid_rays)) << "read-back stopped asking early";
+            }
+        }
+        EXPECT_FALSE(grid->next_level(grid_rays)) << rect_str(c.rect);
+        if (c.rect.width > 8) {
+            EXPECT_GT(covered_rays, 0) << rect_str(c.rect) << ": the test saw no ordering";
+        }
+    }
+}
+
+// Runs a dynamic grid on one disk at the screen centre; returns the dynamic level's pixels and
+// checks it against the coverage that sized it.
+std::vector<glm::ivec2> dynamic_level_for_disk(int w, int h, double radius) {
+    DiskScene scene(w, h, {{w * 0.5, h * 0.5, radius}});
+    auto order = make_ray_order(RayOrderKind::dynamic_grid, w, h, {0, 0, w, h});
+    std::vector<glm::ivec2> rays;
+    EXPECT_TRUE(order->next_level(rays));
+    scene.cast(rays);
+    EXPECT_TRUE(order->wants_coverage()) << "searching for the first surface piece";
+    const std::vector<std::uint8_t> covered = scene.coverage();
+    order->set_coverage(covered);
+    EXPECT_FALSE(order->wants_coverage()) << "the surface has been sized";
+    EXPECT_TRUE(order->next_level(rays));
+    for (glm::ivec2 p : rays)
+        EXPECT_EQ(covered[std::size_t(p.y) * w + p.x], 0) << "a ray on drawn surface " << p.x;
+    return rays;
+}
+
+TEST(RayOrder, DynamicGridSpacingFollowsTheDiskSize) {
+    for (double radius : {10.0, 30.0, 60.0}) {
+        const std::vector<glm::ivec2> rays = dynamic_level_for_disk(400, 300, radius);
+        // Spacing between neighbouring grid columns (the last, clipped column aside).
+        std::vector<int> xs;
+        for (glm::ivec2 p : rays) xs.push_back(p.x);
+        std::sort(xs.begin(), xs.end());
+        xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+        ASSERT_GE(xs.size(), 3u) << "radius " << radius;
+        std::vector<int> gaps;
+        for (std::size_t i = 1; i + 1 < xs.size(); ++i) gaps.push_back(xs[i] - xs[i - 1]);
+        std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+        const double expected = std::sqrt(std::numbers::pi) * radius / 2;
+        EXPECT_NEAR(gaps[gaps.size() / 2], expected, 1.5) << "radius " << radius;
+        // One ray per cell, less those on the drawn disk.
+        const double cells = std::ceil(400 / expected) * std::ceil(300 / expected);
+        EXPECT_LE(double(rays.size()), cells * 1.15) << "radius " << radius;
+        EXPECT_GE(double(rays.size()),
+                  cells * 0.7 - std::numbers::pi * radius * radius / (expected * expected))
+            << "radius " << radius;
+    }
+}
+
+TEST(RayOrder, DynamicGridContinuesWithFinerRefiningLevels) {
+    // Disk radius 30: size ~53 px, so refining goes on with cells under ~26.6 px: 400 / 2^4.
+    const int w = 400, h = 300;
+    DiskScene scene(w, h, {{w * 0.5, h * 0.5, 30.0}, {40, 40, 12.0}});
+    auto order = make_ray_order(RayOrderKind::dynamic_grid, w, h, {0, 0, w, h});
+    const auto levels = run_order(*order, &scene);
+    ASSERT_GE(levels.size(), 4u);
+    auto grid = make_ray_order(RayOrderKind::refining_grid, w, h, {0, 0, w, h});
+    std::vector<std::vector<glm::ivec2>> grid_levels;
+    for (std::vector<glm::ivec2> r; grid->next_level(r);) grid_levels.push_back(r);
+    // levels: 0 = centre (hits the disk), 1 = dynamic grid, 2 = refining level 4, ...
+    EXPECT_EQ(levels[0], grid_levels[0]);
+    for (std::size_t k = 2; k + 1 < levels.size(); ++k) {
+        std::vector<glm::ivec2> sorted = levels[k];
+        std::sort(sorted.begin(), sorted.end(),
+                  [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+        const auto& refining = grid_levels[k + 2];
+        EXPECT_TRUE(std::includes(
+            refining.begin(), refining.end(), sorted.begin(), sorted.end(),
+            [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; }))
+            << "level " << k << " is not inside refining level " << k + 2;
+    }
+    EXPECT_EQ(levels.size(), grid_levels.size() - 3 + 1) << "levels 1-3 replaced by one grid";
+}
+
+TEST(RayOrder, DynamicGridWithoutSurfaceIsTheRefiningGrid) {
+    const PixelRect r{10, 5, 120, 70};
+    auto dynamic = make_ray_order(RayOrderKind::dynamic_grid, 200, 100, r);
+    auto grid = make_ray_order(RayOrderKind::refining_grid, 200, 100, r);
+    // Surface outside the rect does not count.
+    std::vector<std::uint8_t> covered(200 * 100, 0);
+    for (int y = 0; y < 100; ++y) covered[std::size_t(y) * 200 + 150] = 1;
+    std::vector<glm::ivec2> a, b;
+    while (true) {
+        if (dynamic->wants_coverage()) dynamic->set_coverage(covered);
+        const bool more = dynamic->next_level(a);
+        ASSERT_EQ(more, grid->next_level(b));
+        if (!more) break;
+        EXPECT_EQ(a, b) << "level " << dynamic->level();
+    }
+}
+
+TEST(RayOrder, SurfacePieceSize) {
+    const int w = 200, h = 150;
+    std::vector<std::uint8_t> covered(std::size_t(w) * h, 0);
+    EXPECT_EQ(surface_piece_size(covered, w, {0, 0, w, h}), 0.0);
+    EXPECT_EQ(surface_piece_size(covered, w, {0, 0, 0, 0}), 0.0);
+    covered[std::size_t(70) * w + 100] = 1;  // one pixel: clamped up to 4
+    EXPECT_EQ(surface_piece_size(covered, w, {0, 0, w, h}), 4.0);
+    EXPECT_EQ(surface_piece_size(covered, w, {0, 0, 3, 2}), 0.0) << "outside the rect";
+    // Two squares; the first in row-major order is the 10x10 one. A diagonal neighbour is not
+    // 4-connected.
+    std::fill(covered.begin(), covered.end(), 0);
+    for (int y = 20; y < 30; ++y)
+        for (int x = 150; x < 160; ++x) covered[std::size_t(y) * w + x] = 1;
+    for (int y = 50; y < 90; ++y)
+        for (int x = 10; x < 50; ++x) covered[std::size_t(y) * w + x] = 1;
+    covered[std::size_t(30) * w + 160] = 1;
+    EXPECT_DOUBLE_EQ(surface_piece_size(covered, w, {0, 0, w, h}), 10.0);
+    // Only the part inside the rect counts: the big square from row 60 is 40x30.
+    EXPECT_DOUBLE_EQ(surface_piece_size(covered, w, {0, 60, 100, 90}), std::sqrt(1200.0));
+    // The floor of 4 gives way to the rect's larger side when the rect is smaller than that.
+    EXPECT_DOUBLE_EQ(surface_piece_size(covered, w, {10, 50, 3, 2}), 3.0);
+    EXPECT_THROW(surface_piece_size(covered, w, {0, 0, w, h + 1}), std::invalid_argument);
+}
+
+TEST(RayOrder, CoverageOfTheWrongSizeThrows) {
+    for (RayOrderKind k : kAllKinds) {
+        auto order = make_ray_order(k, 20, 10, {0, 0, 20, 10});
+        std::vector<glm::ivec2> rays;
+        ASSERT_TRUE(order->next_level(rays));
+        std::vector<std::uint8_t> covered(20 * 9, 0);
+        EXPECT_THROW(order->set_coverage(covered), std::invalid_argument) << to_string(k);
+    }
+}
+
+// Per-level time on a full 1600x1200 screen, including read-back coverage for the orders that
+// ask. A caster spends well over this on the rays themselves, so "a few tens of ms" is the budget
+// in an optimized build; sanitizer and debug builds run ~20x slower and get a loose bound that
+// still catches a quadratic level. The figures are printed either way.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(NDEBUG)
+constexpr double kLevelBudgetMs = 2000.0;
+#else
+constexpr double kLevelBudgetMs = 50.0;
+#endif
+TEST(RayOrder, LargeScreenLevelsAreFast) {
+    const int w = 1600, h = 1200;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> ux(0, w), uy(0, h), ur(20, 120);
+    std::vector<Disk> disks;
+    for (int i = 0; i < 12; ++i) disks.push_back({ux(rng), uy(rng), ur(rng)});
+    disks.push_back({w * 0.5, h * 0.5, 150});
+    for (RayOrderKind k : kAllKinds) {
+        DiskScene scene(w, h, disks);
+        auto order = make_ray_order(k, w, h, {0, 0, w, h});
+        std::vector<glm::ivec2> rays;
+        double worst_ms = 0, total_ms = 0;
+        std::size_t total_rays = 0;
+        std::string figures;
+        while (true) {
+            std::vector<std::uint8_t> covered;
+            if (order->wants_coverage()) covered = scene.coverage();  // outside the timing
+            const auto t0 = std::chrono::steady_clock::now();
+            if (!covered.empty()) order->set_coverage(covered);
+            const bool more = order->next_level(rays);
+            const double ms =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count();
+            if (!more) break;
+            scene.cast(rays);
+            worst_ms = std::max(worst_ms, ms);
+            total_ms += ms;
+            total_rays += rays.size();
+            char buf[64];
+            std::snprintf(buf, sizeof buf, " %zu:%.2f", rays.size(), ms);
+            figures += buf;
+        }
+        EXPECT_EQ(total_rays, std::size_t(w) * h) << to_string(k);
+        EXPECT_LT(worst_ms, kLevelBudgetMs) << to_string(k);
+        std::printf(
+            "[ ray order ] %-8s 1600x1200: worst level %.2f ms, all levels %.2f ms; "
+            "rays:ms per level%s\n",
+            std::string(to_string(k)).c_str(), worst_ms, total_ms, figures.c_str());
+    }
+}
+
+}  // namespace
+}  // namespace isowall

@@ -1,0 +1,87 @@
+#pragma once
+// The progressive view-dependent engine (chapters 2-3): drives one view (camera, frustum,
+// isovalue) ray by ray in a progressive order until every pixel of the volume's screen box has had
+// its ray, or until it is interrupted. Each ray that finds an unvisited seed starts a propagation
+// pass; the pass's group is drawn at once into the frame being built (no clear, no redraw of
+// older groups), so drawing cost follows new triangles only.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "common/camera.h"
+#include "common/correctness.h"
+#include "common/image.h"
+#include "common/ray_order.h"
+#include "common/surface_extractor.h"
+#include "tile/renderer.h"
+
+namespace isowall {
+
+struct EngineOptions {
+    RayOrderKind order = RayOrderKind::dynamic_grid;
+    IntersectMode intersect = IntersectMode::exact;
+    PropagationParams propagation;
+    bool screen_box = true;  // cast no ray outside the volume's projected bounding box
+    // Timeline sampling: after ray counts growing by this factor, and at least this often.
+    double sample_ray_factor = 1.25;
+    double sample_interval_s = 0.1;
+};
+
+struct FrameView {
+    Camera camera;
+    Frustum frustum;
+    int width = 0;
+    int height = 0;
+    double iso = 0;
+};
+
+// One point of the timeline. Stage times are cumulative seconds since the frame started.
+struct TimelineSample {
+    double time_s = 0;
+    std::size_t rays = 0;
+    std::size_t cells_visited = 0;
+    std::size_t triangles = 0;
+    std::size_t groups = 0;
+    double t_intersect_s = 0, t_propagate_s = 0, t_extract_s = 0, t_render_s = 0;
+    int level = 0;
+    // Filled in by ProgressiveEngine::measure() against the frame's final image.
+    Correctness correctness;
+};
+
+struct FrameResult {
+    bool completed = false;  // false: interrupted before the last ray
+    std::size_t rays_cast = 0;
+    std::size_t rays_screen = 0;  // width * height: the share of rays is rays_cast / rays_screen
+    std::size_t rays_second_pass = 0;  // approximate mode: rays cast again exactly
+    double elapsed_s = 0;
+    std::vector<Group> groups;
+    std::vector<TimelineSample> timeline;
+    Image final_image;  // colour and depth after the last ray (empty when interrupted)
+    PixelRect screen_rect;
+};
+
+class ProgressiveEngine {
+public:
+    ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer, EngineOptions options = {});
+
+    // Runs one frame. `interrupted` is polled between rays and inside long propagation passes;
+    // when it returns true the frame stops at once and the result says completed = false.
+    // `progress` (optional) is called with the latest sample about every 0.5 s.
+    FrameResult run(const FrameView& view, const std::function<bool()>& interrupted = {},
+                    const std::function<void(const TimelineSample&)>& progress = {});
+
+    // Replays the frame's groups in order and measures both correctness measures of the image at
+    // every timeline sample against the final image (not part of the timed run). `on_image` sees
+    // each replayed image, e.g. to write snapshots.
+    void measure(FrameResult& frame, const FrameView& view,
+                 const std::function<void(const TimelineSample&, const Image&)>& on_image = {});
+
+    const EngineOptions& options() const { return options_; }
+
+private:
+    SurfaceExtractor& extractor_;
+    Renderer& renderer_;
+    EngineOptions options_;
+};
+
+}  // namespace isowall
