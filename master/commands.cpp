@@ -1,15 +1,19 @@
 #include "master/commands.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
+#include <glm/trigonometric.hpp>
+
 #include "common/camera.h"
 #include "common/error.h"
-#include "common/extract.h"
 #include "common/phantom.h"
 #include "common/ply.h"
+#include "common/surface_extractor.h"
 #include "common/util.h"
 #include "tile/image_io.h"
+#include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 
 namespace isowall {
@@ -25,16 +29,15 @@ struct Timings {
     }
 };
 
-template <class T>
-MinMaxOctree<T> prepare_octree(const OpenedVolume& ov, Timings& t) {
+std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t) {
     OctreeSource src;
     if (ov.file) src.volume_path = *ov.file;
     src.cache_dir = ov.cache_dir;
     OctreeStats st;
     Stopwatch sw;
-    auto octree = MinMaxOctree<T>::load_or_build(ov.volume.view<T>(), src, &st);
+    auto ex = make_surface_extractor(ov.volume, src, &st);
     t.octree = sw.seconds();
-    const double share = double(octree.bytes()) / double(ov.volume.bytes().size());
+    const double share = double(ex->octree_bytes()) / double(ov.volume.bytes().size());
     if (st.from_cache) {
         std::printf("octree: mapped %s  (%.3f s)\n", st.cache_file.c_str(), t.octree);
     } else {
@@ -43,33 +46,33 @@ MinMaxOctree<T> prepare_octree(const OpenedVolume& ov, Timings& t) {
                     st.cache_file.empty() ? "" : ", cached to ", st.cache_file.c_str());
     }
     if (!st.cache_note.empty()) std::printf("octree: note: %s\n", st.cache_note.c_str());
-    std::printf("octree: %d levels, depth %d, %zu nodes, %.2f MiB = %.2f%% of the volume bytes, values [%g, %g]\n",
-                octree.level_count(), octree.shape().depth(), octree.shape().node_count,
-                double(octree.bytes()) / (1024.0 * 1024.0), 100.0 * share,
-                double(octree.value_min()), double(octree.value_max()));
-    return octree;
+    const OctreeShape& shape = ex->octree_shape();
+    std::printf("octree: %zu levels, depth %d, %zu nodes, %.2f MiB = %.2f%% of the volume bytes, values [%g, %g]\n",
+                shape.levels.size(), shape.depth(), shape.node_count,
+                double(ex->octree_bytes()) / (1024.0 * 1024.0), 100.0 * share, ex->value_min(),
+                ex->value_max());
+    return ex;
 }
 
-double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov, double lo, double hi) {
+double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov, const SurfaceExtractor& ex) {
     const std::string where = ov.file ? ov.file->string() : std::string("phantom");
     if (!iso) {
         if (!ov.file) return kPhantomSkinIso;
         throw InputError(where, "--iso", "an isovalue is required (see `isowall info`)");
     }
-    if (!std::isfinite(*iso) || *iso < lo || *iso > hi) {
+    if (!std::isfinite(*iso) || *iso < ex.value_min() || *iso > ex.value_max()) {
         char msg[160];
         std::snprintf(msg, sizeof(msg), "isovalue %g is outside the volume's value range [%g, %g]",
-                      *iso, lo, hi);
+                      *iso, ex.value_min(), ex.value_max());
         throw InputError(where, "--iso", msg);
     }
     return *iso;
 }
 
-template <class T>
-Mesh extract_timed(const VolumeView<T>& v, const MinMaxOctree<T>& octree, double iso, Timings& t) {
+Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
     ExtractStats es;
     Stopwatch sw;
-    Mesh mesh = extract_full(v, octree, iso, &es);
+    Mesh mesh = ex.extract_full(iso, &es);
     t.extract = sw.seconds();
     std::printf("extract: iso %g: %zu triangles, %zu vertices, %zu active cells, %zu octree nodes "
                 "visited, %zu leaf bricks scanned (%.3f s)\n",
@@ -87,16 +90,123 @@ void check_output_path(const std::string& path, const char* option) {
         throw InputError(path, option, "folder " + dir.string() + " does not exist");
 }
 
+// "out/img.png" + "_c99" -> "out/img_c99.png"
+std::filesystem::path with_suffix(const std::string& path, const std::string& suffix) {
+    std::filesystem::path p(path);
+    return p.parent_path() / (p.stem().string() + suffix + p.extension().string());
+}
+
+std::string percent_label(double pct) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%g", pct);
+    return buf;
+}
+
+EngineOptions engine_options(const RenderOptions& o) {
+    EngineOptions e;
+    const auto order = parse_ray_order(o.order);
+    if (!order) throw InputError("--order", "value", "expected grid, readback or dynamic, got \"" + o.order + "\"");
+    e.order = *order;
+    e.intersect = o.intersect == "approximate" ? IntersectMode::approximate : IntersectMode::exact;
+    e.propagation.mode = o.propagation == "angle" ? PropagationMode::cutoff_angle : PropagationMode::max_count;
+    e.propagation.max_count = o.max_count;
+    e.propagation.cutoff_rad = glm::radians(o.cutoff_deg);
+    e.propagation.foldback_rad = glm::radians(o.foldback_deg);
+    e.propagation.interpolant_cache = !o.no_interpolant_cache;
+    e.screen_box = !o.no_screen_box;
+    e.sample_at_rays = o.snapshot_rays;
+    return e;
+}
+
+void print_thresholds(const FrameResult& fr) {
+    std::printf("correctness (replayed against the final image):\n");
+    std::printf("  %-12s %10s %10s %12s %12s %9s\n", "point", "time s", "rays", "rays %", "triangles",
+                "groups");
+    auto row = [&](const char* label, const std::optional<std::size_t>& i) {
+        if (!i) {
+            std::printf("  %-12s %10s\n", label, "not reached");
+            return;
+        }
+        const TimelineSample& s = fr.timeline[*i];
+        std::printf("  %-12s %10.3f %10zu %11.4f%% %12zu %9zu\n", label, s.time_s, s.rays,
+                    100.0 * double(s.rays) / double(fr.rays_screen), s.triangles, s.groups);
+    };
+    row("C >= 90%", first_reaching(fr.timeline, 0.90));
+    row("C >= 99%", first_reaching(fr.timeline, 0.99));
+    row("C >= 99.9%", first_reaching(fr.timeline, 0.999));
+    row("C = 100%", first_reaching(fr.timeline, 1.0));
+    row("all rays", fr.timeline.size() - 1);
+}
+
+std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                       const FrameView& fv, Timings& t) {
+    ProgressiveEngine engine(ex, renderer, engine_options(o));
+    auto progress = [&](const TimelineSample& s) {
+        if (o.quiet) return;
+        std::printf("  %7.2f s  level %2d  rays %9zu (%6.2f%%)  groups %6zu  triangles %9zu\n", s.time_s,
+                    s.level, s.rays, 100.0 * double(s.rays) / double(fv.width) / double(fv.height),
+                    s.groups, s.triangles);
+        std::fflush(stdout);
+    };
+    FrameResult fr = engine.run(fv, {}, progress);
+    const TimelineSample& last = fr.timeline.back();
+    t.render = fr.elapsed_s;
+    std::printf("progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
+                "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
+                std::string(to_string(engine.options().order)).c_str(), o.intersect.c_str(),
+                o.propagation == "angle" ? "cut-off angle" : ("max count " + std::to_string(o.max_count)).c_str(),
+                fr.rays_cast, 100.0 * double(fr.rays_cast) / double(fr.rays_screen),
+                fr.screen_rect.width, fr.screen_rect.height, fr.elapsed_s, fr.groups.size(),
+                last.triangles, last.cells_visited);
+    std::printf("stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
+                last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+
+    Stopwatch sw;
+    write_image(o.out, fr.final_image);
+    if (!o.depth_out.empty()) write_depth(o.depth_out, fr.final_image);
+    t.write = sw.seconds();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ", o.depth_out.c_str());
+
+    const bool want_measure = !o.no_measure || !o.timeline.empty() || !o.snapshots.empty() ||
+                              !o.snapshot_rays.empty();
+    if (!want_measure) return last.triangles;
+    sw.restart();
+    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
+    engine.measure(fr, fv, [&](const TimelineSample& s, const Image& img) {
+        for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
+            if (c_done[k] || s.correctness.c < o.snapshots[k] / 100.0) continue;
+            c_done[k] = true;
+            const auto path = with_suffix(o.out, "_c" + percent_label(o.snapshots[k]));
+            write_image(path, img);
+            std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n", path.c_str(),
+                        s.correctness.c, s.correctness.final_pixels, s.time_s, s.rays);
+        }
+        for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
+            if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
+            r_done[k] = true;
+            const auto path = with_suffix(o.out, "_r" + std::to_string(o.snapshot_rays[k]));
+            write_image(path, img);
+            std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
+        }
+    });
+    print_thresholds(fr);
+    if (!o.timeline.empty()) {
+        write_timeline_csv(o.timeline, fr.timeline, fr.rays_screen);
+        std::printf("wrote %s (%zu samples; plot with scripts/plot_timeline.py)\n", o.timeline.c_str(),
+                    fr.timeline.size());
+    }
+    std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
+                fr.timeline.size(), sw.seconds());
+    return last.triangles;
+}
+
 }  // namespace
 
 int run_info(const InfoOptions& o) {
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
-    dispatch_voxel_type(ov.volume.type(), [&](auto tag) {
-        using T = decltype(tag);
-        prepare_octree<T>(ov, t);
-    });
+    prepare(ov, t);
     const Box3 b = ov.volume.bounds();
     std::printf("bounds: (%g, %g, %g) - (%g, %g, %g) object units\n", double(b.min.x), double(b.min.y),
                 double(b.min.z), double(b.max.x), double(b.max.y), double(b.max.z));
@@ -110,19 +220,14 @@ int run_extract(const ExtractOptions& o) {
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
-    std::size_t triangles = 0;
-    dispatch_voxel_type(ov.volume.type(), [&](auto tag) {
-        using T = decltype(tag);
-        auto octree = prepare_octree<T>(ov, t);
-        const double iso = checked_iso(o.iso, ov, double(octree.value_min()), double(octree.value_max()));
-        Mesh mesh = extract_timed(ov.volume.view<T>(), octree, iso, t);
-        triangles = mesh.triangle_count();
-        Stopwatch sw;
-        write_ply(o.out, mesh);
-        t.write = sw.seconds();
-        std::printf("wrote %s\n", o.out.c_str());
-    });
-    t.print(triangles);
+    auto ex = prepare(ov, t);
+    const double iso = checked_iso(o.iso, ov, *ex);
+    Mesh mesh = extract_timed(*ex, iso, t);
+    Stopwatch sw;
+    write_ply(o.out, mesh);
+    t.write = sw.seconds();
+    std::printf("wrote %s\n", o.out.c_str());
+    t.print(mesh.triangle_count());
     return 0;
 }
 
@@ -132,45 +237,50 @@ int run_render(const RenderOptions& o) {
         throw InputError("--size", "value", "expected WIDTHxHEIGHT with positive integers, got \"" + o.size + "\"");
     check_output_path(o.out, "--out");
     if (!o.depth_out.empty()) check_output_path(o.depth_out, "--depth-out");
+    if (!o.timeline.empty()) check_output_path(o.timeline, "--timeline");
+    if (o.max_count < 1) throw InputError("--max-count", "value", "expected a positive cell count");
+    for (double c : o.snapshots)
+        if (!(c > 0 && c <= 100)) throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
+    const EngineOptions checked = engine_options(o);  // fails early on a bad --order
+    (void)checked;
     Timings t;
     // Create the GL context first: a missing driver should fail before the volume is read.
     auto renderer = make_renderer(o.gl);
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
-    std::size_t triangles = 0;
-    dispatch_voxel_type(ov.volume.type(), [&](auto tag) {
-        using T = decltype(tag);
-        auto octree = prepare_octree<T>(ov, t);
-        const double iso = checked_iso(o.iso, ov, double(octree.value_min()), double(octree.value_max()));
-        Mesh mesh = extract_timed(ov.volume.view<T>(), octree, iso, t);
-        triangles = mesh.triangle_count();
+    auto ex = prepare(ov, t);
+    const double iso = checked_iso(o.iso, ov, *ex);
 
-        const float aspect = float(size->x) / float(size->y);
-        const Projection proj = o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
-        Camera cam = front_full_view(ov.volume.bounds(), aspect, proj);
-        if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
-        cam = fit_depth_range(zoom(cam, o.zoom), ov.volume.bounds());
+    const float aspect = float(size->x) / float(size->y);
+    const Projection proj = o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
+    Camera cam = front_full_view(ov.volume.bounds(), aspect, proj);
+    if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
+    cam = fit_depth_range(zoom(cam, o.zoom), ov.volume.bounds());
+    FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso};
 
-        Stopwatch sw;
-        Image image;
-        renderer->resize(size->x, size->y);
-        renderer->clear();
-        renderer->draw(mesh, cam.view(), cam.frustum(aspect).matrix());
-        renderer->read_back(image);
-        t.render = sw.seconds();
-        std::size_t covered = 0;
-        for (float d : image.depth) covered += d < 1.0f;
-        std::printf("render: %s %dx%d, %.1f%% of pixels covered (%.3f s)\n",
-                    std::string(renderer->name()).c_str(), size->x, size->y,
-                    100.0 * double(covered) / double(image.pixel_count()), t.render);
-        sw.restart();
-        write_image(o.out, image);
-        if (!o.depth_out.empty()) write_depth(o.depth_out, image);
-        t.write = sw.seconds();
-        std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
-                    o.depth_out.c_str());
-    });
-    t.print(triangles);
+    if (!o.full) {
+        t.print(render_progressive(o, *ex, *renderer, fv, t));
+        return 0;
+    }
+    Mesh mesh = extract_timed(*ex, iso, t);
+    Stopwatch sw;
+    Image image;
+    renderer->resize(size->x, size->y);
+    renderer->clear();
+    renderer->draw(mesh, cam.view(), fv.frustum.matrix());
+    renderer->read_back(image);
+    t.render = sw.seconds();
+    std::size_t covered = 0;
+    for (float d : image.depth) covered += d < 1.0f;
+    std::printf("render: %s %dx%d, %.1f%% of pixels covered (%.3f s)\n",
+                std::string(renderer->name()).c_str(), size->x, size->y,
+                100.0 * double(covered) / double(image.pixel_count()), t.render);
+    sw.restart();
+    write_image(o.out, image);
+    if (!o.depth_out.empty()) write_depth(o.depth_out, image);
+    t.write = sw.seconds();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ", o.depth_out.c_str());
+    t.print(mesh.triangle_count());
     return 0;
 }
 

@@ -27,6 +27,22 @@ struct RenderOptions {
     std::string projection = "perspective";
     std::vector<float> orbit;  // yaw pitch in degrees
     float zoom = 1.0f;
+
+    // Progressive engine (the default) or the full surface.
+    bool full = false;
+    std::string order = "dynamic";
+    std::string intersect = "exact";
+    std::string propagation = "count";
+    int max_count = 8000;
+    float cutoff_deg = 2.0f;
+    float foldback_deg = 0.5f;
+    bool no_interpolant_cache = false;
+    bool no_screen_box = false;
+    std::string timeline;                 // CSV path
+    std::vector<double> snapshots;        // C thresholds in percent
+    std::vector<std::size_t> snapshot_rays;
+    bool no_measure = false;
+    bool quiet = false;
 };
 
 int run_info(const InfoOptions& o);

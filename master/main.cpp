@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
     ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
 
     RenderOptions re;
-    auto* re_cmd = app.add_subcommand("render", "Extract the isosurface and render one image");
+    auto* re_cmd = app.add_subcommand(
+        "render", "Render one view progressively (or the full surface with --full) to an image");
     add_volume_options(*re_cmd, re.volume);
     re_cmd->add_option("--iso", re.iso, "Isovalue (default for the phantom: skin, 50)");
     re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();
@@ -41,6 +42,45 @@ int main(int argc, char** argv) {
     re_cmd->add_option("--zoom", re.zoom, "Zoom factor (>1 moves closer)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    re_cmd->add_flag("--full", re.full,
+                     "Extract and draw the whole surface instead of the progressive engine");
+    re_cmd->add_option("--order", re.order, "Ray order: grid (fixed refining grids), readback "
+                                            "(screen read-back) or dynamic (dynamic grid)")
+        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
+        ->capture_default_str();
+    re_cmd->add_option("--intersect", re.intersect,
+                       "exact (Moller-Trumbore on the cell's triangles) or approximate (first "
+                       "active cell, then an exact second pass)")
+        ->check(CLI::IsMember({"exact", "approximate"}))
+        ->capture_default_str();
+    re_cmd->add_option("--propagation", re.propagation,
+                       "count (at most --max-count cells per seed) or angle (--cutoff-angle with "
+                       "fold-back test)")
+        ->check(CLI::IsMember({"count", "angle"}))
+        ->capture_default_str();
+    re_cmd->add_option("--max-count", re.max_count, "Cells per propagation pass (count mode)")
+        ->capture_default_str();
+    re_cmd->add_option("--cutoff-angle", re.cutoff_deg, "Cut-off angle in degrees (angle mode)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    re_cmd->add_option("--foldback-tolerance", re.foldback_deg,
+                       "Fold-back tolerance in degrees (angle mode)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    re_cmd->add_flag("--no-interpolant-cache", re.no_interpolant_cache,
+                     "Do not share vertices between cells of a group");
+    re_cmd->add_flag("--no-screen-box", re.no_screen_box,
+                     "Cast rays over the whole screen, not only the volume's projected box");
+    re_cmd->add_option("--timeline", re.timeline, "Write the timeline (CSV) of the frame");
+    re_cmd->add_option("--snapshots", re.snapshots,
+                       "Write the image when C first reaches these percentages, e.g. 90,99,99.9")
+        ->delimiter(',');
+    re_cmd->add_option("--snapshot-rays", re.snapshot_rays,
+                       "Write the image after these numbers of rays, e.g. 100,10000")
+        ->delimiter(',');
+    re_cmd->add_flag("--no-measure", re.no_measure,
+                     "Skip the replay that measures correctness against the final image");
+    re_cmd->add_flag("--quiet,-q", re.quiet, "No progress lines while casting");
 
     try {
         app.parse(argc, argv);

@@ -1,5 +1,6 @@
 #include "tile/progressive_engine.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include <glm/matrix.hpp>
@@ -38,9 +39,14 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
 
     TimelineSample now;
     std::size_t next_sample_rays = 1;
+    std::vector<std::size_t> extra = options_.sample_at_rays;
+    std::sort(extra.begin(), extra.end());
+    std::size_t next_extra = 0;
     double last_sample_s = 0, last_progress_s = 0;
     auto record = [&](bool force) {
         now.time_s = since(start);
+        while (next_extra < extra.size() && extra[next_extra] < now.rays) ++next_extra;
+        if (next_extra < extra.size() && extra[next_extra] == now.rays) force = true;
         if (!force && now.rays < next_sample_rays && now.time_s - last_sample_s < options_.sample_interval_s)
             return;
         // The sample shows what is on screen: wait for the queued draws to land.

@@ -13,6 +13,7 @@
 #include "common/image.h"
 #include "common/ray_order.h"
 #include "common/surface_extractor.h"
+#include "common/timeline.h"
 #include "tile/renderer.h"
 
 namespace isowall {
@@ -25,6 +26,8 @@ struct EngineOptions {
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;
+    // Extra samples exactly when these ray counts are reached (snapshots by rays).
+    std::vector<std::size_t> sample_at_rays;
 };
 
 struct FrameView {
@@ -33,19 +36,6 @@ struct FrameView {
     int width = 0;
     int height = 0;
     double iso = 0;
-};
-
-// One point of the timeline. Stage times are cumulative seconds since the frame started.
-struct TimelineSample {
-    double time_s = 0;
-    std::size_t rays = 0;
-    std::size_t cells_visited = 0;
-    std::size_t triangles = 0;
-    std::size_t groups = 0;
-    double t_intersect_s = 0, t_propagate_s = 0, t_extract_s = 0, t_render_s = 0;
-    int level = 0;
-    // Filled in by ProgressiveEngine::measure() against the frame's final image.
-    Correctness correctness;
 };
 
 struct FrameResult {
