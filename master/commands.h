@@ -39,7 +39,8 @@ struct RenderOptions {
     bool no_interpolant_cache = false;
     bool no_screen_box = false;
     std::string timeline;                 // CSV path
-    std::vector<double> snapshots;        // C thresholds in percent
+    std::vector<double> snapshots;        // correctness thresholds in percent
+    std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)
     std::vector<std::size_t> snapshot_rays;
     bool no_measure = false;
     bool quiet = false;

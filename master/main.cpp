@@ -73,8 +73,14 @@ int main(int argc, char** argv) {
                      "Cast rays over the whole screen, not only the volume's projected box");
     re_cmd->add_option("--timeline", re.timeline, "Write the timeline (CSV) of the frame");
     re_cmd->add_option("--snapshots", re.snapshots,
-                       "Write the image when C first reaches these percentages, e.g. 90,99,99.9")
+                       "Write the image when correctness first reaches these percentages, e.g. "
+                       "90,99,99.9")
         ->delimiter(',');
+    re_cmd->add_option("--snapshot-measure", re.snapshot_measure,
+                       "Correctness measure for --snapshots: final (share of final pixels, "
+                       "chapters 2-3) or c (C = 1 - E, section 4.2)")
+        ->check(CLI::IsMember({"final", "c"}))
+        ->capture_default_str();
     re_cmd->add_option("--snapshot-rays", re.snapshot_rays,
                        "Write the image after these numbers of rays, e.g. 100,10000")
         ->delimiter(',');
