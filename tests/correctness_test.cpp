@@ -1,0 +1,168 @@
+// Correctness of an intermediate frame against the final one: final pixels and C = 1 - E.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/correctness.h"
+
+namespace isowall {
+namespace {
+
+// A w x h frame with nothing drawn (black, depth 1).
+Image background(int w, int h) {
+    Image image;
+    image.resize(w, h);
+    return image;
+}
+
+void draw(Image& image, int x, int y, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+    const std::size_t p = static_cast<std::size_t>(y) * image.width + x;
+    image.rgba[p * 4 + 0] = r;
+    image.rgba[p * 4 + 1] = g;
+    image.rgba[p * 4 + 2] = b;
+    image.rgba[p * 4 + 3] = 255;
+    image.depth[p] = 0.5f;
+}
+
+// A w x h frame with every pixel drawn in one colour.
+Image filled(int w, int h, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+    Image image = background(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) draw(image, x, y, r, g, b);
+    return image;
+}
+
+TEST(Correctness, EmptyFinalImageIsTriviallyMatched) {
+    for (auto [w, h] : {std::pair{0, 0}, std::pair{1, 1}, std::pair{7, 3}}) {
+        const Image final_image = background(w, h);
+        for (const Image& intermediate : {background(w, h), filled(w, h, 10, 20, 30)}) {
+            const Correctness m = measure_correctness(intermediate, final_image);
+            EXPECT_EQ(m.significant, 0u) << w << "x" << h;
+            EXPECT_EQ(m.final_pixels, 1.0) << w << "x" << h;
+            EXPECT_EQ(m.c, 1.0) << w << "x" << h;
+        }
+    }
+}
+
+TEST(Correctness, IdenticalImagesAreFullyCorrect) {
+    Image final_image = background(5, 4);
+    draw(final_image, 0, 0, 255, 0, 0);
+    draw(final_image, 4, 3, 1, 2, 3);
+    draw(final_image, 2, 1, 200, 100, 50);
+    const Correctness m = measure_correctness(final_image, final_image);
+    EXPECT_EQ(m.significant, 3u);
+    EXPECT_EQ(m.final_pixels, 1.0);
+    EXPECT_EQ(m.c, 1.0);
+}
+
+TEST(Correctness, EmptyIntermediateIsZero) {
+    const Image final_image = filled(6, 2, 90, 90, 90);
+    const Correctness m = measure_correctness(background(6, 2), final_image);
+    EXPECT_EQ(m.significant, 12u);
+    EXPECT_EQ(m.final_pixels, 0.0);
+    EXPECT_EQ(m.c, 0.0);
+}
+
+TEST(Correctness, HalfTheSignificantPixelsMissing) {
+    const Image final_image = filled(4, 4, 30, 60, 90);
+    Image intermediate = final_image;
+    for (int x = 0; x < 4; ++x)
+        for (int y = 0; y < 2; ++y) intermediate.depth[std::size_t(y) * 4 + x] = 1.0f;
+    const Correctness m = measure_correctness(intermediate, final_image);
+    EXPECT_EQ(m.significant, 16u);
+    EXPECT_DOUBLE_EQ(m.final_pixels, 0.5);
+    // E = sqrt((8 * 1^2 + 8 * 0^2) / 16)
+    EXPECT_DOUBLE_EQ(m.c, 1.0 - std::sqrt(0.5));
+}
+
+TEST(Correctness, UniformColourErrorGivesOneMinusTheError) {
+    const Image final_image = filled(3, 3, 128, 128, 128);
+    for (int d : {2, 17, 100, 127}) {
+        // The same magnitude on every channel, in both directions, so e(P) = d/255 everywhere.
+        const Image intermediate =
+            filled(3, 3, std::uint8_t(128 + d), std::uint8_t(128 - d), std::uint8_t(128 + d));
+        const Correctness m = measure_correctness(intermediate, final_image);
+        EXPECT_NEAR(m.c, 1.0 - d / 255.0, 1e-12) << "d " << d;
+        EXPECT_EQ(m.final_pixels, 0.0) << "d " << d;
+    }
+}
+
+TEST(Correctness, ErrorFollowsTheSection42Formula) {
+    // Pixel (0,0) not drawn yet: e = 1. Pixel (1,0) off by (0.2, 0.4, 0) of full scale:
+    // e^2 = (0.04 + 0.16 + 0) / 3. Pixel (2,0) exact: e = 0. E is the RMS of the three.
+    Image final_image = background(3, 1);
+    draw(final_image, 0, 0, 10, 10, 10);
+    draw(final_image, 1, 0, 51, 102, 7);
+    draw(final_image, 2, 0, 250, 0, 125);
+    Image intermediate = background(3, 1);
+    draw(intermediate, 1, 0, 0, 0, 7);
+    draw(intermediate, 2, 0, 250, 0, 125);
+    const Correctness m = measure_correctness(intermediate, final_image);
+    const double expected_e = std::sqrt((1.0 + (0.04 + 0.16) / 3.0 + 0.0) / 3.0);
+    EXPECT_EQ(m.significant, 3u);
+    EXPECT_NEAR(m.c, 1.0 - expected_e, 1e-12);
+    EXPECT_DOUBLE_EQ(m.final_pixels, 1.0 / 3.0);
+}
+
+TEST(Correctness, BackgroundDrawnOnlyInTheIntermediateDoesNotCount) {
+    // A stray or since-culled triangle covers pixels the final image leaves as background.
+    Image final_image = background(4, 1);
+    draw(final_image, 0, 0, 40, 50, 60);
+    Image intermediate = filled(4, 1, 255, 255, 255);
+    draw(intermediate, 0, 0, 40, 50, 60);
+    const Correctness m = measure_correctness(intermediate, final_image);
+    EXPECT_EQ(m.significant, 1u);
+    EXPECT_EQ(m.final_pixels, 1.0);
+    EXPECT_EQ(m.c, 1.0);
+}
+
+TEST(Correctness, ToleranceDecidesFinalPixels) {
+    const Image final_image = filled(2, 2, 100, 100, 100);
+    const Image off_by_one = filled(2, 2, 101, 99, 100);
+    const Image off_by_two = filled(2, 2, 100, 100, 102);
+    EXPECT_EQ(measure_correctness(off_by_one, final_image).final_pixels, 1.0);  // default 1
+    EXPECT_EQ(measure_correctness(off_by_one, final_image, 0).final_pixels, 0.0);
+    EXPECT_EQ(measure_correctness(off_by_two, final_image).final_pixels, 0.0);
+    EXPECT_EQ(measure_correctness(off_by_two, final_image, 2).final_pixels, 1.0);
+    // C measures the error itself, whatever the tolerance.
+    EXPECT_LT(measure_correctness(off_by_one, final_image).c, 1.0);
+    EXPECT_EQ(measure_correctness(off_by_two, final_image, 2).c,
+              measure_correctness(off_by_two, final_image, 0).c);
+}
+
+TEST(Correctness, AlphaIsIgnored) {
+    const Image final_image = filled(2, 1, 10, 20, 30);
+    Image intermediate = final_image;
+    intermediate.rgba[3] = 0;
+    const Correctness m = measure_correctness(intermediate, final_image, 0);
+    EXPECT_EQ(m.final_pixels, 1.0);
+    EXPECT_EQ(m.c, 1.0);
+}
+
+TEST(Correctness, SizeMismatchThrowsNamingBothSizes) {
+    const Image a = background(4, 3);
+    const Image b = background(3, 4);
+    try {
+        measure_correctness(a, b);
+        FAIL() << "no exception for 4x3 against 3x4";
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("4x3"), std::string::npos) << what;
+        EXPECT_NE(what.find("3x4"), std::string::npos) << what;
+    }
+    EXPECT_THROW(measure_correctness(background(0, 0), background(1, 1)), std::invalid_argument);
+}
+
+TEST(Correctness, MalformedBuffersThrow) {
+    Image short_depth = background(2, 2);
+    short_depth.depth.pop_back();
+    EXPECT_THROW(measure_correctness(short_depth, background(2, 2)), std::invalid_argument);
+    EXPECT_THROW(measure_correctness(background(2, 2), short_depth), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace isowall
