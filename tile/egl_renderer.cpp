@@ -143,7 +143,7 @@ EGLDisplay initialize_display() {
     fail("eglInitialize");
 }
 
-class EglRenderer final : public Renderer {
+class EglRenderer final : public GlRenderer {
   public:
     EglRenderer() : display_(initialize_display()) {
         try {
@@ -161,26 +161,6 @@ class EglRenderer final : public Renderer {
     EglRenderer(const EglRenderer&) = delete;
     EglRenderer& operator=(const EglRenderer&) = delete;
 
-    void resize(int width, int height) override {
-        make_current();
-        core_->resize(width, height);
-    }
-    void clear() override {
-        make_current();
-        core_->clear();
-    }
-    void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) override {
-        make_current();
-        core_->draw(mesh, view, projection);
-    }
-    void read_back(Image& out) override {
-        make_current();
-        core_->read_back(out);
-    }
-    void finish() override {
-        make_current();
-        core_->finish();
-    }
     std::string_view name() const override { return kName; }
 
   private:
@@ -212,7 +192,7 @@ class EglRenderer final : public Renderer {
 
     // Every call makes the context current: another renderer (OSMesa or EGL) may have taken the
     // thread since the last call.
-    void make_current() {
+    void make_current() override {
         if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
             fail("eglMakeCurrent");
     }
@@ -233,7 +213,6 @@ class EglRenderer final : public Renderer {
 
     EGLDisplay display_;
     EGLContext context_ = EGL_NO_CONTEXT;
-    std::unique_ptr<GlCore> core_;
 };
 
 }  // namespace

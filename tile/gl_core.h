@@ -11,6 +11,7 @@
 
 #include "common/image.h"
 #include "common/mesh.h"
+#include "tile/renderer.h"
 
 namespace isowall {
 
@@ -58,6 +59,36 @@ class GlCore {
     int projection_location_ = -1;
     int normal_matrix_location_ = -1;
     int orthographic_location_ = -1;
+};
+
+// The Renderer calls every GL back end shares: make the back end's context current, then let
+// GlCore do the work. A back end supplies the context (make_current) and creates core_.
+class GlRenderer : public Renderer {
+public:
+    void resize(int width, int height) override {
+        make_current();
+        core_->resize(width, height);
+    }
+    void clear() override {
+        make_current();
+        core_->clear();
+    }
+    void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) override {
+        make_current();
+        core_->draw(mesh, view, projection);
+    }
+    void read_back(Image& out) override {
+        make_current();
+        core_->read_back(out);
+    }
+    void finish() override {
+        make_current();
+        core_->finish();
+    }
+
+protected:
+    virtual void make_current() = 0;
+    std::unique_ptr<GlCore> core_;
 };
 
 }  // namespace isowall

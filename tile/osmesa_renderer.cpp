@@ -38,7 +38,7 @@ OSMesaContext create_context() {
     throw RendererError(kName, "OSMesaCreateContextAttribs failed (no core 3.3 or compat context)");
 }
 
-class OsmesaRenderer final : public Renderer {
+class OsmesaRenderer final : public GlRenderer {
   public:
     OsmesaRenderer() : context_(create_context()) {
         try {
@@ -60,39 +60,18 @@ class OsmesaRenderer final : public Renderer {
     OsmesaRenderer(const OsmesaRenderer&) = delete;
     OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
 
-    void resize(int width, int height) override {
-        make_current();
-        core_->resize(width, height);
-    }
-    void clear() override {
-        make_current();
-        core_->clear();
-    }
-    void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) override {
-        make_current();
-        core_->draw(mesh, view, projection);
-    }
-    void read_back(Image& out) override {
-        make_current();
-        core_->read_back(out);
-    }
-    void finish() override {
-        make_current();
-        core_->finish();
-    }
     std::string_view name() const override { return kName; }
 
   private:
     // Every call makes the context current: another renderer (OSMesa or EGL) may have taken the
     // thread since the last call.
-    void make_current() {
+    void make_current() override {
         if (!OSMesaMakeCurrent(context_, dummy_.data(), GL_UNSIGNED_BYTE, 1, 1))
             throw RendererError(kName, "OSMesaMakeCurrent failed");
     }
 
     OSMesaContext context_;
     std::array<unsigned char, 4> dummy_{};
-    std::unique_ptr<GlCore> core_;
 };
 
 }  // namespace
