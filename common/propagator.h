@@ -8,6 +8,12 @@
 //                 of their predecessors' by more than the tolerance: Figure 2.5).
 // Each pass yields one group: an indexed face set triangulated through the interpolant cache,
 // which is reset per pass (section 3.3.4).
+// With a ResolutionMap (chapter 2.1.3) a pass runs at the level of its seed's unit: over meta-cells
+// of that level (face neighbours at stride 2^level, active by their corner signs), and it stops at
+// the resolution boundary: a neighbour that belongs to a unit of another level is not entered.
+// Every cell a meta-cell covers is marked visited with the pass's group id, so no ray seeds inside
+// it again and every visited cell is in exactly one group (units are disjoint, so a unit is either
+// wholly visited or not at all, and testing its first cell is enough).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +24,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "common/adaptive.h"
 #include "common/marching_cubes.h"
 #include "common/visited.h"
 
@@ -36,8 +43,14 @@ struct PropagationParams {
 struct Group {
     std::uint32_t id = 0;
     glm::ivec3 seed{0};
+    int level = 0;  // the resolution of the pass: 0 cells, i >= 1 meta-cells of 2^i cells per side
     Mesh mesh;  // object space
-    std::vector<glm::ivec3> cells;  // the cells this pass took, in BFS order
+    // The cells this pass took, in BFS order; at level >= 1 the first cell of each meta-cell.
+    std::vector<glm::ivec3> cells;
+    // A refinement (adaptive resolution): the full-resolution triangles of the meta-cell of
+    // `level` at `seed`, drawn over its own because a ray saw the surface there that they miss.
+    // It takes no cells: they stay with the pass that took the meta-cell, if any.
+    bool refinement = false;
 };
 
 // Without the interpolant cache every triangle gets its own three vertices (the "caching off"
@@ -52,6 +65,9 @@ class Propagator {
 public:
     explicit Propagator(const VolumeView<T>& v) : v_(v), cache_(v.dims, 4096) {}
 
+    // The resolution of the following passes; default-constructed: full resolution.
+    void set_resolution(const ResolutionMap& resolution) { resolution_ = resolution; }
+
     // Seconds spent triangulating (marching cubes) in the last propagate() call; the rest of the
     // call is the propagation proper (queue, neighbour tests, criteria).
     double last_extract_s() const { return extract_s_; }
@@ -64,13 +80,18 @@ public:
         extract_s_ = 0;
         Group g;
         g.id = group_id;
+        const int level = resolution_.level_of(seed);
+        const int stride = 1 << level;
+        seed &= ~(stride - 1);  // the unit's first cell
         g.seed = seed;
-        if (!visited.insert(seed, group_id)) return g;
+        g.level = level;
+        if (!insert(visited, seed, level, group_id)) return g;
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
         const float cos_cutoff = std::cos(p.cutoff_rad);
+        const float half = 0.5f * static_cast<float>(stride);
         auto angle_of = [&](glm::ivec3 c) {
-            const glm::vec3 to = glm::normalize(glm::vec3(c) + 0.5f - eye);
+            const glm::vec3 to = glm::normalize(glm::vec3(c) + half - eye);
             return std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
         };
         queue_.clear();
@@ -83,7 +104,7 @@ public:
             g.cells.push_back(item.cell);
             if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
             const auto t0 = std::chrono::steady_clock::now();
-            const int cs = triangulate(item.cell, iso, p, g.mesh);
+            const int cs = triangulate(item.cell, level, iso, p, g.mesh);
             extract_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             for (int f = 0; f < 6; ++f) {
                 const int axis = f >> 1, side = f & 1;
@@ -93,20 +114,22 @@ public:
                     if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
                 if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
                 glm::ivec3 nb = item.cell;
-                nb[axis] += side ? 1 : -1;
+                nb[axis] += side ? stride : -stride;
                 if (nb[axis] < 0 || nb[axis] >= cells[axis]) continue;
                 if (visited.contains(nb)) continue;
+                if (resolution_.max_level() > 0 && resolution_.level_of(nb) != level)
+                    continue;  // the resolution boundary
                 float max_angle = item.max_angle;
                 if (p.mode == PropagationMode::max_count) {
                     if (taken >= p.max_count) continue;
                 } else {
-                    const glm::vec3 to = glm::normalize(glm::vec3(nb) + 0.5f - eye);
+                    const glm::vec3 to = glm::normalize(glm::vec3(nb) + half - eye);
                     if (glm::dot(to, dir) < cos_cutoff) continue;
                     const float a = std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
                     if (a < item.max_angle - p.foldback_rad) continue;  // folds back
                     max_angle = std::max(max_angle, a);
                 }
-                visited.insert(nb, group_id);
+                insert(visited, nb, level, group_id);
                 ++taken;
                 queue_.push_back({nb, max_angle});
             }
@@ -114,8 +137,51 @@ public:
         return g;
     }
 
+    // The refinement group of the meta-cell of `level` at `base`: its active cells triangulated at
+    // full resolution, sharing vertices through the interpolant cache.
+    Group refine(glm::ivec3 base, int level, std::uint32_t group_id, double iso,
+                 const PropagationParams& p) {
+        const auto t0 = std::chrono::steady_clock::now();
+        Group g;
+        g.id = group_id;
+        g.seed = base;
+        g.level = level;
+        g.refinement = true;
+        cache_.clear();
+        const int s = 1 << level;
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x)
+                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh);
+        extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return g;
+    }
+
 private:
-    int triangulate(glm::ivec3 c, double iso, const PropagationParams& p, Mesh& mesh) {
+    // Marks every cell of the unit of `level` at `base`; false when it was taken already.
+    static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
+        if (!visited.insert(base, group_id)) return false;
+        const int s = 1 << level;
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x)
+                    if (x | y | z) visited.insert(base + glm::ivec3(x, y, z), group_id);
+        return true;
+    }
+
+    int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
+        if (level > 0) {
+            double corner[8];
+            meta_cell_corners(v_, c, level, corner);
+            const int cs = cell_case(corner, iso);
+            if (p.interpolant_cache) {
+                emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
+            } else {
+                NoEdgeCache none;
+                emit_meta_cell(v_, c, level, iso, cs, corner, none, mesh);
+            }
+            return cs;
+        }
         double corner[8];
         cell_corners(v_, c, corner);
         const int cs = cell_case(corner, iso);
@@ -130,6 +196,7 @@ private:
 
     const VolumeView<T>& v_;
     HashEdgeCache cache_;
+    ResolutionMap resolution_;
     double extract_s_ = 0;
     struct QueueEntry {
         glm::ivec3 cell;

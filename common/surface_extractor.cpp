@@ -20,9 +20,14 @@ public:
     const OctreeShape& octree_shape() const override { return octree_.shape(); }
     std::size_t octree_bytes() const override { return octree_.bytes(); }
 
-    void begin_frame(double iso) override {
+    using SurfaceExtractor::begin_frame;
+    void begin_frame(double iso, const ResolutionLevels& levels) override {
         iso_ = iso;
         visited_.reset(view_.cell_dims());
+        refined_.reset(64);
+        const ResolutionMap resolution(levels, view_.spacing, view_.cell_dims());
+        caster_.set_resolution(resolution);
+        propagator_.set_resolution(resolution);
     }
     double iso() const override { return iso_; }
 
@@ -36,10 +41,26 @@ public:
     Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
                     const Ray& ray, const std::function<bool()>& interrupted) override {
         const Ray vr = to_voxel_space(ray, view_.spacing);
-        return propagator_.propagate(seed, group_id, iso_, p, vr.o, vr.d, visited_, interrupted);
+        Group g = propagator_.propagate(seed, group_id, iso_, p, vr.o, vr.d, visited_, interrupted);
+        extract_s_ = propagator_.last_extract_s();
+        return g;
     }
 
-    double last_extract_s() const override { return propagator_.last_extract_s(); }
+    Group refine(glm::ivec3 unit, int level, std::uint32_t group_id,
+                 const PropagationParams& p) override {
+        extract_s_ = 0;
+        if (!refined_.find_or_insert(visited_.index(unit)).second) {
+            Group none;
+            none.id = group_id;
+            none.refinement = true;
+            return none;
+        }
+        Group g = propagator_.refine(unit, level, group_id, iso_, p);
+        extract_s_ = propagator_.last_extract_s();
+        return g;
+    }
+
+    double last_extract_s() const override { return extract_s_; }
 
     Mesh extract_full(double iso, ExtractStats* stats) const override {
         return isowall::extract_full(view_, octree_, iso, stats);
@@ -52,7 +73,9 @@ private:
     RayCaster<T> caster_;
     Propagator<T> propagator_;
     VisitedCells visited_;
+    EdgeVertexCache refined_;  // first cells of the meta-cells refined this frame
     double iso_ = 0;
+    double extract_s_ = 0;
 };
 
 }  // namespace

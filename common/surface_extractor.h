@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 
+#include "common/adaptive.h"
 #include "common/extract.h"
 #include "common/propagator.h"
 #include "common/raycaster.h"
@@ -24,8 +25,11 @@ public:
     virtual const OctreeShape& octree_shape() const = 0;
     virtual std::size_t octree_bytes() const = 0;
 
-    // Starts a frame at `iso`: forgets every visited cell.
-    virtual void begin_frame(double iso) = 0;
+    // Starts a frame at `iso` at full resolution: forgets every visited cell.
+    void begin_frame(double iso) { begin_frame(iso, ResolutionLevels{}); }
+    // Starts a frame at `iso` with the view's D[] (adaptive resolution, chapter 2.1.3): from now on
+    // cast() may hit meta-cells and propagate() runs at the level of its seed's unit.
+    virtual void begin_frame(double iso, const ResolutionLevels& levels) = 0;
     virtual double iso() const = 0;
 
     // `ray` in object space; t is returned in the ray's own parameter.
@@ -37,7 +41,11 @@ public:
     // A propagation pass from `seed` (must be active) for the seed ray `ray` (object space).
     virtual Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
                             const Ray& ray, const std::function<bool()>& interrupted = {}) = 0;
-    // Seconds of the last propagate() spent in marching cubes (the "extraction" stage).
+    // The refinement group of the meta-cell of `level` at `unit` (a RayHit with refine set), or an
+    // empty group (no triangles) when this frame refined it already.
+    virtual Group refine(glm::ivec3 unit, int level, std::uint32_t group_id,
+                         const PropagationParams& p) = 0;
+    // Seconds of the last propagate() or refine() spent in marching cubes (the "extraction" stage).
     virtual double last_extract_s() const = 0;
     // Every triangle of the surface at `iso` (the oracle; does not touch visited cells).
     virtual Mesh extract_full(double iso, ExtractStats* stats = nullptr) const = 0;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "common/adaptive.h"
 #include "common/camera.h"
 #include "common/correctness.h"
 #include "common/image.h"
@@ -23,6 +24,14 @@ struct EngineOptions {
     IntersectMode intersect = IntersectMode::exact;
     PropagationParams propagation;
     bool screen_box = true;  // cast no ray outside the volume's projected bounding box
+    // Adaptive resolution (chapter 2.1.3): where a meta-cell of 2^i cells per side projects to
+    // less than a pixel, extract it as one cell, up to 2^adaptive_max_level cells per side. Off:
+    // every cell at full resolution, exactly as without the option. adaptive_refine: draw a
+    // meta-cell again at full resolution where a pixel's ray sees the full-resolution surface that
+    // its triangles miss (common/adaptive.h); false: the text's distance rule alone.
+    bool adaptive = false;
+    int adaptive_max_level = kMaxMetaLevel;
+    bool adaptive_refine = true;
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;
