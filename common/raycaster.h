@@ -102,10 +102,12 @@ private:
         t_end = std::min(t_end, t_max_);
         const glm::ivec3 leaf_dims = shape.levels[0].dims;
         const int levels = octree_.level_count();
-        // Steps past a node's exit by this much (in cells) to land in the next node.
-        constexpr float kNudge = 1e-4f;
+        // Steps past a node's exit by this much (in cells) to land in the next node; it grows
+        // with t so that t + nudge is a different float even far from the eye (a fixed 1e-4 is
+        // below one ulp once t passes ~1000, and the walk would never advance).
+        auto nudge = [](float at) { return 1e-4f + 4e-7f * std::abs(at); };
         while (t <= t_end) {
-            const glm::vec3 p = ray_.at(t + kNudge);
+            const glm::vec3 p = ray_.at(t + nudge(t));
             const glm::ivec3 brick = glm::clamp(glm::ivec3(glm::floor(p)) >> OctreeShape::kLeafLog2,
                                                 glm::ivec3(0), leaf_dims - 1);
             int skip = -1;  // the highest level whose node around p is inactive
@@ -118,7 +120,7 @@ private:
             if (skip < 0 &&
                 walk_brick(shape.cell_begin(0, n), shape.cell_end(0, n), t, std::min(n1, t_end)))
                 return;
-            t = std::max(n1, t + kNudge);
+            t = std::max(n1, t + nudge(t));
         }
     }
 

@@ -114,6 +114,8 @@ EngineOptions engine_options(const RenderOptions& o) {
     e.propagation.foldback_rad = glm::radians(o.foldback_deg);
     e.propagation.interpolant_cache = !o.no_interpolant_cache;
     e.screen_box = !o.no_screen_box;
+    e.adaptive = o.adaptive;
+    e.adaptive_max_level = o.adaptive_max_level;
     e.sample_at_rays = o.snapshot_rays;
     return e;
 }
@@ -264,6 +266,10 @@ int run_render(const RenderOptions& o) {
     if (!o.depth_out.empty()) check_output_path(o.depth_out, "--depth-out");
     if (!o.timeline.empty()) check_output_path(o.timeline, "--timeline");
     if (o.max_count < 1) throw InputError("--max-count", "value", "expected a positive cell count");
+    if (o.adaptive_max_level < 1 || o.adaptive_max_level > kMaxMetaLevel)
+        throw InputError("--adaptive-max-level", "value",
+                         "expected 1 to " + std::to_string(kMaxMetaLevel) + ", got " +
+                             std::to_string(o.adaptive_max_level));
     for (double c : o.snapshots)
         if (!(c > 0 && c <= 100)) throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
     const EngineOptions checked = engine_options(o);  // fails early on a bad --order

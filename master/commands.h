@@ -38,6 +38,8 @@ struct RenderOptions {
     float foldback_deg = 0.5f;
     bool no_interpolant_cache = false;
     bool no_screen_box = false;
+    bool adaptive = false;
+    int adaptive_max_level = 3;
     std::string timeline;                 // CSV path
     std::vector<double> snapshots;        // correctness thresholds in percent
     std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)

@@ -71,6 +71,12 @@ int main(int argc, char** argv) {
                      "Do not share vertices between cells of a group");
     re_cmd->add_flag("--no-screen-box", re.no_screen_box,
                      "Cast rays over the whole screen, not only the volume's projected box");
+    re_cmd->add_flag("--adaptive", re.adaptive,
+                     "Adaptive resolution: extract regions whose cells project below a pixel as "
+                     "meta-cells of 2^i cells per side");
+    re_cmd->add_option("--adaptive-max-level", re.adaptive_max_level,
+                       "Largest meta-cell level i with --adaptive")
+        ->capture_default_str();
     re_cmd->add_option("--timeline", re.timeline, "Write the timeline (CSV) of the frame");
     re_cmd->add_option("--snapshots", re.snapshots,
                        "Write the image when correctness first reaches these percentages, e.g. "

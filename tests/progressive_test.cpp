@@ -122,6 +122,25 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(PropagationMode::max_count, PropagationMode::cutoff_angle)),
     [](const auto& info) { return combo_name(info.param); });
 
+TEST(Engine, FarViewMatchesTheFullSurface) {
+    // Far from the eye the ray parameter is large: a walk that nudges t by a fixed amount stops
+    // advancing once the nudge is below one float ulp (it hung at zoom 0.3 on vhp_ct_head).
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    ProgressiveEngine engine(*ex, *renderer);
+    FrameView fv = make_view(p, 320, 240, kPhantomSkinIso);
+    fv.camera = fit_depth_range(zoom(fv.camera, 0.02f), p.bounds());
+    fv.frustum = fv.camera.frustum(320.0f / 240.0f);
+    ASSERT_GT(fv.camera.distance(), 5000.0f);
+    FrameResult fr = engine.run(fv);
+    ASSERT_TRUE(fr.completed);
+    const Image full = full_surface_image(*ex, *renderer, fv);
+    const ImageMatch m = compare(fr.final_image, full);
+    EXPECT_GE(m.mask_iou, 0.999);
+    EXPECT_GE(m.equal_share, 0.999);
+}
+
 TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
