@@ -34,7 +34,7 @@ enum class PropagationMode { max_count, cutoff_angle };
 
 struct PropagationParams {
     PropagationMode mode = PropagationMode::max_count;
-    int max_count = 8000;
+    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
     float cutoff_rad = 0.0349f;    // 2 degrees
     float foldback_rad = 0.0087f;  // 0.5 degree
     bool interpolant_cache = true;

@@ -33,7 +33,7 @@ struct RenderOptions {
     std::string order = "dynamic";
     std::string intersect = "exact";
     std::string propagation = "count";
-    int max_count = 8000;
+    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
     float cutoff_deg = 2.0f;
     float foldback_deg = 0.5f;
     bool no_interpolant_cache = false;

@@ -152,8 +152,8 @@ def main():
                           ("Cut-off angle", run(iso, "--order", "grid", "--propagation", "angle"))])
         if "3.4" in tables:
             side_by_side("Table 3.4: interpolant cache (max count 8000, grid order)",
-                         [("Caching on", run(iso, "--order", "grid")),
-                          ("Caching off", run(iso, "--order", "grid", "--no-interpolant-cache"))])
+                         [("Caching on", run(iso, "--order", "grid", "--max-count", "8000")),
+                          ("Caching off", run(iso, "--order", "grid", "--max-count", "8000", "--no-interpolant-cache"))])
         if "3.5" in tables:
             print("\nTable 3.5: screen bounding box: reduction in running time (all rays)")
             print(f"  {'size':>6} {'box on s':>9} {'box off s':>9} {'reduction':>9}")
