@@ -132,7 +132,7 @@ TEST(Renderer, RejectsBadSizesAndDrawBeforeResize) {
     for (const char* backend : kBackends) {
         SCOPED_TRACE(backend);
         auto renderer = make_renderer(backend);
-        EXPECT_EQ(renderer->name(), backend);
+        EXPECT_EQ(std::string(renderer->name()), std::string(backend));
         EXPECT_THROW(renderer->clear(), RendererError);
         EXPECT_THROW(renderer->resize(0, 10), RendererError);
         try {
