@@ -240,13 +240,8 @@ inline int emit_meta_cell(const VolumeView<T>& v, glm::ivec3 base, int level, do
             pb_fine[axis] += 1;
             glm::vec3 pos = glm::vec3(pa);
             pos[axis] += x.t();
-            const glm::vec3 g =
-                glm::mix(gradient(v, pa_fine, inv_step), gradient(v, pb_fine, inv_step), x.frac);
-            const float len2 = glm::dot(g, g);
-            const glm::vec3 n = len2 > 0 ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
-            *slot = static_cast<std::uint32_t>(mesh.positions.size());
-            mesh.positions.push_back(pos * v.spacing);
-            mesh.normals.push_back(n);
+            *slot = append_vertex(mesh, pos, gradient(v, pa_fine, inv_step),
+                                  gradient(v, pb_fine, inv_step), x.frac, v.spacing);
         }
         mesh.indices.push_back(*slot);
     }

@@ -88,6 +88,18 @@ inline glm::vec3 gradient(const VolumeView<T>& v, glm::ivec3 p) {
     return gradient(v, p, 0.5f / v.spacing);
 }
 
+// Appends a vertex at `pos` (voxel space) whose normal mixes the gradients at the edge's two ends
+// at t, and returns its index. The surface faces the low side: the normal is the negated gradient.
+inline std::uint32_t append_vertex(Mesh& mesh, glm::vec3 pos, glm::vec3 g0, glm::vec3 g1, float t,
+                                   glm::vec3 spacing) {
+    const glm::vec3 g = glm::mix(g0, g1, t);
+    const float len2 = glm::dot(g, g);
+    const glm::vec3 n = len2 > 0 ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
+    mesh.positions.push_back(pos * spacing);
+    mesh.normals.push_back(n);
+    return static_cast<std::uint32_t>(mesh.positions.size() - 1);
+}
+
 // Emits the triangles of case `cs` of cell c, whose corner values are known, into `mesh`, sharing
 // vertices through `cache` (HashEdgeCache or BrickEdgeCache: cells triangulated with one cache
 // form one connected indexed face set). Returns the number of triangles added.
@@ -112,13 +124,8 @@ inline int emit_cell(const VolumeView<T>& v, glm::ivec3 c, double iso, int cs,
             const float t = static_cast<float>((iso - va) / (vb - va));
             glm::vec3 pos = glm::vec3(pa);
             pos[axis] += t;
-            const glm::vec3 g = glm::mix(gradient(v, pa, inv_step), gradient(v, pb, inv_step), t);
-            const float len2 = glm::dot(g, g);
-            // The surface faces the low side: the normal is the negated gradient.
-            const glm::vec3 n = len2 > 0 ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
-            *slot = static_cast<std::uint32_t>(mesh.positions.size());
-            mesh.positions.push_back(pos * v.spacing);
-            mesh.normals.push_back(n);
+            *slot = append_vertex(mesh, pos, gradient(v, pa, inv_step), gradient(v, pb, inv_step), t,
+                                  v.spacing);
         }
         mesh.indices.push_back(*slot);
     }

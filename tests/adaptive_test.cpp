@@ -4,6 +4,8 @@
 // triangles.
 #include <gtest/gtest.h>
 
+#include "tests/engine_util.h"
+
 #include <array>
 #include <cmath>
 #include <iostream>
@@ -181,25 +183,7 @@ TEST(Adaptive, LevelZeroMetaCellIsTheCell) {
 }
 
 FrameView front_view(const Volume& v, int w, int h, float zoom_factor) {
-    FrameView fv;
-    fv.width = w;
-    fv.height = h;
-    fv.iso = kPhantomSkinIso;
-    Camera c = front_full_view(v.bounds(), float(w) / float(h));
-    if (zoom_factor != 1.0f) c = zoom(c, zoom_factor);
-    fv.camera = fit_depth_range(c, v.bounds());
-    fv.frustum = fv.camera.frustum(float(w) / float(h));
-    return fv;
-}
-
-Image full_surface_image(SurfaceExtractor& ex, Renderer& r, const FrameView& fv) {
-    const Mesh m = ex.extract_full(fv.iso);
-    Image img;
-    r.resize(fv.width, fv.height);
-    r.clear();
-    r.draw(m, fv.camera.view(), fv.frustum.matrix());
-    r.read_back(img);
-    return img;
+    return test::make_view(v, w, h, kPhantomSkinIso, 0, 0, zoom_factor);
 }
 
 struct Figures {
@@ -275,7 +259,7 @@ Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions
         f.units[std::size_t(g.level)] += g.cells.size();
     }
     expect_groups_partition_the_visited_cells(*ex, volume, fr);
-    f.correctness = measure_correctness(fr.final_image, full_surface_image(*ex, *renderer, fv));
+    f.correctness = measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv));
     return f;
 }
 

@@ -7,6 +7,7 @@
 
 #include "common/phantom.h"
 #include "common/volume.h"
+#include "tests/engine_util.h"
 #include "tests/test_util.h"
 #include "tile/image_io.h"
 #include "tile/progressive_engine.h"
@@ -33,25 +34,8 @@ ImageMatch compare(const Image& a, const Image& b) {
     return {uni ? double(inter) / double(uni) : 1.0, double(equal) / double(a.pixel_count())};
 }
 
-FrameView make_view(const Volume& v, int w, int h, double iso, float yaw = 0, float pitch = 0) {
-    FrameView fv;
-    fv.width = w;
-    fv.height = h;
-    fv.iso = iso;
-    fv.camera = fit_depth_range(orbit(front_full_view(v.bounds(), float(w) / float(h)), yaw, pitch), v.bounds());
-    fv.frustum = fv.camera.frustum(float(w) / float(h));
-    return fv;
-}
-
-Image full_surface_image(SurfaceExtractor& ex, Renderer& r, const FrameView& fv) {
-    const Mesh m = ex.extract_full(fv.iso);
-    Image img;
-    r.resize(fv.width, fv.height);
-    r.clear();
-    r.draw(m, fv.camera.view(), fv.frustum.matrix());
-    r.read_back(img);
-    return img;
-}
+using test::full_surface_image;
+using test::make_view;
 
 using Combo = std::tuple<RayOrderKind, IntersectMode, PropagationMode>;
 
