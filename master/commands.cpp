@@ -22,7 +22,14 @@ namespace {
 // One line per stage, then a summary line that scripts can grep for.
 struct Timings {
     double load = 0, octree = 0, extract = 0, render = 0, write = 0;
+    double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
     void print(std::size_t triangles) const {
+        if (frame >= 0) {
+            std::printf("timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
+                        " | triangles %zu | peak RSS %.1f MiB\n",
+                        load, octree, frame, write, triangles, peak_rss_mib());
+            return;
+        }
         std::printf("timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
                     " | triangles %zu | peak RSS %.1f MiB\n",
                     load, octree, extract, render, write, triangles, peak_rss_mib());
@@ -157,7 +164,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     };
     FrameResult fr = engine.run(fv, {}, progress);
     const TimelineSample& last = fr.timeline.back();
-    t.render = fr.elapsed_s;
+    t.frame = fr.elapsed_s;
     std::printf("progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
                 "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
                 std::string(to_string(engine.options().order)).c_str(), o.intersect.c_str(),
