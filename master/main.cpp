@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "master/commands.h"
+#include "master/wall_run.h"
 
 int main(int argc, char** argv) {
     using namespace isowall;
@@ -94,6 +95,24 @@ int main(int argc, char** argv) {
                      "Skip the replay that measures correctness against the final image");
     re_cmd->add_flag("--quiet,-q", re.quiet, "No progress lines while casting");
 
+    WallOptions wall;
+    auto* wall_cmd = app.add_subcommand(
+        "wall", "Display-wall run under mpirun: rank 0 is the master, ranks 1..T drive one tile each");
+    add_volume_options(*wall_cmd, wall.volume);
+    wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
+    wall_cmd->add_option("--iso", wall.iso, "Isovalue (default for the phantom: skin, 50)");
+    wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")->capture_default_str();
+    wall_cmd->add_option("--tiles-out", wall.tiles_out, "Also write each tile's image into this folder");
+    wall_cmd->add_option("--gl", wall.gl, "OpenGL back end")
+        ->check(CLI::IsMember({"osmesa", "egl"}))
+        ->capture_default_str();
+    wall_cmd->add_option("--order", wall.order, "Ray order: grid, readback or dynamic")
+        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
+        ->capture_default_str();
+    wall_cmd->add_option("--max-count", wall.max_count, "Cells per propagation pass")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -112,6 +131,10 @@ int main(int argc, char** argv) {
         if (info_cmd->parsed()) return run_info(info);
         if (ex_cmd->parsed()) return run_extract(ex);
         if (re_cmd->parsed()) return run_render(re);
+        if (wall_cmd->parsed()) {
+            auto comm = make_mpi_comm(argc, argv);
+            return run_wall(wall, *comm);
+        }
     } catch (const std::exception& e) {
         std::fflush(stdout);
         std::fprintf(stderr, "isowall: error: %s\n", e.what());

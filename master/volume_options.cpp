@@ -49,7 +49,7 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
 
 }  // namespace
 
-OpenedVolume open_volume(const VolumeOptions& o) {
+OpenedVolume open_volume(const VolumeOptions& o, bool quiet) {
     OpenedVolume out;
     Stopwatch sw;
     if (o.path.empty()) {
@@ -63,6 +63,7 @@ OpenedVolume open_volume(const VolumeOptions& o) {
     out.load_s = sw.seconds();
     if (out.file && !o.no_cache)
         out.cache_dir = o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
+    if (quiet) return out;
     const Volume& v = out.volume;
     const glm::ivec3 d = v.dims();
     const glm::vec3 s = v.spacing();

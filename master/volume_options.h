@@ -32,6 +32,6 @@ struct OpenedVolume {
 };
 
 // Loads the file (or generates the phantom) and prints one line about it.
-OpenedVolume open_volume(const VolumeOptions& opts);
+OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false);
 
 }  // namespace isowall

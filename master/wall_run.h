@@ -1,0 +1,27 @@
+#pragma once
+// `isowall wall`: the display-wall run under mpirun. Rank 0 (the master) reads the wall file,
+// computes each tile's off-axis frustum from one wall camera, sends every tile rank its view,
+// gathers the tile images into a mosaic of the virtual screen (bezel gaps as dark bars, overlaps
+// blended) and prints the per-rank table. Ranks 1..T each run the progressive engine on their
+// own frustum.
+#include <string>
+
+#include "master/comm.h"
+#include "master/volume_options.h"
+
+namespace isowall {
+
+struct WallOptions {
+    VolumeOptions volume;
+    std::string wall;
+    std::optional<double> iso;
+    std::string out = "mosaic.png";
+    std::string tiles_out;  // folder for per-tile images (optional)
+    std::string gl = "osmesa";
+    std::string order = "dynamic";
+    int max_count = 2000;
+};
+
+int run_wall(const WallOptions& o, Comm& comm);
+
+}  // namespace isowall
