@@ -112,6 +112,9 @@ int main(int argc, char** argv) {
     wall_cmd->add_option("--max-count", wall.max_count, "Cells per propagation pass")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    bool ranks_needed = false;
+    wall_cmd->add_flag("--ranks-needed", ranks_needed,
+                       "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");
 
     try {
         app.parse(argc, argv);
@@ -131,6 +134,10 @@ int main(int argc, char** argv) {
         if (info_cmd->parsed()) return run_info(info);
         if (ex_cmd->parsed()) return run_extract(ex);
         if (re_cmd->parsed()) return run_render(re);
+        if (wall_cmd->parsed() && ranks_needed) {
+            std::printf("%d\n", rank_count(load_wall(wall.wall)));
+            return 0;
+        }
         if (wall_cmd->parsed()) {
             auto comm = make_mpi_comm(argc, argv);
             return run_wall(wall, *comm);
