@@ -68,6 +68,42 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
     EXPECT_NE(log.find("makespan"), std::string::npos) << log;
 }
 
+TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
+    // 2x2 tiles of 120x90 with 8-pixel mullions (4 px on each tile's side): the virtual screen is
+    // 248x188 (outer bezels are not part of it), and tile (c, r) sits at (c * 128, r * 98).
+    const auto dir = test::scratch_dir("wall_bezels");
+    std::ofstream(dir / "wall.toml") << "tiles = [2, 2]\ntile_size_px = [120, 90]\nbezel_px = 4\n";
+    std::filesystem::create_directories(dir / "tiles");
+    ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir / "wall.toml").string() + "' --out '" +
+                      (dir / "mosaic.png").string() + "' --tiles-out '" + (dir / "tiles").string() + "'",
+                  dir / "wall.log"),
+              0)
+        << slurp(dir / "wall.log");
+    const Image mosaic = read_image(dir / "mosaic.png");
+    ASSERT_EQ(mosaic.width, 2 * 120 + 8);
+    ASSERT_EQ(mosaic.height, 2 * 90 + 8);
+    ASSERT_EQ(run("'" + std::string(ISOWALL_BINARY) + "' render -q --no-measure --size " +
+                      std::to_string(mosaic.width) + "x" + std::to_string(mosaic.height) + " --out '" +
+                      (dir / "single.png").string() + "'",
+                  dir / "render.log"),
+              0)
+        << slurp(dir / "render.log");
+    const Image single = read_image(dir / "single.png");
+    for (int tile = 0; tile < 4; ++tile) {
+        const Image img = read_image(dir / "tiles" / ("tile_" + std::to_string(tile) + ".png"));
+        const int x0 = (tile % 2) * (120 + 8), y0 = (tile / 2) * (90 + 8);
+        std::size_t differ = 0;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x)
+                for (int k = 0; k < 3; ++k) {
+                    const int a = img.rgba[4 * (std::size_t(y) * img.width + x) + k];
+                    const int b = single.rgba[4 * (std::size_t(y0 + y) * single.width + x0 + x) + k];
+                    differ += std::abs(a - b) > 1;
+                }
+        EXPECT_LE(double(differ) / double(img.pixel_count()), 0.001) << "tile " << tile;
+    }
+}
+
 TEST(WallRun, BadInputEndsEveryRank) {
     const auto dir = test::scratch_dir("wall_bad");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
