@@ -1,0 +1,54 @@
+#pragma once
+// Wall scripts: one command per line, the same commands the master's console takes.
+//   orbit YAW PITCH            turn the camera about the volume centre (degrees)
+//   look-at EX EY EZ TX TY TZ  eye and target in object space
+//   zoom F                     F > 1 moves closer
+//   iso V                      new isovalue
+//   wait rays N | wait time S | wait done
+//   snapshot NAME              write the mosaic as NAME.png
+//   quit
+// '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
+// frame on every tile (and interrupts the current one).
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace isowall {
+
+struct OrbitCmd {
+    float yaw_deg = 0, pitch_deg = 0;
+};
+struct LookAtCmd {
+    glm::vec3 eye{0}, target{0};
+};
+struct ZoomCmd {
+    float factor = 1;
+};
+struct IsoCmd {
+    double iso = 0;
+};
+struct WaitCmd {
+    enum class Until { rays, time, done } until = Until::done;
+    double amount = 0;  // rays or seconds
+};
+struct SnapshotCmd {
+    std::string name;
+};
+struct QuitCmd {};
+
+using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
+
+struct ScriptLine {
+    int line = 0;  // 1-based, for messages
+    ScriptCommand command;
+};
+
+// One command; throws InputError naming `where` (e.g. "demo.txt:3") and the command.
+ScriptCommand parse_command(std::string_view text, const std::string& where);
+// A whole script; blank and comment lines are skipped.
+std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file);
+
+}  // namespace isowall

@@ -1,0 +1,71 @@
+// Wall scripts: every command parses, every mistake names the file, line and command.
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "common/script.h"
+
+namespace isowall {
+namespace {
+
+TEST(Script, ParsesEveryCommand) {
+    const auto lines = parse_script(
+        "# a demo\n"
+        "orbit 30 -10\n"
+        "\n"
+        "look-at 0 -500 100  255 255 117   # from the front\n"
+        "zoom 1.5\n"
+        "iso 105\n"
+        "wait rays 10000\n"
+        "wait time 0.5\n"
+        "wait done\n"
+        "snapshot bone\n"
+        "quit",
+        "demo.txt");
+    ASSERT_EQ(lines.size(), 9u);
+    EXPECT_EQ(lines[0].line, 2);
+    EXPECT_FLOAT_EQ(std::get<OrbitCmd>(lines[0].command).pitch_deg, -10.0f);
+    EXPECT_EQ(lines[1].line, 4);
+    EXPECT_FLOAT_EQ(std::get<LookAtCmd>(lines[1].command).eye.y, -500.0f);
+    EXPECT_FLOAT_EQ(std::get<ZoomCmd>(lines[2].command).factor, 1.5f);
+    EXPECT_DOUBLE_EQ(std::get<IsoCmd>(lines[3].command).iso, 105.0);
+    EXPECT_EQ(std::get<WaitCmd>(lines[4].command).until, WaitCmd::Until::rays);
+    EXPECT_DOUBLE_EQ(std::get<WaitCmd>(lines[5].command).amount, 0.5);
+    EXPECT_EQ(std::get<WaitCmd>(lines[6].command).until, WaitCmd::Until::done);
+    EXPECT_EQ(std::get<SnapshotCmd>(lines[7].command).name, "bone");
+    EXPECT_TRUE(std::holds_alternative<QuitCmd>(lines[8].command));
+}
+
+TEST(Script, EmptyScriptHasNoCommands) {
+    EXPECT_TRUE(parse_script("", "e.txt").empty());
+    EXPECT_TRUE(parse_script("# only a comment\n\n   \n", "e.txt").empty());
+}
+
+TEST(Script, MistakesNameTheFileLineAndCommand) {
+    struct Case {
+        const char* text;
+        const char* mentions;
+    };
+    const Case cases[] = {
+        {"orbit 30", "s.txt:1: orbit: expected \"orbit YAW PITCH\""},
+        {"\nzoom -2", "s.txt:2: zoom: expected a positive factor"},
+        {"iso abc", "s.txt:1: iso: expected a number, got \"abc\""},
+        {"wait forever", "s.txt:1: wait: expected"},
+        {"wait rays -5", "s.txt:1: wait: expected a non-negative amount"},
+        {"snapshot a/b", "s.txt:1: snapshot: expected a plain name"},
+        {"fly 1 2", "s.txt:1: command: unknown command \"fly\""},
+        {"quit now", "s.txt:1: quit: expected \"quit\""},
+        {"orbit 1 nan", "s.txt:1: orbit: expected a number"},
+    };
+    for (const Case& c : cases) {
+        try {
+            parse_script(c.text, "s.txt");
+            ADD_FAILURE() << "no error for: " << c.text;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(c.mentions), std::string::npos)
+                << "got: " << e.what() << "\nwanted: " << c.mentions;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace isowall
