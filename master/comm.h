@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <span>
 #include <string>
 #include <vector>
@@ -14,7 +16,10 @@
 
 namespace isowall {
 
-enum class Tag : int { view = 1, tile_result = 2 };
+// view: master -> tile, a new frame (interrupts the current one); snapshot: master -> tile, send
+// the current image; quit: master -> tile, send the final result and stop; progress and image:
+// tile -> master; tile_result: tile -> master, the last message of a tile.
+enum class Tag : int { view = 1, tile_result = 2, snapshot = 3, quit = 4, progress = 5, image = 6 };
 
 class Comm {
 public:
@@ -26,6 +31,11 @@ public:
     virtual void send(int dest, Tag tag, std::span<const std::byte> bytes) = 0;
     // Blocks until a message with `tag` from `source` arrives.
     virtual std::vector<std::byte> recv(int source, Tag tag) = 0;
+    // The tag of a message from `source` (any rank when source < 0) waiting to be received, if
+    // any (does not block).
+    virtual std::optional<Tag> probe(int source) = 0;
+    // Blocks until any message from `source` (or from any rank when source < 0) arrives.
+    virtual std::pair<Tag, std::vector<std::byte>> recv_any(int source, int* from = nullptr) = 0;
     virtual void barrier() = 0;
     // Ends every rank of the job at once (a failing rank must not leave others waiting).
     [[noreturn]] virtual void abort(int code) = 0;

@@ -54,6 +54,24 @@ public:
                                   MPI_STATUS_IGNORE));
         return bytes;
     }
+    std::optional<Tag> probe(int source) override {
+        int flag = 0;
+        MPI_Status status;
+        ISOWALL_MPI_CALL(MPI_Iprobe(source < 0 ? MPI_ANY_SOURCE : source, MPI_ANY_TAG, comm_, &flag, &status));
+        if (!flag) return std::nullopt;
+        return static_cast<Tag>(status.MPI_TAG);
+    }
+    std::pair<Tag, std::vector<std::byte>> recv_any(int source, int* from) override {
+        MPI_Status status;
+        ISOWALL_MPI_CALL(MPI_Probe(source < 0 ? MPI_ANY_SOURCE : source, MPI_ANY_TAG, comm_, &status));
+        int count = 0;
+        ISOWALL_MPI_CALL(MPI_Get_count(&status, MPI_BYTE, &count));
+        std::vector<std::byte> bytes(static_cast<std::size_t>(count));
+        ISOWALL_MPI_CALL(MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG,
+                                  comm_, MPI_STATUS_IGNORE));
+        if (from) *from = status.MPI_SOURCE;
+        return {static_cast<Tag>(status.MPI_TAG), std::move(bytes)};
+    }
     void barrier() override { ISOWALL_MPI_CALL(MPI_Barrier(comm_)); }
     [[noreturn]] void abort(int code) override {
         std::fflush(stdout);

@@ -112,6 +112,13 @@ int main(int argc, char** argv) {
     wall_cmd->add_option("--max-count", wall.max_count, "Cells per propagation pass")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    wall_cmd->add_option("--script", wall.script,
+                         "Commands (orbit, look-at, zoom, iso, wait, snapshot, quit), one per line; "
+                         "- reads them from the master's console");
+    wall_cmd->add_option("--timeout", wall.timeout_s,
+                         "Seconds a silent tile rank may take before the job ends")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     bool ranks_needed = false;
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");

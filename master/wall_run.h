@@ -20,6 +20,8 @@ struct WallOptions {
     std::string gl = "osmesa";
     std::string order = "dynamic";
     int max_count = 2000;
+    std::string script;       // script file, "-" for the master's console, empty: one frame
+    double timeout_s = 120;   // a tile silent this long ends the job
 };
 
 int run_wall(const WallOptions& o, Comm& comm);

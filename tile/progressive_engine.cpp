@@ -91,7 +91,7 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
         while (next_sample_rays <= now.rays)
             next_sample_rays = std::max(next_sample_rays + 1,
                                         static_cast<std::size_t>(double(next_sample_rays) * options_.sample_ray_factor));
-        if (progress && now.time_s - last_progress_s >= 0.5) {
+        if (progress && now.time_s - last_progress_s >= options_.progress_interval_s) {
             last_progress_s = now.time_s;
             progress(now);
         }

@@ -35,6 +35,8 @@ struct EngineOptions {
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;
+    // How often run() calls its progress callback (at sample points).
+    double progress_interval_s = 0.5;
     // Extra samples exactly when these ray counts are reached (snapshots by rays).
     std::vector<std::size_t> sample_at_rays;
 };
