@@ -139,7 +139,10 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
             generation = r.get<std::uint64_t>();
             const FrameView view = decode_view(r.get_bytes());
             std::size_t polls = 0;
+            // Sticky: once a new view or quit is pending, every later poll says stop too (the engine
+            // polls again after a propagation pass it cut short).
             auto interrupted = [&] {
+                if (pending) return true;
                 if (++polls % 32 != 0) return false;
                 while (auto t = comm.probe(kMasterRank)) {
                     if (*t == Tag::snapshot) {

@@ -37,6 +37,13 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
                                    const std::function<void(const TimelineSample&)>& progress) {
     FrameResult frame;
     const auto start = Clock::now();
+    // Once the caller says stop, stay stopped: a propagation pass cut short is followed by another
+    // poll, and a caller that only reports a change once must not see the frame go on.
+    bool stopped = false;
+    const std::function<bool()> stop = [&] {
+        if (!stopped && interrupted && interrupted()) stopped = true;
+        return stopped;
+    };
     const glm::mat4 view_m = view.camera.view();
     const glm::mat4 proj_m = view.frustum.matrix();
     const glm::mat4 view_inv = glm::inverse(view_m);
@@ -105,7 +112,7 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
         while (order->next_level(pixels)) {
             now.level = order->level();
             for (const glm::ivec2 px : pixels) {
-                if (interrupted && interrupted()) return false;
+                if (stop()) return false;
                 const Ray ray = pixel_ray(view_inv, view.frustum, view.width, view.height, px);
                 auto t0 = Clock::now();
                 const RayHit hit = extractor_.cast(ray, mode);
@@ -119,12 +126,12 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
                     const auto id = static_cast<std::uint32_t>(frame.groups.size());
                     Group g = hit.refine ? extractor_.refine(hit.cell, hit.level, id, options_.propagation)
                                          : extractor_.propagate(hit.cell, id, options_.propagation,
-                                                                ray, interrupted);
+                                                                ray, stop);
                     const double pass_s = since(t0);
                     const double extract_s = extractor_.last_extract_s();
                     now.t_extract_s += extract_s;
                     now.t_propagate_s += pass_s - extract_s;
-                    if (interrupted && interrupted()) return false;
+                    if (stop()) return false;
                     if (!g.mesh.indices.empty() || !g.refinement) {
                         t0 = Clock::now();
                         renderer_.draw(g.mesh, view_m, proj_m);
