@@ -119,6 +119,9 @@ int main(int argc, char** argv) {
                          "Seconds a silent tile rank may take before the job ends")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    wall_cmd->add_option("--trace", wall.trace,
+                         "Write per-rank spans by stage with thread CPU time: PREFIX.json (Chrome "
+                         "trace, opens in Perfetto) and PREFIX.csv");
     bool ranks_needed = false;
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");

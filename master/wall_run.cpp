@@ -1,7 +1,5 @@
 #include "master/wall_run.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <chrono>
@@ -15,6 +13,7 @@
 #include "common/phantom.h"
 #include "common/script.h"
 #include "common/surface_extractor.h"
+#include "common/trace.h"
 #include "common/util.h"
 #include "common/wall.h"
 #include "tile/image_io.h"
@@ -26,14 +25,6 @@ namespace {
 constexpr std::uint8_t kViewVersion = 1;
 constexpr std::uint8_t kResultVersion = 1;
 constexpr std::uint8_t kGap = 40;  // grey of the bezel bars in the mosaic
-
-// CPU time of the calling thread: with more ranks than cores, wall-clock time says nothing about
-// parallel speed, CPU time does.
-double thread_cpu_s() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 std::vector<std::byte> encode_view(const FrameView& v) {
     MessageWriter w(kViewVersion);
@@ -88,6 +79,7 @@ struct TileStats {
     std::string host;
     double cpu_s = 0, wall_s = 0, rss_mib = 0;
     std::uint64_t rays = 0, groups = 0, triangles = 0, frames = 0, interrupted = 0;
+    std::vector<TraceSpan> spans;
 };
 
 std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov) {
@@ -117,21 +109,27 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
     opt.order = parse_ray_order(o.order).value_or(RayOrderKind::dynamic_grid);
     opt.propagation.max_count = o.max_count;
     opt.progress_interval_s = 0.05;
+    TraceRecorder trace;
+    opt.trace = &trace;
     ProgressiveEngine engine(*ex, *renderer, opt);
 
     std::optional<std::pair<Tag, std::vector<std::byte>>> pending;
     std::uint64_t generation = 0, rays = 0, groups = 0, triangles = 0, frames = 0, interrupted_frames = 0;
     double cpu_s = 0, frame_s = 0;
     auto send_progress = [&](std::uint64_t frame_rays, bool done) {
+        const Stage left = trace.switch_to(Stage::comm);
         MessageWriter w(kResultVersion);
         w.put(generation);
         w.put(frame_rays);
         w.put(static_cast<std::uint8_t>(done));
         comm.send(kMasterRank, Tag::progress, w.bytes());
+        trace.switch_to(left);
     };
     for (;;) {
+        trace.switch_to(Stage::idle);
         auto [tag, bytes] = pending ? std::move(*pending) : comm.recv_any(kMasterRank);
         pending.reset();
+        trace.switch_to(Stage::comm);
         if (tag == Tag::snapshot) {
             send_image(comm, Tag::image, generation, *renderer);
         } else if (tag == Tag::view) {
@@ -146,8 +144,10 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
                 if (++polls % 32 != 0) return false;
                 while (auto t = comm.probe(kMasterRank)) {
                     if (*t == Tag::snapshot) {
+                        const Stage left = trace.switch_to(Stage::comm);
                         comm.recv(kMasterRank, Tag::snapshot);
                         send_image(comm, Tag::image, generation, *renderer);
+                        trace.switch_to(left);
                         continue;
                     }
                     pending = comm.recv_any(kMasterRank);  // a new view or quit: stop this frame
@@ -155,10 +155,10 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
                 }
                 return false;
             };
-            const double cpu0 = thread_cpu_s();
+            const double cpu0 = thread_cpu_seconds();
             FrameResult fr = engine.run(view, interrupted,
                                         [&](const TimelineSample& s) { send_progress(s.rays, false); });
-            cpu_s += thread_cpu_s() - cpu0;
+            cpu_s += thread_cpu_seconds() - cpu0;
             frame_s += fr.elapsed_s;
             ++frames;
             rays += fr.rays_cast;
@@ -181,6 +181,14 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
             w.put(interrupted_frames);
             const std::string host = comm.host();
             w.put_bytes(std::as_bytes(std::span(host)));
+            trace.close();
+            w.put(static_cast<std::uint64_t>(trace.spans().size()));
+            for (const TraceSpan& sp : trace.spans()) {
+                w.put(sp.stage);
+                w.put(sp.start_s);
+                w.put(sp.wall_s);
+                w.put(sp.cpu_s);
+            }
             comm.send(kMasterRank, Tag::tile_result, w.bytes());
             send_image(comm, Tag::image, generation, *renderer);
             return 0;
@@ -237,6 +245,7 @@ public:
 
     // A new frame on every tile: bumps the generation, so progress of older frames is ignored.
     void send_views() {
+        const Stage left = trace_.switch_to(Stage::comm);
         ++generation_;
         const Camera cam = fit_depth_range(camera_, bounds_);
         const Frustum wall = cam.frustum(aspect_);
@@ -250,6 +259,7 @@ public:
             progress_[static_cast<std::size_t>(rank)] = {};
         }
         frame_start_ = Stopwatch();
+        trace_.switch_to(left);
     }
 
     // Runs one command; throws InputError for a command that cannot apply (isovalue out of range).
@@ -316,6 +326,13 @@ public:
             s.interrupted = r.get<std::uint64_t>();
             const auto host = r.get_bytes();
             s.host.assign(reinterpret_cast<const char*>(host.data()), host.size());
+            s.spans.resize(static_cast<std::size_t>(r.get<std::uint64_t>()));
+            for (TraceSpan& sp : s.spans) {
+                sp.stage = r.get<std::uint8_t>();
+                sp.start_s = r.get<double>();
+                sp.wall_s = r.get<double>();
+                sp.cpu_s = r.get<double>();
+            }
             ++results;
         }
         write_image(o_.out, mosaic.image);
@@ -335,11 +352,39 @@ public:
         }
         std::printf("makespan %.3f s (CPU), total %.3f s, balance %.2f (mean/max)\n", makespan, total,
                     total / double(comm_.size() - 1) / std::max(makespan, 1e-9));
+        trace_.close();
+        print_stage_table(stats);
+        if (!o_.trace.empty()) {
+            std::vector<RankTrace> ranks{{kMasterRank, "master", trace_.spans()}};
+            for (int rank = 1; rank < comm_.size(); ++rank)
+                ranks.push_back({rank, "tile " + std::to_string(tile_of_rank(spec_, rank)),
+                                 stats[static_cast<std::size_t>(rank)].spans});
+            write_chrome_trace(o_.trace + ".json", ranks);
+            write_trace_csv(o_.trace + ".csv", ranks);
+            std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
+                        o_.trace.c_str());
+        }
         std::printf("wrote %s\n", o_.out.c_str());
         return 0;
     }
 
 private:
+    void print_stage_table(const std::vector<TileStats>& stats) const {
+        std::printf("CPU seconds by stage (thread CPU time; propagation includes marching cubes):\n  %4s",
+                    "rank");
+        for (const char* name : kTraceStages) std::printf(" %12s", name);
+        std::printf("\n");
+        auto row = [&](int rank, const std::vector<TraceSpan>& spans) {
+            std::vector<double> sum(std::size(kTraceStages), 0.0);
+            for (const TraceSpan& sp : spans) sum[sp.stage] += sp.cpu_s;
+            std::printf("  %4d", rank);
+            for (double v : sum) std::printf(" %12.3f", v);
+            std::printf("\n");
+        };
+        row(kMasterRank, trace_.spans());
+        for (int rank = 1; rank < comm_.size(); ++rank) row(rank, stats[static_cast<std::size_t>(rank)].spans);
+    }
+
     struct Progress {
         std::uint64_t rays = 0;
         bool done = false;
@@ -347,6 +392,12 @@ private:
 
     // The next message from any tile; a tile silent for --timeout seconds ends the job.
     std::pair<Tag, std::vector<std::byte>> receive(int* from) {
+        const Stage left = trace_.switch_to(Stage::idle);
+        struct Restore {
+            TraceRecorder& t;
+            Stage s;
+            ~Restore() { t.switch_to(s); }
+        } restore{trace_, left};
         Stopwatch waited;
         for (;;) {
             for (int rank = 1; rank < comm_.size(); ++rank)
@@ -428,6 +479,7 @@ private:
     }
 
     void paste_image(Mosaic& m, const std::vector<std::byte>& bytes, int from) {
+        const Stage left = trace_.switch_to(Stage::compose);
         MessageReader r(bytes, kResultVersion);
         r.get<std::uint64_t>();  // generation
         const auto rgba = r.get_bytes();
@@ -441,6 +493,7 @@ private:
         paste(m.image, img, rect, m.count);
         if (!o_.tiles_out.empty())
             write_image(std::filesystem::path(o_.tiles_out) / ("tile_" + std::to_string(tile) + ".png"), img);
+        trace_.switch_to(left);
     }
 
     // Asks every tile for the image it shows now and pastes the answers into a mosaic.
@@ -470,6 +523,7 @@ private:
     std::uint64_t generation_ = 0;
     std::vector<Progress> progress_;
     Stopwatch frame_start_;
+    TraceRecorder trace_;
 };
 
 int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, const OpenedVolume& ov,

@@ -22,6 +22,7 @@ struct WallOptions {
     int max_count = 2000;
     std::string script;       // script file, "-" for the master's console, empty: one frame
     double timeout_s = 120;   // a tile silent this long ends the job
+    std::string trace;        // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
 };
 
 int run_wall(const WallOptions& o, Comm& comm);

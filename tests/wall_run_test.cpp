@@ -131,7 +131,8 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
     // The change comes after 200 rays of a 76,800-ray frame: every tile is still casting.
     std::ofstream(dir / "script.txt") << "wait rays 200\norbit 60 -20\niso 160\nwait done\nsnapshot last\nquit\n";
     ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --script '" +
-                      (dir / "script.txt").string() + "' --out '" + (dir / "mosaic.png").string() + "'",
+                      (dir / "script.txt").string() + "' --out '" + (dir / "mosaic.png").string() +
+                      "' --trace '" + (dir / "trace").string() + "'",
                   dir / "wall.log"),
               0)
         << slurp(dir / "wall.log");
@@ -145,6 +146,18 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
         EXPECT_GE(m.iou, 0.999) << name;
         EXPECT_GE(m.equal_share, 0.999) << name;
     }
+    // The trace: every rank has spans, the tiles in the engine's stages and waiting on the master.
+    const std::string csv = slurp(dir / "trace.csv");
+    const std::string json = slurp(dir / "trace.json");
+    EXPECT_NE(json.find("\"traceEvents\""), std::string::npos);
+    for (int rank = 0; rank <= 4; ++rank) {
+        std::string pid = "\"pid\": ";
+        pid += std::to_string(rank);
+        EXPECT_NE(json.find(pid), std::string::npos) << "rank " << rank;
+    }
+    for (const char* row : {"\n1,tile 0,intersection,", "\n1,tile 0,propagation,", "\n1,tile 0,render,",
+                            "\n4,tile 3,idle,", "\n0,master,idle,", "\n0,master,compose,"})
+        EXPECT_NE(csv.find(row), std::string::npos) << row;
     // Every tile rank saw three frames, and at least the first was cut short.
     const std::string log = slurp(dir / "wall.log");
     for (int rank = 1; rank <= 4; ++rank) {

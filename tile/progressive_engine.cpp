@@ -61,7 +61,8 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
         levels.refine = options_.adaptive_refine;
         extractor_.begin_frame(view.iso, levels);
     } else {
-        extractor_.begin_frame(view.iso);
+        if (options_.trace) options_.trace->switch_to(Stage::intersection);
+    extractor_.begin_frame(view.iso);
     }
     renderer_.resize(view.width, view.height);
     renderer_.clear();
@@ -84,9 +85,11 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
         // each time (about 7 ms at 1600x1200 in llvmpipe), so between refreshes a sample may
         // count groups still in flight: sample times are exact to one refresh (1/60 s).
         if (dirty && (force || now.time_s - last_finish_s >= kRefreshS)) {
+            const Stage left = options_.trace ? options_.trace->switch_to(Stage::render) : Stage::render;
             const auto t0 = Clock::now();
             renderer_.finish();
             now.t_render_s += since(t0);
+            if (options_.trace) options_.trace->switch_to(left);
             now.time_s = since(start);
             last_finish_s = now.time_s;
             dirty = false;
@@ -122,6 +125,7 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
                 // A meta-cell whose triangles miss this pixel's surface gets its full-resolution
                 // triangles drawn over (adaptive resolution only); any other unvisited hit seeds.
                 if (hit.found && (hit.refine || !extractor_.visited(hit.cell))) {
+                    if (options_.trace) options_.trace->switch_to(Stage::propagation);
                     t0 = Clock::now();
                     const auto id = static_cast<std::uint32_t>(frame.groups.size());
                     Group g = hit.refine ? extractor_.refine(hit.cell, hit.level, id, options_.propagation)
@@ -132,6 +136,7 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
                     now.t_extract_s += extract_s;
                     now.t_propagate_s += pass_s - extract_s;
                     if (stop()) return false;
+                    if (options_.trace) options_.trace->switch_to(Stage::render);
                     if (!g.mesh.indices.empty() || !g.refinement) {
                         t0 = Clock::now();
                         renderer_.draw(g.mesh, view_m, proj_m);
@@ -140,16 +145,19 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const std::function<bo
                         now.triangles += g.mesh.triangle_count();
                         frame.groups.push_back(std::move(g));
                     }
+                    if (options_.trace) options_.trace->switch_to(Stage::intersection);
                 }
                 record(false);
             }
             if (order->wants_coverage()) {
+                if (options_.trace) options_.trace->switch_to(Stage::render);
                 const auto t0 = Clock::now();
                 renderer_.read_back(coverage_image);
                 covered.resize(coverage_image.depth.size());
                 for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = coverage_image.depth[i] < 1.0f;
                 order->set_coverage(covered);
                 now.t_render_s += since(t0);
+                if (options_.trace) options_.trace->switch_to(Stage::intersection);
             }
             record(true);
         }

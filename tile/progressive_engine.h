@@ -15,6 +15,7 @@
 #include "common/ray_order.h"
 #include "common/surface_extractor.h"
 #include "common/timeline.h"
+#include "common/trace.h"
 #include "tile/renderer.h"
 
 namespace isowall {
@@ -35,6 +36,8 @@ struct EngineOptions {
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;
+    // Optional per-stage spans with thread CPU time (wall runs); null: no spans.
+    TraceRecorder* trace = nullptr;
     // How often run() calls its progress callback (at sample points).
     double progress_interval_s = 0.5;
     // Extra samples exactly when these ray counts are reached (snapshots by rays).

@@ -1,0 +1,57 @@
+#pragma once
+// Per-rank timing by stage: a thread's time is cut into consecutive spans, each named for the stage
+// it was in (intersection, propagation, render, comm, idle, ...), with wall time and the thread's
+// CPU time (CLOCK_THREAD_CPUTIME_ID). With more ranks than cores, wall time says nothing about
+// parallel speed; CPU time does. Spans change only at stage boundaries (per propagation pass, per
+// message), never per ray, so recording costs two clock reads per boundary.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace isowall {
+
+struct TraceSpan {
+    std::uint8_t stage = 0;  // index into kTraceStages
+    double start_s = 0;      // wall clock, seconds since the Unix epoch (aligned across ranks)
+    double wall_s = 0;
+    double cpu_s = 0;
+};
+
+inline constexpr const char* kTraceStages[] = {"intersection", "propagation", "render", "comm",
+                                               "idle",         "compose",     "setup"};
+enum class Stage : std::uint8_t { intersection, propagation, render, comm, idle, compose, setup };
+
+double thread_cpu_seconds();
+
+class TraceRecorder {
+public:
+    TraceRecorder();
+    // Ends the current span and starts one in `stage`; returns the stage it left.
+    Stage switch_to(Stage stage);
+    // Ends the current span (the recorder can go on with switch_to).
+    void close();
+    const std::vector<TraceSpan>& spans() const { return spans_; }
+    // CPU seconds per stage, summed over the spans.
+    std::vector<double> cpu_by_stage() const;
+
+private:
+    std::vector<TraceSpan> spans_;
+    Stage current_ = Stage::setup;
+    bool open_ = false;
+    double wall0_ = 0, cpu0_ = 0;
+};
+
+struct RankTrace {
+    int rank = 0;
+    std::string label;  // e.g. "master" or "tile 3"
+    std::vector<TraceSpan> spans;
+};
+
+// Chrome trace-event JSON (opens in Perfetto / chrome://tracing): one process per rank, one
+// complete event per span, with its CPU milliseconds in args.
+void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks);
+// rank,label,stage,start_s,wall_s,cpu_s
+void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks);
+
+}  // namespace isowall
