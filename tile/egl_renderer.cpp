@@ -4,6 +4,7 @@
 #include <EGL/eglext.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -106,6 +107,26 @@ std::vector<EGLDisplay> candidate_displays() {
     const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
         eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    // ISOWALL_EGL_DEVICE=N picks the N-th EGL device (one GPU per rank on a multi-GPU node, e.g.
+    // set from OMPI_COMM_WORLD_LOCAL_RANK in a launch wrapper); it must exist.
+    if (const char* want = std::getenv("ISOWALL_EGL_DEVICE"); want && *want) {
+        auto query_devices =
+            reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        EGLDeviceEXT devices[16];
+        EGLint count = 0;
+        if (get_platform_display == nullptr || query_devices == nullptr || !query_devices(16, devices, &count))
+            fail("ISOWALL_EGL_DEVICE: eglQueryDevicesEXT (no EGL device platform)");
+        char* end = nullptr;
+        const long n = std::strtol(want, &end, 10);
+        if (*end != '\0' || n < 0 || n >= count)
+            throw RendererError(kName, "ISOWALL_EGL_DEVICE=" + std::string(want) +
+                                           ": expected a device index from 0 to " +
+                                           std::to_string(count - 1));
+        EGLDisplay d = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[n], nullptr);
+        if (d == EGL_NO_DISPLAY) fail("eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device " + std::string(want) + ")");
+        displays.push_back(d);
+        return displays;
+    }
     if (get_platform_display != nullptr) {
         if (has_extension(client, "EGL_MESA_platform_surfaceless")) {
             EGLDisplay d =
