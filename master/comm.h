@@ -18,8 +18,9 @@ namespace isowall {
 
 // view: master -> tile, a new frame (interrupts the current one); snapshot: master -> tile, send
 // the current image; quit: master -> tile, send the final result and stop; progress and image:
-// tile -> master; tile_result: tile -> master, the last message of a tile.
-enum class Tag : int { view = 1, tile_result = 2, snapshot = 3, quit = 4, progress = 5, image = 6 };
+// tile -> master; tile_result: tile -> master, the last message of a tile; hello: tile -> master,
+// its host name, first thing.
+enum class Tag : int { view = 1, tile_result = 2, snapshot = 3, quit = 4, progress = 5, image = 6, hello = 7 };
 
 class Comm {
 public:

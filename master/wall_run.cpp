@@ -1,6 +1,7 @@
 #include "master/wall_run.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <chrono>
 #include <filesystem>
@@ -103,6 +104,19 @@ void send_image(Comm& comm, Tag tag, std::uint64_t generation, Renderer& rendere
 // mid-frame interrupts the frame at once; a snapshot request is answered from the frame being
 // built, and progress goes to the master at every timeline sample.
 int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
+    {
+        const std::string host = comm.host();
+        comm.send(kMasterRank, Tag::hello, std::as_bytes(std::span(host)));
+    }
+    // Test hook for fault handling: ISOWALL_TEST_FAULT=hang:R or exit:R makes tile rank R stop
+    // answering, or die, after its first view arrives.
+    std::string fault;
+    if (const char* f = std::getenv("ISOWALL_TEST_FAULT")) {
+        const std::string spec = f;
+        const auto colon = spec.find(':');
+        if (colon != std::string::npos && std::atoi(spec.c_str() + colon + 1) == comm.rank())
+            fault = spec.substr(0, colon);
+    }
     auto ex = open_extractor(ov);
     auto renderer = make_renderer(o.gl);
     EngineOptions opt;
@@ -133,6 +147,8 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
         if (tag == Tag::snapshot) {
             send_image(comm, Tag::image, generation, *renderer);
         } else if (tag == Tag::view) {
+            if (fault == "hang") std::this_thread::sleep_for(std::chrono::hours(1));
+            if (fault == "exit") std::_Exit(3);
             MessageReader r(bytes, kViewVersion);
             generation = r.get<std::uint64_t>();
             const FrameView view = decode_view(r.get_bytes());
@@ -229,7 +245,16 @@ public:
         progress_.resize(static_cast<std::size_t>(comm.size()));
     }
 
-    void print_map() const {
+    // Waits for every tile's hello (its host), then prints the rank -> host -> tile map.
+    void print_map() {
+        std::vector<std::string> hosts(static_cast<std::size_t>(comm_.size()));
+        for (int got = 0; got < comm_.size() - 1;) {
+            int from = 0;
+            auto [tag, bytes] = receive(&from);
+            if (tag != Tag::hello) continue;
+            hosts[static_cast<std::size_t>(from)].assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+            ++got;
+        }
         const PixelSize vs = virtual_screen_size(spec_);
         std::printf("wall: %s: %dx%d tiles of %dx%d, virtual screen %dx%d, %d tile ranks, master on %s\n",
                     o_.wall.c_str(), spec_.columns, spec_.rows, spec_.tile_width_px, spec_.tile_height_px,
@@ -237,8 +262,9 @@ public:
         for (int rank = 1; rank < comm_.size(); ++rank) {
             const int tile = tile_of_rank(spec_, rank);
             const PixelRect r = tile_rect(spec_, tile);
-            std::printf("  rank %2d -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d\n", rank, tile,
-                        tile % spec_.columns, tile / spec_.columns, r.x, r.y, r.width, r.height);
+            std::printf("  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d\n", rank,
+                        hosts[static_cast<std::size_t>(rank)].c_str(), tile, tile % spec_.columns,
+                        tile / spec_.columns, r.x, r.y, r.width, r.height);
         }
         std::fflush(stdout);
     }
@@ -403,7 +429,7 @@ private:
             for (int rank = 1; rank < comm_.size(); ++rank)
                 if (comm_.probe(rank)) return comm_.recv_any(rank, from);
             if (waited.seconds() > o_.timeout_s) {
-                std::fprintf(stderr, "isowall: error: no tile rank has answered for %.0f s (waiting on %s); "
+                std::fprintf(stderr, "isowall: error: no tile rank has answered for %g s (waiting on %s); "
                              "ending the job\n", o_.timeout_s, waiting_on().c_str());
                 comm_.abort(2);
             }

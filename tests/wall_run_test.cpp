@@ -177,6 +177,40 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
     }
 }
 
+TEST(WallRun, ATileThatStopsAnsweringOrDiesEndsTheJobInBoundedTime) {
+    const auto dir = test::scratch_dir("wall_fault");
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
+    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() + "' --timeout 3 --out '" +
+                             (dir / "m.png").string() + "'";
+    // Stops answering: the master names the silent tile and ends the job after --timeout.
+    int rc = run("env ISOWALL_TEST_FAULT=hang:2 " + mpirun(5) + wall, dir / "hang.log");
+    std::string log = slurp(dir / "hang.log");
+    EXPECT_NE(rc, 0) << log;
+    EXPECT_NE(rc, 124) << "timed out: " << log;
+    EXPECT_NE(log.find("waiting on rank 2 (tile 1)"), std::string::npos) << log;
+    // Dies: Open MPI ends every rank and names the process.
+    rc = run("env ISOWALL_TEST_FAULT=exit:3 " + mpirun(5) + wall, dir / "exit.log");
+    log = slurp(dir / "exit.log");
+    EXPECT_NE(rc, 0) << log;
+    EXPECT_NE(rc, 124) << "timed out: " << log;
+    EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
+}
+
+TEST(WallRun, ConsoleCommandsDriveTheWall) {
+    const auto dir = test::scratch_dir("wall_console");
+    std::ofstream(dir / "1x1.toml") << "tiles = [1, 1]\ntile_size_px = [96, 72]\n";
+    std::ofstream(dir / "typed.txt") << "orbit 30 0\nfly away\nwait done\nsnapshot typed\nquit\n";
+    const int rc = run(mpirun(2) + "wall --wall '" + (dir / "1x1.toml").string() + "' --script - --out '" +
+                           (dir / "m.png").string() + "' < '" + (dir / "typed.txt").string() + "'",
+                       dir / "console.log");
+    const std::string log = slurp(dir / "console.log");
+    EXPECT_EQ(rc, 0) << log;
+    // A typo on the console is reported and skipped, not fatal.
+    EXPECT_NE(log.find("console:2: command: unknown command \"fly\""), std::string::npos) << log;
+    EXPECT_TRUE(std::filesystem::exists(dir / "typed.png")) << log;
+    EXPECT_TRUE(std::filesystem::exists(dir / "m.png")) << log;
+}
+
 TEST(WallRun, BadInputEndsEveryRank) {
     const auto dir = test::scratch_dir("wall_bad");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
