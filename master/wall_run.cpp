@@ -361,6 +361,7 @@ public:
             }
             ++results;
         }
+        trace_.switch_to(Stage::compose);
         write_image(o_.out, mosaic.image);
         std::printf("per rank (CPU seconds of each tile's frame thread, all frames; makespan = the largest):\n");
         std::printf("  %4s %-12s %4s %8s %8s %7s %6s %10s %7s %10s %8s\n", "rank", "host", "tile", "cpu s",
