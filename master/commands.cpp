@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <glm/trigonometric.hpp>
 
 #include "common/camera.h"
 #include "common/error.h"
@@ -110,19 +109,7 @@ std::string percent_label(double pct) {
 }
 
 EngineOptions engine_options(const RenderOptions& o) {
-    EngineOptions e;
-    const auto order = parse_ray_order(o.order);
-    if (!order) throw InputError("--order", "value", "expected grid, readback or dynamic, got \"" + o.order + "\"");
-    e.order = *order;
-    e.intersect = o.intersect == "approximate" ? IntersectMode::approximate : IntersectMode::exact;
-    e.propagation.mode = o.propagation == "angle" ? PropagationMode::cutoff_angle : PropagationMode::max_count;
-    e.propagation.max_count = o.max_count;
-    e.propagation.cutoff_rad = glm::radians(o.cutoff_deg);
-    e.propagation.foldback_rad = glm::radians(o.foldback_deg);
-    e.propagation.interpolant_cache = !o.no_interpolant_cache;
-    e.screen_box = !o.no_screen_box;
-    e.adaptive = o.adaptive;
-    e.adaptive_max_level = o.adaptive_max_level;
+    EngineOptions e = to_engine_options(o.engine);
     e.sample_at_rays = o.snapshot_rays;
     return e;
 }
@@ -167,8 +154,9 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     t.frame = fr.elapsed_s;
     std::printf("progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
                 "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
-                std::string(to_string(engine.options().order)).c_str(), o.intersect.c_str(),
-                o.propagation == "angle" ? "cut-off angle" : ("max count " + std::to_string(o.max_count)).c_str(),
+                std::string(to_string(engine.options().order)).c_str(), o.engine.intersect.c_str(),
+                o.engine.propagation == "angle" ? "cut-off angle"
+                                                : ("max count " + std::to_string(o.engine.max_count)).c_str(),
                 fr.rays_cast, 100.0 * double(fr.rays_cast) / double(fr.rays_screen),
                 fr.screen_rect.width, fr.screen_rect.height, fr.elapsed_s, fr.groups.size(),
                 last.triangles, last.cells_visited);
@@ -272,11 +260,6 @@ int run_render(const RenderOptions& o) {
     check_output_path(o.out, "--out");
     if (!o.depth_out.empty()) check_output_path(o.depth_out, "--depth-out");
     if (!o.timeline.empty()) check_output_path(o.timeline, "--timeline");
-    if (o.max_count < 1) throw InputError("--max-count", "value", "expected a positive cell count");
-    if (o.adaptive_max_level < 1 || o.adaptive_max_level > kMaxMetaLevel)
-        throw InputError("--adaptive-max-level", "value",
-                         "expected 1 to " + std::to_string(kMaxMetaLevel) + ", got " +
-                             std::to_string(o.adaptive_max_level));
     for (double c : o.snapshots)
         if (!(c > 0 && c <= 100)) throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
     const EngineOptions checked = engine_options(o);  // fails early on a bad --order

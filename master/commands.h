@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "master/engine_cli.h"
 #include "master/volume_options.h"
 
 namespace isowall {
@@ -30,16 +31,7 @@ struct RenderOptions {
 
     // Progressive engine (the default) or the full surface.
     bool full = false;
-    std::string order = "dynamic";
-    std::string intersect = "exact";
-    std::string propagation = "count";
-    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
-    float cutoff_deg = 2.0f;
-    float foldback_deg = 0.5f;
-    bool no_interpolant_cache = false;
-    bool no_screen_box = false;
-    bool adaptive = false;
-    int adaptive_max_level = 3;
+    EngineCli engine;
     std::string timeline;                 // CSV path
     std::vector<double> snapshots;        // correctness thresholds in percent
     std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)

@@ -45,39 +45,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     re_cmd->add_flag("--full", re.full,
                      "Extract and draw the whole surface instead of the progressive engine");
-    re_cmd->add_option("--order", re.order, "Ray order: grid (fixed refining grids), readback "
-                                            "(screen read-back) or dynamic (dynamic grid)")
-        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
-        ->capture_default_str();
-    re_cmd->add_option("--intersect", re.intersect,
-                       "exact (Moller-Trumbore on the cell's triangles) or approximate (first "
-                       "active cell, then an exact second pass)")
-        ->check(CLI::IsMember({"exact", "approximate"}))
-        ->capture_default_str();
-    re_cmd->add_option("--propagation", re.propagation,
-                       "count (at most --max-count cells per seed) or angle (--cutoff-angle with "
-                       "fold-back test)")
-        ->check(CLI::IsMember({"count", "angle"}))
-        ->capture_default_str();
-    re_cmd->add_option("--max-count", re.max_count, "Cells per propagation pass (count mode)")
-        ->capture_default_str();
-    re_cmd->add_option("--cutoff-angle", re.cutoff_deg, "Cut-off angle in degrees (angle mode)")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    re_cmd->add_option("--foldback-tolerance", re.foldback_deg,
-                       "Fold-back tolerance in degrees (angle mode)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    re_cmd->add_flag("--no-interpolant-cache", re.no_interpolant_cache,
-                     "Do not share vertices between cells of a group");
-    re_cmd->add_flag("--no-screen-box", re.no_screen_box,
-                     "Cast rays over the whole screen, not only the volume's projected box");
-    re_cmd->add_flag("--adaptive", re.adaptive,
-                     "Adaptive resolution: extract regions whose cells project below a pixel as "
-                     "meta-cells of 2^i cells per side");
-    re_cmd->add_option("--adaptive-max-level", re.adaptive_max_level,
-                       "Largest meta-cell level i with --adaptive")
-        ->capture_default_str();
+    add_engine_options(*re_cmd, re.engine);
     re_cmd->add_option("--timeline", re.timeline, "Write the timeline (CSV) of the frame");
     re_cmd->add_option("--snapshots", re.snapshots,
                        "Write the image when correctness first reaches these percentages, e.g. "
@@ -106,12 +74,7 @@ int main(int argc, char** argv) {
     wall_cmd->add_option("--gl", wall.gl, "OpenGL back end")
         ->check(CLI::IsMember({"osmesa", "egl"}))
         ->capture_default_str();
-    wall_cmd->add_option("--order", wall.order, "Ray order: grid, readback or dynamic")
-        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
-        ->capture_default_str();
-    wall_cmd->add_option("--max-count", wall.max_count, "Cells per propagation pass")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+    add_engine_options(*wall_cmd, wall.engine);
     wall_cmd->add_option("--script", wall.script,
                          "Commands (orbit, look-at, zoom, iso, wait, snapshot, quit), one per line; "
                          "- reads them from the master's console");

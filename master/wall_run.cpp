@@ -119,9 +119,7 @@ int run_tile(const WallOptions& o, Comm& comm, const OpenedVolume& ov) {
     }
     auto ex = open_extractor(ov);
     auto renderer = make_renderer(o.gl);
-    EngineOptions opt;
-    opt.order = parse_ray_order(o.order).value_or(RayOrderKind::dynamic_grid);
-    opt.propagation.max_count = o.max_count;
+    EngineOptions opt = to_engine_options(o.engine);
     opt.progress_interval_s = 0.05;
     TraceRecorder trace;
     opt.trace = &trace;
@@ -627,6 +625,7 @@ int run_wall(const WallOptions& o, Comm& comm) {
             auto dir = std::filesystem::path(o.out).parent_path();
             if (!dir.empty() && !std::filesystem::is_directory(dir))
                 throw InputError(o.out, "--out", "folder " + dir.string() + " does not exist");
+            to_engine_options(o.engine);  // a bad engine option stops the job before any frame
             // The whole script is checked before any frame starts: a bad line stops the job here.
             if (!o.script.empty() && o.script != "-") {
                 std::ifstream in(o.script);

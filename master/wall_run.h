@@ -7,6 +7,7 @@
 #include <string>
 
 #include "master/comm.h"
+#include "master/engine_cli.h"
 #include "master/volume_options.h"
 
 namespace isowall {
@@ -18,8 +19,7 @@ struct WallOptions {
     std::string out = "mosaic.png";
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";
-    std::string order = "dynamic";
-    int max_count = 2000;
+    EngineCli engine;
     std::string script;       // script file, "-" for the master's console, empty: one frame
     double timeout_s = 120;   // a tile silent this long ends the job
     std::string trace;        // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
