@@ -366,16 +366,10 @@ TEST(RayOrder, CoverageOfTheWrongSizeThrows) {
     }
 }
 
-// Per-level time on a full 1600x1200 screen, including read-back coverage for the orders that
-// ask. A caster spends well over this on the rays themselves, so "a few tens of ms" is the budget
-// in an optimized build; sanitizer and debug builds run ~20x slower and get a loose bound that
-// still catches a quadratic level. The figures are printed either way.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(NDEBUG)
-constexpr double kLevelBudgetMs = 2000.0;
-#else
-constexpr double kLevelBudgetMs = 50.0;
-#endif
-TEST(RayOrder, LargeScreenLevelsAreFast) {
+// A full 1600x1200 screen: every pixel exactly once. The per-level times are printed for the
+// reader (about 10 ms for the 1.6 M-pixel fill level in a release build) but not asserted: the
+// machines are shared and noisy, and speed is for benchmarks, not unit tests.
+TEST(RayOrder, LargeScreenHandsOutEveryPixelOnce) {
     const int w = 1600, h = 1200;
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> ux(0, w), uy(0, h), ur(20, 120);
@@ -408,7 +402,6 @@ TEST(RayOrder, LargeScreenLevelsAreFast) {
             figures += buf;
         }
         EXPECT_EQ(total_rays, std::size_t(w) * h) << to_string(k);
-        EXPECT_LT(worst_ms, kLevelBudgetMs) << to_string(k);
         std::printf(
             "[ ray order ] %-8s 1600x1200: worst level %.2f ms, all levels %.2f ms; "
             "rays:ms per level%s\n",
