@@ -181,7 +181,9 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
 TEST(WallRun, ATileThatStopsAnsweringOrDiesEndsTheJobInBoundedTime) {
     const auto dir = test::scratch_dir("wall_fault");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
-    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() + "' --timeout 3 --out '" +
+    // The timeout counts silence from every tile; it must outlast a slow start (tiles build the
+    // phantom before their first message: seconds under ASan on 2 cores), so 20 s, not 3.
+    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() + "' --timeout 20 --out '" +
                              (dir / "m.png").string() + "'";
     // Stops answering: the master names the silent tile and ends the job after --timeout.
     int rc = run("env ISOWALL_TEST_FAULT=hang:2 " + mpirun(5) + wall, dir / "hang.log");
