@@ -5,13 +5,13 @@
 #include <filesystem>
 
 
-#include "common/camera.h"
-#include "common/error.h"
-#include "common/phantom.h"
-#include "common/ply.h"
-#include "common/surface_extractor.h"
-#include "common/util.h"
-#include "tile/image_io.h"
+#include "common/core/camera.h"
+#include "common/core/error.h"
+#include "common/volume/phantom.h"
+#include "common/io/ply.h"
+#include "common/extract/surface_extractor.h"
+#include "common/core/util.h"
+#include "common/io/image_io.h"
 #include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 

@@ -2,7 +2,7 @@
 
 #include <glm/trigonometric.hpp>
 
-#include "common/error.h"
+#include "common/core/error.h"
 
 namespace isowall {
 

@@ -2,10 +2,10 @@
 
 #include <cstdio>
 
-#include "common/error.h"
-#include "common/octree.h"
-#include "common/phantom.h"
-#include "common/util.h"
+#include "common/core/error.h"
+#include "common/volume/octree.h"
+#include "common/volume/phantom.h"
+#include "common/core/util.h"
 
 namespace isowall {
 

@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "common/volume.h"
+#include "common/volume/volume.h"
 
 namespace isowall {
 

@@ -10,14 +10,14 @@
 #include <sstream>
 #include <thread>
 
-#include "common/error.h"
-#include "common/phantom.h"
-#include "common/script.h"
-#include "common/surface_extractor.h"
-#include "common/trace.h"
-#include "common/util.h"
-#include "common/wall.h"
-#include "tile/image_io.h"
+#include "common/core/error.h"
+#include "common/volume/phantom.h"
+#include "common/wall/script.h"
+#include "common/extract/surface_extractor.h"
+#include "common/progressive/trace.h"
+#include "common/core/util.h"
+#include "common/wall/wall.h"
+#include "common/io/image_io.h"
 #include "tile/progressive_engine.h"
 
 namespace isowall {

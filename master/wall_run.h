@@ -6,7 +6,7 @@
 // own frustum.
 #include <string>
 
-#include "master/comm.h"
+#include "comm/comm.h"
 #include "master/engine_cli.h"
 #include "master/volume_options.h"
 

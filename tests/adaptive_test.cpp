@@ -12,10 +12,10 @@
 #include <limits>
 #include <vector>
 
-#include "common/adaptive.h"
-#include "common/correctness.h"
-#include "common/phantom.h"
-#include "common/volume.h"
+#include "common/extract/adaptive.h"
+#include "common/progressive/correctness.h"
+#include "common/volume/phantom.h"
+#include "common/volume/volume.h"
 #include "tile/progressive_engine.h"
 
 namespace isowall {

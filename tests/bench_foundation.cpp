@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "common/camera.h"
-#include "common/extract.h"
-#include "common/phantom.h"
-#include "common/util.h"
+#include "common/core/camera.h"
+#include "common/extract/extract.h"
+#include "common/volume/phantom.h"
+#include "common/core/util.h"
 #include "tile/renderer.h"
 
 namespace {

@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "common/camera.h"
-#include "common/util.h"
+#include "common/core/camera.h"
+#include "common/core/util.h"
 
 namespace isowall {
 namespace {

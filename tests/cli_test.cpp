@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/ply.h"
+#include "common/io/ply.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "common/correctness.h"
+#include "common/progressive/correctness.h"
 
 namespace isowall {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // Helpers shared by the engine tests: views of a volume and the full-surface reference image.
-#include "common/surface_extractor.h"
-#include "common/volume.h"
+#include "common/extract/surface_extractor.h"
+#include "common/volume/volume.h"
 #include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 

@@ -5,9 +5,9 @@
 #include <map>
 #include <numbers>
 
-#include "common/extract.h"
-#include "common/phantom.h"
-#include "common/ply.h"
+#include "common/extract/extract.h"
+#include "common/volume/phantom.h"
+#include "common/io/ply.h"
 #include "tests/test_util.h"
 
 namespace isowall {

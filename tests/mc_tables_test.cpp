@@ -1,4 +1,4 @@
-#include "common/mc_tables.h"
+#include "common/extract/mc_tables.h"
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <random>
 
-#include "common/octree.h"
-#include "common/phantom.h"
+#include "common/volume/octree.h"
+#include "common/volume/phantom.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -5,11 +5,11 @@
 #include <set>
 #include <tuple>
 
-#include "common/phantom.h"
-#include "common/volume.h"
+#include "common/volume/phantom.h"
+#include "common/volume/volume.h"
 #include "tests/engine_util.h"
 #include "tests/test_util.h"
-#include "tile/image_io.h"
+#include "common/io/image_io.h"
 #include "tile/progressive_engine.h"
 
 namespace isowall {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "common/ray_order.h"
+#include "common/progressive/ray_order.h"
 
 namespace isowall {
 namespace {

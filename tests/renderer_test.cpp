@@ -15,11 +15,11 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "common/camera.h"
-#include "common/image.h"
-#include "common/mesh.h"
+#include "common/core/camera.h"
+#include "common/core/image.h"
+#include "common/core/mesh.h"
 #include "tests/test_util.h"
-#include "tile/image_io.h"
+#include "common/io/image_io.h"
 #include "tile/renderer.h"
 
 namespace isowall {

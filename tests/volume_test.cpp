@@ -5,8 +5,8 @@
 #include <fstream>
 #include <random>
 
-#include "common/error.h"
-#include "common/volume.h"
+#include "common/core/error.h"
+#include "common/volume/volume.h"
 #include "tests/test_util.h"
 
 namespace isowall {

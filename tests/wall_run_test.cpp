@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "tests/test_util.h"
-#include "tile/image_io.h"
+#include "common/io/image_io.h"
 
 namespace isowall {
 namespace {

@@ -10,8 +10,8 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/error.h"
-#include "common/wall.h"
+#include "common/core/error.h"
+#include "common/wall/wall.h"
 
 namespace isowall {
 namespace {

@@ -9,8 +9,8 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/image.h"
-#include "common/mesh.h"
+#include "common/core/image.h"
+#include "common/core/mesh.h"
 #include "tile/renderer.h"
 
 namespace isowall {

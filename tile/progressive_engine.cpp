@@ -5,7 +5,7 @@
 
 #include <glm/matrix.hpp>
 
-#include "common/ray.h"
+#include "common/core/ray.h"
 
 namespace isowall {
 namespace {

@@ -8,14 +8,14 @@
 #include <functional>
 #include <vector>
 
-#include "common/adaptive.h"
-#include "common/camera.h"
-#include "common/correctness.h"
-#include "common/image.h"
-#include "common/ray_order.h"
-#include "common/surface_extractor.h"
-#include "common/timeline.h"
-#include "common/trace.h"
+#include "common/extract/adaptive.h"
+#include "common/core/camera.h"
+#include "common/progressive/correctness.h"
+#include "common/core/image.h"
+#include "common/progressive/ray_order.h"
+#include "common/extract/surface_extractor.h"
+#include "common/progressive/timeline.h"
+#include "common/progressive/trace.h"
 #include "tile/renderer.h"
 
 namespace isowall {

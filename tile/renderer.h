@@ -7,8 +7,8 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/image.h"
-#include "common/mesh.h"
+#include "common/core/image.h"
+#include "common/core/mesh.h"
 
 namespace isowall {
 

@@ -1,0 +1,115 @@
+#include "common/core/camera.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtx/rotate_vector.hpp>
+
+namespace isowall {
+
+glm::mat4 Frustum::matrix() const {
+    if (projection == Projection::perspective)
+        return glm::frustum(left, right, bottom, top, near_z, far_z);
+    return glm::ortho(left, right, bottom, top, near_z, far_z);
+}
+
+Frustum sub_frustum(const Frustum& full, int screen_w, int screen_h, const PixelRect& rect) {
+    Frustum f = full;
+    const float sx = full.width() / static_cast<float>(screen_w);
+    const float sy = full.height() / static_cast<float>(screen_h);
+    f.left = full.left + sx * static_cast<float>(rect.x);
+    f.right = full.left + sx * static_cast<float>(rect.x + rect.width);
+    // Pixel rows count down from the top edge.
+    f.top = full.top - sy * static_cast<float>(rect.y);
+    f.bottom = full.top - sy * static_cast<float>(rect.y + rect.height);
+    return f;
+}
+
+glm::mat4 Camera::view() const { return glm::lookAt(eye, target, up); }
+
+float Camera::distance() const { return glm::length(eye - target); }
+
+Frustum Camera::frustum(float aspect) const {
+    Frustum f;
+    f.projection = projection;
+    f.near_z = near_z;
+    f.far_z = far_z;
+    float half_h = projection == Projection::perspective
+                       ? near_z * std::tan(glm::radians(fovy_deg) * 0.5f)
+                       : ortho_height * 0.5f;
+    f.top = half_h;
+    f.bottom = -half_h;
+    f.right = half_h * aspect;
+    f.left = -half_h * aspect;
+    return f;
+}
+
+Camera fit_depth_range(const Camera& c, const Box3& bounds) {
+    Camera out = c;
+    const float radius = 0.5f * glm::length(bounds.extent());
+    const float d = glm::length(bounds.center() - c.eye);
+    // Keep near positive and not too small: depth precision falls with far/near.
+    out.near_z = std::max(d - radius * 1.05f, radius * 0.01f);
+    out.far_z = d + radius * 1.05f;
+    return out;
+}
+
+Camera front_full_view(const Box3& bounds, float aspect, Projection projection) {
+    Camera c;
+    c.projection = projection;
+    c.target = bounds.center();
+    c.up = glm::vec3(0, 0, 1);
+    const glm::vec3 half = 0.5f * bounds.extent();
+    // Looking along +y: x is screen-right, z is screen-up, y is depth. Place the eye at the
+    // smallest distance where all eight corners project inside the view, with a 4% margin.
+    const float tan_y = std::tan(glm::radians(c.fovy_deg) * 0.5f);
+    const float tan_x = tan_y * aspect;
+    float dist = 0;
+    float ortho_half_h = 0;
+    for (float sy : {-1.0f, 1.0f}) {
+        const float depth_offset = sy * half.y;  // corner depth relative to the target
+        dist = std::max({dist, half.x / tan_x - depth_offset, half.z / tan_y - depth_offset});
+        ortho_half_h = std::max({ortho_half_h, half.z, half.x / aspect});
+    }
+    dist = std::max(dist * 1.04f, half.y * 1.1f + 1e-3f);
+    c.eye = c.target - glm::vec3(0, dist, 0);
+    c.ortho_height = 2.0f * ortho_half_h * 1.04f;
+    return fit_depth_range(c, bounds);
+}
+
+Camera orbit(const Camera& c, float yaw_deg, float pitch_deg) {
+    Camera out = c;
+    glm::vec3 offset = c.eye - c.target;
+    const glm::vec3 up = glm::normalize(c.up);
+    offset = glm::rotate(offset, glm::radians(yaw_deg), up);
+    const glm::vec3 right = glm::normalize(glm::cross(-offset, up));
+    offset = glm::rotate(offset, glm::radians(pitch_deg), right);
+    out.eye = c.target + offset;
+    // Keep up orthogonal to the view direction so that lookAt never degenerates.
+    out.up = glm::normalize(glm::cross(right, -offset));
+    return out;
+}
+
+Camera zoom(const Camera& c, float factor) {
+    Camera out = c;
+    if (c.projection == Projection::perspective) {
+        out.eye = c.target + (c.eye - c.target) / factor;
+    } else {
+        out.ortho_height = c.ortho_height / factor;
+    }
+    return out;
+}
+
+std::ostream& operator<<(std::ostream& os, const Frustum& f) {
+    return os << "Frustum{l=" << f.left << " r=" << f.right << " b=" << f.bottom << " t=" << f.top
+              << " n=" << f.near_z << " f=" << f.far_z
+              << (f.projection == Projection::perspective ? " persp}" : " ortho}");
+}
+
+std::ostream& operator<<(std::ostream& os, const Camera& c) {
+    return os << "Camera{eye=" << c.eye << " target=" << c.target << " up=" << c.up
+              << " fovy=" << c.fovy_deg << "}";
+}
+
+}  // namespace isowall

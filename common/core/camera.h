@@ -1,0 +1,65 @@
+#pragma once
+// Camera and frustum value types. A Frustum is the general off-axis form (the extents of the
+// near plane in view space), so a wall tile is just a sub-rectangle of the wall's frustum.
+#include <ostream>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "common/core/box.h"
+
+namespace isowall {
+
+enum class Projection { perspective, orthographic };
+
+struct Frustum {
+    // View-space extents at the near plane (perspective) or of the view box (orthographic).
+    float left = -1, right = 1, bottom = -1, top = 1;
+    float near_z = 0.1f, far_z = 100.0f;  // positive distances along -z of view space
+    Projection projection = Projection::perspective;
+
+    glm::mat4 matrix() const;  // OpenGL clip-space projection matrix
+    float width() const { return right - left; }
+    float height() const { return top - bottom; }
+};
+
+// A pixel rectangle with (x, y) at the top-left, as images are stored.
+struct PixelRect {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+
+// The frustum of `rect` when the whole of `full` maps onto a screen of screen_w x screen_h pixels.
+Frustum sub_frustum(const Frustum& full, int screen_w, int screen_h, const PixelRect& rect);
+
+struct Camera {
+    glm::vec3 eye{0, 0, 10};
+    glm::vec3 target{0, 0, 0};
+    glm::vec3 up{0, 1, 0};
+    Projection projection = Projection::perspective;
+    float fovy_deg = 30.0f;     // vertical field of view (perspective)
+    float ortho_height = 2.0f;  // full view height in object units (orthographic)
+    float near_z = 0.1f;
+    float far_z = 100.0f;
+
+    glm::mat4 view() const;  // object -> view space (look-at)
+    // The symmetric frustum for a screen of the given aspect (width / height).
+    Frustum frustum(float aspect) const;
+    float distance() const;
+};
+
+// Front full view: looking along +y of the volume (front of a head scan) with +z up, at the
+// nearest distance where every corner of `bounds` is in view (4% margin).
+Camera front_full_view(const Box3& bounds, float aspect, Projection projection = Projection::perspective);
+
+// Rotate the eye around the target: yaw about the up vector, pitch about the right vector.
+Camera orbit(const Camera& c, float yaw_deg, float pitch_deg);
+// factor > 1 moves closer (perspective) or narrows the view (orthographic).
+Camera zoom(const Camera& c, float factor);
+
+// Set near/far so that `bounds` lies between them, with a small margin.
+Camera fit_depth_range(const Camera& c, const Box3& bounds);
+
+std::ostream& operator<<(std::ostream& os, const Frustum& f);
+std::ostream& operator<<(std::ostream& os, const Camera& c);
+
+}  // namespace isowall

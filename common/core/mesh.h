@@ -1,0 +1,28 @@
+#pragma once
+// Indexed face set: the unit every extractor produces and every renderer draws.
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "common/core/box.h"
+
+namespace isowall {
+
+struct Mesh {
+    std::vector<glm::vec3> positions;  // object space (voxel index * spacing)
+    std::vector<glm::vec3> normals;    // unit, one per position
+    std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
+
+    std::size_t triangle_count() const { return indices.size() / 3; }
+    std::size_t vertex_count() const { return positions.size(); }
+    bool empty() const { return indices.empty(); }
+    Box3 bounds() const {
+        Box3 b;
+        for (const auto& p : positions) b.merge(p);
+        return b;
+    }
+    void append(const Mesh& other);
+};
+
+}  // namespace isowall

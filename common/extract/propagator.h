@@ -1,0 +1,208 @@
+#pragma once
+// Limited propagation from a seed cell (chapter 2.1.2, section 3.2): breadth first over active
+// face neighbours (a face whose four corners straddle the isovalue is crossed by the surface, so
+// the cell behind it is active), bounded by
+//   max_count:    at most m cells per pass;
+//   cutoff_angle: cells whose direction from the eye is more than theta from the seed ray, and
+//                 cells where the surface folds back (their distance angle falls below the largest
+//                 of their predecessors' by more than the tolerance: Figure 2.5).
+// Each pass yields one group: an indexed face set triangulated through the interpolant cache,
+// which is reset per pass (section 3.3.4).
+// With a ResolutionMap (chapter 2.1.3) a pass runs at the level of its seed's unit: over meta-cells
+// of that level (face neighbours at stride 2^level, active by their corner signs), and it stops at
+// the resolution boundary: a neighbour that belongs to a unit of another level is not entered.
+// Every cell a meta-cell covers is marked visited with the pass's group id, so no ray seeds inside
+// it again and every visited cell is in exactly one group (units are disjoint, so a unit is either
+// wholly visited or not at all, and testing its first cell is enough).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "common/extract/adaptive.h"
+#include "common/extract/marching_cubes.h"
+#include "common/extract/visited.h"
+
+namespace isowall {
+
+enum class PropagationMode { max_count, cutoff_angle };
+
+struct PropagationParams {
+    PropagationMode mode = PropagationMode::max_count;
+    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
+    float cutoff_rad = 0.0349f;    // 2 degrees
+    float foldback_rad = 0.0087f;  // 0.5 degree
+    bool interpolant_cache = true;
+};
+
+struct Group {
+    std::uint32_t id = 0;
+    glm::ivec3 seed{0};
+    int level = 0;  // the resolution of the pass: 0 cells, i >= 1 meta-cells of 2^i cells per side
+    Mesh mesh;  // object space
+    // The cells this pass took, in BFS order; at level >= 1 the first cell of each meta-cell.
+    std::vector<glm::ivec3> cells;
+    // A refinement (adaptive resolution): the full-resolution triangles of the meta-cell of
+    // `level` at `seed`, drawn over its own because a ray saw the surface there that they miss.
+    // It takes no cells: they stay with the pass that took the meta-cell, if any.
+    bool refinement = false;
+};
+
+// Without the interpolant cache every triangle gets its own three vertices (the "caching off"
+// row of Table 3.4).
+struct NoEdgeCache {
+    std::pair<std::uint32_t*, bool> find_or_insert(glm::ivec3, int) { return {&scratch, true}; }
+    std::uint32_t scratch = 0;
+};
+
+template <class T>
+class Propagator {
+public:
+    explicit Propagator(const VolumeView<T>& v) : v_(v), cache_(v.dims, 4096) {}
+
+    // The resolution of the following passes; default-constructed: full resolution.
+    void set_resolution(const ResolutionMap& resolution) { resolution_ = resolution; }
+
+    // Seconds spent triangulating (marching cubes) in the last propagate() call; the rest of the
+    // call is the propagation proper (queue, neighbour tests, criteria).
+    double last_extract_s() const { return extract_s_; }
+
+    // `eye` and `ray_dir` in voxel space (for the angle criteria). `interrupted` is polled every
+    // few hundred cells so a long pass stops promptly when the view changes.
+    Group propagate(glm::ivec3 seed, std::uint32_t group_id, double iso, const PropagationParams& p,
+                    glm::vec3 eye, glm::vec3 ray_dir, VisitedCells& visited,
+                    const std::function<bool()>& interrupted = {}) {
+        extract_s_ = 0;
+        Group g;
+        g.id = group_id;
+        const int level = resolution_.level_of(seed);
+        const int stride = 1 << level;
+        seed &= ~(stride - 1);  // the unit's first cell
+        g.seed = seed;
+        g.level = level;
+        if (!insert(visited, seed, level, group_id)) return g;
+        cache_.clear();
+        const glm::vec3 dir = glm::normalize(ray_dir);
+        const float cos_cutoff = std::cos(p.cutoff_rad);
+        const float half = 0.5f * static_cast<float>(stride);
+        auto angle_of = [&](glm::ivec3 c) {
+            const glm::vec3 to = glm::normalize(glm::vec3(c) + half - eye);
+            return std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
+        };
+        queue_.clear();
+        queue_.push_back({seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed) : 0.0f});
+        int taken = 1;
+        const glm::ivec3 cells = visited.dims();
+        while (!queue_.empty()) {
+            const QueueEntry item = queue_.front();
+            queue_.pop_front();
+            g.cells.push_back(item.cell);
+            if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
+            const auto t0 = std::chrono::steady_clock::now();
+            const int cs = triangulate(item.cell, level, iso, p, g.mesh);
+            extract_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            for (int f = 0; f < 6; ++f) {
+                const int axis = f >> 1, side = f & 1;
+                // The face's four corners: those with bit `axis` equal to `side`.
+                int on_face = 0;
+                for (int k = 0; k < 8; ++k)
+                    if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
+                if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
+                glm::ivec3 nb = item.cell;
+                nb[axis] += side ? stride : -stride;
+                if (nb[axis] < 0 || nb[axis] >= cells[axis]) continue;
+                if (visited.contains(nb)) continue;
+                if (resolution_.max_level() > 0 && resolution_.level_of(nb) != level)
+                    continue;  // the resolution boundary
+                float max_angle = item.max_angle;
+                if (p.mode == PropagationMode::max_count) {
+                    if (taken >= p.max_count) continue;
+                } else {
+                    const glm::vec3 to = glm::normalize(glm::vec3(nb) + half - eye);
+                    if (glm::dot(to, dir) < cos_cutoff) continue;
+                    const float a = std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
+                    if (a < item.max_angle - p.foldback_rad) continue;  // folds back
+                    max_angle = std::max(max_angle, a);
+                }
+                insert(visited, nb, level, group_id);
+                ++taken;
+                queue_.push_back({nb, max_angle});
+            }
+        }
+        return g;
+    }
+
+    // The refinement group of the meta-cell of `level` at `base`: its active cells triangulated at
+    // full resolution, sharing vertices through the interpolant cache.
+    Group refine(glm::ivec3 base, int level, std::uint32_t group_id, double iso,
+                 const PropagationParams& p) {
+        const auto t0 = std::chrono::steady_clock::now();
+        Group g;
+        g.id = group_id;
+        g.seed = base;
+        g.level = level;
+        g.refinement = true;
+        cache_.clear();
+        const int s = 1 << level;
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x)
+                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh);
+        extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return g;
+    }
+
+private:
+    // Marks every cell of the unit of `level` at `base`; false when it was taken already.
+    static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
+        if (!visited.insert(base, group_id)) return false;
+        const int s = 1 << level;
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x)
+                    if (x | y | z) visited.insert(base + glm::ivec3(x, y, z), group_id);
+        return true;
+    }
+
+    int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
+        if (level > 0) {
+            double corner[8];
+            meta_cell_corners(v_, c, level, corner);
+            const int cs = cell_case(corner, iso);
+            if (p.interpolant_cache) {
+                emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
+            } else {
+                NoEdgeCache none;
+                emit_meta_cell(v_, c, level, iso, cs, corner, none, mesh);
+            }
+            return cs;
+        }
+        double corner[8];
+        cell_corners(v_, c, corner);
+        const int cs = cell_case(corner, iso);
+        if (p.interpolant_cache) {
+            emit_cell(v_, c, iso, cs, corner, cache_, mesh);
+        } else {
+            NoEdgeCache none;
+            emit_cell(v_, c, iso, cs, corner, none, mesh);
+        }
+        return cs;
+    }
+
+    const VolumeView<T>& v_;
+    HashEdgeCache cache_;
+    ResolutionMap resolution_;
+    double extract_s_ = 0;
+    struct QueueEntry {
+        glm::ivec3 cell;
+        float max_angle;  // largest distance angle along the path from the seed
+    };
+    std::deque<QueueEntry> queue_;
+};
+
+}  // namespace isowall

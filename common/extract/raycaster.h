@@ -1,0 +1,327 @@
+#pragma once
+// Seed finding by ray casting (chapter 2.1.1): a front-to-back walk of the min/max octree in voxel
+// space, down to the cells of active leaf bricks, which are stepped through in ray order (3D DDA).
+//   exact:       the first active cell whose marching-cubes triangles the ray hits (Moller-
+//                Trumbore); when a cell's triangles miss, the walk resumes (Figure 2.2).
+//   approximate: the first active cell the ray enters (section 3.1.1).
+// With a ResolutionMap (adaptive resolution, chapter 2.1.3) the walk stops at the unit a far region
+// is extracted at: an octree node, a leaf brick or an eighth of one that is a meta-cell unit is
+// tested as one cell (activity and triangles from its eight corners), and a leaf brick holding
+// units of several levels is walked by front-to-back subdivision instead of the DDA. Where a
+// meta-cell's triangles miss the ray, the exact walk also steps through its cells and reports a
+// full-resolution hit as a refinement (RayHit::refine).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "common/extract/adaptive.h"
+#include "common/extract/marching_cubes.h"
+#include "common/volume/octree.h"
+#include "common/core/ray.h"
+
+namespace isowall {
+
+enum class IntersectMode { exact, approximate };
+
+struct RayHit {
+    bool found = false;
+    glm::ivec3 cell{0};  // the cell, or the first cell of the meta-cell
+    float t = 0;  // ray parameter of the hit (exact) or of the cell entry (approximate)
+    int level = 0;  // 0: a cell; i >= 1: the meta-cell of 2^i cells per side at `cell`
+    // Exact walk with adaptive resolution only: the meta-cell's own triangles miss the ray, but
+    // its full-resolution triangles are hit (in fine_cell, at t). The meta-cell needs refining
+    // for this pixel to show the surface.
+    bool refine = false;
+    glm::ivec3 fine_cell{0};
+};
+
+// The triangles of cell c in voxel space (three vertices each); returns the triangle count.
+template <class T>
+int cell_triangles(const VolumeView<T>& v, glm::ivec3 c, double iso,
+                   std::array<glm::vec3, 3 * mc::kMaxTriangles>& out) {
+    double corner[8];
+    cell_corners(v, c, corner);
+    const int cs = cell_case(corner, iso);
+    const int count = mc::kTriangleCount[static_cast<std::size_t>(cs)];
+    const auto& edges = mc::kTriangleEdges[static_cast<std::size_t>(cs)];
+    for (int i = 0; i < 3 * count; ++i) {
+        const auto e = static_cast<std::size_t>(edges[static_cast<std::size_t>(i)]);
+        const int ca = mc::kEdgeCorners[e][0], cb = mc::kEdgeCorners[e][1];
+        const auto& oa = mc::kCornerOffset[static_cast<std::size_t>(ca)];
+        glm::vec3 p = glm::vec3(c + glm::ivec3(oa[0], oa[1], oa[2]));
+        p[mc::kEdgeAxis[e]] += static_cast<float>((iso - corner[ca]) / (corner[cb] - corner[ca]));
+        out[static_cast<std::size_t>(i)] = p;
+    }
+    return count;
+}
+
+template <class T>
+class RayCaster {
+public:
+    RayCaster(const VolumeView<T>& volume, const MinMaxOctree<T>& octree)
+        : v_(volume), octree_(octree) {}
+
+    // The resolution of the following casts; default-constructed: full resolution.
+    void set_resolution(const ResolutionMap& resolution) { resolution_ = resolution; }
+
+    // `ray` in voxel space. Stops at t_max (e.g. the depth already drawn at this pixel).
+    RayHit cast(const Ray& ray, double iso, IntersectMode mode,
+                float t_max = std::numeric_limits<float>::max()) {
+        ray_ = ray;
+        for (int a = 0; a < 3; ++a)
+            inv_d_[a] = std::abs(ray.d[a]) > 1e-20f ? 1.0f / ray.d[a] : std::copysign(1e30f, ray.d[a]);
+        iso_ = iso;
+        mode_ = mode;
+        t_max_ = t_max;
+        hit_ = {};
+        cells_tested_ = 0;
+        // Full resolution takes the hierarchical DDA; meta-cell units need the top-down descent,
+        // which knows which coarser unit encloses a node.
+        if (resolution_.max_level() == 0) {
+            walk();
+        } else {
+            visit(octree_.level_count() - 1, glm::ivec3(0));
+        }
+        return hit_;
+    }
+    std::size_t cells_tested() const { return cells_tested_; }
+
+private:
+    // Hierarchical DDA at full resolution: from the ray's entry into the volume, find the largest
+    // octree node around the current point that cannot hold the surface and jump to its exit;
+    // where the leaf brick is active, step through its cells. Half the time per ray of the
+    // recursive front-to-back descent below, which tests every child's box and sorts the children
+    // at every level (intersection stage 0.88 s -> 0.42 s for the 1.05 M rays of vhp_ct_head skin
+    // at 1600x1200, same groups and triangles).
+    void walk() {
+        const OctreeShape& shape = octree_.shape();
+        float t, t_end;
+        if (!intersect_box(ray_, inv_d_, glm::vec3(0), glm::vec3(shape.cell_dims), t, t_end)) return;
+        t = std::max(t, 0.0f);
+        t_end = std::min(t_end, t_max_);
+        const glm::ivec3 leaf_dims = shape.levels[0].dims;
+        const int levels = octree_.level_count();
+        // Steps past a node's exit by this much (in cells) to land in the next node; it grows
+        // with t so that t + nudge is a different float even far from the eye (a fixed 1e-4 is
+        // below one ulp once t passes ~1000, and the walk would never advance).
+        auto nudge = [](float at) { return 1e-4f + 4e-7f * std::abs(at); };
+        while (t <= t_end) {
+            const glm::vec3 p = ray_.at(t + nudge(t));
+            const glm::ivec3 brick = glm::clamp(glm::ivec3(glm::floor(p)) >> OctreeShape::kLeafLog2,
+                                                glm::ivec3(0), leaf_dims - 1);
+            int skip = -1;  // the highest level whose node around p is inactive
+            while (skip + 1 < levels && !octree_.active(skip + 1, brick >> (skip + 1), iso_)) ++skip;
+            const int level = skip >= 0 ? skip : 0;
+            const glm::ivec3 n = brick >> level;
+            float n0, n1;
+            intersect_box(ray_, inv_d_, glm::vec3(shape.cell_begin(level, n)),
+                          glm::vec3(shape.cell_end(level, n)), n0, n1);
+            if (skip < 0 &&
+                walk_brick(shape.cell_begin(0, n), shape.cell_end(0, n), t, std::min(n1, t_end)))
+                return;
+            t = std::max(n1, t + nudge(t));
+        }
+    }
+
+    // Returns true when the ray has been answered (hit found or walk ended).
+    bool visit(int level, glm::ivec3 n) {
+        const OctreeShape& shape = octree_.shape();
+        const glm::ivec3 b = shape.cell_begin(level, n), e = shape.cell_end(level, n);
+        float t0, t1;
+        if (!intersect_box(ray_, inv_d_, glm::vec3(b), glm::vec3(e), t0, t1)) return false;
+        if (t1 < 0 || t0 > t_max_) return false;
+        if (!octree_.active(level, n, iso_)) return false;
+        // A node is a whole meta-cell of level + kLeafLog2; the walk came here top down, so no
+        // coarser unit holds it.
+        const int meta = level + OctreeShape::kLeafLog2;
+        if (meta <= resolution_.max_level() && resolution_.coarse_enough(b, meta))
+            return test_unit(b, meta);
+        if (level == 0) {
+            if (resolution_.may_coarsen(glm::vec3(b), glm::vec3(e), 1))
+                return walk_meta(b, OctreeShape::kLeafLog2);
+            return walk_brick(b, e, std::max(t0, 0.0f), std::min(t1, t_max_));
+        }
+        // Children front to back: sort by entry parameter.
+        const auto& below = shape.levels[static_cast<std::size_t>(level - 1)];
+        const glm::ivec3 c0 = 2 * n, c1 = glm::min(c0 + 2, below.dims);
+        std::array<std::pair<float, glm::ivec3>, 8> kids;
+        int count = 0;
+        for (int z = c0.z; z < c1.z; ++z)
+            for (int y = c0.y; y < c1.y; ++y)
+                for (int x = c0.x; x < c1.x; ++x) {
+                    const glm::ivec3 k(x, y, z);
+                    float k0, k1;
+                    if (!intersect_box(ray_, inv_d_, glm::vec3(shape.cell_begin(level - 1, k)),
+                                       glm::vec3(shape.cell_end(level - 1, k)), k0, k1))
+                        continue;
+                    if (k1 < 0 || k0 > t_max_) continue;
+                    kids[static_cast<std::size_t>(count++)] = {k0, k};
+                }
+        // Insertion sort: at most eight children.
+        for (int i = 1; i < count; ++i)
+            for (int j = i; j > 0 && kids[static_cast<std::size_t>(j)].first <
+                                         kids[static_cast<std::size_t>(j - 1)].first;
+                 --j)
+                std::swap(kids[static_cast<std::size_t>(j)], kids[static_cast<std::size_t>(j - 1)]);
+        for (int i = 0; i < count; ++i)
+            if (visit(level - 1, kids[static_cast<std::size_t>(i)].second)) return true;
+        return false;
+    }
+
+    // 3D DDA through the cells of one leaf brick [b, e) from t0 to t1.
+    bool walk_brick(glm::ivec3 b, glm::ivec3 e, float t0, float t1) {
+        const glm::vec3 p = ray_.at(t0);
+        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(p)), b, e - 1);
+        glm::ivec3 step;
+        glm::vec3 t_next, t_delta;
+        for (int a = 0; a < 3; ++a) {
+            if (ray_.d[a] > 0) {
+                step[a] = 1;
+                t_next[a] = (static_cast<float>(c[a] + 1) - ray_.o[a]) * inv_d_[a];
+                t_delta[a] = inv_d_[a];
+            } else if (ray_.d[a] < 0) {
+                step[a] = -1;
+                t_next[a] = (static_cast<float>(c[a]) - ray_.o[a]) * inv_d_[a];
+                t_delta[a] = -inv_d_[a];
+            } else {
+                step[a] = 0;
+                t_next[a] = std::numeric_limits<float>::max();
+                t_delta[a] = std::numeric_limits<float>::max();
+            }
+        }
+        const InsideTest<T> inside(iso_);
+        for (;;) {
+            ++cells_tested_;
+            if (test_cell(c, inside)) return true;
+            const int a = t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2)
+                                              : (t_next.y < t_next.z ? 1 : 2);
+            if (t_next[a] > t1) return false;
+            c[a] += step[a];
+            if (c[a] < b[a] || c[a] >= e[a]) return false;
+            t_next[a] += t_delta[a];
+        }
+    }
+
+    // Front to back through the eight children (meta-cells of level - 1, clipped to the volume)
+    // of the meta-cell of `level` at `base`, none of which has a coarser unit around it.
+    bool walk_meta(glm::ivec3 base, int level) {
+        const int k = level - 1, s = 1 << k;
+        const glm::ivec3 dims = octree_.shape().cell_dims;
+        std::array<std::pair<float, glm::ivec3>, 8> kids;
+        int count = 0;
+        for (int i = 0; i < 8; ++i) {
+            const glm::ivec3 c = base + s * glm::ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+            if (c.x >= dims.x || c.y >= dims.y || c.z >= dims.z) continue;
+            float k0, k1;
+            if (!intersect_box(ray_, inv_d_, glm::vec3(c), glm::vec3(glm::min(c + s, dims)), k0, k1))
+                continue;
+            if (k1 < 0 || k0 > t_max_) continue;
+            kids[static_cast<std::size_t>(count++)] = {k0, c};
+        }
+        for (int i = 1; i < count; ++i)
+            for (int j = i; j > 0 && kids[static_cast<std::size_t>(j)].first <
+                                         kids[static_cast<std::size_t>(j - 1)].first;
+                 --j)
+                std::swap(kids[static_cast<std::size_t>(j)], kids[static_cast<std::size_t>(j - 1)]);
+        for (int i = 0; i < count; ++i) {
+            const glm::ivec3 c = kids[static_cast<std::size_t>(i)].second;
+            if (k == 0 || resolution_.coarse_enough(c, k)) {
+                if (test_unit(c, k)) return true;
+            } else if (walk_meta(c, k)) {
+                return true;
+            }
+        }
+        return false;
+    }
+
+    // A cell (level 0) or a meta-cell unit, judged by its eight corners.
+    bool test_unit(glm::ivec3 base, int level) {
+        ++cells_tested_;
+        double corner[8];
+        meta_cell_corners(v_, base, level, corner);
+        const int cs = cell_case(corner, iso_);
+        const int s = 1 << level;
+        float t0, t1;
+        intersect_box(ray_, inv_d_, glm::vec3(base), glm::vec3(base + s), t0, t1);
+        t0 = std::max(t0, 0.0f);
+        const bool active = cs != 0 && cs != 255;
+        if (active && mode_ == IntersectMode::approximate) {
+            hit_ = {true, base, t0, level, false, base};
+            return true;
+        }
+        if (active && mode_ == IntersectMode::exact) {
+            const int count = meta_cell_triangles(v_, base, level, iso_, tris_);
+            bool any = false;
+            float best = std::numeric_limits<float>::max();
+            for (int i = 0; i < count; ++i) {
+                float t;
+                const auto k = static_cast<std::size_t>(3 * i);
+                if (intersect_triangle(ray_, tris_[k], tris_[k + 1], tris_[k + 2], 0.0f, t) &&
+                    t < best) {
+                    best = t;
+                    any = true;
+                }
+            }
+            if (any && best <= t_max_) {
+                hit_ = {true, base, best, level, false, base};
+                return true;
+            }
+        }
+        // The meta-cell's triangles miss the ray (or it has none), but the full-resolution
+        // surface inside it may not: on a silhouette or across a crack at a resolution boundary
+        // a sub-pixel difference uncovers a whole pixel. The exact walk looks at its cells.
+        if (level == 0 || mode_ != IntersectMode::exact || !resolution_.refine()) return false;
+        if (!walk_brick(base, base + s, t0, std::min(t1, t_max_))) return false;
+        hit_.refine = true;
+        hit_.fine_cell = hit_.cell;
+        hit_.cell = base;
+        hit_.level = level;
+        return true;
+    }
+
+    bool test_cell(glm::ivec3 c, const InsideTest<T>& inside) {
+        const std::size_t base = v_.index(c.x, c.y, c.z);
+        const std::size_t sy = static_cast<std::size_t>(v_.dims.x);
+        const std::size_t sz = sy * static_cast<std::size_t>(v_.dims.y);
+        const int n = inside(v_.data[base]) + inside(v_.data[base + 1]) + inside(v_.data[base + sy]) +
+                      inside(v_.data[base + sy + 1]) + inside(v_.data[base + sz]) +
+                      inside(v_.data[base + sz + 1]) + inside(v_.data[base + sz + sy]) +
+                      inside(v_.data[base + sz + sy + 1]);
+        if (n == 0 || n == 8) return false;
+        if (mode_ == IntersectMode::approximate) {
+            float t0, t1;
+            intersect_box(ray_, inv_d_, glm::vec3(c), glm::vec3(c + 1), t0, t1);
+            hit_ = {true, c, std::max(t0, 0.0f), 0, false, c};
+            return true;
+        }
+        const int count = cell_triangles(v_, c, iso_, tris_);
+        bool any = false;
+        float best = std::numeric_limits<float>::max();
+        for (int i = 0; i < count; ++i) {
+            float t;
+            const auto k = static_cast<std::size_t>(3 * i);
+            if (intersect_triangle(ray_, tris_[k], tris_[k + 1], tris_[k + 2], 0.0f, t) && t < best) {
+                best = t;
+                any = true;
+            }
+        }
+        if (!any || best > t_max_) return false;  // the walk resumes past this cell
+        hit_ = {true, c, best, 0, false, c};
+        return true;
+    }
+
+    const VolumeView<T>& v_;
+    const MinMaxOctree<T>& octree_;
+    Ray ray_;
+    glm::vec3 inv_d_{0};
+    double iso_ = 0;
+    IntersectMode mode_ = IntersectMode::exact;
+    float t_max_ = 0;
+    RayHit hit_;
+    std::size_t cells_tested_ = 0;
+    ResolutionMap resolution_;
+    std::array<glm::vec3, 3 * mc::kMaxTriangles> tris_{};
+};
+
+}  // namespace isowall

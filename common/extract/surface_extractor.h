@@ -1,0 +1,59 @@
+#pragma once
+// One volume with its octree, behind a voxel-type-free interface: the per-type cores (RayCaster,
+// Propagator, extract_full) are instantiated once per voxel type in surface_extractor.cpp, so
+// callers (the progressive engine, the CLI, the wall) are not templates.
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+
+#include "common/extract/adaptive.h"
+#include "common/extract/extract.h"
+#include "common/extract/propagator.h"
+#include "common/extract/raycaster.h"
+#include "common/volume/volume.h"
+
+namespace isowall {
+
+class SurfaceExtractor {
+public:
+    virtual ~SurfaceExtractor() = default;
+
+    virtual const Volume& volume() const = 0;
+    virtual double value_min() const = 0;
+    virtual double value_max() const = 0;
+    virtual const OctreeShape& octree_shape() const = 0;
+    virtual std::size_t octree_bytes() const = 0;
+
+    // Starts a frame at `iso` at full resolution: forgets every visited cell.
+    void begin_frame(double iso) { begin_frame(iso, ResolutionLevels{}); }
+    // Starts a frame at `iso` with the view's D[] (adaptive resolution, chapter 2.1.3): from now on
+    // cast() may hit meta-cells and propagate() runs at the level of its seed's unit.
+    virtual void begin_frame(double iso, const ResolutionLevels& levels) = 0;
+    virtual double iso() const = 0;
+
+    // `ray` in object space; t is returned in the ray's own parameter.
+    virtual RayHit cast(const Ray& ray, IntersectMode mode,
+                        float t_max = std::numeric_limits<float>::max()) = 0;
+    virtual bool visited(glm::ivec3 cell) const = 0;
+    virtual std::uint32_t group_of(glm::ivec3 cell) = 0;
+    virtual std::size_t visited_count() const = 0;
+    // A propagation pass from `seed` (must be active) for the seed ray `ray` (object space).
+    virtual Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
+                            const Ray& ray, const std::function<bool()>& interrupted = {}) = 0;
+    // The refinement group of the meta-cell of `level` at `unit` (a RayHit with refine set), or an
+    // empty group (no triangles) when this frame refined it already.
+    virtual Group refine(glm::ivec3 unit, int level, std::uint32_t group_id,
+                         const PropagationParams& p) = 0;
+    // Seconds of the last propagate() or refine() spent in marching cubes (the "extraction" stage).
+    virtual double last_extract_s() const = 0;
+    // Every triangle of the surface at `iso` (the oracle; does not touch visited cells).
+    virtual Mesh extract_full(double iso, ExtractStats* stats = nullptr) const = 0;
+};
+
+// Builds (or maps from the cache) the octree of `volume`, which must outlive the extractor.
+std::unique_ptr<SurfaceExtractor> make_surface_extractor(const Volume& volume,
+                                                         const OctreeSource& source = {},
+                                                         OctreeStats* stats = nullptr);
+
+}  // namespace isowall

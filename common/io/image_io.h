@@ -1,0 +1,22 @@
+#pragma once
+// Reading and writing frames with OpenImageIO. Writers go through a temporary file in the target
+// folder and rename it into place, so a failed or interrupted write never leaves a half-written
+// image behind. Every error is a std::runtime_error naming the file and OIIO's message.
+#include <filesystem>
+
+#include "common/core/image.h"
+
+namespace isowall {
+
+// Colour, format by extension (PNG, TIFF, ...): RGBA where the format stores alpha, else RGB.
+void write_image(const std::filesystem::path& path, const Image& image);
+// Window depth as one float channel "Z"; use an .exr path.
+void write_depth(const std::filesystem::path& path, const Image& image);
+
+// Colour of an 8-bit image (grey, grey+alpha, RGB or RGBA; missing alpha reads as opaque). Files
+// hold no depth, so depth is 1 (nothing drawn) everywhere.
+Image read_image(const std::filesystem::path& path);
+// The first channel of a depth file written by write_depth(); rgba is black.
+Image read_depth(const std::filesystem::path& path);
+
+}  // namespace isowall

@@ -1,0 +1,106 @@
+#include "common/progressive/trace.h"
+
+#include <time.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace isowall {
+namespace {
+
+double wall_now_s() {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+TraceRecorder::TraceRecorder() { switch_to(Stage::setup); }
+
+Stage TraceRecorder::switch_to(Stage stage) {
+    const Stage left = current_;
+    const double wall = wall_now_s(), cpu = thread_cpu_seconds();
+    if (open_) {
+        // Consecutive spans of one stage merge, so a chatty boundary does not grow the list.
+        if (!spans_.empty() && spans_.back().stage == static_cast<std::uint8_t>(current_) &&
+            spans_.back().start_s + spans_.back().wall_s >= wall0_ - 1e-9) {
+            spans_.back().wall_s = wall - spans_.back().start_s;
+            spans_.back().cpu_s += cpu - cpu0_;
+        } else {
+            spans_.push_back({static_cast<std::uint8_t>(current_), wall0_, wall - wall0_, cpu - cpu0_});
+        }
+    }
+    current_ = stage;
+    open_ = true;
+    wall0_ = wall;
+    cpu0_ = cpu;
+    return left;
+}
+
+void TraceRecorder::close() {
+    switch_to(current_);
+    open_ = false;
+}
+
+std::vector<double> TraceRecorder::cpu_by_stage() const {
+    std::vector<double> sum(std::size(kTraceStages), 0.0);
+    for (const TraceSpan& s : spans_) sum[s.stage] += s.cpu_s;
+    return sum;
+}
+
+void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks) {
+    std::ofstream out(path);
+    if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+    double t0 = 0;
+    bool first_span = true;
+    for (const RankTrace& r : ranks)
+        for (const TraceSpan& s : r.spans)
+            if (first_span || s.start_s < t0) {
+                t0 = s.start_s;
+                first_span = false;
+            }
+    out << "{\"displayTimeUnit\": \"ms\", \"traceEvents\": [\n";
+    bool first = true;
+    char line[512];
+    for (const RankTrace& r : ranks) {
+        std::snprintf(line, sizeof(line),
+                      "%s{\"name\": \"process_name\", \"ph\": \"M\", \"pid\": %d, \"tid\": 0, "
+                      "\"args\": {\"name\": \"rank %d (%s)\"}}",
+                      first ? "" : ",\n", r.rank, r.rank, r.label.c_str());
+        out << line;
+        first = false;
+        for (const TraceSpan& s : r.spans) {
+            std::snprintf(line, sizeof(line),
+                          ",\n{\"name\": \"%s\", \"ph\": \"X\", \"pid\": %d, \"tid\": 0, \"ts\": %.1f, "
+                          "\"dur\": %.1f, \"args\": {\"cpu_ms\": %.3f}}",
+                          kTraceStages[s.stage], r.rank, (s.start_s - t0) * 1e6, s.wall_s * 1e6,
+                          s.cpu_s * 1e3);
+            out << line;
+        }
+    }
+    out << "\n]}\n";
+    if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks) {
+    std::ofstream out(path);
+    if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+    out << "rank,label,stage,start_s,wall_s,cpu_s\n";
+    char line[256];
+    for (const RankTrace& r : ranks)
+        for (const TraceSpan& s : r.spans) {
+            std::snprintf(line, sizeof(line), "%d,%s,%s,%.6f,%.6f,%.6f\n", r.rank, r.label.c_str(),
+                          kTraceStages[s.stage], s.start_s, s.wall_s, s.cpu_s);
+            out << line;
+        }
+    if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+}  // namespace isowall

@@ -1,0 +1,142 @@
+#pragma once
+// A scalar volume: dims, spacing, voxel type, and read-only bytes that are either a memory map of
+// the file (raw encoding in host byte order: no copy) or an owned decoded buffer (gzip, swapped
+// endianness, generated volumes). Algorithms read it through a typed VolumeView<T>.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "common/core/box.h"
+#include "common/volume/mapped_file.h"
+
+namespace isowall {
+
+enum class VoxelType { u8, i8, u16, i16, u32, i32, f32, f64 };
+enum class Endian { little, big };
+
+std::size_t voxel_size(VoxelType t);
+std::string_view type_name(VoxelType t);  // "uint8", "int16", "float32", ...
+// Accepts our names and the common NRRD/C spellings (uchar, short, float, double, ...).
+std::optional<VoxelType> parse_voxel_type(std::string_view s);
+constexpr Endian host_endian() { return Endian::little; }  // x86-64 and aarch64 Linux
+
+template <class T>
+struct VolumeView {
+    const T* data = nullptr;
+    glm::ivec3 dims{0};
+    glm::vec3 spacing{1.0f};
+
+    std::size_t index(int x, int y, int z) const {
+        return (static_cast<std::size_t>(z) * dims.y + y) * dims.x + x;
+    }
+    T at(int x, int y, int z) const { return data[index(x, y, z)]; }
+    glm::ivec3 cell_dims() const { return glm::max(dims - 1, glm::ivec3(0)); }
+    std::size_t voxel_count() const {
+        return static_cast<std::size_t>(dims.x) * dims.y * dims.z;
+    }
+    // Object-space bounds: voxel index times spacing.
+    Box3 bounds() const {
+        Box3 b;
+        b.merge(glm::vec3(0));
+        b.merge(glm::vec3(dims - 1) * spacing);
+        return b;
+    }
+};
+
+class Volume {
+public:
+    Volume() = default;
+    // A volume over an owned buffer (must hold dims.x*dims.y*dims.z voxels of `type`).
+    Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::vector<std::byte> bytes,
+           std::string source);
+    // A volume over `count` bytes at `offset` of a mapped file.
+    Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile file,
+           std::size_t offset, std::string source);
+
+    glm::ivec3 dims() const { return dims_; }
+    glm::vec3 spacing() const { return spacing_; }
+    VoxelType type() const { return type_; }
+    const std::string& source() const { return source_; }  // file name or "phantom"
+    std::span<const std::byte> bytes() const { return bytes_; }
+    bool mapped() const { return file_.size() > 0; }
+    std::size_t voxel_count() const {
+        return static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
+    }
+    Box3 bounds() const;
+
+    template <class T>
+    VolumeView<T> view() const {
+        return {reinterpret_cast<const T*>(bytes_.data()), dims_, spacing_};
+    }
+
+private:
+    glm::ivec3 dims_{0};
+    glm::vec3 spacing_{1.0f};
+    VoxelType type_ = VoxelType::u8;
+    std::string source_;
+    MappedFile file_;
+    std::vector<std::byte> owned_;
+    std::span<const std::byte> bytes_;
+};
+
+// Calls f(T{}) with the C++ type of t, so one templated body serves every voxel type.
+template <class F>
+decltype(auto) dispatch_voxel_type(VoxelType t, F&& f) {
+    switch (t) {
+        case VoxelType::u8: return f(std::uint8_t{});
+        case VoxelType::i8: return f(std::int8_t{});
+        case VoxelType::u16: return f(std::uint16_t{});
+        case VoxelType::i16: return f(std::int16_t{});
+        case VoxelType::u32: return f(std::uint32_t{});
+        case VoxelType::i32: return f(std::int32_t{});
+        case VoxelType::f32: return f(float{});
+        case VoxelType::f64: return f(double{});
+    }
+    return f(std::uint8_t{});
+}
+
+template <class T>
+constexpr VoxelType voxel_type_of() {
+    if constexpr (std::is_same_v<T, std::uint8_t>) return VoxelType::u8;
+    else if constexpr (std::is_same_v<T, std::int8_t>) return VoxelType::i8;
+    else if constexpr (std::is_same_v<T, std::uint16_t>) return VoxelType::u16;
+    else if constexpr (std::is_same_v<T, std::int16_t>) return VoxelType::i16;
+    else if constexpr (std::is_same_v<T, std::uint32_t>) return VoxelType::u32;
+    else if constexpr (std::is_same_v<T, std::int32_t>) return VoxelType::i32;
+    else if constexpr (std::is_same_v<T, float>) return VoxelType::f32;
+    else return VoxelType::f64;
+}
+
+struct RawSpec {
+    glm::ivec3 dims{0};
+    VoxelType type = VoxelType::u8;
+    glm::vec3 spacing{1.0f};
+    Endian endian = Endian::little;
+    std::size_t header_bytes = 0;  // bytes to skip at the start of the file
+};
+
+// Headerless voxels, x fastest. The file must hold exactly header_bytes + voxels * size bytes.
+Volume load_raw(const std::filesystem::path& path, const RawSpec& spec);
+// NRRD through Teem: attached or detached header, raw or gzip (any encoding Teem reads).
+// Raw data in host byte order is memory-mapped, everything else decoded into memory.
+Volume load_nrrd(const std::filesystem::path& path);
+// Picks the loader by extension (.nrrd/.nhdr -> NRRD, anything else needs a RawSpec).
+Volume load_volume(const std::filesystem::path& path, const std::optional<RawSpec>& raw);
+
+// Writes through Teem (for tests and conversions): encoding "raw" or "gzip"; detached when the
+// path ends in .nhdr (data beside it as NAME.raw or NAME.raw.gz).
+void save_nrrd(const std::filesystem::path& path, const Volume& volume, std::string_view encoding,
+               Endian endian);
+
+// Reverses the byte order of every voxel in place.
+void swap_bytes(std::span<std::byte> bytes, std::size_t voxel_size);
+
+}  // namespace isowall

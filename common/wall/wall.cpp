@@ -1,0 +1,424 @@
+#include "common/wall/wall.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include <toml++/toml.h>
+
+#include "common/core/error.h"
+
+namespace isowall {
+namespace {
+
+// A TOML value as the user wrote it, for "got ..." in error messages (toml++'s own printer
+// pads arrays as "[ 6, 0 ]" and can span lines).
+std::string describe(const toml::node& node) {
+    std::ostringstream os;
+    if (const auto* a = node.as_array()) {
+        os << '[';
+        for (size_t i = 0; i < a->size(); ++i) os << (i ? ", " : "") << describe(*a->get(i));
+        os << ']';
+    } else if (node.is_table()) {
+        os << "a table";
+    } else if (const auto* s = node.as_string()) {
+        os << '"' << s->get() << '"';
+    } else if (const auto* b = node.as_boolean()) {
+        os << (b->get() ? "true" : "false");
+    } else if (const auto* i = node.as_integer()) {
+        os << i->get();
+    } else if (const auto* f = node.as_floating_point()) {
+        // Keep 2.0 looking like a float, or "expected integers, got [2, 2]" reads as nonsense.
+        os << f->get() << (std::isfinite(f->get()) && f->get() == std::floor(f->get()) ? ".0" : "");
+    } else {
+        os << "a date or time";
+    }
+    return os.str();
+}
+
+// Reads one table, naming fields with their dotted path, so every error says where it is.
+class Reader {
+  public:
+    Reader(const std::string& where, const toml::table& table, std::string prefix)
+        : where_(where), table_(table), prefix_(std::move(prefix)) {}
+
+    [[noreturn]] void fail(std::string_view key, const std::string& message) const {
+        throw InputError(where_, field(key), message);
+    }
+
+    std::string field(std::string_view key) const { return prefix_ + std::string(key); }
+
+    // Unknown keys are errors: a misspelt optional key would otherwise be silently ignored.
+    void check_keys(std::initializer_list<std::string_view> allowed) const {
+        for (auto&& [key, node] : table_) {
+            if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
+            std::string list;
+            for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+            fail(key.str(), "unknown key; expected one of " + list);
+        }
+    }
+
+    const toml::node* find(std::string_view key) const { return table_.get(key); }
+
+    const toml::node& require(std::string_view key, const std::string& expected) const {
+        const toml::node* n = find(key);
+        if (!n) fail(key, "missing; expected " + expected);
+        return *n;
+    }
+
+    // `count` integers, each at least `min`.
+    std::vector<int> ints(std::string_view key, size_t count, long long min,
+                          const std::string& expected) const {
+        const toml::node& n = require(key, expected);
+        const auto* a = n.as_array();
+        std::vector<int> out;
+        if (a && a->size() == count)
+            for (const toml::node& e : *a) {
+                const auto* i = e.as_integer();
+                if (!i || i->get() < min || i->get() > std::numeric_limits<int>::max()) break;
+                out.push_back(static_cast<int>(i->get()));
+            }
+        if (out.size() != count) fail(key, "expected " + expected + ", got " + describe(n));
+        return out;
+    }
+
+    static std::optional<double> number(const toml::node& n) {
+        if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
+        if (const auto* f = n.as_floating_point())
+            if (std::isfinite(f->get())) return f->get();
+        return std::nullopt;
+    }
+
+    std::vector<double> numbers(std::string_view key, size_t count, bool positive,
+                                const std::string& expected) const {
+        const toml::node& n = require(key, expected);
+        const auto* a = n.as_array();
+        std::vector<double> out;
+        if (a && a->size() == count)
+            for (const toml::node& e : *a) {
+                const auto v = number(e);
+                if (!v || (positive && *v <= 0)) break;
+                out.push_back(*v);
+            }
+        if (out.size() != count) fail(key, "expected " + expected + ", got " + describe(n));
+        return out;
+    }
+
+    const std::string& where() const { return where_; }
+
+  private:
+    const std::string& where_;
+    const toml::table& table_;
+    std::string prefix_;
+};
+
+// bezel_px / bezel_mm: one number for all four sides, or a table {left, right, top, bottom}
+// with missing sides 0.
+template <typename T>
+void read_bezels(const Reader& r, std::string_view key, T& left, T& right, T& top, T& bottom) {
+    const toml::node* n = r.find(key);
+    if (!n) return;
+    const bool integer = std::is_integral_v<T>;
+    const std::string expected =
+        integer ? "an integer or a table {left, right, top, bottom} of integers"
+                : "a number or a table {left, right, top, bottom} of numbers";
+    auto value = [&](const toml::node& v) -> std::optional<T> {
+        if (integer) {
+            const auto* i = v.as_integer();
+            if (!i || std::abs(i->get()) > 1'000'000) return std::nullopt;
+            return static_cast<T>(i->get());
+        }
+        const auto d = Reader::number(v);
+        return d ? std::optional<T>(static_cast<T>(*d)) : std::nullopt;
+    };
+    if (const auto* t = n->as_table()) {
+        const Reader sides(r.where(), *t, r.field(key) + ".");
+        sides.check_keys({"left", "right", "top", "bottom"});
+        for (auto [name, out] : {std::pair<std::string_view, T*>{"left", &left},
+                                 {"right", &right},
+                                 {"top", &top},
+                                 {"bottom", &bottom}})
+            if (const toml::node* s = sides.find(name)) {
+                const auto v = value(*s);
+                if (!v)
+                    sides.fail(name, "expected " +
+                                         std::string(integer ? "an integer" : "a number") +
+                                         ", got " + describe(*s));
+                *out = *v;
+            }
+        return;
+    }
+    const auto v = value(*n);
+    if (!v) r.fail(key, "expected " + expected + ", got " + describe(*n));
+    left = right = top = bottom = *v;
+}
+
+RankOrder read_rank_order(const Reader& r) {
+    const toml::node* n = r.find("rank_order");
+    if (!n) return RankOrder::row_major;
+    const auto* s = n->as_string();
+    for (RankOrder o : {RankOrder::row_major, RankOrder::column_major, RankOrder::serpentine})
+        if (s && s->get() == to_string(o)) return o;
+    r.fail("rank_order",
+           "expected \"row-major\", \"column-major\" or \"serpentine\", got " + describe(*n));
+}
+
+PhysicalSize read_physical(const Reader& top, WallSpec& spec) {
+    const toml::node* n = top.find("physical");
+    const auto* t = n->as_table();
+    if (!t) top.fail("physical", "expected a table, got " + describe(*n));
+    const Reader r(top.where(), *t, "physical.");
+    r.check_keys({"tile_size_mm", "bezel_mm", "viewer_mm"});
+    PhysicalSize p;
+    const auto size = r.numbers("tile_size_mm", 2, true, "two positive numbers (width, height)");
+    p.tile_width_mm = size[0];
+    p.tile_height_mm = size[1];
+    if (r.find("bezel_mm")) {
+        if (top.find("bezel_px"))
+            r.fail("bezel_mm", "conflicts with bezel_px; give the bezels once, in mm or in pixels");
+        BezelsMm& b = p.bezel_mm;
+        read_bezels(r, "bezel_mm", b.left, b.right, b.top, b.bottom);
+        // The pixel pitch of the tile carries the bezels into pixels, so the virtual screen keeps
+        // the wall's true proportions and lines stay straight across the mullions.
+        const double pitch_x = p.tile_width_mm / spec.tile_width_px;
+        const double pitch_y = p.tile_height_mm / spec.tile_height_px;
+        spec.bezel_px = {static_cast<int>(std::lround(b.left / pitch_x)),
+                         static_cast<int>(std::lround(b.right / pitch_x)),
+                         static_cast<int>(std::lround(b.top / pitch_y)),
+                         static_cast<int>(std::lround(b.bottom / pitch_y))};
+    }
+    if (r.find("viewer_mm")) {
+        const auto v = r.numbers("viewer_mm", 3, false, "three numbers (x, y, z) with z > 0");
+        if (v[2] <= 0)
+            r.fail("viewer_mm", "expected three numbers (x, y, z) with z > 0, got " +
+                                    describe(*r.find("viewer_mm")));
+        p.viewer_mm = glm::dvec3(v[0], v[1], v[2]);
+    }
+    return p;
+}
+
+void read_overrides(const Reader& top, WallSpec& spec) {
+    const toml::node* n = top.find("tile");
+    const auto* a = n->as_array();
+    if (!a || !a->is_array_of_tables())
+        top.fail("tile", "expected [[tile]] tables, got " + describe(*n));
+    for (size_t i = 0; i < a->size(); ++i) {
+        const Reader r(top.where(), *a->get(i)->as_table(), "tile[" + std::to_string(i) + "].");
+        r.check_keys({"column", "row", "disabled", "offset_px"});
+        TileOverride o;
+        auto index = [&](std::string_view key, int count) {
+            const std::string expected = "an integer in [0, " + std::to_string(count - 1) + "]";
+            const toml::node& v = r.require(key, expected);
+            const auto* iv = v.as_integer();
+            if (!iv || iv->get() < 0 || iv->get() >= count)
+                r.fail(key, "expected " + expected + ", got " + describe(v));
+            return static_cast<int>(iv->get());
+        };
+        o.column = index("column", spec.columns);
+        o.row = index("row", spec.rows);
+        if (const toml::node* d = r.find("disabled")) {
+            const auto* b = d->as_boolean();
+            if (!b) r.fail("disabled", "expected true or false, got " + describe(*d));
+            o.disabled = b->get();
+        }
+        if (r.find("offset_px")) {
+            const auto off = r.ints("offset_px", 2, -1'000'000, "two integers (x right, y down)");
+            o.offset_x_px = off[0];
+            o.offset_y_px = off[1];
+        }
+        for (const TileOverride& prev : spec.overrides)
+            if (prev.column == o.column && prev.row == o.row)
+                r.fail("column", "tile (" + std::to_string(o.column) + ", " +
+                                     std::to_string(o.row) + ") is given twice");
+        spec.overrides.push_back(o);
+    }
+    if (rank_count(spec) == 1) top.fail("tile", "every tile is disabled; expected at least one");
+}
+
+const TileOverride* override_of(const WallSpec& spec, int tile_index) {
+    for (const TileOverride& o : spec.overrides)
+        if (o.row * spec.columns + o.column == tile_index) return &o;
+    return nullptr;
+}
+
+void check_tile(const WallSpec& spec, int tile_index) {
+    if (tile_index < 0 || tile_index >= tile_count(spec))
+        throw std::out_of_range("tile index " + std::to_string(tile_index) + " outside [0, " +
+                                std::to_string(tile_count(spec)) + ")");
+}
+
+// The tile at position k of the rank order, disabled tiles included.
+int tile_at_order(const WallSpec& spec, int k) {
+    switch (spec.rank_order) {
+        case RankOrder::row_major:
+            return k;
+        case RankOrder::column_major:
+            return (k % spec.rows) * spec.columns + k / spec.rows;
+        case RankOrder::serpentine: {
+            const int row = k / spec.columns, c = k % spec.columns;
+            return row * spec.columns + (row % 2 ? spec.columns - 1 - c : c);
+        }
+    }
+    return k;
+}
+
+}  // namespace
+
+std::string to_string(RankOrder order) {
+    switch (order) {
+        case RankOrder::row_major:
+            return "row-major";
+        case RankOrder::column_major:
+            return "column-major";
+        case RankOrder::serpentine:
+            return "serpentine";
+    }
+    return "?";
+}
+
+WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
+    toml::table doc;
+    try {
+        doc = toml::parse(toml_text, where);
+    } catch (const toml::parse_error& e) {
+        std::string msg(e.description());
+        std::replace(msg.begin(), msg.end(), '\n', ' ');
+        const auto& pos = e.source().begin;
+        throw InputError(
+            where, "line " + std::to_string(pos.line) + ", column " + std::to_string(pos.column),
+            "TOML syntax: " + msg);
+    }
+    const Reader r(where, doc, "");
+    r.check_keys({"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile"});
+
+    WallSpec spec;
+    const auto tiles = r.ints("tiles", 2, 1, "two positive integers (columns, rows)");
+    spec.columns = tiles[0];
+    spec.rows = tiles[1];
+    if (static_cast<long long>(spec.columns) * spec.rows > 1'000'000)
+        r.fail("tiles", "expected at most a million tiles, got " + describe(*r.find("tiles")));
+    const auto size = r.ints("tile_size_px", 2, 1, "two positive integers (width, height)");
+    spec.tile_width_px = size[0];
+    spec.tile_height_px = size[1];
+    Bezels& b = spec.bezel_px;
+    read_bezels(r, "bezel_px", b.left, b.right, b.top, b.bottom);
+    spec.rank_order = read_rank_order(r);
+    if (r.find("physical")) spec.physical = read_physical(r, spec);
+
+    // Overlap of a whole tile or more would reorder the tiles on the virtual screen.
+    const std::string bezel_field = r.find("bezel_px") ? "bezel_px" : "physical.bezel_mm";
+    if (b.left + b.right <= -spec.tile_width_px)
+        throw InputError(where, bezel_field,
+                         "expected horizontal overlap (-(left + right) = " +
+                             std::to_string(-(b.left + b.right)) +
+                             " px) less than the tile width " + std::to_string(spec.tile_width_px));
+    if (b.top + b.bottom <= -spec.tile_height_px)
+        throw InputError(
+            where, bezel_field,
+            "expected vertical overlap (-(top + bottom) = " + std::to_string(-(b.top + b.bottom)) +
+                " px) less than the tile height " + std::to_string(spec.tile_height_px));
+
+    if (r.find("tile")) read_overrides(r, spec);
+    return spec;
+}
+
+WallSpec load_wall(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path.string(), "file", "cannot be opened");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_wall(text.str(), path.string());
+}
+
+int tile_count(const WallSpec& spec) {
+    return spec.columns * spec.rows;
+}
+
+int tile_index(const WallSpec& spec, int column, int row) {
+    return row * spec.columns + column;
+}
+
+bool tile_enabled(const WallSpec& spec, int tile_index) {
+    check_tile(spec, tile_index);
+    const TileOverride* o = override_of(spec, tile_index);
+    return !(o && o->disabled);
+}
+
+int rank_count(const WallSpec& spec) {
+    int disabled = 0;
+    for (const TileOverride& o : spec.overrides) disabled += o.disabled ? 1 : 0;
+    return 1 + tile_count(spec) - disabled;
+}
+
+PixelSize virtual_screen_size(const WallSpec& spec) {
+    const Bezels& b = spec.bezel_px;
+    return {spec.columns * spec.tile_width_px + (spec.columns - 1) * (b.left + b.right),
+            spec.rows * spec.tile_height_px + (spec.rows - 1) * (b.top + b.bottom)};
+}
+
+PixelRect tile_rect(const WallSpec& spec, int tile_index) {
+    check_tile(spec, tile_index);
+    const Bezels& b = spec.bezel_px;
+    const int column = tile_index % spec.columns, row = tile_index / spec.columns;
+    PixelRect r{column * (spec.tile_width_px + b.left + b.right),
+                row * (spec.tile_height_px + b.top + b.bottom), spec.tile_width_px,
+                spec.tile_height_px};
+    if (const TileOverride* o = override_of(spec, tile_index)) {
+        r.x += o->offset_x_px;
+        r.y += o->offset_y_px;
+    }
+    return r;
+}
+
+Frustum tile_frustum(const Frustum& wall, const WallSpec& spec, int tile_index) {
+    const PixelSize screen = virtual_screen_size(spec);
+    return sub_frustum(wall, screen.width, screen.height, tile_rect(spec, tile_index));
+}
+
+int tile_of_rank(const WallSpec& spec, int rank) {
+    if (rank < 0 || rank >= rank_count(spec))
+        throw std::out_of_range("rank " + std::to_string(rank) + " outside [0, " +
+                                std::to_string(rank_count(spec)) + ")");
+    if (rank == kMasterRank) return kNoTile;
+    // Walk the rank order, skipping disabled tiles; walls are small enough that this is free.
+    for (int k = 0, seen = 0; k < tile_count(spec); ++k) {
+        const int tile = tile_at_order(spec, k);
+        if (tile_enabled(spec, tile) && ++seen == rank) return tile;
+    }
+    return kNoTile;  // unreachable: rank < rank_count
+}
+
+int rank_of_tile(const WallSpec& spec, int tile_index) {
+    check_tile(spec, tile_index);
+    if (!tile_enabled(spec, tile_index)) return kNoRank;
+    for (int k = 0, rank = 0; k < tile_count(spec); ++k) {
+        const int tile = tile_at_order(spec, k);
+        if (tile_enabled(spec, tile)) ++rank;
+        if (tile == tile_index) return rank;
+    }
+    return kNoRank;  // unreachable: every tile appears once in the order
+}
+
+std::ostream& operator<<(std::ostream& os, const WallSpec& spec) {
+    const Bezels& b = spec.bezel_px;
+    os << "WallSpec{" << spec.columns << "x" << spec.rows << " tiles of " << spec.tile_width_px
+       << "x" << spec.tile_height_px << " px, bezel_px l" << b.left << " r" << b.right << " t"
+       << b.top << " b" << b.bottom << ", " << to_string(spec.rank_order);
+    if (spec.physical)
+        os << ", tile " << spec.physical->tile_width_mm << "x" << spec.physical->tile_height_mm
+           << " mm";
+    for (const TileOverride& o : spec.overrides)
+        os << ", tile (" << o.column << "," << o.row << ")" << (o.disabled ? " disabled" : "")
+           << " offset " << o.offset_x_px << "," << o.offset_y_px;
+    return os << "}";
+}
+
+std::ostream& operator<<(std::ostream& os, const PixelRect& r) {
+    return os << "PixelRect{" << r.x << ", " << r.y << ", " << r.width << "x" << r.height << "}";
+}
+
+}  // namespace isowall
