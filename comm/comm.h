@@ -1,94 +1,66 @@
 #pragma once
-// The thin messaging layer between the master and the tile ranks (STYLE.md: IceT's communicator,
-// OSPRay's MPI_CALL). Only comm_mpi.cpp includes mpi.h; the wall logic talks to this interface.
+// The thin messaging layer between the ranks of a wall run (STYLE.md: IceT's communicator,
+// OSPRay's MPI_CALL). Two transports: MPI (comm/mpi_comm.cpp, the only file that includes mpi.h)
+// and in-process (comm/inproc_comm.h: every rank a thread, for tests). The wall logic sees only
+// this interface and the typed messages of comm/protocol.h.
 #include <cstddef>
-#include <cstdint>
-#include <cstring>
-#include <stdexcept>
+#include <limits>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "comm/protocol.h"
 #include "common/wall/wall.h"  // kMasterRank
 
 namespace isowall {
 
-// view: master -> tile, a new frame (interrupts the current one); snapshot: master -> tile, send
-// the current image; quit: master -> tile, send the final result and stop; progress and image:
-// tile -> master; tile_result: tile -> master, the last message of a tile; hello: tile -> master,
-// its host name, first thing.
-enum class Tag : int { view = 1, tile_result = 2, snapshot = 3, quit = 4, progress = 5, image = 6, hello = 7 };
+inline constexpr double kForever = std::numeric_limits<double>::infinity();
 
+struct Envelope {
+    int from = -1;
+    Tag tag{};
+    std::vector<std::byte> bytes;
+};
+
+// Thrown on every rank of an in-process world once any rank aborts it (the MPI transport ends the
+// processes instead), so blocked threads wake up and unwind.
+class CommAborted : public std::runtime_error {
+  public:
+    explicit CommAborted(int code) : std::runtime_error("the job was ended"), code_(code) {}
+    int code() const { return code_; }
+
+  private:
+    int code_;
+};
+
+// Thread-safe: a rank's frame thread may send while its communication thread receives.
 class Comm {
-public:
+  public:
     virtual ~Comm() = default;
     virtual int rank() const = 0;
     virtual int size() const = 0;
     bool is_master() const { return rank() == kMasterRank; }
     virtual std::string host() const = 0;
     virtual void send(int dest, Tag tag, std::span<const std::byte> bytes) = 0;
-    // Blocks until a message with `tag` from `source` arrives.
-    virtual std::vector<std::byte> recv(int source, Tag tag) = 0;
-    // The tag of a message from `source` (any rank when source < 0) waiting to be received, if
-    // any (does not block).
-    virtual std::optional<Tag> probe(int source) = 0;
-    // Blocks until any message from `source` (or from any rank when source < 0) arrives.
-    virtual std::pair<Tag, std::vector<std::byte>> recv_any(int source, int* from = nullptr) = 0;
+    // The next message from `source` (any rank when source < 0), waiting at most timeout_s
+    // (0: only look, kForever: block); nullopt when none came in time.
+    virtual std::optional<Envelope> receive(int source, double timeout_s) = 0;
     virtual void barrier() = 0;
     // Ends every rank of the job at once (a failing rank must not leave others waiting).
     [[noreturn]] virtual void abort(int code) = 0;
 };
 
-// MPI_Init (once) and a duplicate of MPI_COMM_WORLD, so our traffic never matches anyone
-// else's. Finalizes MPI when destroyed.
+template <class T>
+void send_message(Comm& comm, int dest, const T& message) {
+    comm.send(dest, T::kTag, encode(message));
+}
+
+// MPI_Init (once, asking for MPI_THREAD_SERIALIZED: calls are serialised by a lock) and a
+// duplicate of MPI_COMM_WORLD, so our traffic never matches anyone else's. Finalizes MPI when
+// destroyed.
 std::unique_ptr<Comm> make_mpi_comm(int& argc, char**& argv);
-
-// Little-endian message building, with a version byte first: never raw padded structs.
-class MessageWriter {
-public:
-    explicit MessageWriter(std::uint8_t version) { put(version); }
-    template <class T>
-    void put(const T& value) {
-        const auto* p = reinterpret_cast<const std::byte*>(&value);
-        bytes_.insert(bytes_.end(), p, p + sizeof(T));
-    }
-    void put_bytes(std::span<const std::byte> b) {
-        put(static_cast<std::uint64_t>(b.size()));
-        bytes_.insert(bytes_.end(), b.begin(), b.end());
-    }
-    const std::vector<std::byte>& bytes() const { return bytes_; }
-
-private:
-    std::vector<std::byte> bytes_;
-};
-
-class MessageReader {
-public:
-    MessageReader(std::span<const std::byte> bytes, std::uint8_t version) : bytes_(bytes) {
-        if (get<std::uint8_t>() != version) throw std::runtime_error("message: wrong version");
-    }
-    template <class T>
-    T get() {
-        if (pos_ + sizeof(T) > bytes_.size()) throw std::runtime_error("message: truncated");
-        T value;
-        std::memcpy(&value, bytes_.data() + pos_, sizeof(T));
-        pos_ += sizeof(T);
-        return value;
-    }
-    std::span<const std::byte> get_bytes() {
-        const auto n = static_cast<std::size_t>(get<std::uint64_t>());
-        if (pos_ + n > bytes_.size()) throw std::runtime_error("message: truncated");
-        auto s = bytes_.subspan(pos_, n);
-        pos_ += n;
-        return s;
-    }
-
-private:
-    std::span<const std::byte> bytes_;
-    std::size_t pos_ = 0;
-};
 
 }  // namespace isowall

@@ -4,14 +4,13 @@
 #include <cstdio>
 #include <filesystem>
 
-
 #include "common/core/camera.h"
 #include "common/core/error.h"
-#include "common/volume/phantom.h"
-#include "common/io/ply.h"
-#include "common/extract/surface_extractor.h"
 #include "common/core/util.h"
+#include "common/extract/surface_extractor.h"
 #include "common/io/image_io.h"
+#include "common/io/ply.h"
+#include "common/volume/phantom.h"
 #include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 
@@ -24,14 +23,16 @@ struct Timings {
     double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
     void print(std::size_t triangles) const {
         if (frame >= 0) {
-            std::printf("timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
-                        " | triangles %zu | peak RSS %.1f MiB\n",
-                        load, octree, frame, write, triangles, peak_rss_mib());
+            std::printf(
+                "timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
+                " | triangles %zu | peak RSS %.1f MiB\n",
+                load, octree, frame, write, triangles, peak_rss_mib());
             return;
         }
-        std::printf("timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
-                    " | triangles %zu | peak RSS %.1f MiB\n",
-                    load, octree, extract, render, write, triangles, peak_rss_mib());
+        std::printf(
+            "timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
+            " | triangles %zu | peak RSS %.1f MiB\n",
+            load, octree, extract, render, write, triangles, peak_rss_mib());
     }
 };
 
@@ -53,14 +54,17 @@ std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t) {
     }
     if (!st.cache_note.empty()) std::printf("octree: note: %s\n", st.cache_note.c_str());
     const OctreeShape& shape = ex->octree_shape();
-    std::printf("octree: %zu levels, depth %d, %zu nodes, %.2f MiB = %.2f%% of the volume bytes, values [%g, %g]\n",
-                shape.levels.size(), shape.depth(), shape.node_count,
-                double(ex->octree_bytes()) / (1024.0 * 1024.0), 100.0 * share, ex->value_min(),
-                ex->value_max());
+    std::printf(
+        "octree: %zu levels, depth %d, %zu nodes, %.2f MiB = %.2f%% of the volume bytes, values "
+        "[%g, %g]\n",
+        shape.levels.size(), shape.depth(), shape.node_count,
+        double(ex->octree_bytes()) / (1024.0 * 1024.0), 100.0 * share, ex->value_min(),
+        ex->value_max());
     return ex;
 }
 
-double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov, const SurfaceExtractor& ex) {
+double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov,
+                   const SurfaceExtractor& ex) {
     const std::string where = ov.file ? ov.file->string() : std::string("phantom");
     if (!iso) {
         if (!ov.file) return kPhantomSkinIso;
@@ -80,10 +84,11 @@ Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
     Stopwatch sw;
     Mesh mesh = ex.extract_full(iso, &es);
     t.extract = sw.seconds();
-    std::printf("extract: iso %g: %zu triangles, %zu vertices, %zu active cells, %zu octree nodes "
-                "visited, %zu leaf bricks scanned (%.3f s)\n",
-                iso, mesh.triangle_count(), mesh.vertex_count(), es.cells_active, es.nodes_visited,
-                es.leaves_active, t.extract);
+    std::printf(
+        "extract: iso %g: %zu triangles, %zu vertices, %zu active cells, %zu octree nodes "
+        "visited, %zu leaf bricks scanned (%.3f s)\n",
+        iso, mesh.triangle_count(), mesh.vertex_count(), es.cells_active, es.nodes_visited,
+        es.leaves_active, t.extract);
     return mesh;
 }
 
@@ -115,12 +120,12 @@ EngineOptions engine_options(const RenderOptions& o) {
 }
 
 // Both measures: the share of final pixels (chapters 2-3, which the dissertation's tables call C)
-// and C = 1 - E (section 4.2). The second counts an undrawn pixel as a full error and takes the RMS,
-// so C = 0.99 allows only 0.01% of the significant pixels to be missing.
+// and C = 1 - E (section 4.2). The second counts an undrawn pixel as a full error and takes the
+// RMS, so C = 0.99 allows only 0.01% of the significant pixels to be missing.
 void print_thresholds(const FrameResult& fr) {
     std::printf("correctness (replayed against the final image):\n");
-    std::printf("  %-20s %10s %10s %12s %12s %9s\n", "point", "time s", "rays", "rays %", "triangles",
-                "groups");
+    std::printf("  %-20s %10s %10s %12s %12s %9s\n", "point", "time s", "rays", "rays %",
+                "triangles", "groups");
     auto row = [&](const std::string& label, const std::optional<std::size_t>& i) {
         if (!i) {
             std::printf("  %-20s %10s\n", label.c_str(), "not reached");
@@ -133,69 +138,16 @@ void print_thresholds(const FrameResult& fr) {
     for (Measure m : {Measure::final_pixels, Measure::c}) {
         const char* name = m == Measure::c ? "C=1-E" : "final px";
         for (double th : {0.90, 0.99, 0.999})
-            row(std::string(name) + " >= " + percent_label(100 * th) + "%", first_reaching(fr.timeline, th, m));
+            row(std::string(name) + " >= " + percent_label(100 * th) + "%",
+                first_reaching(fr.timeline, th, m));
         row(std::string(name) + " = 100%", first_reaching(fr.timeline, 1.0, m));
     }
     row("all rays", fr.timeline.size() - 1);
 }
 
-std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
-                       const FrameView& fv, Timings& t) {
-    ProgressiveEngine engine(ex, renderer, engine_options(o));
-    auto progress = [&](const TimelineSample& s) {
-        if (o.quiet) return;
-        std::printf("  %7.2f s  level %2d  rays %9zu (%6.2f%%)  groups %6zu  triangles %9zu\n", s.time_s,
-                    s.level, s.rays, 100.0 * double(s.rays) / double(fv.width) / double(fv.height),
-                    s.groups, s.triangles);
-        std::fflush(stdout);
-    };
-    FrameResult fr = engine.run(fv, {}, progress);
-    const TimelineSample& last = fr.timeline.back();
-    t.frame = fr.elapsed_s;
-    std::printf("progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
-                "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
-                std::string(to_string(engine.options().order)).c_str(), o.engine.intersect.c_str(),
-                o.engine.propagation == "angle" ? "cut-off angle"
-                                                : ("max count " + std::to_string(o.engine.max_count)).c_str(),
-                fr.rays_cast, 100.0 * double(fr.rays_cast) / double(fr.rays_screen),
-                fr.screen_rect.width, fr.screen_rect.height, fr.elapsed_s, fr.groups.size(),
-                last.triangles, last.cells_visited);
-    std::printf("stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
-                last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
-
-    Stopwatch sw;
-    write_image(o.out, fr.final_image);
-    if (!o.depth_out.empty()) write_depth(o.depth_out, fr.final_image);
-    t.write = sw.seconds();
-    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ", o.depth_out.c_str());
-
-    const bool want_measure = !o.no_measure || !o.timeline.empty() || !o.snapshots.empty() ||
-                              !o.snapshot_rays.empty();
-    if (!want_measure) return last.triangles;
-    sw.restart();
-    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
-    engine.measure(fr, fv, [&](const TimelineSample& s, const Image& img) {
-        for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
-            const double m = o.snapshot_measure == "c" ? s.correctness.c : s.correctness.final_pixels;
-            if (c_done[k] || m < o.snapshots[k] / 100.0) continue;
-            c_done[k] = true;
-            const auto path = with_suffix(o.out, (o.snapshot_measure == "c" ? "_c" : "_final") +
-                                                     percent_label(o.snapshots[k]));
-            write_image(path, img);
-            std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n", path.c_str(),
-                        s.correctness.c, s.correctness.final_pixels, s.time_s, s.rays);
-        }
-        for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
-            if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
-            r_done[k] = true;
-            const auto path = with_suffix(o.out, "_r" + std::to_string(o.snapshot_rays[k]));
-            write_image(path, img);
-            std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
-        }
-    });
-    print_thresholds(fr);
-    // The floor for "C = 99% in time T": drawing the same triangles in one go, with no
-    // extraction at all (the benchmark's target compares T with this).
+// The floor for "C = 99% in time T": drawing the same triangles in one go, with no extraction at
+// all (the benchmark's target compares T with this).
+void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& renderer) {
     for (Measure m : {Measure::final_pixels, Measure::c}) {
         const auto i = first_reaching(fr.timeline, 0.99, m);
         if (!i) continue;
@@ -207,15 +159,80 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         renderer.draw(merged, fv.camera.view(), fv.frustum.matrix());
         renderer.finish();
         const double draw_s = draw.seconds();
-        std::printf("draw-only: the %zu triangles on screen at %s >= 99%% draw in %.3f s; the "
-                    "engine took %.3f s (%.2fx)\n",
-                    merged.triangle_count(), m == Measure::c ? "C" : "final px", draw_s,
-                    fr.timeline[*i].time_s, fr.timeline[*i].time_s / std::max(draw_s, 1e-9));
+        std::printf(
+            "draw-only: the %zu triangles on screen at %s >= 99%% draw in %.3f s; the "
+            "engine took %.3f s (%.2fx)\n",
+            merged.triangle_count(), m == Measure::c ? "C" : "final px", draw_s,
+            fr.timeline[*i].time_s, fr.timeline[*i].time_s / std::max(draw_s, 1e-9));
     }
+}
+
+std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                               const FrameView& fv, Timings& t) {
+    ProgressiveEngine engine(ex, renderer, engine_options(o));
+    auto progress = [&](const TimelineSample& s) {
+        if (o.quiet) return;
+        std::printf("  %7.2f s  level %2d  rays %9zu (%6.2f%%)  groups %6zu  triangles %9zu\n",
+                    s.time_s, s.level, s.rays,
+                    100.0 * double(s.rays) / double(fv.width) / double(fv.height), s.groups,
+                    s.triangles);
+        std::fflush(stdout);
+    };
+    FrameResult fr = engine.run(fv, nullptr, progress);
+    const TimelineSample& last = fr.timeline.back();
+    t.frame = fr.elapsed_s;
+    std::printf(
+        "progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
+        "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
+        std::string(to_string(engine.options().order)).c_str(), o.engine.intersect.c_str(),
+        o.engine.propagation == "angle"
+            ? "cut-off angle"
+            : ("max count " + std::to_string(o.engine.max_count)).c_str(),
+        fr.rays_cast, 100.0 * double(fr.rays_cast) / double(fr.rays_screen), fr.screen_rect.width,
+        fr.screen_rect.height, fr.elapsed_s, fr.groups.size(), last.triangles, last.cells_visited);
+    std::printf(
+        "stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
+        last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+
+    Stopwatch sw;
+    write_image(o.out, fr.final_image);
+    if (!o.depth_out.empty()) write_depth(o.depth_out, fr.final_image);
+    t.write = sw.seconds();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
+                o.depth_out.c_str());
+
+    const bool want_measure =
+        !o.no_measure || !o.timeline.empty() || !o.snapshots.empty() || !o.snapshot_rays.empty();
+    if (!want_measure) return last.triangles;
+    sw.restart();
+    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
+    engine.measure(fr, fv, [&](const TimelineSample& s, const Image& img) {
+        for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
+            const double m =
+                o.snapshot_measure == "c" ? s.correctness.c : s.correctness.final_pixels;
+            if (c_done[k] || m < o.snapshots[k] / 100.0) continue;
+            c_done[k] = true;
+            const auto path = with_suffix(o.out, (o.snapshot_measure == "c" ? "_c" : "_final") +
+                                                     percent_label(o.snapshots[k]));
+            write_image(path, img);
+            std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n",
+                        path.c_str(), s.correctness.c, s.correctness.final_pixels, s.time_s,
+                        s.rays);
+        }
+        for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
+            if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
+            r_done[k] = true;
+            const auto path = with_suffix(o.out, "_r" + std::to_string(o.snapshot_rays[k]));
+            write_image(path, img);
+            std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
+        }
+    });
+    print_thresholds(fr);
+    print_draw_only(fr, fv, renderer);
     if (!o.timeline.empty()) {
         write_timeline_csv(o.timeline, fr.timeline, fr.rays_screen);
-        std::printf("wrote %s (%zu samples; plot with scripts/plot_timeline.py)\n", o.timeline.c_str(),
-                    fr.timeline.size());
+        std::printf("wrote %s (%zu samples; plot with scripts/plot_timeline.py)\n",
+                    o.timeline.c_str(), fr.timeline.size());
     }
     std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
                 fr.timeline.size(), sw.seconds());
@@ -230,8 +247,9 @@ int run_info(const InfoOptions& o) {
     t.load = ov.load_s;
     prepare(ov, t);
     const Box3 b = ov.volume.bounds();
-    std::printf("bounds: (%g, %g, %g) - (%g, %g, %g) object units\n", double(b.min.x), double(b.min.y),
-                double(b.min.z), double(b.max.x), double(b.max.y), double(b.max.z));
+    std::printf("bounds: (%g, %g, %g) - (%g, %g, %g) object units\n", double(b.min.x),
+                double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y),
+                double(b.max.z));
     if (!ov.file)
         std::printf("suggested isovalues: skin %g, bone %g\n", kPhantomSkinIso, kPhantomBoneIso);
     return 0;
@@ -256,12 +274,14 @@ int run_extract(const ExtractOptions& o) {
 int run_render(const RenderOptions& o) {
     const auto size = parse_size(o.size);
     if (!size)
-        throw InputError("--size", "value", "expected WIDTHxHEIGHT with positive integers, got \"" + o.size + "\"");
+        throw InputError("--size", "value",
+                         "expected WIDTHxHEIGHT with positive integers, got \"" + o.size + "\"");
     check_output_path(o.out, "--out");
     if (!o.depth_out.empty()) check_output_path(o.depth_out, "--depth-out");
     if (!o.timeline.empty()) check_output_path(o.timeline, "--timeline");
     for (double c : o.snapshots)
-        if (!(c > 0 && c <= 100)) throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
+        if (!(c > 0 && c <= 100))
+            throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
     const EngineOptions checked = engine_options(o);  // fails early on a bad --order
     (void)checked;
     Timings t;
@@ -273,7 +293,8 @@ int run_render(const RenderOptions& o) {
     const double iso = checked_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);
-    const Projection proj = o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
+    const Projection proj =
+        o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
     Camera cam = front_full_view(ov.volume.bounds(), aspect, proj);
     if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
     cam = fit_depth_range(zoom(cam, o.zoom), ov.volume.bounds());
@@ -300,7 +321,8 @@ int run_render(const RenderOptions& o) {
     write_image(o.out, image);
     if (!o.depth_out.empty()) write_depth(o.depth_out, image);
     t.write = sw.seconds();
-    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ", o.depth_out.c_str());
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
+                o.depth_out.c_str());
     t.print(mesh.triangle_count());
     return 0;
 }

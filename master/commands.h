@@ -32,8 +32,8 @@ struct RenderOptions {
     // Progressive engine (the default) or the full surface.
     bool full = false;
     EngineCli engine;
-    std::string timeline;                 // CSV path
-    std::vector<double> snapshots;        // correctness thresholds in percent
+    std::string timeline;                    // CSV path
+    std::vector<double> snapshots;           // correctness thresholds in percent
     std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)
     std::vector<std::size_t> snapshot_rays;
     bool no_measure = false;

@@ -7,8 +7,9 @@
 namespace isowall {
 
 void add_engine_options(CLI::App& app, EngineCli& e) {
-    app.add_option("--order", e.order, "Ray order: grid (fixed refining grids), readback "
-                                       "(screen read-back) or dynamic (dynamic grid)")
+    app.add_option("--order", e.order,
+                   "Ray order: grid (fixed refining grids), readback "
+                   "(screen read-back) or dynamic (dynamic grid)")
         ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
         ->capture_default_str();
     app.add_option("--intersect", e.intersect,
@@ -26,7 +27,8 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_option("--cutoff-angle", e.cutoff_deg, "Cut-off angle in degrees (angle mode)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
-    app.add_option("--foldback-tolerance", e.foldback_deg, "Fold-back tolerance in degrees (angle mode)")
+    app.add_option("--foldback-tolerance", e.foldback_deg,
+                   "Fold-back tolerance in degrees (angle mode)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     app.add_flag("--no-interpolant-cache", e.no_interpolant_cache,
@@ -36,23 +38,28 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_flag("--adaptive", e.adaptive,
                  "Adaptive resolution: extract regions whose cells project below a pixel as "
                  "meta-cells of 2^i cells per side");
-    app.add_option("--adaptive-max-level", e.adaptive_max_level, "Largest meta-cell level i with --adaptive")
+    app.add_option("--adaptive-max-level", e.adaptive_max_level,
+                   "Largest meta-cell level i with --adaptive")
         ->capture_default_str();
 }
 
 EngineOptions to_engine_options(const EngineCli& c) {
     if (c.max_count < 1)
-        throw InputError("--max-count", "value", "expected a positive cell count, got " + std::to_string(c.max_count));
+        throw InputError("--max-count", "value",
+                         "expected a positive cell count, got " + std::to_string(c.max_count));
     if (c.adaptive_max_level < 1 || c.adaptive_max_level > kMaxMetaLevel)
         throw InputError("--adaptive-max-level", "value",
                          "expected 1 to " + std::to_string(kMaxMetaLevel) + ", got " +
                              std::to_string(c.adaptive_max_level));
     EngineOptions e;
     const auto order = parse_ray_order(c.order);
-    if (!order) throw InputError("--order", "value", "expected grid, readback or dynamic, got \"" + c.order + "\"");
+    if (!order)
+        throw InputError("--order", "value",
+                         "expected grid, readback or dynamic, got \"" + c.order + "\"");
     e.order = *order;
     e.intersect = c.intersect == "approximate" ? IntersectMode::approximate : IntersectMode::exact;
-    e.propagation.mode = c.propagation == "angle" ? PropagationMode::cutoff_angle : PropagationMode::max_count;
+    e.propagation.mode =
+        c.propagation == "angle" ? PropagationMode::cutoff_angle : PropagationMode::max_count;
     e.propagation.max_count = c.max_count;
     e.propagation.cutoff_rad = glm::radians(c.cutoff_deg);
     e.propagation.foldback_rad = glm::radians(c.foldback_deg);

@@ -1,30 +1,20 @@
 // isowall: progressive view-dependent isosurfaces for display walls.
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 
 #include "master/commands.h"
 #include "master/wall_run.h"
 
-int main(int argc, char** argv) {
-    using namespace isowall;
-    CLI::App app{"isowall: isosurfaces of large volumes on tiled display walls"};
-    app.require_subcommand(1);
-    app.set_version_flag("--version", "isowall 0.1.0");
+namespace {
 
-    InfoOptions info;
-    auto* info_cmd = app.add_subcommand("info", "Print a volume's size, type, value range and octree");
-    add_volume_options(*info_cmd, info.volume);
+using namespace isowall;
 
-    ExtractOptions ex;
-    auto* ex_cmd = app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
-    add_volume_options(*ex_cmd, ex.volume);
-    ex_cmd->add_option("--iso", ex.iso, "Isovalue (default for the phantom: skin, 50)");
-    ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
-
-    RenderOptions re;
+CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
         "render", "Render one view progressively (or the full surface with --full) to an image");
     add_volume_options(*re_cmd, re.volume);
@@ -39,7 +29,8 @@ int main(int argc, char** argv) {
     re_cmd->add_option("--projection", re.projection, "perspective or orthographic")
         ->check(CLI::IsMember({"perspective", "orthographic"}))
         ->capture_default_str();
-    re_cmd->add_option("--orbit", re.orbit, "Rotate the front view: YAW PITCH in degrees")->expected(2);
+    re_cmd->add_option("--orbit", re.orbit, "Rotate the front view: YAW PITCH in degrees")
+        ->expected(2);
     re_cmd->add_option("--zoom", re.zoom, "Zoom factor (>1 moves closer)")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
@@ -47,44 +38,82 @@ int main(int argc, char** argv) {
                      "Extract and draw the whole surface instead of the progressive engine");
     add_engine_options(*re_cmd, re.engine);
     re_cmd->add_option("--timeline", re.timeline, "Write the timeline (CSV) of the frame");
-    re_cmd->add_option("--snapshots", re.snapshots,
-                       "Write the image when correctness first reaches these percentages, e.g. "
-                       "90,99,99.9")
+    re_cmd
+        ->add_option("--snapshots", re.snapshots,
+                     "Write the image when correctness first reaches these percentages, e.g. "
+                     "90,99,99.9")
         ->delimiter(',');
-    re_cmd->add_option("--snapshot-measure", re.snapshot_measure,
-                       "Correctness measure for --snapshots: final (share of final pixels, "
-                       "chapters 2-3) or c (C = 1 - E, section 4.2)")
+    re_cmd
+        ->add_option("--snapshot-measure", re.snapshot_measure,
+                     "Correctness measure for --snapshots: final (share of final pixels, "
+                     "chapters 2-3) or c (C = 1 - E, section 4.2)")
         ->check(CLI::IsMember({"final", "c"}))
         ->capture_default_str();
-    re_cmd->add_option("--snapshot-rays", re.snapshot_rays,
-                       "Write the image after these numbers of rays, e.g. 100,10000")
+    re_cmd
+        ->add_option("--snapshot-rays", re.snapshot_rays,
+                     "Write the image after these numbers of rays, e.g. 100,10000")
         ->delimiter(',');
     re_cmd->add_flag("--no-measure", re.no_measure,
                      "Skip the replay that measures correctness against the final image");
     re_cmd->add_flag("--quiet,-q", re.quiet, "No progress lines while casting");
 
-    WallOptions wall;
+    return re_cmd;
+}
+
+CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     auto* wall_cmd = app.add_subcommand(
-        "wall", "Display-wall run under mpirun: rank 0 is the master, ranks 1..T drive one tile each");
+        "wall",
+        "Display-wall run under mpirun: rank 0 is the master, ranks 1..T drive one tile each");
     add_volume_options(*wall_cmd, wall.volume);
     wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
     wall_cmd->add_option("--iso", wall.iso, "Isovalue (default for the phantom: skin, 50)");
-    wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")->capture_default_str();
-    wall_cmd->add_option("--tiles-out", wall.tiles_out, "Also write each tile's image into this folder");
+    wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")
+        ->capture_default_str();
+    wall_cmd->add_option("--tiles-out", wall.tiles_out,
+                         "Also write each tile's image into this folder");
     wall_cmd->add_option("--gl", wall.gl, "OpenGL back end")
         ->check(CLI::IsMember({"osmesa", "egl"}))
         ->capture_default_str();
     add_engine_options(*wall_cmd, wall.engine);
-    wall_cmd->add_option("--script", wall.script,
-                         "Commands (orbit, look-at, zoom, iso, wait, snapshot, quit), one per line; "
-                         "- reads them from the master's console");
-    wall_cmd->add_option("--timeout", wall.timeout_s,
-                         "Seconds a silent tile rank may take before the job ends")
+    wall_cmd->add_option(
+        "--script", wall.script,
+        "Commands (orbit, look-at, zoom, iso, wait, snapshot, quit), one per line; "
+        "- reads them from the master's console");
+    wall_cmd
+        ->add_option("--timeout", wall.timeout_s,
+                     "Seconds a silent tile rank may take before the job ends")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     wall_cmd->add_option("--trace", wall.trace,
                          "Write per-rank spans by stage with thread CPU time: PREFIX.json (Chrome "
                          "trace, opens in Perfetto) and PREFIX.csv");
+    return wall_cmd;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace isowall;
+    CLI::App app{"isowall: isosurfaces of large volumes on tiled display walls"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "isowall 0.1.0");
+
+    InfoOptions info;
+    auto* info_cmd =
+        app.add_subcommand("info", "Print a volume's size, type, value range and octree");
+    add_volume_options(*info_cmd, info.volume);
+
+    ExtractOptions ex;
+    auto* ex_cmd =
+        app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
+    add_volume_options(*ex_cmd, ex.volume);
+    ex_cmd->add_option("--iso", ex.iso, "Isovalue (default for the phantom: skin, 50)");
+    ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
+
+    RenderOptions re;
+    auto* re_cmd = add_render_command(app, re);
+    WallOptions wall;
+    auto* wall_cmd = add_wall_command(app, wall);
     bool ranks_needed = false;
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");
@@ -112,6 +141,8 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (wall_cmd->parsed()) {
+            std::tie(wall.fault_kind, wall.fault_rank) =
+                parse_test_fault(std::getenv("ISOWALL_TEST_FAULT"));
             auto comm = make_mpi_comm(argc, argv);
             return run_wall(wall, *comm);
         }

@@ -3,9 +3,9 @@
 #include <cstdio>
 
 #include "common/core/error.h"
+#include "common/core/util.h"
 #include "common/volume/octree.h"
 #include "common/volume/phantom.h"
-#include "common/core/util.h"
 
 namespace isowall {
 
@@ -13,16 +13,19 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
     app.add_option("--volume,-v", o.path,
                    "Volume file: .nrrd/.nhdr (NRRD), or headerless raw with --dims and --type. "
                    "Default: the built-in phantom");
-    app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")->expected(3);
+    app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
+        ->expected(3);
     app.add_option("--type", o.type,
                    "Raw voxel type: uint8 int8 uint16 int16 uint32 int32 float32 float64");
-    app.add_option("--spacing", o.spacing, "Raw voxel spacing: SX SY SZ (default 1 1 1)")->expected(3);
+    app.add_option("--spacing", o.spacing, "Raw voxel spacing: SX SY SZ (default 1 1 1)")
+        ->expected(3);
     app.add_option("--endian", o.endian, "Raw byte order: little or big")
         ->check(CLI::IsMember({"little", "big"}));
     app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file");
     app.add_option("--cache-dir", o.cache_dir,
                    "Octree cache folder (default $ISOWALL_CACHE_DIR, else ~/.cache/isowall)");
-    app.add_flag("--no-cache", o.no_cache, "Always build the octree; never read or write the cache");
+    app.add_flag("--no-cache", o.no_cache,
+                 "Always build the octree; never read or write the cache");
 }
 
 namespace {
@@ -30,16 +33,18 @@ namespace {
 std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
     const bool raw = !o.dims.empty() || !o.type.empty();
     if (!raw) return std::nullopt;
-    if (o.path.empty()) throw InputError("--dims/--type", "--volume", "a raw volume needs --volume FILE");
+    if (o.path.empty())
+        throw InputError("--dims/--type", "--volume", "a raw volume needs --volume FILE");
     if (o.dims.size() != 3) throw InputError(o.path, "--dims", "a raw volume needs --dims X Y Z");
     if (o.type.empty()) throw InputError(o.path, "--type", "a raw volume needs --type T");
     RawSpec spec;
     spec.dims = {o.dims[0], o.dims[1], o.dims[2]};
     const auto type = parse_voxel_type(o.type);
     if (!type)
-        throw InputError(o.path, "--type",
-                         "expected one of uint8 int8 uint16 int16 uint32 int32 float32 float64, got \"" +
-                             o.type + "\"");
+        throw InputError(
+            o.path, "--type",
+            "expected one of uint8 int8 uint16 int16 uint32 int32 float32 float64, got \"" +
+                o.type + "\"");
     spec.type = *type;
     if (!o.spacing.empty()) spec.spacing = {o.spacing[0], o.spacing[1], o.spacing[2]};
     spec.endian = o.endian == "big" ? Endian::big : Endian::little;
@@ -62,7 +67,8 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet) {
     }
     out.load_s = sw.seconds();
     if (out.file && !o.no_cache)
-        out.cache_dir = o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
+        out.cache_dir =
+            o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
     if (quiet) return out;
     const Volume& v = out.volume;
     const glm::ivec3 d = v.dims();

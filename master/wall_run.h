@@ -1,10 +1,11 @@
 #pragma once
-// `isowall wall`: the display-wall run under mpirun. Rank 0 (the master) reads the wall file,
-// computes each tile's off-axis frustum from one wall camera, sends every tile rank its view,
-// gathers the tile images into a mosaic of the virtual screen (bezel gaps as dark bars, overlaps
-// blended) and prints the per-rank table. Ranks 1..T each run the progressive engine on their
-// own frustum.
+// `isowall wall`: the display-wall run. Rank 0 (the master, master/wall_master.h) reads the wall
+// file, computes each tile's off-axis frustum from one wall camera, sends every tile rank its
+// view, gathers the tile images into a mosaic of the virtual screen and prints the per-rank table.
+// Ranks 1..T each run a tile (tile/tile_loop.h). The same code runs under MPI and in process.
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "comm/comm.h"
 #include "master/engine_cli.h"
@@ -20,11 +21,23 @@ struct WallOptions {
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";
     EngineCli engine;
-    std::string script;       // script file, "-" for the master's console, empty: one frame
-    double timeout_s = 120;   // a tile silent this long ends the job
-    std::string trace;        // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    std::string script;      // script file, "-" for the master's console, empty: one frame
+    double timeout_s = 120;  // a wall silent this long ends the job
+    std::string trace;       // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    // Test hook (ISOWALL_TEST_FAULT=KIND:RANK): the rank named fails in the way named (tile:
+    // hang, exit, throw; master: throw).
+    std::string fault_kind;
+    int fault_rank = -1;
+    // When set, the master also leaves every tile's figures here (by rank; for tests).
+    std::vector<TileResultMsg>* results_out = nullptr;
 };
 
+// Every rank calls this. Any failure on any rank ends the whole job through one path: one line
+// on stderr naming the rank and the cause, then comm.abort() (which under MPI ends every rank,
+// and in process wakes every rank with CommAborted). Returns the rank's exit code otherwise.
 int run_wall(const WallOptions& o, Comm& comm);
+
+// "KIND:RANK" -> (kind, rank); empty kind when `spec` is empty or malformed.
+std::pair<std::string, int> parse_test_fault(const char* spec);
 
 }  // namespace isowall

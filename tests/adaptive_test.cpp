@@ -259,7 +259,8 @@ Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions
         f.units[std::size_t(g.level)] += g.cells.size();
     }
     expect_groups_partition_the_visited_cells(*ex, volume, fr);
-    f.correctness = measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv));
+    f.correctness =
+        measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv));
     return f;
 }
 

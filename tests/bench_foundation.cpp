@@ -1,6 +1,7 @@
 // Foundation benchmark: octree build, full extraction and render for one volume and isovalue.
 // Prints one "key value" line per figure so scripts/bench_foundation.py can put VTK's flying
-// edges beside it. Each stage runs `repeats` times; the fastest run is printed (the machine is shared and noisy: the minimum is the most repeatable figure).
+// edges beside it. Each stage runs `repeats` times; the fastest run is printed (the machine is
+// shared and noisy: the minimum is the most repeatable figure).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -9,9 +10,9 @@
 #include <vector>
 
 #include "common/core/camera.h"
+#include "common/core/util.h"
 #include "common/extract/extract.h"
 #include "common/volume/phantom.h"
-#include "common/core/util.h"
 #include "tile/renderer.h"
 
 namespace {
@@ -56,7 +57,8 @@ int bench(const isowall::Volume& vol, double iso, int repeats, const std::string
     std::printf("volume %s\n", vol.source().c_str());
     std::printf("voxels %.0f\n", voxels);
     std::printf("dims %d %d %d\n", vol.dims().x, vol.dims().y, vol.dims().z);
-    std::printf("spacing %g %g %g\n", double(vol.spacing().x), double(vol.spacing().y), double(vol.spacing().z));
+    std::printf("spacing %g %g %g\n", double(vol.spacing().x), double(vol.spacing().y),
+                double(vol.spacing().z));
     std::printf("type %s\n", std::string(type_name(vol.type())).c_str());
     std::printf("volume_bytes %zu\n", vol.bytes().size());
     std::printf("iso %g\n", iso);
@@ -77,7 +79,9 @@ int bench(const isowall::Volume& vol, double iso, int repeats, const std::string
 int main(int argc, char** argv) {
     using namespace isowall;
     if (argc < 2) {
-        std::fprintf(stderr, "usage: %s VOLUME.nhdr|phantom ISO [REPEATS] [osmesa|egl] [SAVE.raw]\n", argv[0]);
+        std::fprintf(stderr,
+                     "usage: %s VOLUME.nhdr|phantom ISO [REPEATS] [osmesa|egl] [SAVE.raw]\n",
+                     argv[0]);
         return 2;
     }
     try {
@@ -90,13 +94,13 @@ int main(int argc, char** argv) {
         // what we extract from, whatever the source format (the phantom exists only in memory).
         if (argc > 5) {
             std::FILE* f = std::fopen(argv[5], "wb");
-            if (!f || std::fwrite(vol.bytes().data(), 1, vol.bytes().size(), f) != vol.bytes().size())
+            if (!f ||
+                std::fwrite(vol.bytes().data(), 1, vol.bytes().size(), f) != vol.bytes().size())
                 throw std::runtime_error(std::string(argv[5]) + ": cannot write");
             std::fclose(f);
         }
-        return dispatch_voxel_type(vol.type(), [&](auto tag) {
-            return bench<decltype(tag)>(vol, iso, repeats, gl);
-        });
+        return dispatch_voxel_type(
+            vol.type(), [&](auto tag) { return bench<decltype(tag)>(vol, iso, repeats, gl); });
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_foundation: error: %s\n", e.what());
         return 1;

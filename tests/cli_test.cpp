@@ -30,8 +30,9 @@ std::string slurp(const std::filesystem::path& p) {
 // Runs the real binary under `timeout`, so a hang fails the test instead of the suite.
 RunResult run_isowall(const std::filesystem::path& dir, const std::string& args) {
     const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = "cd '" + dir.string() + "' && timeout 120 '" + std::string(ISOWALL_BINARY) +
-                            "' " + args + " > '" + out.string() + "' 2> '" + err.string() + "'";
+    const std::string cmd = "cd '" + dir.string() + "' && timeout 120 '" +
+                            std::string(ISOWALL_BINARY) + "' " + args + " > '" + out.string() +
+                            "' 2> '" + err.string() + "'";
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -40,20 +41,24 @@ RunResult run_isowall(const std::filesystem::path& dir, const std::string& args)
     return r;
 }
 
-void write_text(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write_text(const std::filesystem::path& p, const std::string& text) {
+    std::ofstream(p) << text;
+}
 
 void expect_one_line_error(const RunResult& r, std::initializer_list<std::string> mentions) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.exit_code, 124) << "timed out";
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
     EXPECT_EQ(r.err.rfind("isowall: error: ", 0), 0u) << "stderr: " << r.err;
-    for (const auto& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << "missing \"" << m << "\" in: " << r.err;
+    for (const auto& m : mentions)
+        EXPECT_NE(r.err.find(m), std::string::npos) << "missing \"" << m << "\" in: " << r.err;
 }
 
 class Cli : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
-        dir_ = test::scratch_dir(std::string("cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = test::scratch_dir(std::string("cli_") +
+                                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
         write_text(dir_ / "ok.raw", std::string(4 * 4 * 4, '\x01'));
     }
     std::filesystem::path dir_;
@@ -66,11 +71,14 @@ TEST_F(Cli, MissingFile) {
 }
 
 TEST_F(Cli, DataFileShorterOrLongerThanTheHeader) {
-    const std::string hdr = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 5\nencoding: raw\ndata file: ok.raw\n";
+    const std::string hdr =
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 5\nencoding: raw\ndata file: ok.raw\n";
     write_text(dir_ / "short.nhdr", hdr);
     expect_one_line_error(run_isowall(dir_, "extract -v short.nhdr --iso 1 --out s.ply"),
                           {"ok.raw", "size", "shorter", "80", "64"});
-    write_text(dir_ / "long.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 3\nencoding: raw\ndata file: ok.raw\n");
+    write_text(
+        dir_ / "long.nhdr",
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 3\nencoding: raw\ndata file: ok.raw\n");
     expect_one_line_error(run_isowall(dir_, "extract -v long.nhdr --iso 1 --out s.ply"),
                           {"ok.raw", "size", "longer"});
     // Raw files are held to the same rule.
@@ -80,18 +88,27 @@ TEST_F(Cli, DataFileShorterOrLongerThanTheHeader) {
 }
 
 TEST_F(Cli, MalformedHeader) {
-    write_text(dir_ / "bad.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4\nencoding: raw\ndata file: ok.raw\n");
+    write_text(
+        dir_ / "bad.nhdr",
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4\nencoding: raw\ndata file: ok.raw\n");
     expect_one_line_error(run_isowall(dir_, "info -v bad.nhdr"), {"bad.nhdr", "header"});
     write_text(dir_ / "garbage.nrrd", "hello world\n");
     expect_one_line_error(run_isowall(dir_, "info -v garbage.nrrd"), {"garbage.nrrd", "header"});
-    write_text(dir_ / "dim2.nhdr", "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 8 8\nencoding: raw\ndata file: ok.raw\n");
-    expect_one_line_error(run_isowall(dir_, "info -v dim2.nhdr"), {"dim2.nhdr", "dimension", "expected 3"});
+    write_text(
+        dir_ / "dim2.nhdr",
+        "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 8 8\nencoding: raw\ndata file: ok.raw\n");
+    expect_one_line_error(run_isowall(dir_, "info -v dim2.nhdr"),
+                          {"dim2.nhdr", "dimension", "expected 3"});
 }
 
 TEST_F(Cli, UnsupportedType) {
-    write_text(dir_ / "i64.nhdr", "NRRD0004\ntype: long long\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: little\ndata file: ok.raw\n");
-    expect_one_line_error(run_isowall(dir_, "info -v i64.nhdr"), {"i64.nhdr", "type", "unsupported"});
-    expect_one_line_error(run_isowall(dir_, "info -v ok.raw --dims 4 4 4 --type int64"), {"ok.raw", "--type", "int64"});
+    write_text(dir_ / "i64.nhdr",
+               "NRRD0004\ntype: long long\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nendian: "
+               "little\ndata file: ok.raw\n");
+    expect_one_line_error(run_isowall(dir_, "info -v i64.nhdr"),
+                          {"i64.nhdr", "type", "unsupported"});
+    expect_one_line_error(run_isowall(dir_, "info -v ok.raw --dims 4 4 4 --type int64"),
+                          {"ok.raw", "--type", "int64"});
 }
 
 TEST_F(Cli, BadSize) {
@@ -105,8 +122,9 @@ TEST_F(Cli, BadSize) {
 TEST_F(Cli, IsovalueOutsideTheRange) {
     expect_one_line_error(run_isowall(dir_, "render --iso 999 --size 64x48 --out img.png"),
                           {"phantom", "--iso", "999", "[0, 220]"});
-    expect_one_line_error(run_isowall(dir_, "extract -v ok.raw --dims 4 4 4 --type uint8 --iso -3 --out s.ply"),
-                          {"ok.raw", "--iso", "outside"});
+    expect_one_line_error(
+        run_isowall(dir_, "extract -v ok.raw --dims 4 4 4 --type uint8 --iso -3 --out s.ply"),
+        {"ok.raw", "--iso", "outside"});
     EXPECT_FALSE(std::filesystem::exists(dir_ / "img.png"));
     EXPECT_FALSE(std::filesystem::exists(dir_ / "s.ply"));
 }
@@ -124,16 +142,19 @@ TEST_F(Cli, ExtractWritesThePhantomSurface) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const Mesh m = read_ply(dir_ / "bone.ply");
     EXPECT_GT(m.triangle_count(), 100000u);
-    EXPECT_NE(r.out.find("triangles " + std::to_string(m.triangle_count())), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("triangles " + std::to_string(m.triangle_count())), std::string::npos)
+        << r.out;
     auto info = run_isowall(dir_, "info");
     ASSERT_EQ(info.exit_code, 0) << info.err;
-    EXPECT_NE(info.out.find("suggested isovalues: skin 50, bone 160"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("suggested isovalues: skin 50, bone 160"), std::string::npos)
+        << info.out;
 }
 
 TEST_F(Cli, HelpListsTheSubcommands) {
     auto r = run_isowall(dir_, "--help");
     EXPECT_EQ(r.exit_code, 0);
-    for (const char* sub : {"info", "extract", "render"}) EXPECT_NE(r.out.find(sub), std::string::npos);
+    for (const char* sub : {"info", "extract", "render"})
+        EXPECT_NE(r.out.find(sub), std::string::npos);
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "common/extract/extract.h"
-#include "common/volume/phantom.h"
 #include "common/io/ply.h"
+#include "common/volume/phantom.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -26,7 +26,8 @@ SphereField sphere_field(glm::ivec3 d, glm::vec3 spacing, glm::vec3 centre, floa
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x)
-                s.data[(std::size_t(z) * d.y + y) * d.x + x] = r - glm::length(glm::vec3(x, y, z) * spacing - centre);
+                s.data[(std::size_t(z) * d.y + y) * d.x + x] =
+                    r - glm::length(glm::vec3(x, y, z) * spacing - centre);
     s.view = {s.data.data(), d, spacing};
     s.centre = centre;
     return s;
@@ -66,7 +67,8 @@ TEST(Extract, SphereIsClosedWithTheRightArea) {
         auto s = sphere_field(d, spacing, c, r);
         auto o = MinMaxOctree<float>::build(s.view);
         const Mesh m = extract_full(s.view, o, 0.0, nullptr);
-        SCOPED_TRACE(::testing::Message() << "spacing " << spacing.x << " " << spacing.y << " " << spacing.z);
+        SCOPED_TRACE(::testing::Message()
+                     << "spacing " << spacing.x << " " << spacing.y << " " << spacing.z);
         ASSERT_GT(m.triangle_count(), 1000u);
         expect_closed_and_oriented(m);
         const double want = 4.0 * std::numbers::pi * r * r;
@@ -85,7 +87,8 @@ TEST(Extract, SphereIsClosedWithTheRightArea) {
         EXPECT_EQ(misdrawn, 0u);
         // Vertices sit on the sphere (linear interpolation error is second order).
         double worst = 0;
-        for (const auto& p : m.positions) worst = std::max(worst, std::abs(double(glm::length(p - c)) - r));
+        for (const auto& p : m.positions)
+            worst = std::max(worst, std::abs(double(glm::length(p - c)) - r));
         EXPECT_LT(worst, 0.05 * double(glm::length(spacing)));
     }
 }
@@ -98,8 +101,8 @@ TEST(Extract, IsovalueEqualToSamplesStillCloses) {
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x)
-                data[(std::size_t(z) * d.y + y) * d.x + x] = static_cast<std::uint8_t>(
-                    std::max(0.0f, 10.0f - 0.8f * glm::length(glm::vec3(x, y, z) - glm::vec3(11.5f))));
+                data[(std::size_t(z) * d.y + y) * d.x + x] = static_cast<std::uint8_t>(std::max(
+                    0.0f, 10.0f - 0.8f * glm::length(glm::vec3(x, y, z) - glm::vec3(11.5f))));
     VolumeView<std::uint8_t> v{data.data(), d, glm::vec3(1)};
     auto o = MinMaxOctree<std::uint8_t>::build(v);
     for (double iso : {3.0, 5.0, 7.0}) {

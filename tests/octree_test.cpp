@@ -20,8 +20,10 @@ void expect_nodes_match_brute_force(const VolumeView<T>& v, const MinMaxOctree<T
         const std::size_t count = std::size_t(L.dims.x) * L.dims.y * L.dims.z;
         const bool all = samples <= 0 || count <= std::size_t(samples);
         for (std::size_t k = 0; k < (all ? count : std::size_t(samples)); ++k) {
-            const std::size_t i = all ? k : std::uniform_int_distribution<std::size_t>(0, count - 1)(rng);
-            const glm::ivec3 n(int(i % L.dims.x), int(i / L.dims.x % L.dims.y), int(i / L.dims.x / L.dims.y));
+            const std::size_t i =
+                all ? k : std::uniform_int_distribution<std::size_t>(0, count - 1)(rng);
+            const glm::ivec3 n(int(i % L.dims.x), int(i / L.dims.x % L.dims.y),
+                               int(i / L.dims.x / L.dims.y));
             const glm::ivec3 b = shape.cell_begin(l, n), e = shape.cell_end(l, n);
             ASSERT_TRUE(b.x < e.x && b.y < e.y && b.z < e.z) << "empty node at level " << l;
             T lo = v.at(b.x, b.y, b.z), hi = lo;
@@ -31,8 +33,10 @@ void expect_nodes_match_brute_force(const VolumeView<T>& v, const MinMaxOctree<T
                         lo = std::min(lo, v.at(x, y, z));
                         hi = std::max(hi, v.at(x, y, z));
                     }
-            ASSERT_EQ(o.min(l, n), lo) << "level " << l << " node " << n.x << "," << n.y << "," << n.z;
-            ASSERT_EQ(o.max(l, n), hi) << "level " << l << " node " << n.x << "," << n.y << "," << n.z;
+            ASSERT_EQ(o.min(l, n), lo)
+                << "level " << l << " node " << n.x << "," << n.y << "," << n.z;
+            ASSERT_EQ(o.max(l, n), hi)
+                << "level " << l << " node " << n.x << "," << n.y << "," << n.z;
         }
     }
 }
@@ -50,7 +54,8 @@ TEST(Octree, RandomVolumesOfOddSizesMatchBruteForce) {
     for (glm::ivec3 d : {glm::ivec3(2, 2, 2), glm::ivec3(3, 5, 7), glm::ivec3(17, 33, 9),
                          glm::ivec3(65, 40, 31), glm::ivec3(6, 129, 2)}) {
         std::vector<std::int16_t> data(std::size_t(d.x) * d.y * d.z);
-        for (auto& x : data) x = static_cast<std::int16_t>(std::uniform_int_distribution<int>(-30000, 30000)(rng));
+        for (auto& x : data)
+            x = static_cast<std::int16_t>(std::uniform_int_distribution<int>(-30000, 30000)(rng));
         VolumeView<std::int16_t> v{data.data(), d, glm::vec3(1)};
         auto o = MinMaxOctree<std::int16_t>::build(v);
         SCOPED_TRACE(::testing::Message() << "dims " << d.x << "x" << d.y << "x" << d.z);
@@ -73,11 +78,12 @@ void check_random_crops(const VolumeView<T>& v, int crops, std::mt19937& rng) {
         for (int z = 0; z < size.z; ++z)
             for (int y = 0; y < size.y; ++y)
                 for (int x = 0; x < size.x; ++x)
-                    crop[(std::size_t(z) * size.y + y) * size.x + x] = v.at(lo.x + x, lo.y + y, lo.z + z);
+                    crop[(std::size_t(z) * size.y + y) * size.x + x] =
+                        v.at(lo.x + x, lo.y + y, lo.z + z);
         VolumeView<T> cv{crop.data(), size, v.spacing};
         auto o = MinMaxOctree<T>::build(cv);
-        SCOPED_TRACE(::testing::Message() << "crop at " << lo.x << "," << lo.y << "," << lo.z << " size "
-                                          << size.x << "x" << size.y << "x" << size.z);
+        SCOPED_TRACE(::testing::Message() << "crop at " << lo.x << "," << lo.y << "," << lo.z
+                                          << " size " << size.x << "x" << size.y << "x" << size.z);
         expect_nodes_match_brute_force(cv, o, 200, rng);
     }
 }

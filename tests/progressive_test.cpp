@@ -8,31 +8,12 @@
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
 #include "tests/engine_util.h"
+#include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "common/io/image_io.h"
 #include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
-
-struct ImageMatch {
-    double mask_iou = 0;
-    double equal_share = 0;  // pixels whose colour differs by <= 1 in every channel
-};
-
-ImageMatch compare(const Image& a, const Image& b) {
-    std::size_t inter = 0, uni = 0, equal = 0;
-    for (std::size_t i = 0; i < a.pixel_count(); ++i) {
-        const bool ca = a.depth[i] < 1.0f, cb = b.depth[i] < 1.0f;
-        inter += ca && cb;
-        uni += ca || cb;
-        bool same = true;
-        for (int k = 0; k < 3; ++k)
-            same = same && std::abs(int(a.rgba[4 * i + k]) - int(b.rgba[4 * i + k])) <= 1;
-        equal += same;
-    }
-    return {uni ? double(inter) / double(uni) : 1.0, double(equal) / double(a.pixel_count())};
-}
 
 using test::full_surface_image;
 using test::make_view;
@@ -59,22 +40,10 @@ void expect_final_matches_full(const Volume& volume, double iso, const Combo& co
     FrameResult fr = engine.run(fv);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
-    const ImageMatch m = compare(fr.final_image, full);
-    if (m.mask_iou < 0.999 || m.equal_share < 0.999) {
-        // Leave the evidence: both images and a mask of the pixels that differ.
-        const auto dir = test::scratch_dir("final_" + combo_name(combo));
-        Image diff = full;
-        for (std::size_t i = 0; i < diff.pixel_count(); ++i) {
-            const bool a = fr.final_image.depth[i] < 1.0f, b = full.depth[i] < 1.0f;
-            diff.rgba[4 * i] = a && !b ? 255 : 0;      // red: only progressive
-            diff.rgba[4 * i + 1] = b && !a ? 255 : 0;  // green: only full
-            diff.rgba[4 * i + 2] = 0;
-        }
-        write_image(dir / "progressive.png", fr.final_image);
-        write_image(dir / "full.png", full);
-        write_image(dir / "diff.png", diff);
-        std::cout << "images in " << dir << "\n";
-    }
+    const test::ImageComparison m = test::compare_images(fr.final_image, full);
+    if (m.mask_iou < 0.999 || m.equal_share < 0.999)
+        test::write_diff_images(test::scratch_dir("final_" + combo_name(combo)), "final",
+                                fr.final_image, full);
     EXPECT_GE(m.mask_iou, 0.999) << combo_name(combo) << " iso " << iso;
     EXPECT_GE(m.equal_share, 0.999) << combo_name(combo) << " iso " << iso;
     // Every pixel of the screen box had its ray (and the approximate mode a second, exact one).
@@ -88,7 +57,8 @@ void expect_final_matches_full(const Volume& volume, double iso, const Combo& co
 
 TEST_P(FinalImage, PhantomMatchesTheFullSurface) {
     const Volume p = make_phantom();
-    for (double iso : {kPhantomSkinIso, kPhantomBoneIso}) expect_final_matches_full(p, iso, GetParam(), 240, 180, 25);
+    for (double iso : {kPhantomSkinIso, kPhantomBoneIso})
+        expect_final_matches_full(p, iso, GetParam(), 240, 180, 25);
 }
 
 TEST_P(FinalImage, SharedCtHeadMatchesTheFullSurface) {
@@ -103,7 +73,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Combine(::testing::Values(RayOrderKind::refining_grid, RayOrderKind::screen_readback,
                                          RayOrderKind::dynamic_grid),
                        ::testing::Values(IntersectMode::exact, IntersectMode::approximate),
-                       ::testing::Values(PropagationMode::max_count, PropagationMode::cutoff_angle)),
+                       ::testing::Values(PropagationMode::max_count,
+                                         PropagationMode::cutoff_angle)),
     [](const auto& info) { return combo_name(info.param); });
 
 TEST(Engine, FarViewMatchesTheFullSurface) {
@@ -120,7 +91,7 @@ TEST(Engine, FarViewMatchesTheFullSurface) {
     FrameResult fr = engine.run(fv);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
-    const ImageMatch m = compare(fr.final_image, full);
+    const test::ImageComparison m = test::compare_images(fr.final_image, full);
     EXPECT_GE(m.mask_iou, 0.999);
     EXPECT_GE(m.equal_share, 0.999);
 }
@@ -160,7 +131,8 @@ TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
 }
 
 // Triangles as sorted vertex-position triples, so indexed and unindexed meshes compare.
-std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> soup(const Mesh& m) {
+std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> soup(
+    const Mesh& m) {
     std::multiset<std::tuple<float, float, float, float, float, float, float, float, float>> s;
     for (std::size_t t = 0; t < m.triangle_count(); ++t) {
         const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
@@ -195,10 +167,16 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
-    ProgressiveEngine engine(*ex, *renderer);
+    EngineOptions opt;
+    opt.progress_interval_s = 0;  // progress at every sample
+    ProgressiveEngine engine(*ex, *renderer, opt);
     const FrameView first = make_view(p, 200, 150, kPhantomSkinIso);
-    std::size_t polls = 0;
-    FrameResult a = engine.run(first, [&] { return ++polls > 400; });
+    // The stop flag is set as a communication thread would, here from the first sample at 300 rays
+    // or more (samples grow by 1.25x, so that sample is at most 375 rays).
+    std::atomic<bool> stop{false};
+    FrameResult a = engine.run(first, &stop, [&](const TimelineSample& s) {
+        if (s.rays >= 300) stop = true;
+    });
     EXPECT_FALSE(a.completed);
     EXPECT_LE(a.rays_cast, 400u);
     EXPECT_EQ(a.final_image.pixel_count(), 0u);
@@ -208,7 +186,7 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     FrameResult b = engine.run(second);
     ASSERT_TRUE(b.completed);
     const Image full = full_surface_image(*ex, *renderer, second);
-    const ImageMatch m = compare(b.final_image, full);
+    const test::ImageComparison m = test::compare_images(b.final_image, full);
     EXPECT_GE(m.mask_iou, 0.999);
     EXPECT_GE(m.equal_share, 0.999);
 }

@@ -1,5 +1,4 @@
-// Renderer back ends (OSMesa, EGL) against each other and against analytic silhouettes, and the
-// OpenImageIO image reader/writer.
+// Renderer back ends (OSMesa, EGL) against each other and against analytic silhouettes.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,7 +6,6 @@
 #include <filesystem>
 #include <functional>
 #include <numbers>
-#include <random>
 #include <string>
 #include <utility>
 
@@ -18,8 +16,9 @@
 #include "common/core/camera.h"
 #include "common/core/image.h"
 #include "common/core/mesh.h"
-#include "tests/test_util.h"
 #include "common/io/image_io.h"
+#include "tests/image_compare.h"
+#include "tests/test_util.h"
 #include "tile/renderer.h"
 
 namespace isowall {
@@ -185,22 +184,14 @@ TEST(Renderer, OsmesaAndEglAgree) {
     write_image(dir / "osmesa.png", a);
     write_image(dir / "egl.png", b);
 
-    std::size_t both = 0, either = 0;
-    double colour_error = 0.0;
-    for (std::size_t i = 0; i < a.pixel_count(); ++i) {
-        const bool ca = a.depth[i] < 1.0f, cb = b.depth[i] < 1.0f;
-        both += ca && cb;
-        either += ca || cb;
-        for (int c = 0; c < 3; ++c)
-            colour_error += std::abs(int(a.rgba[i * 4 + c]) - int(b.rgba[i * 4 + c]));
-    }
-    const double iou = either == 0 ? 0.0 : static_cast<double>(both) / static_cast<double>(either);
-    const double mean_error = colour_error / (3.0 * static_cast<double>(a.pixel_count()));
-    std::cout << "[ figures  ] mask IoU " << iou << ", mean |colour diff| " << mean_error
-              << " /255 over " << a.pixel_count() << " pixels, " << either << " covered\n";
-    EXPECT_GT(either, a.pixel_count() / 10) << "scene barely covers the frame";
-    EXPECT_GE(iou, 0.999);
-    EXPECT_LT(mean_error, 1.0);
+    const test::ImageComparison m = test::compare_images(a, b);
+    std::cout << "[ figures  ] mask IoU " << m.mask_iou << ", mean |colour diff| "
+              << m.mean_channel_error << " /255 over " << m.pixels << " pixels, "
+              << m.covered_either << " covered\n";
+    // Checked first: an empty frame would make the IoU below meaningless (1 for two empty masks).
+    EXPECT_GT(m.covered_either, a.pixel_count() / 10) << "scene barely covers the frame";
+    EXPECT_GE(m.mask_iou, 0.999);
+    EXPECT_LT(m.mean_channel_error, 1.0);
 }
 
 // Silhouette of a sphere of radius r seen from distance d: a cone of half-angle asin(r/d), so its
@@ -366,61 +357,6 @@ TEST(Renderer, BackFacesAreLitInTheirOwnColour) {
         EXPECT_GT(back[2], back[0]);
         EXPECT_GT(back[2], 180) << "back face is not lit";
     }
-}
-
-Image test_pattern(int width, int height) {
-    Image image;
-    image.resize(width, height);
-    std::mt19937 random(20240601u);
-    std::uniform_int_distribution<int> byte(0, 255);
-    for (auto& v : image.rgba) v = static_cast<std::uint8_t>(byte(random));
-    for (std::size_t i = 0; i < image.pixel_count(); ++i)
-        image.depth[i] = static_cast<float>(i % 97) / 96.0f;
-    return image;
-}
-
-TEST(ImageIo, PngRoundTripIsExact) {
-    const auto dir = test::scratch_dir("image_io_png");
-    const Image image = test_pattern(37, 23);
-    const auto path = dir / "pattern.png";
-    write_image(path, image);
-    const Image back = read_image(path);
-    ASSERT_EQ(back.width, image.width);
-    ASSERT_EQ(back.height, image.height);
-    EXPECT_EQ(back.rgba, image.rgba);
-    // The temporary file was renamed, not left beside the result.
-    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 1);
-}
-
-TEST(ImageIo, DepthExrIsReadable) {
-    const auto dir = test::scratch_dir("image_io_exr");
-    const Image image = test_pattern(19, 11);
-    const auto path = dir / "depth.exr";
-    write_depth(path, image);
-    const Image back = read_depth(path);
-    ASSERT_EQ(back.width, image.width);
-    ASSERT_EQ(back.height, image.height);
-    EXPECT_EQ(back.depth, image.depth);
-}
-
-TEST(ImageIo, MissingFolderThrowsNamingThePath) {
-    const auto path = test::scratch_dir("image_io_missing") / "no" / "such" / "frame.png";
-    const Image image = test_pattern(4, 4);
-    for (const auto& write : {write_image, write_depth}) {
-        try {
-            write(path, image);
-            FAIL() << "writing " << path << " did not throw";
-        } catch (const std::runtime_error& e) {
-            EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
-        }
-    }
-    EXPECT_THROW(read_image(path), std::runtime_error);
-}
-
-TEST(ImageIo, RejectsAnEmptyImage) {
-    const auto path = test::scratch_dir("image_io_empty") / "empty.png";
-    EXPECT_THROW(write_image(path, Image{}), std::runtime_error);
-    EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 }  // namespace

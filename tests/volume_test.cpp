@@ -16,14 +16,22 @@ constexpr glm::ivec3 kDims{7, 5, 3};  // odd sizes on purpose
 
 std::string nrrd_type(VoxelType t) {
     switch (t) {
-        case VoxelType::u8: return "uchar";
-        case VoxelType::i8: return "signed char";
-        case VoxelType::u16: return "ushort";
-        case VoxelType::i16: return "short";
-        case VoxelType::u32: return "uint";
-        case VoxelType::i32: return "int";
-        case VoxelType::f32: return "float";
-        case VoxelType::f64: return "double";
+        case VoxelType::u8:
+            return "uchar";
+        case VoxelType::i8:
+            return "signed char";
+        case VoxelType::u16:
+            return "ushort";
+        case VoxelType::i16:
+            return "short";
+        case VoxelType::u32:
+            return "uint";
+        case VoxelType::i32:
+            return "int";
+        case VoxelType::f32:
+            return "float";
+        case VoxelType::f64:
+            return "double";
     }
     return "";
 }
@@ -47,16 +55,20 @@ std::vector<std::byte> make_values(VoxelType t, std::size_t count) {
     return bytes;
 }
 
-void write_file(const std::filesystem::path& p, const std::string& text, std::span<const std::byte> data) {
+void write_file(const std::filesystem::path& p, const std::string& text,
+                std::span<const std::byte> data) {
     std::ofstream out(p, std::ios::binary);
     out << text;
-    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+    out.write(reinterpret_cast<const char*>(data.data()),
+              static_cast<std::streamsize>(data.size()));
 }
 
 std::string header(VoxelType t, Endian e, const std::string& data_file) {
-    std::string h = "NRRD0004\ntype: " + nrrd_type(t) + "\ndimension: 3\nsizes: 7 5 3\n"
+    std::string h = "NRRD0004\ntype: " + nrrd_type(t) +
+                    "\ndimension: 3\nsizes: 7 5 3\n"
                     "spacings: 0.5 1 2\nencoding: raw\n";
-    if (voxel_size(t) > 1) h += std::string("endian: ") + (e == Endian::big ? "big" : "little") + "\n";
+    if (voxel_size(t) > 1)
+        h += std::string("endian: ") + (e == Endian::big ? "big" : "little") + "\n";
     if (!data_file.empty()) h += "data file: " + data_file + "\n";
     return h;
 }
@@ -110,15 +122,16 @@ TEST_P(LoaderAgreement, NrrdAndRawGiveTheSameVoxels) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    AllTypes, LoaderAgreement,
-    ::testing::Combine(::testing::Values(VoxelType::u8, VoxelType::i8, VoxelType::u16, VoxelType::i16,
-                                         VoxelType::u32, VoxelType::i32, VoxelType::f32, VoxelType::f64),
-                       ::testing::Values(Endian::little, Endian::big)),
-    [](const auto& info) {
-        return std::string(type_name(std::get<0>(info.param))) +
-               (std::get<1>(info.param) == Endian::big ? "_big" : "_little");
-    });
+INSTANTIATE_TEST_SUITE_P(AllTypes, LoaderAgreement,
+                         ::testing::Combine(::testing::Values(VoxelType::u8, VoxelType::i8,
+                                                              VoxelType::u16, VoxelType::i16,
+                                                              VoxelType::u32, VoxelType::i32,
+                                                              VoxelType::f32, VoxelType::f64),
+                                            ::testing::Values(Endian::little, Endian::big)),
+                         [](const auto& info) {
+                             return std::string(type_name(std::get<0>(info.param))) +
+                                    (std::get<1>(info.param) == Endian::big ? "_big" : "_little");
+                         });
 
 TEST(Volume, SizeMismatchIsAnErrorNamingTheFile) {
     const auto dir = test::scratch_dir("volume_size");

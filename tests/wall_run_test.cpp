@@ -8,16 +8,18 @@
 #include <fstream>
 #include <sstream>
 
-#include "tests/test_util.h"
 #include "common/io/image_io.h"
+#include "tests/image_compare.h"
+#include "tests/test_util.h"
 
 namespace isowall {
 namespace {
 
 // Runs a command under `timeout` (the test guards against hangs itself) and returns its exit code.
 int run(const std::string& cmd, const std::filesystem::path& log) {
-    const std::string full = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 " + cmd +
-                             " > '" + log.string() + "' 2>&1";
+    const std::string full =
+        "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 " + cmd + " > '" +
+        log.string() + "' 2>&1";
     const int status = std::system(full.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -42,25 +44,8 @@ std::string slurp(const std::filesystem::path& p) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-struct Match {
-    double iou = 0, equal_share = 0;
-};
-
-Match compare(const Image& mosaic, const Image& single) {
-    std::size_t inter = 0, uni = 0, equal = 0;
-    for (std::size_t i = 0; i < single.pixel_count(); ++i) {
-        bool a = false, b = false, same = true;
-        for (int k = 0; k < 3; ++k) {
-            a = a || mosaic.rgba[4 * i + k] > 0;
-            b = b || single.rgba[4 * i + k] > 0;
-            same = same && std::abs(int(mosaic.rgba[4 * i + k]) - int(single.rgba[4 * i + k])) <= 1;
-        }
-        inter += a && b;
-        uni += a || b;
-        equal += same;
-    }
-    return {uni ? double(inter) / double(uni) : 1.0, double(equal) / double(single.pixel_count())};
-}
+// PNG files carry no depth: a pixel is covered where its colour is not the black background.
+const test::CompareOptions kFromFiles{.coverage = test::Coverage::colour};
 
 TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
     const auto dir = test::scratch_dir("wall_mosaic");
@@ -79,10 +64,10 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
     const Image single = read_image(dir / "single.png");
     ASSERT_EQ(mosaic.width, single.width);
     ASSERT_EQ(mosaic.height, single.height);
-    const Match m = compare(mosaic, single);
-    EXPECT_GE(m.iou, 0.999);
+    const test::ImageComparison m = test::compare_images(mosaic, single, kFromFiles);
+    EXPECT_GE(m.mask_iou, 0.999);
     EXPECT_GE(m.equal_share, 0.999);
-    std::cout << "mosaic vs single view: mask IoU " << m.iou << ", " << 100 * m.equal_share
+    std::cout << "mosaic vs single view: mask IoU " << m.mask_iou << ", " << 100 * m.equal_share
               << "% of pixels equal\n";
     const std::string log = slurp(dir / "wall.log");
     EXPECT_NE(log.find("rank  4 on "), std::string::npos) << log;
@@ -96,19 +81,20 @@ TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
     const auto dir = test::scratch_dir("wall_bezels");
     std::ofstream(dir / "wall.toml") << "tiles = [2, 2]\ntile_size_px = [120, 90]\nbezel_px = 4\n";
     std::filesystem::create_directories(dir / "tiles");
-    ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir / "wall.toml").string() + "' --out '" +
-                      (dir / "mosaic.png").string() + "' --tiles-out '" + (dir / "tiles").string() + "'",
-                  dir / "wall.log"),
-              0)
+    ASSERT_EQ(
+        run(mpirun(5) + "wall --wall '" + (dir / "wall.toml").string() + "' --out '" +
+                (dir / "mosaic.png").string() + "' --tiles-out '" + (dir / "tiles").string() + "'",
+            dir / "wall.log"),
+        0)
         << slurp(dir / "wall.log");
     const Image mosaic = read_image(dir / "mosaic.png");
     ASSERT_EQ(mosaic.width, 2 * 120 + 8);
     ASSERT_EQ(mosaic.height, 2 * 90 + 8);
-    ASSERT_EQ(run(isowall_cmd() + "render -q --no-measure --size " +
-                      std::to_string(mosaic.width) + "x" + std::to_string(mosaic.height) + " --out '" +
-                      (dir / "single.png").string() + "'",
-                  dir / "render.log"),
-              0)
+    ASSERT_EQ(
+        run(isowall_cmd() + "render -q --no-measure --size " + std::to_string(mosaic.width) + "x" +
+                std::to_string(mosaic.height) + " --out '" + (dir / "single.png").string() + "'",
+            dir / "render.log"),
+        0)
         << slurp(dir / "render.log");
     const Image single = read_image(dir / "single.png");
     for (int tile = 0; tile < 4; ++tile) {
@@ -119,7 +105,8 @@ TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
             for (int x = 0; x < img.width; ++x)
                 for (int k = 0; k < 3; ++k) {
                     const int a = img.rgba[4 * (std::size_t(y) * img.width + x) + k];
-                    const int b = single.rgba[4 * (std::size_t(y0 + y) * single.width + x0 + x) + k];
+                    const int b =
+                        single.rgba[4 * (std::size_t(y0 + y) * single.width + x0 + x) + k];
                     differ += std::abs(a - b) > 1;
                 }
         EXPECT_LE(double(differ) / double(img.pixel_count()), 0.001) << "tile " << tile;
@@ -130,21 +117,24 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
     const auto dir = test::scratch_dir("wall_script");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
     // The change comes after 200 rays of a 76,800-ray frame: every tile is still casting.
-    std::ofstream(dir / "script.txt") << "wait rays 200\norbit 60 -20\niso 160\nwait done\nsnapshot last\nquit\n";
+    std::ofstream(dir / "script.txt")
+        << "wait rays 200\norbit 60 -20\niso 160\nwait done\nsnapshot last\nquit\n";
     ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --script '" +
                       (dir / "script.txt").string() + "' --out '" + (dir / "mosaic.png").string() +
                       "' --trace '" + (dir / "trace").string() + "'",
                   dir / "wall.log"),
               0)
         << slurp(dir / "wall.log");
-    ASSERT_EQ(run(isowall_cmd() + "render --size 320x240 --orbit 60 -20 --iso 160 -q --no-measure --out '" +
+    ASSERT_EQ(run(isowall_cmd() +
+                      "render --size 320x240 --orbit 60 -20 --iso 160 -q --no-measure --out '" +
                       (dir / "single.png").string() + "'",
                   dir / "render.log"),
               0);
     const Image single = read_image(dir / "single.png");
     for (const char* name : {"mosaic.png", "last.png"}) {
-        const Match m = compare(read_image(dir / name), single);
-        EXPECT_GE(m.iou, 0.999) << name;
+        const test::ImageComparison m =
+            test::compare_images(read_image(dir / name), single, kFromFiles);
+        EXPECT_GE(m.mask_iou, 0.999) << name;
         EXPECT_GE(m.equal_share, 0.999) << name;
     }
     // The trace: every rank has spans, the tiles in the engine's stages and waiting on the master.
@@ -156,8 +146,9 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
         pid += std::to_string(rank);
         EXPECT_NE(json.find(pid), std::string::npos) << "rank " << rank;
     }
-    for (const char* row : {"\n1,tile 0,intersection,", "\n1,tile 0,propagation,", "\n1,tile 0,render,",
-                            "\n4,tile 3,idle,", "\n0,master,idle,", "\n0,master,compose,"})
+    for (const char* row :
+         {"\n1,tile 0,intersection,", "\n1,tile 0,propagation,", "\n1,tile 0,render,",
+          "\n4,tile 3,idle,", "\n0,master,idle,", "\n0,master,compose,"})
         EXPECT_NE(csv.find(row), std::string::npos) << row;
     // Every tile rank saw three frames, and at least the first was cut short.
     const std::string log = slurp(dir / "wall.log");
@@ -183,8 +174,8 @@ TEST(WallRun, ATileThatStopsAnsweringOrDiesEndsTheJobInBoundedTime) {
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
     // The timeout counts silence from every tile; it must outlast a slow start (tiles build the
     // phantom before their first message: seconds under ASan on 2 cores), so 20 s, not 3.
-    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() + "' --timeout 20 --out '" +
-                             (dir / "m.png").string() + "'";
+    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() +
+                             "' --timeout 20 --out '" + (dir / "m.png").string() + "'";
     // Stops answering: the master names the silent tile and ends the job after --timeout.
     int rc = run("env ISOWALL_TEST_FAULT=hang:2 " + mpirun(5) + wall, dir / "hang.log");
     std::string log = slurp(dir / "hang.log");
@@ -203,9 +194,10 @@ TEST(WallRun, ConsoleCommandsDriveTheWall) {
     const auto dir = test::scratch_dir("wall_console");
     std::ofstream(dir / "1x1.toml") << "tiles = [1, 1]\ntile_size_px = [96, 72]\n";
     std::ofstream(dir / "typed.txt") << "orbit 30 0\nfly away\nwait done\nsnapshot typed\nquit\n";
-    const int rc = run(mpirun(2) + "wall --wall '" + (dir / "1x1.toml").string() + "' --script - --out '" +
-                           (dir / "m.png").string() + "' < '" + (dir / "typed.txt").string() + "'",
-                       dir / "console.log");
+    const int rc =
+        run(mpirun(2) + "wall --wall '" + (dir / "1x1.toml").string() + "' --script - --out '" +
+                (dir / "m.png").string() + "' < '" + (dir / "typed.txt").string() + "'",
+            dir / "console.log");
     const std::string log = slurp(dir / "console.log");
     EXPECT_EQ(rc, 0) << log;
     // A typo on the console is reported and skipped, not fatal.
@@ -220,18 +212,23 @@ TEST(WallRun, BadInputEndsEveryRank) {
     std::ofstream(dir / "bad.toml") << "tiles = [2, 0]\ntile_size_px = [64, 48]\n";
     std::ofstream(dir / "bad_script.txt") << "orbit 10 0\nfly 1 2\n";
     std::ofstream(dir / "iso.txt") << "iso 999\nwait done\n";
-    const std::string wall = " wall --wall '" + (dir / "2x2.toml").string() + "' --out '" + (dir / "m.png").string() + "'";
+    const std::string wall = " wall --wall '" + (dir / "2x2.toml").string() + "' --out '" +
+                             (dir / "m.png").string() + "'";
     struct Case {
         std::string name, cmd, expect;
     };
     const Case cases[] = {
         {"wrong rank count", mpirun(3) + wall, "needs mpirun -np 5"},
-        {"bad wall file", mpirun(5) + " wall --wall '" + (dir / "bad.toml").string() + "'", "tiles"},
-        {"missing volume", mpirun(5) + wall + " -v '" + (dir / "nope.nhdr").string() + "' --iso 1", "nope.nhdr"},
+        {"bad wall file", mpirun(5) + " wall --wall '" + (dir / "bad.toml").string() + "'",
+         "tiles"},
+        {"missing volume", mpirun(5) + wall + " -v '" + (dir / "nope.nhdr").string() + "' --iso 1",
+         "nope.nhdr"},
         {"isovalue out of range", mpirun(5) + wall + " --iso 999", "--iso"},
-        {"bad script line", mpirun(5) + wall + " --script '" + (dir / "bad_script.txt").string() + "'",
+        {"bad script line",
+         mpirun(5) + wall + " --script '" + (dir / "bad_script.txt").string() + "'",
          "bad_script.txt:2: command: unknown command \"fly\""},
-        {"isovalue out of range in a script", mpirun(5) + wall + " --script '" + (dir / "iso.txt").string() + "'",
+        {"isovalue out of range in a script",
+         mpirun(5) + wall + " --script '" + (dir / "iso.txt").string() + "'",
          "iso.txt:1: iso: isovalue 999"},
     };
     for (const Case& c : cases) {

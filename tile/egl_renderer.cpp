@@ -114,7 +114,8 @@ std::vector<EGLDisplay> candidate_displays() {
             reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
         EGLDeviceEXT devices[16];
         EGLint count = 0;
-        if (get_platform_display == nullptr || query_devices == nullptr || !query_devices(16, devices, &count))
+        if (get_platform_display == nullptr || query_devices == nullptr ||
+            !query_devices(16, devices, &count))
             fail("ISOWALL_EGL_DEVICE: eglQueryDevicesEXT (no EGL device platform)");
         char* end = nullptr;
         const long n = std::strtol(want, &end, 10);
@@ -123,7 +124,9 @@ std::vector<EGLDisplay> candidate_displays() {
                                            ": expected a device index from 0 to " +
                                            std::to_string(count - 1));
         EGLDisplay d = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[n], nullptr);
-        if (d == EGL_NO_DISPLAY) fail("eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device " + std::string(want) + ")");
+        if (d == EGL_NO_DISPLAY)
+            fail("eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device " + std::string(want) +
+                 ")");
         displays.push_back(d);
         return displays;
     }

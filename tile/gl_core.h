@@ -64,7 +64,7 @@ class GlCore {
 // The Renderer calls every GL back end shares: make the back end's context current, then let
 // GlCore do the work. A back end supplies the context (make_current) and creates core_.
 class GlRenderer : public Renderer {
-public:
+  public:
     void resize(int width, int height) override {
         make_current();
         core_->resize(width, height);
@@ -86,7 +86,7 @@ public:
         core_->finish();
     }
 
-protected:
+  protected:
     virtual void make_current() = 0;
     std::unique_ptr<GlCore> core_;
 };

@@ -1,21 +1,25 @@
 #pragma once
-// The progressive view-dependent engine (chapters 2-3): drives one view (camera, frustum,
-// isovalue) ray by ray in a progressive order until every pixel of the volume's screen box has had
-// its ray, or until it is interrupted. Each ray that finds an unvisited seed starts a propagation
-// pass; the pass's group is drawn at once into the frame being built (no clear, no redraw of
-// older groups), so drawing cost follows new triangles only.
+// The progressive view-dependent engine (chapters 2-3): fills a region of one view's pixels (a
+// whole tile, or later a screen-region job) ray by ray in a progressive order until every pixel of
+// the region that the volume covers has had its ray, or until it is stopped. Each ray that finds an
+// unvisited seed starts a propagation pass; the pass's group goes at once to a group sink (drawn
+// into the frame being built: no clear, no redraw of older groups, so drawing cost follows new
+// triangles only; recorded for the replay; later streamed).
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
-#include "common/extract/adaptive.h"
 #include "common/core/camera.h"
-#include "common/progressive/correctness.h"
 #include "common/core/image.h"
-#include "common/progressive/ray_order.h"
+#include "common/core/view.h"
+#include "common/extract/adaptive.h"
 #include "common/extract/surface_extractor.h"
+#include "common/progressive/correctness.h"
+#include "common/progressive/ray_order.h"
 #include "common/progressive/timeline.h"
 #include "common/progressive/trace.h"
+#include "tile/group_sink.h"
 #include "tile/renderer.h"
 
 namespace isowall {
@@ -44,35 +48,37 @@ struct EngineOptions {
     std::vector<std::size_t> sample_at_rays;
 };
 
-struct FrameView {
-    Camera camera;
-    Frustum frustum;
-    int width = 0;
-    int height = 0;
-    double iso = 0;
-};
-
 struct FrameResult {
     bool completed = false;  // false: interrupted before the last ray
     std::size_t rays_cast = 0;
     std::size_t rays_screen = 0;  // width * height: the share of rays is rays_cast / rays_screen
     std::size_t rays_second_pass = 0;  // approximate mode: rays cast again exactly
     double elapsed_s = 0;
-    std::vector<Group> groups;
+    std::size_t group_count = 0;
+    std::vector<Group> groups;  // every group in order (the convenience run() only)
     std::vector<TimelineSample> timeline;
-    Image final_image;  // colour and depth after the last ray (empty when interrupted)
-    PixelRect screen_rect;
+    Image final_image;  // colour and depth after the last ray (the convenience run() only; empty
+                        // when interrupted)
+    PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
 };
 
 class ProgressiveEngine {
-public:
+  public:
     ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer, EngineOptions options = {});
 
-    // Runs one frame. `interrupted` is polled between rays and inside long propagation passes;
-    // when it returns true the frame stops at once and the result says completed = false.
-    // `progress` (optional) is called with the latest sample about every 0.5 s.
-    FrameResult run(const FrameView& view, const std::function<bool()>& interrupted = {},
-                    const std::function<void(const TimelineSample&)>& progress = {});
+    using Progress = std::function<void(const TimelineSample&)>;
+
+    // Fills `region` of `view`'s screen, handing each group to `sink`. `stop` is read between rays
+    // and inside long propagation passes (a communication thread sets it when a new view
+    // arrives); once it reads true the frame ends at once with completed = false. `progress`
+    // (optional) sees the latest sample about every options().progress_interval_s.
+    FrameResult run(const FrameView& view, const PixelRect& region, GroupSink& sink,
+                    const std::atomic<bool>& stop, const Progress& progress = {});
+
+    // The whole screen into this engine's renderer, keeping every group and the final image in
+    // the result (what `isowall render` and the tests use).
+    FrameResult run(const FrameView& view, const std::atomic<bool>* stop = nullptr,
+                    const Progress& progress = {});
 
     // Replays the frame's groups in order and measures both correctness measures of the image at
     // every timeline sample against the final image (not part of the timed run). `on_image` sees
@@ -82,7 +88,7 @@ public:
 
     const EngineOptions& options() const { return options_; }
 
-private:
+  private:
     SurfaceExtractor& extractor_;
     Renderer& renderer_;
     EngineOptions options_;

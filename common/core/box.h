@@ -1,7 +1,7 @@
 #pragma once
 // Axis-aligned box. An empty box is inverted (min=+inf, max=-inf) so merge() needs no flag.
-#include <glm/vec3.hpp>
 #include <glm/common.hpp>
+#include <glm/vec3.hpp>
 #include <limits>
 #include <ostream>
 

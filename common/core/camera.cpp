@@ -26,9 +26,13 @@ Frustum sub_frustum(const Frustum& full, int screen_w, int screen_h, const Pixel
     return f;
 }
 
-glm::mat4 Camera::view() const { return glm::lookAt(eye, target, up); }
+glm::mat4 Camera::view() const {
+    return glm::lookAt(eye, target, up);
+}
 
-float Camera::distance() const { return glm::length(eye - target); }
+float Camera::distance() const {
+    return glm::length(eye - target);
+}
 
 Frustum Camera::frustum(float aspect) const {
     Frustum f;

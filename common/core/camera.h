@@ -49,7 +49,8 @@ struct Camera {
 
 // Front full view: looking along +y of the volume (front of a head scan) with +z up, at the
 // nearest distance where every corner of `bounds` is in view (4% margin).
-Camera front_full_view(const Box3& bounds, float aspect, Projection projection = Projection::perspective);
+Camera front_full_view(const Box3& bounds, float aspect,
+                       Projection projection = Projection::perspective);
 
 // Rotate the eye around the target: yaw about the up vector, pitch about the right vector.
 Camera orbit(const Camera& c, float yaw_deg, float pitch_deg);

@@ -7,7 +7,7 @@
 namespace isowall {
 
 class InputError : public std::runtime_error {
-public:
+  public:
     // e.g. InputError("head.nhdr", "sizes", "expected 3 positive integers, got \"256 256\"")
     InputError(const std::string& where, const std::string& field, const std::string& message)
         : std::runtime_error(where + ": " + field + ": " + message) {}

@@ -19,7 +19,9 @@ struct Image {
     }
     std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
     // A pixel is covered when something was drawn into it (depth < 1).
-    bool covered(int x, int y) const { return depth[static_cast<std::size_t>(y) * width + x] < 1.0f; }
+    bool covered(int x, int y) const {
+        return depth[static_cast<std::size_t>(y) * width + x] < 1.0f;
+    }
 };
 
 }  // namespace isowall

@@ -10,8 +10,8 @@
 namespace isowall {
 
 struct Mesh {
-    std::vector<glm::vec3> positions;  // object space (voxel index * spacing)
-    std::vector<glm::vec3> normals;    // unit, one per position
+    std::vector<glm::vec3> positions;    // object space (voxel index * spacing)
+    std::vector<glm::vec3> normals;      // unit, one per position
     std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
 
     std::size_t triangle_count() const { return indices.size() / 3; }

@@ -13,7 +13,7 @@
 namespace isowall {
 
 struct Ray {
-    glm::vec3 o{0};  // origin
+    glm::vec3 o{0};         // origin
     glm::vec3 d{0, 0, -1};  // direction (not necessarily unit length)
     glm::vec3 at(float t) const { return o + t * d; }
 };
@@ -24,15 +24,16 @@ Ray pixel_ray(const glm::mat4& view_inverse, const Frustum& frustum, int width, 
               glm::ivec2 pixel);
 
 // Object space -> voxel space.
-inline Ray to_voxel_space(const Ray& r, glm::vec3 spacing) { return {r.o / spacing, r.d / spacing}; }
+inline Ray to_voxel_space(const Ray& r, glm::vec3 spacing) {
+    return {r.o / spacing, r.d / spacing};
+}
 
 // Slab test against [lo, hi]: the entry and exit parameters, or false when the ray misses.
 bool intersect_box(const Ray& r, const glm::vec3& inv_d, glm::vec3 lo, glm::vec3 hi, float& t0,
                    float& t1);
 
 // Moller-Trumbore: the ray parameter of the hit, or false (two-sided, t >= t_min).
-bool intersect_triangle(const Ray& r, glm::vec3 a, glm::vec3 b, glm::vec3 c, float t_min,
-                        float& t);
+bool intersect_triangle(const Ray& r, glm::vec3 a, glm::vec3 b, glm::vec3 c, float t_min, float& t);
 
 // The pixel rectangle covered by the projection of box `b` (object space), clipped to the screen;
 // empty (width 0) when the box is entirely outside. Corners behind the eye make the whole

@@ -13,10 +13,11 @@
 namespace isowall {
 
 class EdgeVertexCache {
-public:
+  public:
     explicit EdgeVertexCache(std::size_t expected = 1024) { reset(expected); }
 
-    // The slot for `key` and whether it was just inserted (its value is then for the caller to set).
+    // The slot for `key` and whether it was just inserted (its value is then for the caller to
+    // set).
     std::pair<std::uint32_t*, bool> find_or_insert(std::uint64_t key) {
         if (2 * (size_ + 1) > keys_.size()) grow();
         std::size_t i = hash(key) & mask_;
@@ -44,7 +45,7 @@ public:
     }
     std::size_t size() const { return size_; }
 
-private:
+  private:
     static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
     static std::uint64_t hash(std::uint64_t k) {
         k ^= k >> 33;
@@ -65,24 +66,25 @@ private:
     std::size_t size_ = 0;
 };
 
-// Vertex caches hand triangulate_cell a slot per cell edge: find_or_insert(lower voxel, axis)
+// Vertex caches hand emit_meta_cell a slot per cell edge: find_or_insert(lower voxel, axis)
 // returns the slot and whether it is new (the caller then stores the vertex id in it). The slot
 // pointer is valid until the next call.
 
 // Any set of cells (one propagation pass, say): one hash lookup per edge.
 class HashEdgeCache {
-public:
+  public:
     HashEdgeCache(glm::ivec3 dims, std::size_t expected = 1024) : dims_(dims), map_(expected) {}
     std::pair<std::uint32_t*, bool> find_or_insert(glm::ivec3 p, int axis) {
         const auto voxel = (static_cast<std::uint64_t>(p.z) * static_cast<std::uint64_t>(dims_.y) +
-                            static_cast<std::uint64_t>(p.y)) * static_cast<std::uint64_t>(dims_.x) +
+                            static_cast<std::uint64_t>(p.y)) *
+                               static_cast<std::uint64_t>(dims_.x) +
                            static_cast<std::uint64_t>(p.x);
         return map_.find_or_insert(voxel * 3 + static_cast<std::uint64_t>(axis));
     }
     void clear() { map_.clear(); }
     std::size_t size() const { return map_.size(); }
 
-private:
+  private:
     glm::ivec3 dims_;
     EdgeVertexCache map_;
 };
@@ -92,7 +94,7 @@ private:
 // brick or its seven upper neighbours, so begin_brick() lets the cache resolve those eight tables
 // once per brick instead of hashing once per edge (a likely cache miss on a large surface).
 class BrickEdgeCache {
-public:
+  public:
     explicit BrickEdgeCache(glm::ivec3 dims) : bricks_((dims >> kLog2) + 1), index_(1024) {}
 
     // Cells from now on lie in brick b (a brick of the octree's leaf level).
@@ -107,18 +109,20 @@ public:
         if (table == kNone) table = table_for(current_ + d);
         const glm::ivec3 l = p & (kSide - 1);
         std::uint32_t& e =
-            tables_[table][static_cast<std::size_t>(((l.z * kSide + l.y) * kSide + l.x) * 3 + axis)];
+            tables_[table]
+                   [static_cast<std::size_t>(((l.z * kSide + l.y) * kSide + l.x) * 3 + axis)];
         return {&e, e == kNone};
     }
 
-private:
+  private:
     static constexpr int kLog2 = 2;  // matches OctreeShape::kLeafLog2
     static constexpr int kSide = 1 << kLog2;
     static constexpr std::uint32_t kNone = ~std::uint32_t{0};
 
     std::uint32_t table_for(glm::ivec3 b) {
         const auto id = (static_cast<std::uint64_t>(b.z) * static_cast<std::uint64_t>(bricks_.y) +
-                         static_cast<std::uint64_t>(b.y)) * static_cast<std::uint64_t>(bricks_.x) +
+                         static_cast<std::uint64_t>(b.y)) *
+                            static_cast<std::uint64_t>(bricks_.x) +
                         static_cast<std::uint64_t>(b.x);
         auto [slot, inserted] = index_.find_or_insert(id);
         if (inserted) {

@@ -30,19 +30,20 @@ void emit_brick(const VolumeView<T>& v, glm::ivec3 b, glm::ivec3 e, double iso, 
             const T* row = v.data + v.index(b.x, b.y + y, b.z + z);
             for (int x = 0; x < n.x; ++x) inside[z][y][x] = is_inside(row[x]);
         }
-    if constexpr (requires { cache.begin_brick(b); }) cache.begin_brick(b >> OctreeShape::kLeafLog2);
+    if constexpr (requires { cache.begin_brick(b); })
+        cache.begin_brick(b >> OctreeShape::kLeafLog2);
     double corner[8];
     for (int z = 0; z + 1 < n.z; ++z)
         for (int y = 0; y + 1 < n.y; ++y)
             for (int x = 0; x + 1 < n.x; ++x) {
-                const int cs = inside[z][y][x] | inside[z][y][x + 1] << 1 | inside[z][y + 1][x] << 2 |
-                               inside[z][y + 1][x + 1] << 3 | inside[z + 1][y][x] << 4 |
-                               inside[z + 1][y][x + 1] << 5 | inside[z + 1][y + 1][x] << 6 |
-                               inside[z + 1][y + 1][x + 1] << 7;
+                const int cs = inside[z][y][x] | inside[z][y][x + 1] << 1 |
+                               inside[z][y + 1][x] << 2 | inside[z][y + 1][x + 1] << 3 |
+                               inside[z + 1][y][x] << 4 | inside[z + 1][y][x + 1] << 5 |
+                               inside[z + 1][y + 1][x] << 6 | inside[z + 1][y + 1][x + 1] << 7;
                 if (cs == 0 || cs == 255) continue;
                 const glm::ivec3 c = b + glm::ivec3(x, y, z);
-                cell_corners(v, c, corner);
-                emit_cell(v, c, iso, cs, corner, cache, mesh);
+                meta_cell_corners(v, c, 0, corner);
+                emit_meta_cell(v, c, 0, iso, cs, corner, cache, mesh);
                 ++st.cells_active;
             }
 }

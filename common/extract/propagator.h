@@ -25,6 +25,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/extract/adaptive.h"
+#include "common/extract/group.h"
 #include "common/extract/marching_cubes.h"
 #include "common/extract/visited.h"
 
@@ -34,23 +35,10 @@ enum class PropagationMode { max_count, cutoff_angle };
 
 struct PropagationParams {
     PropagationMode mode = PropagationMode::max_count;
-    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
-    float cutoff_rad = 0.0349f;    // 2 degrees
+    int max_count = 2000;        // measured best on vhp_ct_head skin and bone (README, Benchmarks)
+    float cutoff_rad = 0.0349f;  // 2 degrees
     float foldback_rad = 0.0087f;  // 0.5 degree
     bool interpolant_cache = true;
-};
-
-struct Group {
-    std::uint32_t id = 0;
-    glm::ivec3 seed{0};
-    int level = 0;  // the resolution of the pass: 0 cells, i >= 1 meta-cells of 2^i cells per side
-    Mesh mesh;  // object space
-    // The cells this pass took, in BFS order; at level >= 1 the first cell of each meta-cell.
-    std::vector<glm::ivec3> cells;
-    // A refinement (adaptive resolution): the full-resolution triangles of the meta-cell of
-    // `level` at `seed`, drawn over its own because a ray saw the surface there that they miss.
-    // It takes no cells: they stay with the pass that took the meta-cell, if any.
-    bool refinement = false;
 };
 
 // Without the interpolant cache every triangle gets its own three vertices (the "caching off"
@@ -62,7 +50,7 @@ struct NoEdgeCache {
 
 template <class T>
 class Propagator {
-public:
+  public:
     explicit Propagator(const VolumeView<T>& v) : v_(v), cache_(v.dims, 4096) {}
 
     // The resolution of the following passes; default-constructed: full resolution.
@@ -85,6 +73,7 @@ public:
         seed &= ~(stride - 1);  // the unit's first cell
         g.seed = seed;
         g.level = level;
+        g.iso = iso;
         if (!insert(visited, seed, level, group_id)) return g;
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
@@ -105,7 +94,8 @@ public:
             if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
             const auto t0 = std::chrono::steady_clock::now();
             const int cs = triangulate(item.cell, level, iso, p, g.mesh);
-            extract_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            extract_s_ +=
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             for (int f = 0; f < 6; ++f) {
                 const int axis = f >> 1, side = f & 1;
                 // The face's four corners: those with bit `axis` equal to `side`.
@@ -146,6 +136,7 @@ public:
         g.id = group_id;
         g.seed = base;
         g.level = level;
+        g.iso = iso;
         g.refinement = true;
         cache_.clear();
         const int s = 1 << level;
@@ -157,7 +148,7 @@ public:
         return g;
     }
 
-private:
+  private:
     // Marks every cell of the unit of `level` at `base`; false when it was taken already.
     static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
         if (!visited.insert(base, group_id)) return false;
@@ -169,27 +160,16 @@ private:
         return true;
     }
 
+    // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
     int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
-        if (level > 0) {
-            double corner[8];
-            meta_cell_corners(v_, c, level, corner);
-            const int cs = cell_case(corner, iso);
-            if (p.interpolant_cache) {
-                emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
-            } else {
-                NoEdgeCache none;
-                emit_meta_cell(v_, c, level, iso, cs, corner, none, mesh);
-            }
-            return cs;
-        }
         double corner[8];
-        cell_corners(v_, c, corner);
+        meta_cell_corners(v_, c, level, corner);
         const int cs = cell_case(corner, iso);
         if (p.interpolant_cache) {
-            emit_cell(v_, c, iso, cs, corner, cache_, mesh);
+            emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
         } else {
             NoEdgeCache none;
-            emit_cell(v_, c, iso, cs, corner, none, mesh);
+            emit_meta_cell(v_, c, level, iso, cs, corner, none, mesh);
         }
         return cs;
     }

@@ -15,10 +15,10 @@
 #include <cmath>
 #include <limits>
 
+#include "common/core/ray.h"
 #include "common/extract/adaptive.h"
 #include "common/extract/marching_cubes.h"
 #include "common/volume/octree.h"
-#include "common/core/ray.h"
 
 namespace isowall {
 
@@ -27,8 +27,8 @@ enum class IntersectMode { exact, approximate };
 struct RayHit {
     bool found = false;
     glm::ivec3 cell{0};  // the cell, or the first cell of the meta-cell
-    float t = 0;  // ray parameter of the hit (exact) or of the cell entry (approximate)
-    int level = 0;  // 0: a cell; i >= 1: the meta-cell of 2^i cells per side at `cell`
+    float t = 0;         // ray parameter of the hit (exact) or of the cell entry (approximate)
+    int level = 0;       // 0: a cell; i >= 1: the meta-cell of 2^i cells per side at `cell`
     // Exact walk with adaptive resolution only: the meta-cell's own triangles miss the ray, but
     // its full-resolution triangles are hit (in fine_cell, at t). The meta-cell needs refining
     // for this pixel to show the surface.
@@ -36,29 +36,9 @@ struct RayHit {
     glm::ivec3 fine_cell{0};
 };
 
-// The triangles of cell c in voxel space (three vertices each); returns the triangle count.
-template <class T>
-int cell_triangles(const VolumeView<T>& v, glm::ivec3 c, double iso,
-                   std::array<glm::vec3, 3 * mc::kMaxTriangles>& out) {
-    double corner[8];
-    cell_corners(v, c, corner);
-    const int cs = cell_case(corner, iso);
-    const int count = mc::kTriangleCount[static_cast<std::size_t>(cs)];
-    const auto& edges = mc::kTriangleEdges[static_cast<std::size_t>(cs)];
-    for (int i = 0; i < 3 * count; ++i) {
-        const auto e = static_cast<std::size_t>(edges[static_cast<std::size_t>(i)]);
-        const int ca = mc::kEdgeCorners[e][0], cb = mc::kEdgeCorners[e][1];
-        const auto& oa = mc::kCornerOffset[static_cast<std::size_t>(ca)];
-        glm::vec3 p = glm::vec3(c + glm::ivec3(oa[0], oa[1], oa[2]));
-        p[mc::kEdgeAxis[e]] += static_cast<float>((iso - corner[ca]) / (corner[cb] - corner[ca]));
-        out[static_cast<std::size_t>(i)] = p;
-    }
-    return count;
-}
-
 template <class T>
 class RayCaster {
-public:
+  public:
     RayCaster(const VolumeView<T>& volume, const MinMaxOctree<T>& octree)
         : v_(volume), octree_(octree) {}
 
@@ -70,8 +50,10 @@ public:
                 float t_max = std::numeric_limits<float>::max()) {
         ray_ = ray;
         for (int a = 0; a < 3; ++a)
-            inv_d_[a] = std::abs(ray.d[a]) > 1e-20f ? 1.0f / ray.d[a] : std::copysign(1e30f, ray.d[a]);
+            inv_d_[a] =
+                std::abs(ray.d[a]) > 1e-20f ? 1.0f / ray.d[a] : std::copysign(1e30f, ray.d[a]);
         iso_ = iso;
+        inside_ = InsideTest<T>(iso);
         mode_ = mode;
         t_max_ = t_max;
         hit_ = {};
@@ -87,7 +69,7 @@ public:
     }
     std::size_t cells_tested() const { return cells_tested_; }
 
-private:
+  private:
     // Hierarchical DDA at full resolution: from the ray's entry into the volume, find the largest
     // octree node around the current point that cannot hold the surface and jump to its exit;
     // where the leaf brick is active, step through its cells. Half the time per ray of the
@@ -97,7 +79,8 @@ private:
     void walk() {
         const OctreeShape& shape = octree_.shape();
         float t, t_end;
-        if (!intersect_box(ray_, inv_d_, glm::vec3(0), glm::vec3(shape.cell_dims), t, t_end)) return;
+        if (!intersect_box(ray_, inv_d_, glm::vec3(0), glm::vec3(shape.cell_dims), t, t_end))
+            return;
         t = std::max(t, 0.0f);
         t_end = std::min(t_end, t_max_);
         const glm::ivec3 leaf_dims = shape.levels[0].dims;
@@ -111,7 +94,8 @@ private:
             const glm::ivec3 brick = glm::clamp(glm::ivec3(glm::floor(p)) >> OctreeShape::kLeafLog2,
                                                 glm::ivec3(0), leaf_dims - 1);
             int skip = -1;  // the highest level whose node around p is inactive
-            while (skip + 1 < levels && !octree_.active(skip + 1, brick >> (skip + 1), iso_)) ++skip;
+            while (skip + 1 < levels && !octree_.active(skip + 1, brick >> (skip + 1), iso_))
+                ++skip;
             const int level = skip >= 0 ? skip : 0;
             const glm::ivec3 n = brick >> level;
             float n0, n1;
@@ -190,12 +174,10 @@ private:
                 t_delta[a] = std::numeric_limits<float>::max();
             }
         }
-        const InsideTest<T> inside(iso_);
         for (;;) {
-            ++cells_tested_;
-            if (test_cell(c, inside)) return true;
-            const int a = t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2)
-                                              : (t_next.y < t_next.z ? 1 : 2);
+            if (test_unit(c, 0)) return true;
+            const int a =
+                t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2) : (t_next.y < t_next.z ? 1 : 2);
             if (t_next[a] > t1) return false;
             c[a] += step[a];
             if (c[a] < b[a] || c[a] >= e[a]) return false;
@@ -214,7 +196,8 @@ private:
             const glm::ivec3 c = base + s * glm::ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
             if (c.x >= dims.x || c.y >= dims.y || c.z >= dims.z) continue;
             float k0, k1;
-            if (!intersect_box(ray_, inv_d_, glm::vec3(c), glm::vec3(glm::min(c + s, dims)), k0, k1))
+            if (!intersect_box(ray_, inv_d_, glm::vec3(c), glm::vec3(glm::min(c + s, dims)), k0,
+                               k1))
                 continue;
             if (k1 < 0 || k0 > t_max_) continue;
             kids[static_cast<std::size_t>(count++)] = {k0, c};
@@ -235,44 +218,20 @@ private:
         return false;
     }
 
-    // A cell (level 0) or a meta-cell unit, judged by its eight corners.
+    // A cell (level 0) or a meta-cell unit, judged by its eight corners. The DDA calls this for
+    // every cell it steps through, so an inactive cell costs only its classification.
     bool test_unit(glm::ivec3 base, int level) {
         ++cells_tested_;
-        double corner[8];
-        meta_cell_corners(v_, base, level, corner);
-        const int cs = cell_case(corner, iso_);
-        const int s = 1 << level;
-        float t0, t1;
-        intersect_box(ray_, inv_d_, glm::vec3(base), glm::vec3(base + s), t0, t1);
-        t0 = std::max(t0, 0.0f);
-        const bool active = cs != 0 && cs != 255;
-        if (active && mode_ == IntersectMode::approximate) {
-            hit_ = {true, base, t0, level, false, base};
-            return true;
-        }
-        if (active && mode_ == IntersectMode::exact) {
-            const int count = meta_cell_triangles(v_, base, level, iso_, tris_);
-            bool any = false;
-            float best = std::numeric_limits<float>::max();
-            for (int i = 0; i < count; ++i) {
-                float t;
-                const auto k = static_cast<std::size_t>(3 * i);
-                if (intersect_triangle(ray_, tris_[k], tris_[k + 1], tris_[k + 2], 0.0f, t) &&
-                    t < best) {
-                    best = t;
-                    any = true;
-                }
-            }
-            if (any && best <= t_max_) {
-                hit_ = {true, base, best, level, false, base};
-                return true;
-            }
-        }
+        const int cs = meta_cell_case(v_, base, level, inside_);
+        if (cs != 0 && cs != 255 && hit_unit(base, level)) return true;
         // The meta-cell's triangles miss the ray (or it has none), but the full-resolution
         // surface inside it may not: on a silhouette or across a crack at a resolution boundary
         // a sub-pixel difference uncovers a whole pixel. The exact walk looks at its cells.
         if (level == 0 || mode_ != IntersectMode::exact || !resolution_.refine()) return false;
-        if (!walk_brick(base, base + s, t0, std::min(t1, t_max_))) return false;
+        const int s = 1 << level;
+        float t0, t1;
+        intersect_box(ray_, inv_d_, glm::vec3(base), glm::vec3(base + s), t0, t1);
+        if (!walk_brick(base, base + s, std::max(t0, 0.0f), std::min(t1, t_max_))) return false;
         hit_.refine = true;
         hit_.fine_cell = hit_.cell;
         hit_.cell = base;
@@ -280,34 +239,29 @@ private:
         return true;
     }
 
-    bool test_cell(glm::ivec3 c, const InsideTest<T>& inside) {
-        const std::size_t base = v_.index(c.x, c.y, c.z);
-        const std::size_t sy = static_cast<std::size_t>(v_.dims.x);
-        const std::size_t sz = sy * static_cast<std::size_t>(v_.dims.y);
-        const int n = inside(v_.data[base]) + inside(v_.data[base + 1]) + inside(v_.data[base + sy]) +
-                      inside(v_.data[base + sy + 1]) + inside(v_.data[base + sz]) +
-                      inside(v_.data[base + sz + 1]) + inside(v_.data[base + sz + sy]) +
-                      inside(v_.data[base + sz + sy + 1]);
-        if (n == 0 || n == 8) return false;
+    // Whether the ray hits the active unit: approximate, where it enters the unit; exact, on the
+    // unit's triangles no farther than t_max (else the walk resumes past it). Sets hit_.
+    bool hit_unit(glm::ivec3 base, int level) {
         if (mode_ == IntersectMode::approximate) {
             float t0, t1;
-            intersect_box(ray_, inv_d_, glm::vec3(c), glm::vec3(c + 1), t0, t1);
-            hit_ = {true, c, std::max(t0, 0.0f), 0, false, c};
+            intersect_box(ray_, inv_d_, glm::vec3(base), glm::vec3(base + (1 << level)), t0, t1);
+            hit_ = {true, base, std::max(t0, 0.0f), level, false, base};
             return true;
         }
-        const int count = cell_triangles(v_, c, iso_, tris_);
+        const int count = meta_cell_triangles(v_, base, level, iso_, tris_);
         bool any = false;
         float best = std::numeric_limits<float>::max();
         for (int i = 0; i < count; ++i) {
             float t;
             const auto k = static_cast<std::size_t>(3 * i);
-            if (intersect_triangle(ray_, tris_[k], tris_[k + 1], tris_[k + 2], 0.0f, t) && t < best) {
+            if (intersect_triangle(ray_, tris_[k], tris_[k + 1], tris_[k + 2], 0.0f, t) &&
+                t < best) {
                 best = t;
                 any = true;
             }
         }
-        if (!any || best > t_max_) return false;  // the walk resumes past this cell
-        hit_ = {true, c, best, 0, false, c};
+        if (!any || best > t_max_) return false;
+        hit_ = {true, base, best, level, false, base};
         return true;
     }
 
@@ -316,6 +270,7 @@ private:
     Ray ray_;
     glm::vec3 inv_d_{0};
     double iso_ = 0;
+    InsideTest<T> inside_{0.0};
     IntersectMode mode_ = IntersectMode::exact;
     float t_max_ = 0;
     RayHit hit_;

@@ -1,14 +1,18 @@
 #pragma once
 // One volume with its octree, behind a voxel-type-free interface: the per-type cores (RayCaster,
 // Propagator, extract_full) are instantiated once per voxel type in surface_extractor.cpp, so
-// callers (the progressive engine, the CLI, the wall) are not templates.
+// callers (the progressive engine, the CLI, the wall) are not templates. Inside, an extractor is
+// shared read-only data, one frame state and per-thread workers (extractor_parts.h).
 #include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 
+#include "common/core/thread_budget.h"
 #include "common/extract/adaptive.h"
 #include "common/extract/extract.h"
+#include "common/extract/group.h"
 #include "common/extract/propagator.h"
 #include "common/extract/raycaster.h"
 #include "common/volume/volume.h"
@@ -16,7 +20,7 @@
 namespace isowall {
 
 class SurfaceExtractor {
-public:
+  public:
     virtual ~SurfaceExtractor() = default;
 
     virtual const Volume& volume() const = 0;
@@ -24,6 +28,8 @@ public:
     virtual double value_max() const = 0;
     virtual const OctreeShape& octree_shape() const = 0;
     virtual std::size_t octree_bytes() const = 0;
+    // The workers this extractor holds: its thread budget. The calls below run on the first.
+    virtual int threads() const = 0;
 
     // Starts a frame at `iso` at full resolution: forgets every visited cell.
     void begin_frame(double iso) { begin_frame(iso, ResolutionLevels{}); }
@@ -52,8 +58,11 @@ public:
 };
 
 // Builds (or maps from the cache) the octree of `volume`, which must outlive the extractor.
-std::unique_ptr<SurfaceExtractor> make_surface_extractor(const Volume& volume,
-                                                         const OctreeSource& source = {},
-                                                         OctreeStats* stats = nullptr);
+// `budget` is the rank's: the octree build runs on its threads and the extractor holds one worker
+// per thread. Without one, the build takes every core (ThreadBudget::hardware()) and there is one
+// worker.
+std::unique_ptr<SurfaceExtractor> make_surface_extractor(
+    const Volume& volume, const OctreeSource& source = {}, OctreeStats* stats = nullptr,
+    std::optional<ThreadBudget> budget = std::nullopt);
 
 }  // namespace isowall

@@ -12,7 +12,7 @@
 namespace isowall {
 
 class VisitedCells {
-public:
+  public:
     explicit VisitedCells(glm::ivec3 cell_dims = glm::ivec3(0)) { reset(cell_dims); }
 
     void reset(glm::ivec3 cell_dims) {
@@ -24,7 +24,8 @@ public:
     }
     std::uint64_t index(glm::ivec3 c) const {
         return (static_cast<std::uint64_t>(c.z) * static_cast<std::uint64_t>(dims_.y) +
-                static_cast<std::uint64_t>(c.y)) * static_cast<std::uint64_t>(dims_.x) +
+                static_cast<std::uint64_t>(c.y)) *
+                   static_cast<std::uint64_t>(dims_.x) +
                static_cast<std::uint64_t>(c.x);
     }
     bool contains(glm::ivec3 c) const {
@@ -47,7 +48,7 @@ public:
     std::size_t size() const { return count_; }
     glm::ivec3 dims() const { return dims_; }
 
-private:
+  private:
     glm::ivec3 dims_{0};
     std::vector<std::uint64_t> bits_;
     EdgeVertexCache groups_;

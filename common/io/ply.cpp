@@ -38,7 +38,8 @@ void write_ply(const std::filesystem::path& path, const Mesh& mesh) {
             char* f = faces.data() + 13 * t;
             f[0] = 3;
             for (int k = 0; k < 3; ++k) {
-                const auto idx = static_cast<std::int32_t>(mesh.indices[3 * t + static_cast<std::size_t>(k)]);
+                const auto idx =
+                    static_cast<std::int32_t>(mesh.indices[3 * t + static_cast<std::size_t>(k)]);
                 std::memcpy(f + 1 + 4 * k, &idx, 4);
             }
         }
@@ -68,7 +69,8 @@ Mesh read_ply(const std::filesystem::path& path) {
     }
     Mesh m;
     std::vector<float> verts(nv * 6);
-    in.read(reinterpret_cast<char*>(verts.data()), static_cast<std::streamsize>(verts.size() * sizeof(float)));
+    in.read(reinterpret_cast<char*>(verts.data()),
+            static_cast<std::streamsize>(verts.size() * sizeof(float)));
     m.positions.resize(nv);
     m.normals.resize(nv);
     for (std::size_t i = 0; i < nv; ++i)

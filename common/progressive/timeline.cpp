@@ -8,8 +8,8 @@
 
 namespace isowall {
 
-void write_timeline_csv(const std::filesystem::path& path, const std::vector<TimelineSample>& samples,
-                        std::size_t rays_screen) {
+void write_timeline_csv(const std::filesystem::path& path,
+                        const std::vector<TimelineSample>& samples, std::size_t rays_screen) {
     auto tmp = path;
     tmp += ".tmp" + std::to_string(::getpid());
     {
@@ -19,11 +19,11 @@ void write_timeline_csv(const std::filesystem::path& path, const std::vector<Tim
                "t_intersect_s,t_propagate_s,t_extract_s,t_render_s,level\n";
         char line[512];
         for (const auto& s : samples) {
-            std::snprintf(line, sizeof(line), "%.6f,%zu,%.8f,%zu,%zu,%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d\n",
-                          s.time_s, s.rays,
-                          rays_screen ? double(s.rays) / double(rays_screen) : 0.0, s.cells_visited,
-                          s.triangles, s.groups, s.correctness.final_pixels, s.correctness.c,
-                          s.t_intersect_s, s.t_propagate_s, s.t_extract_s, s.t_render_s, s.level);
+            std::snprintf(
+                line, sizeof(line), "%.6f,%zu,%.8f,%zu,%zu,%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d\n",
+                s.time_s, s.rays, rays_screen ? double(s.rays) / double(rays_screen) : 0.0,
+                s.cells_visited, s.triangles, s.groups, s.correctness.final_pixels, s.correctness.c,
+                s.t_intersect_s, s.t_propagate_s, s.t_extract_s, s.t_render_s, s.level);
             out << line;
         }
         if (!out) throw std::runtime_error(path.string() + ": write failed");
@@ -34,8 +34,8 @@ void write_timeline_csv(const std::filesystem::path& path, const std::vector<Tim
 std::optional<std::size_t> first_reaching(const std::vector<TimelineSample>& samples,
                                           double threshold, Measure measure) {
     for (std::size_t i = 0; i < samples.size(); ++i) {
-        const double m = measure == Measure::c ? samples[i].correctness.c
-                                               : samples[i].correctness.final_pixels;
+        const double m =
+            measure == Measure::c ? samples[i].correctness.c : samples[i].correctness.final_pixels;
         if (m >= threshold) return i;
     }
     return std::nullopt;

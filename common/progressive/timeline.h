@@ -19,14 +19,14 @@ struct TimelineSample {
     std::size_t groups = 0;
     // Cumulative seconds per stage (chapter 2.2: intersection, propagation, extraction, rendering).
     double t_intersect_s = 0, t_propagate_s = 0, t_extract_s = 0, t_render_s = 0;
-    int level = 0;  // ray-order level being cast
+    int level = 0;            // ray-order level being cast
     Correctness correctness;  // against the final image; filled by a replay
 };
 
 // Columns: time_s, rays, rays_share (of `rays_screen`), cells_visited, triangles, groups,
 // final_pixels, c, t_intersect_s, t_propagate_s, t_extract_s, t_render_s, level.
-void write_timeline_csv(const std::filesystem::path& path, const std::vector<TimelineSample>& samples,
-                        std::size_t rays_screen);
+void write_timeline_csv(const std::filesystem::path& path,
+                        const std::vector<TimelineSample>& samples, std::size_t rays_screen);
 
 enum class Measure { c, final_pixels };
 // The first sample whose measure is >= threshold (0..1), if any.

@@ -11,7 +11,8 @@ namespace isowall {
 namespace {
 
 double wall_now_s() {
-    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+        .count();
 }
 
 }  // namespace
@@ -22,7 +23,9 @@ double thread_cpu_seconds() {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-TraceRecorder::TraceRecorder() { switch_to(Stage::setup); }
+TraceRecorder::TraceRecorder() {
+    switch_to(Stage::setup);
+}
 
 Stage TraceRecorder::switch_to(Stage stage) {
     const Stage left = current_;
@@ -34,7 +37,8 @@ Stage TraceRecorder::switch_to(Stage stage) {
             spans_.back().wall_s = wall - spans_.back().start_s;
             spans_.back().cpu_s += cpu - cpu0_;
         } else {
-            spans_.push_back({static_cast<std::uint8_t>(current_), wall0_, wall - wall0_, cpu - cpu0_});
+            spans_.push_back(
+                {static_cast<std::uint8_t>(current_), wall0_, wall - wall0_, cpu - cpu0_});
         }
     }
     current_ = stage;
@@ -77,11 +81,12 @@ void write_chrome_trace(const std::filesystem::path& path, const std::vector<Ran
         out << line;
         first = false;
         for (const TraceSpan& s : r.spans) {
-            std::snprintf(line, sizeof(line),
-                          ",\n{\"name\": \"%s\", \"ph\": \"X\", \"pid\": %d, \"tid\": 0, \"ts\": %.1f, "
-                          "\"dur\": %.1f, \"args\": {\"cpu_ms\": %.3f}}",
-                          kTraceStages[s.stage], r.rank, (s.start_s - t0) * 1e6, s.wall_s * 1e6,
-                          s.cpu_s * 1e3);
+            std::snprintf(
+                line, sizeof(line),
+                ",\n{\"name\": \"%s\", \"ph\": \"X\", \"pid\": %d, \"tid\": 0, \"ts\": %.1f, "
+                "\"dur\": %.1f, \"args\": {\"cpu_ms\": %.3f}}",
+                kTraceStages[s.stage], r.rank, (s.start_s - t0) * 1e6, s.wall_s * 1e6,
+                s.cpu_s * 1e3);
             out << line;
         }
     }

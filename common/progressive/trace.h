@@ -25,7 +25,7 @@ enum class Stage : std::uint8_t { intersection, propagation, render, comm, idle,
 double thread_cpu_seconds();
 
 class TraceRecorder {
-public:
+  public:
     TraceRecorder();
     // Ends the current span and starts one in `stage`; returns the stage it left.
     Stage switch_to(Stage stage);
@@ -35,7 +35,7 @@ public:
     // CPU seconds per stage, summed over the spans.
     std::vector<double> cpu_by_stage() const;
 
-private:
+  private:
     std::vector<TraceSpan> spans_;
     Stage current_ = Stage::setup;
     bool open_ = false;

@@ -14,8 +14,7 @@ namespace isowall {
 
 MappedFile::MappedFile(const std::filesystem::path& path) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        throw std::runtime_error(path.string() + ": cannot open: " + std::strerror(errno));
+    if (fd < 0) throw std::runtime_error(path.string() + ": cannot open: " + std::strerror(errno));
     struct stat st {};
     if (::fstat(fd, &st) != 0) {
         const int err = errno;

@@ -8,7 +8,7 @@
 namespace isowall {
 
 class MappedFile {
-public:
+  public:
     MappedFile() = default;
     // Throws std::runtime_error naming the file when it cannot be opened or mapped.
     explicit MappedFile(const std::filesystem::path& path);
@@ -21,7 +21,7 @@ public:
     std::span<const std::byte> bytes() const { return {data_, size_}; }
     std::size_t size() const { return size_; }
 
-private:
+  private:
     const std::byte* data_ = nullptr;
     std::size_t size_ = 0;
 };

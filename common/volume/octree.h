@@ -22,6 +22,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "common/core/thread_budget.h"
 #include "common/volume/mapped_file.h"
 #include "common/volume/volume.h"
 
@@ -69,13 +70,16 @@ struct OctreeStats {
 
 template <class T>
 class MinMaxOctree {
-public:
+  public:
     MinMaxOctree() = default;
 
-    static MinMaxOctree build(const VolumeView<T>& volume);
+    // Splits the leaf level over `budget` threads (the rank's budget; by default every core).
+    static MinMaxOctree build(const VolumeView<T>& volume,
+                              ThreadBudget budget = ThreadBudget::hardware());
     // Map a cache file when its key matches the volume, else build and write it.
     static MinMaxOctree load_or_build(const VolumeView<T>& volume, const OctreeSource& source,
-                                      OctreeStats* stats);
+                                      OctreeStats* stats,
+                                      ThreadBudget budget = ThreadBudget::hardware());
 
     const OctreeShape& shape() const { return shape_; }
     int level_count() const { return static_cast<int>(shape_.levels.size()); }
@@ -91,7 +95,7 @@ public:
     std::span<const T> nodes() const { return nodes_; }
     std::size_t bytes() const { return nodes_.size_bytes(); }
 
-private:
+  private:
     OctreeShape shape_;
     std::span<const T> nodes_;  // (min, max) per node, in node_index order
     std::vector<T> owned_;
@@ -112,7 +116,7 @@ std::filesystem::path file_for(const std::filesystem::path& cache_dir,
                                const std::filesystem::path& volume_path);
 // The node bytes of a cache file whose header matches `key`; nullopt (and `why`) otherwise.
 std::optional<std::span<const std::byte>> match(const MappedFile& file, const Key& key,
-                                                 std::size_t node_bytes, std::string* why);
+                                                std::size_t node_bytes, std::string* why);
 // Writes header + nodes to a temporary file and renames it into place (atomic for readers).
 bool write(const std::filesystem::path& file, const Key& key, std::span<const std::byte> nodes,
            std::string* why);
@@ -121,7 +125,7 @@ std::filesystem::path default_dir();
 }  // namespace octree_cache
 
 template <class T>
-MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v) {
+MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v, ThreadBudget budget) {
     MinMaxOctree o;
     o.shape_ = OctreeShape::for_cells(v.cell_dims());
     o.owned_.resize(2 * o.shape_.node_count);
@@ -152,9 +156,8 @@ MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v) {
                     nodes[i + 1] = hi;
                 }
     };
-    // Leaf slabs are independent; split them over the cores (the build runs once per volume).
-    const int threads = std::max(1, std::min<int>(static_cast<int>(std::thread::hardware_concurrency()),
-                                                  leaf.dims.z));
+    // Leaf slabs are independent; split them over the budget (the build runs once per volume).
+    const int threads = std::max(1, std::min(budget.usable(), leaf.dims.z));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t)
         pool.emplace_back(leaf_rows, leaf.dims.z * t / threads, leaf.dims.z * (t + 1) / threads);
@@ -190,7 +193,7 @@ MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v) {
 
 template <class T>
 MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const OctreeSource& src,
-                                               OctreeStats* stats) {
+                                               OctreeStats* stats, ThreadBudget budget) {
     OctreeStats local;
     OctreeStats& st = stats ? *stats : local;
     std::optional<octree_cache::Key> key;
@@ -206,7 +209,8 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
                 auto mapped = std::make_shared<MappedFile>(file);
                 const OctreeShape shape = OctreeShape::for_cells(v.cell_dims());
                 const std::size_t count = 2 * shape.node_count;
-                if (auto bytes = octree_cache::match(*mapped, *key, count * sizeof(T), &st.cache_note)) {
+                if (auto bytes =
+                        octree_cache::match(*mapped, *key, count * sizeof(T), &st.cache_note)) {
                     MinMaxOctree o;
                     o.shape_ = shape;
                     o.mapped_ = std::move(mapped);
@@ -222,7 +226,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
         st.cache_note = "cannot stat the volume file";
     }
     const auto t0 = std::chrono::steady_clock::now();
-    MinMaxOctree o = build(v);
+    MinMaxOctree o = build(v, budget);
     st.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (key) octree_cache::write(file, *key, std::as_bytes(o.nodes_), &st.cache_note);
     return o;

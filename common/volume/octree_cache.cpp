@@ -1,12 +1,12 @@
 #include "common/volume/octree.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <sstream>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace isowall {
 
@@ -67,7 +67,8 @@ std::optional<Key> key_for(const std::filesystem::path& volume_path, VoxelType t
     k.type = static_cast<std::uint32_t>(type);
     k.dims = dims;
     k.volume_file_size = static_cast<std::uint64_t>(st.st_size);
-    k.volume_mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
+    k.volume_mtime_ns =
+        static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
     return k;
 }
 
@@ -83,7 +84,7 @@ std::filesystem::path file_for(const std::filesystem::path& cache_dir,
 }
 
 std::optional<std::span<const std::byte>> match(const MappedFile& file, const Key& key,
-                                                 std::size_t node_bytes, std::string* why) {
+                                                std::size_t node_bytes, std::string* why) {
     const Header want = header_for(key, node_bytes);
     if (file.size() != kNodeOffset + node_bytes ||
         std::memcmp(file.bytes().data(), &want, sizeof(Header)) != 0) {
@@ -107,7 +108,8 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
         char pad[kNodeOffset] = {};
         std::memcpy(pad, &h, sizeof(h));
         out.write(pad, kNodeOffset);
-        out.write(reinterpret_cast<const char*>(nodes.data()), static_cast<std::streamsize>(nodes.size()));
+        out.write(reinterpret_cast<const char*>(nodes.data()),
+                  static_cast<std::streamsize>(nodes.size()));
         if (!out) {
             if (why) *why = "cannot write cache file " + tmp.string();
             std::filesystem::remove(tmp, ec);
@@ -125,7 +127,8 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
 
 std::filesystem::path default_dir() {
     if (const char* d = std::getenv("ISOWALL_CACHE_DIR"); d && *d) return d;
-    if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return std::filesystem::path(d) / "isowall";
+    if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
+        return std::filesystem::path(d) / "isowall";
     if (const char* d = std::getenv("HOME"); d && *d)
         return std::filesystem::path(d) / ".cache" / "isowall";
     return std::filesystem::temp_directory_path() / "isowall-cache";

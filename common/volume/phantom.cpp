@@ -18,7 +18,9 @@ constexpr float kRampVoxels = 3.0f;
 
 // 1 inside (sd < 0), 0 outside, a linear ramp kRampVoxels wide across the surface, so the field
 // is smooth enough for central-difference normals after rounding to 8 bits.
-float occupancy(float sd) { return std::clamp(0.5f - sd / kRampVoxels, 0.0f, 1.0f); }
+float occupancy(float sd) {
+    return std::clamp(0.5f - sd / kRampVoxels, 0.0f, 1.0f);
+}
 
 // Approximate signed distance (in voxels) to an ellipsoid with semi-axes `a`.
 float sd_ellipsoid(glm::vec3 p, glm::vec3 a) {
@@ -43,12 +45,10 @@ float phantom_value(glm::vec3 p, glm::vec3 half) {
 
     const float shell_sd = std::abs(sd_ellipsoid(p, 0.62f * half)) - 0.045f * r;
     // Two "eye" holes through the front (-y) and one through the top.
-    const float holes = std::min({sd_cylinder({p.x, p.z}, {-0.2f * r, 0.1f * r}, 0.16f * r) +
-                                      (p.y > 0 ? 1e6f : 0.0f),
-                                  sd_cylinder({p.x, p.z}, {0.2f * r, 0.1f * r}, 0.16f * r) +
-                                      (p.y > 0 ? 1e6f : 0.0f),
-                                  sd_cylinder({p.x, p.y}, {0.1f * r, 0.0f}, 0.2f * r) +
-                                      (p.z < 0 ? 1e6f : 0.0f)});
+    const float holes = std::min(
+        {sd_cylinder({p.x, p.z}, {-0.2f * r, 0.1f * r}, 0.16f * r) + (p.y > 0 ? 1e6f : 0.0f),
+         sd_cylinder({p.x, p.z}, {0.2f * r, 0.1f * r}, 0.16f * r) + (p.y > 0 ? 1e6f : 0.0f),
+         sd_cylinder({p.x, p.y}, {0.1f * r, 0.0f}, 0.2f * r) + (p.z < 0 ? 1e6f : 0.0f)});
     const float shell = std::max(shell_sd, -holes);
     const float torus = sd_torus(p - glm::vec3(0, 0.05f * r, -0.05f * r), 0.26f * r, 0.09f * r);
 
@@ -68,7 +68,8 @@ Volume make_phantom(const PhantomSpec& spec) {
                     const glm::vec3 p = glm::vec3(x, y, z) - half;
                     const float v = std::round(phantom_value(p, half));
                     bytes[(static_cast<std::size_t>(z) * d.y + y) * d.x + x] =
-                        static_cast<std::byte>(static_cast<std::uint8_t>(std::clamp(v, 0.0f, 255.0f)));
+                        static_cast<std::byte>(
+                            static_cast<std::uint8_t>(std::clamp(v, 0.0f, 255.0f)));
                 }
     };
     // Two halves on two threads: the result does not depend on the split.

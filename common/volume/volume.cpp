@@ -21,14 +21,22 @@ std::size_t voxel_size(VoxelType t) {
 
 std::string_view type_name(VoxelType t) {
     switch (t) {
-        case VoxelType::u8: return "uint8";
-        case VoxelType::i8: return "int8";
-        case VoxelType::u16: return "uint16";
-        case VoxelType::i16: return "int16";
-        case VoxelType::u32: return "uint32";
-        case VoxelType::i32: return "int32";
-        case VoxelType::f32: return "float32";
-        case VoxelType::f64: return "float64";
+        case VoxelType::u8:
+            return "uint8";
+        case VoxelType::i8:
+            return "int8";
+        case VoxelType::u16:
+            return "uint16";
+        case VoxelType::i16:
+            return "int16";
+        case VoxelType::u32:
+            return "uint32";
+        case VoxelType::i32:
+            return "int32";
+        case VoxelType::f32:
+            return "float32";
+        case VoxelType::f64:
+            return "float64";
     }
     return "?";
 }
@@ -39,14 +47,14 @@ std::optional<VoxelType> parse_voxel_type(std::string_view s) {
         VoxelType type;
     };
     static constexpr Alias kAliases[] = {
-        {"uint8", VoxelType::u8},    {"uchar", VoxelType::u8},    {"u8", VoxelType::u8},
-        {"int8", VoxelType::i8},     {"char", VoxelType::i8},     {"i8", VoxelType::i8},
-        {"uint16", VoxelType::u16},  {"ushort", VoxelType::u16},  {"u16", VoxelType::u16},
-        {"int16", VoxelType::i16},   {"short", VoxelType::i16},   {"i16", VoxelType::i16},
-        {"uint32", VoxelType::u32},  {"uint", VoxelType::u32},    {"u32", VoxelType::u32},
-        {"int32", VoxelType::i32},   {"int", VoxelType::i32},     {"i32", VoxelType::i32},
-        {"float32", VoxelType::f32}, {"float", VoxelType::f32},   {"f32", VoxelType::f32},
-        {"float64", VoxelType::f64}, {"double", VoxelType::f64},  {"f64", VoxelType::f64},
+        {"uint8", VoxelType::u8},    {"uchar", VoxelType::u8},   {"u8", VoxelType::u8},
+        {"int8", VoxelType::i8},     {"char", VoxelType::i8},    {"i8", VoxelType::i8},
+        {"uint16", VoxelType::u16},  {"ushort", VoxelType::u16}, {"u16", VoxelType::u16},
+        {"int16", VoxelType::i16},   {"short", VoxelType::i16},  {"i16", VoxelType::i16},
+        {"uint32", VoxelType::u32},  {"uint", VoxelType::u32},   {"u32", VoxelType::u32},
+        {"int32", VoxelType::i32},   {"int", VoxelType::i32},    {"i32", VoxelType::i32},
+        {"float32", VoxelType::f32}, {"float", VoxelType::f32},  {"f32", VoxelType::f32},
+        {"float64", VoxelType::f64}, {"double", VoxelType::f64}, {"f64", VoxelType::f64},
     };
     for (const auto& a : kAliases)
         if (a.name == s) return a.type;
@@ -62,14 +70,20 @@ void swap_bytes(std::span<std::byte> bytes, std::size_t size) {
 
 Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::vector<std::byte> bytes,
                std::string source)
-    : dims_(dims), spacing_(spacing), type_(type), source_(std::move(source)),
+    : dims_(dims),
+      spacing_(spacing),
+      type_(type),
+      source_(std::move(source)),
       owned_(std::move(bytes)) {
     bytes_ = owned_;
 }
 
 Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile file,
                std::size_t offset, std::string source)
-    : dims_(dims), spacing_(spacing), type_(type), source_(std::move(source)),
+    : dims_(dims),
+      spacing_(spacing),
+      type_(type),
+      source_(std::move(source)),
       file_(std::move(file)) {
     bytes_ = file_.bytes().subspan(offset, voxel_count() * voxel_size(type));
 }
@@ -99,14 +113,16 @@ void check_dims(const std::string& where, const std::string& field, glm::ivec3 d
 // wrong size almost always means wrong dims or type, and a silent crop would hide it.
 void check_size(const std::string& file, std::size_t have, std::size_t offset, std::size_t need) {
     if (have < offset + need) {
-        throw InputError(file, "size", "file is shorter than the header says: expected " +
-                                           std::to_string(offset + need) + " bytes, found " +
-                                           std::to_string(have));
+        throw InputError(file, "size",
+                         "file is shorter than the header says: expected " +
+                             std::to_string(offset + need) + " bytes, found " +
+                             std::to_string(have));
     }
     if (have > offset + need) {
-        throw InputError(file, "size", "file is longer than the header says: expected " +
-                                           std::to_string(offset + need) + " bytes, found " +
-                                           std::to_string(have));
+        throw InputError(file, "size",
+                         "file is longer than the header says: expected " +
+                             std::to_string(offset + need) + " bytes, found " +
+                             std::to_string(have));
     }
 }
 
@@ -117,7 +133,8 @@ Volume read_swapped(const fs::path& path, glm::ivec3 dims, VoxelType type, glm::
     std::ifstream in(path, std::ios::binary);
     in.seekg(static_cast<std::streamoff>(offset));
     in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(need));
-    if (!in) throw InputError(path.string(), "data", "cannot read " + std::to_string(need) + " bytes");
+    if (!in)
+        throw InputError(path.string(), "data", "cannot read " + std::to_string(need) + " bytes");
     swap_bytes(bytes, voxel_size(type));
     return Volume(dims, type, spacing, std::move(bytes), std::move(source));
 }
@@ -146,28 +163,45 @@ struct NioDeleter {
 
 std::optional<VoxelType> from_teem_type(int t) {
     switch (t) {
-        case nrrdTypeUChar: return VoxelType::u8;
-        case nrrdTypeChar: return VoxelType::i8;
-        case nrrdTypeUShort: return VoxelType::u16;
-        case nrrdTypeShort: return VoxelType::i16;
-        case nrrdTypeUInt: return VoxelType::u32;
-        case nrrdTypeInt: return VoxelType::i32;
-        case nrrdTypeFloat: return VoxelType::f32;
-        case nrrdTypeDouble: return VoxelType::f64;
-        default: return std::nullopt;
+        case nrrdTypeUChar:
+            return VoxelType::u8;
+        case nrrdTypeChar:
+            return VoxelType::i8;
+        case nrrdTypeUShort:
+            return VoxelType::u16;
+        case nrrdTypeShort:
+            return VoxelType::i16;
+        case nrrdTypeUInt:
+            return VoxelType::u32;
+        case nrrdTypeInt:
+            return VoxelType::i32;
+        case nrrdTypeFloat:
+            return VoxelType::f32;
+        case nrrdTypeDouble:
+            return VoxelType::f64;
+        default:
+            return std::nullopt;
     }
 }
 
 int to_teem_type(VoxelType t) {
     switch (t) {
-        case VoxelType::u8: return nrrdTypeUChar;
-        case VoxelType::i8: return nrrdTypeChar;
-        case VoxelType::u16: return nrrdTypeUShort;
-        case VoxelType::i16: return nrrdTypeShort;
-        case VoxelType::u32: return nrrdTypeUInt;
-        case VoxelType::i32: return nrrdTypeInt;
-        case VoxelType::f32: return nrrdTypeFloat;
-        case VoxelType::f64: return nrrdTypeDouble;
+        case VoxelType::u8:
+            return nrrdTypeUChar;
+        case VoxelType::i8:
+            return nrrdTypeChar;
+        case VoxelType::u16:
+            return nrrdTypeUShort;
+        case VoxelType::i16:
+            return nrrdTypeShort;
+        case VoxelType::u32:
+            return nrrdTypeUInt;
+        case VoxelType::i32:
+            return nrrdTypeInt;
+        case VoxelType::f32:
+            return nrrdTypeFloat;
+        case VoxelType::f64:
+            return nrrdTypeDouble;
     }
     return nrrdTypeUnknown;
 }
@@ -181,7 +215,8 @@ glm::vec3 nrrd_spacing(const Nrrd* n) {
         } else if (n->spaceDim > 0) {
             double len2 = 0;
             for (unsigned d = 0; d < n->spaceDim; ++d)
-                if (std::isfinite(ax.spaceDirection[d])) len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
+                if (std::isfinite(ax.spaceDirection[d]))
+                    len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
             if (len2 > 0) s[i] = static_cast<float>(std::sqrt(len2));
         }
     }
@@ -193,7 +228,8 @@ std::optional<std::size_t> attached_data_offset(std::span<const std::byte> bytes
     for (std::size_t i = 0; i + 1 < bytes.size(); ++i) {
         if (bytes[i] != std::byte{'\n'}) continue;
         if (bytes[i + 1] == std::byte{'\n'}) return i + 2;
-        if (bytes[i + 1] == std::byte{'\r'} && i + 2 < bytes.size() && bytes[i + 2] == std::byte{'\n'})
+        if (bytes[i + 1] == std::byte{'\r'} && i + 2 < bytes.size() &&
+            bytes[i + 2] == std::byte{'\n'})
             return i + 3;
     }
     return std::nullopt;
@@ -229,18 +265,20 @@ Volume load_nrrd(const fs::path& path) {
         throw InputError(where, "dimension", "expected 3, got " + std::to_string(nrrd->dim));
     const auto type = from_teem_type(nrrd->type);
     if (!type)
-        throw InputError(where, "type", std::string("unsupported voxel type \"") +
-                                            airEnumStr(nrrdType, nrrd->type) +
-                                            "\" (expected one of uint8 int8 uint16 int16 uint32 "
-                                            "int32 float32 float64)");
-    const glm::ivec3 dims(static_cast<int>(nrrd->axis[0].size), static_cast<int>(nrrd->axis[1].size),
+        throw InputError(where, "type",
+                         std::string("unsupported voxel type \"") +
+                             airEnumStr(nrrdType, nrrd->type) +
+                             "\" (expected one of uint8 int8 uint16 int16 uint32 "
+                             "int32 float32 float64)");
+    const glm::ivec3 dims(static_cast<int>(nrrd->axis[0].size),
+                          static_cast<int>(nrrd->axis[1].size),
                           static_cast<int>(nrrd->axis[2].size));
     check_dims(where, "sizes", dims);
     const glm::vec3 spacing = nrrd_spacing(nrrd.get());
     const std::size_t need = expected_bytes(dims, *type);
     const bool raw = nio->encoding == nrrdEncodingRaw;
-    const bool host_order = voxel_size(*type) == 1 || (nio->endian == airEndianLittle) ==
-                                                          (host_endian() == Endian::little);
+    const bool host_order = voxel_size(*type) == 1 ||
+                            (nio->endian == airEndianLittle) == (host_endian() == Endian::little);
     const unsigned data_files = nio->dataFNArr ? nio->dataFNArr->len : 0;
 
     if (raw && data_files <= 1 && nio->lineSkip == 0) {

@@ -26,7 +26,9 @@ std::size_t voxel_size(VoxelType t);
 std::string_view type_name(VoxelType t);  // "uint8", "int16", "float32", ...
 // Accepts our names and the common NRRD/C spellings (uchar, short, float, double, ...).
 std::optional<VoxelType> parse_voxel_type(std::string_view s);
-constexpr Endian host_endian() { return Endian::little; }  // x86-64 and aarch64 Linux
+constexpr Endian host_endian() {
+    return Endian::little;
+}  // x86-64 and aarch64 Linux
 
 template <class T>
 struct VolumeView {
@@ -39,9 +41,7 @@ struct VolumeView {
     }
     T at(int x, int y, int z) const { return data[index(x, y, z)]; }
     glm::ivec3 cell_dims() const { return glm::max(dims - 1, glm::ivec3(0)); }
-    std::size_t voxel_count() const {
-        return static_cast<std::size_t>(dims.x) * dims.y * dims.z;
-    }
+    std::size_t voxel_count() const { return static_cast<std::size_t>(dims.x) * dims.y * dims.z; }
     // Object-space bounds: voxel index times spacing.
     Box3 bounds() const {
         Box3 b;
@@ -52,14 +52,14 @@ struct VolumeView {
 };
 
 class Volume {
-public:
+  public:
     Volume() = default;
     // A volume over an owned buffer (must hold dims.x*dims.y*dims.z voxels of `type`).
     Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::vector<std::byte> bytes,
            std::string source);
     // A volume over `count` bytes at `offset` of a mapped file.
-    Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile file,
-           std::size_t offset, std::string source);
+    Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile file, std::size_t offset,
+           std::string source);
 
     glm::ivec3 dims() const { return dims_; }
     glm::vec3 spacing() const { return spacing_; }
@@ -77,7 +77,7 @@ public:
         return {reinterpret_cast<const T*>(bytes_.data()), dims_, spacing_};
     }
 
-private:
+  private:
     glm::ivec3 dims_{0};
     glm::vec3 spacing_{1.0f};
     VoxelType type_ = VoxelType::u8;
@@ -91,28 +91,44 @@ private:
 template <class F>
 decltype(auto) dispatch_voxel_type(VoxelType t, F&& f) {
     switch (t) {
-        case VoxelType::u8: return f(std::uint8_t{});
-        case VoxelType::i8: return f(std::int8_t{});
-        case VoxelType::u16: return f(std::uint16_t{});
-        case VoxelType::i16: return f(std::int16_t{});
-        case VoxelType::u32: return f(std::uint32_t{});
-        case VoxelType::i32: return f(std::int32_t{});
-        case VoxelType::f32: return f(float{});
-        case VoxelType::f64: return f(double{});
+        case VoxelType::u8:
+            return f(std::uint8_t{});
+        case VoxelType::i8:
+            return f(std::int8_t{});
+        case VoxelType::u16:
+            return f(std::uint16_t{});
+        case VoxelType::i16:
+            return f(std::int16_t{});
+        case VoxelType::u32:
+            return f(std::uint32_t{});
+        case VoxelType::i32:
+            return f(std::int32_t{});
+        case VoxelType::f32:
+            return f(float{});
+        case VoxelType::f64:
+            return f(double{});
     }
     return f(std::uint8_t{});
 }
 
 template <class T>
 constexpr VoxelType voxel_type_of() {
-    if constexpr (std::is_same_v<T, std::uint8_t>) return VoxelType::u8;
-    else if constexpr (std::is_same_v<T, std::int8_t>) return VoxelType::i8;
-    else if constexpr (std::is_same_v<T, std::uint16_t>) return VoxelType::u16;
-    else if constexpr (std::is_same_v<T, std::int16_t>) return VoxelType::i16;
-    else if constexpr (std::is_same_v<T, std::uint32_t>) return VoxelType::u32;
-    else if constexpr (std::is_same_v<T, std::int32_t>) return VoxelType::i32;
-    else if constexpr (std::is_same_v<T, float>) return VoxelType::f32;
-    else return VoxelType::f64;
+    if constexpr (std::is_same_v<T, std::uint8_t>)
+        return VoxelType::u8;
+    else if constexpr (std::is_same_v<T, std::int8_t>)
+        return VoxelType::i8;
+    else if constexpr (std::is_same_v<T, std::uint16_t>)
+        return VoxelType::u16;
+    else if constexpr (std::is_same_v<T, std::int16_t>)
+        return VoxelType::i16;
+    else if constexpr (std::is_same_v<T, std::uint32_t>)
+        return VoxelType::u32;
+    else if constexpr (std::is_same_v<T, std::int32_t>)
+        return VoxelType::i32;
+    else if constexpr (std::is_same_v<T, float>)
+        return VoxelType::f32;
+    else
+        return VoxelType::f64;
 }
 
 struct RawSpec {

@@ -31,8 +31,9 @@ double number(const std::string& word, const std::string& where, const std::stri
 void expect_args(const std::vector<std::string>& w, std::size_t n, const std::string& where,
                  const std::string& usage) {
     if (w.size() != n + 1)
-        throw InputError(where, w[0], "expected \"" + usage + "\", got " + std::to_string(w.size() - 1) +
-                                          " argument(s)");
+        throw InputError(
+            where, w[0],
+            "expected \"" + usage + "\", got " + std::to_string(w.size() - 1) + " argument(s)");
 }
 
 }  // namespace
@@ -68,7 +69,8 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
             if (a < 0) throw InputError(where, c, "expected a non-negative amount, got " + w[2]);
             return WaitCmd{w[1] == "rays" ? WaitCmd::Until::rays : WaitCmd::Until::time, a};
         }
-        throw InputError(where, c, "expected \"wait rays N\", \"wait time SECONDS\" or \"wait done\"");
+        throw InputError(where, c,
+                         "expected \"wait rays N\", \"wait time SECONDS\" or \"wait done\"");
     }
     if (c == "snapshot") {
         expect_args(w, 1, where, "snapshot NAME");
@@ -93,7 +95,8 @@ std::vector<ScriptLine> parse_script(std::string_view text, const std::string& f
         const std::size_t end = std::min(text.find('\n', pos), text.size());
         std::string_view line = text.substr(pos, end - pos);
         ++n;
-        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+        if (const auto hash = line.find('#'); hash != std::string_view::npos)
+            line = line.substr(0, hash);
         if (line.find_first_not_of(" \t\r") != std::string_view::npos)
             lines.push_back({n, parse_command(line, file + ":" + std::to_string(n))});
         if (end == text.size()) break;

@@ -39,7 +39,8 @@ struct SnapshotCmd {
 };
 struct QuitCmd {};
 
-using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
+using ScriptCommand =
+    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages

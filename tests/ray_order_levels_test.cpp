@@ -1,177 +1,21 @@
-// Ray-casting orders: every rect pixel exactly once, refining levels, read-back ordering, the
-// dynamic grid sized from the first surface piece.
+// Ray-casting orders, the levels of each kind: the refining grid doubling, read-back putting
+// uncovered pixels first, the dynamic grid sized from the first surface piece and refining on from
+// there, and the surface piece size itself.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
-#include <random>
 #include <stdexcept>
-#include <string>
 #include <vector>
 
 #include "common/progressive/ray_order.h"
+#include "tests/ray_order_test_util.h"
 
 namespace isowall {
 namespace {
 
-constexpr RayOrderKind kAllKinds[] = {RayOrderKind::refining_grid, RayOrderKind::screen_readback,
-                                      RayOrderKind::dynamic_grid};
-
-std::string rect_str(const PixelRect& r) {
-    return "rect{" + std::to_string(r.x) + ", " + std::to_string(r.y) + ", " +
-           std::to_string(r.width) + "x" + std::to_string(r.height) + "}";
-}
-
-struct Disk {
-    double cx, cy, radius;
-    bool contains(int x, int y) const {
-        const double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
-        return dx * dx + dy * dy <= radius * radius;
-    }
-};
-
-// A synthetic screen: each disk is a piece of surface that is drawn whole as soon as a ray hits
-// one of its pixels, as propagation from a seed would draw it.
-class DiskScene {
-  public:
-    DiskScene(int width, int height, std::vector<Disk> disks)
-        : width_(width), height_(height), disks_(std::move(disks)), drawn_(disks_.size(), false) {}
-
-    void cast(const std::vector<glm::ivec2>& rays) {
-        for (glm::ivec2 p : rays)
-            for (std::size_t d = 0; d < disks_.size(); ++d)
-                if (disks_[d].contains(p.x, p.y)) drawn_[d] = true;
-    }
-
-    std::vector<std::uint8_t> coverage() const {
-        std::vector<std::uint8_t> covered(std::size_t(width_) * std::size_t(height_), 0);
-        for (std::size_t d = 0; d < disks_.size(); ++d) {
-            if (!drawn_[d]) continue;
-            const Disk& disk = disks_[d];
-            const int x0 = std::max(0, int(disk.cx - disk.radius) - 1);
-            const int x1 = std::min(width_, int(disk.cx + disk.radius) + 2);
-            const int y0 = std::max(0, int(disk.cy - disk.radius) - 1);
-            const int y1 = std::min(height_, int(disk.cy + disk.radius) + 2);
-            for (int y = y0; y < y1; ++y)
-                for (int x = x0; x < x1; ++x)
-                    if (disks_[d].contains(x, y)) covered[std::size_t(y) * width_ + x] = 1;
-        }
-        return covered;
-    }
-
-  private:
-    int width_, height_;
-    std::vector<Disk> disks_;
-    std::vector<bool> drawn_;
-};
-
-// A disk of a quarter of the rect's smaller side at its centre, and a smaller one near a corner.
-DiskScene scene_for(int screen_w, int screen_h, const PixelRect& r) {
-    const double small_side = std::min(r.width, r.height);
-    return DiskScene(
-        screen_w, screen_h,
-        {{r.x + r.width * 0.5, r.y + r.height * 0.5, std::max(1.0, small_side / 4)},
-         {r.x + r.width * 0.15, r.y + r.height * 0.8, std::max(1.0, small_side / 10)}});
-}
-
-// Runs an order to the end, feeding the scene's coverage whenever the order asks for it.
-std::vector<std::vector<glm::ivec2>> run_order(RayOrder& order, DiskScene* scene) {
-    std::vector<std::vector<glm::ivec2>> levels;
-    std::vector<glm::ivec2> rays;
-    while (true) {
-        if (order.wants_coverage()) {
-            EXPECT_NE(scene, nullptr) << "an order asked for coverage";
-            if (scene) order.set_coverage(scene->coverage());
-        }
-        if (!order.next_level(rays)) break;
-        EXPECT_FALSE(rays.empty()) << "level " << levels.size();
-        EXPECT_EQ(order.level(), int(levels.size()));
-        if (scene) scene->cast(rays);
-        levels.push_back(rays);
-    }
-    EXPECT_FALSE(order.wants_coverage()) << "after the last level";
-    return levels;
-}
-
-struct ScreenCase {
-    int screen_w, screen_h;
-    PixelRect rect;
-};
-
-const ScreenCase kCases[] = {
-    {1, 1, {0, 0, 1, 1}},         {7, 5, {0, 0, 7, 5}},         {64, 48, {0, 0, 64, 48}},
-    {200, 100, {37, 21, 90, 55}}, {200, 100, {199, 0, 1, 100}}, {1600, 1200, {0, 0, 1600, 1200}},
-};
-
-TEST(RayOrder, ParseAndToStringRoundTrip) {
-    for (RayOrderKind k : kAllKinds) EXPECT_EQ(parse_ray_order(to_string(k)), k) << to_string(k);
-    EXPECT_EQ(parse_ray_order("grid"), RayOrderKind::refining_grid);
-    EXPECT_EQ(parse_ray_order("refining"), RayOrderKind::refining_grid);
-    EXPECT_EQ(parse_ray_order("readback"), RayOrderKind::screen_readback);
-    EXPECT_EQ(parse_ray_order("dynamic"), RayOrderKind::dynamic_grid);
-    EXPECT_EQ(parse_ray_order(""), std::nullopt);
-    EXPECT_EQ(parse_ray_order("Dynamic"), std::nullopt);
-    EXPECT_EQ(parse_ray_order("dynamic_grid2"), std::nullopt);
-}
-
-TEST(RayOrder, EmptyRectGivesNoLevel) {
-    const PixelRect empties[] = {{0, 0, 0, 0}, {5, 5, 0, 10}, {5, 5, 10, -3}, {300, 10, 20, 20}};
-    for (RayOrderKind k : kAllKinds)
-        for (const PixelRect& r : empties) {
-            auto order = make_ray_order(k, 200, 100, r);
-            std::vector<glm::ivec2> rays{{1, 1}};
-            EXPECT_FALSE(order->wants_coverage()) << to_string(k) << " " << rect_str(r);
-            EXPECT_FALSE(order->next_level(rays)) << to_string(k) << " " << rect_str(r);
-            EXPECT_TRUE(rays.empty()) << to_string(k) << " " << rect_str(r);
-            EXPECT_EQ(order->level(), -1) << to_string(k) << " " << rect_str(r);
-            EXPECT_FALSE(order->wants_coverage()) << to_string(k) << " " << rect_str(r);
-        }
-}
-
-TEST(RayOrder, EveryRectPixelExactlyOnce) {
-    for (RayOrderKind k : kAllKinds)
-        for (const ScreenCase& c : kCases) {
-            DiskScene scene = scene_for(c.screen_w, c.screen_h, c.rect);
-            auto order = make_ray_order(k, c.screen_w, c.screen_h, c.rect);
-            const auto levels = run_order(*order, &scene);
-            std::vector<int> count(std::size_t(c.screen_w) * c.screen_h, 0);
-            for (const auto& level : levels)
-                for (glm::ivec2 p : level) {
-                    ASSERT_TRUE(p.x >= 0 && p.y >= 0 && p.x < c.screen_w && p.y < c.screen_h)
-                        << to_string(k) << " " << rect_str(c.rect) << " pixel " << p.x << ","
-                        << p.y;
-                    ++count[std::size_t(p.y) * c.screen_w + p.x];
-                }
-            int wrong = 0;
-            for (int y = 0; y < c.screen_h; ++y)
-                for (int x = 0; x < c.screen_w; ++x) {
-                    const bool inside = x >= c.rect.x && x < c.rect.x + c.rect.width &&
-                                        y >= c.rect.y && y < c.rect.y + c.rect.height;
-                    if (count[std::size_t(y) * c.screen_w + x] != (inside ? 1 : 0)) ++wrong;
-                }
-            EXPECT_EQ(wrong, 0) << to_string(k) << " " << rect_str(c.rect) << " on " << c.screen_w
-                                << "x" << c.screen_h << ", " << levels.size() << " levels";
-        }
-}
-
-TEST(RayOrder, RectIsClippedToTheScreen) {
-    for (RayOrderKind k : kAllKinds) {
-        auto order = make_ray_order(k, 50, 40, {-10, 30, 30, 30});
-        DiskScene blank(50, 40, {});
-        const auto levels = run_order(*order, &blank);
-        std::size_t total = 0;
-        for (const auto& level : levels)
-            for (glm::ivec2 p : level) {
-                EXPECT_TRUE(p.x >= 0 && p.x < 20 && p.y >= 30 && p.y < 40)
-                    << to_string(k) << " pixel " << p.x << "," << p.y;
-                ++total;
-            }
-        EXPECT_EQ(total, 20u * 10u) << to_string(k);
-    }
-}
+using namespace ray_order_testing;
 
 TEST(RayOrder, RefiningLevelsDoubleTheGrid) {
     for (const ScreenCase& c : kCases) {
@@ -354,59 +198,6 @@ TEST(RayOrder, SurfacePieceSize) {
     // The floor of 4 gives way to the rect's larger side when the rect is smaller than that.
     EXPECT_DOUBLE_EQ(surface_piece_size(covered, w, {10, 50, 3, 2}), 3.0);
     EXPECT_THROW(surface_piece_size(covered, w, {0, 0, w, h + 1}), std::invalid_argument);
-}
-
-TEST(RayOrder, CoverageOfTheWrongSizeThrows) {
-    for (RayOrderKind k : kAllKinds) {
-        auto order = make_ray_order(k, 20, 10, {0, 0, 20, 10});
-        std::vector<glm::ivec2> rays;
-        ASSERT_TRUE(order->next_level(rays));
-        std::vector<std::uint8_t> covered(20 * 9, 0);
-        EXPECT_THROW(order->set_coverage(covered), std::invalid_argument) << to_string(k);
-    }
-}
-
-// A full 1600x1200 screen: every pixel exactly once. The per-level times are printed for the
-// reader (about 10 ms for the 1.6 M-pixel fill level in a release build) but not asserted: the
-// machines are shared and noisy, and speed is for benchmarks, not unit tests.
-TEST(RayOrder, LargeScreenHandsOutEveryPixelOnce) {
-    const int w = 1600, h = 1200;
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<double> ux(0, w), uy(0, h), ur(20, 120);
-    std::vector<Disk> disks;
-    for (int i = 0; i < 12; ++i) disks.push_back({ux(rng), uy(rng), ur(rng)});
-    disks.push_back({w * 0.5, h * 0.5, 150});
-    for (RayOrderKind k : kAllKinds) {
-        DiskScene scene(w, h, disks);
-        auto order = make_ray_order(k, w, h, {0, 0, w, h});
-        std::vector<glm::ivec2> rays;
-        double worst_ms = 0, total_ms = 0;
-        std::size_t total_rays = 0;
-        std::string figures;
-        while (true) {
-            std::vector<std::uint8_t> covered;
-            if (order->wants_coverage()) covered = scene.coverage();  // outside the timing
-            const auto t0 = std::chrono::steady_clock::now();
-            if (!covered.empty()) order->set_coverage(covered);
-            const bool more = order->next_level(rays);
-            const double ms =
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
-            if (!more) break;
-            scene.cast(rays);
-            worst_ms = std::max(worst_ms, ms);
-            total_ms += ms;
-            total_rays += rays.size();
-            char buf[64];
-            std::snprintf(buf, sizeof buf, " %zu:%.2f", rays.size(), ms);
-            figures += buf;
-        }
-        EXPECT_EQ(total_rays, std::size_t(w) * h) << to_string(k);
-        std::printf(
-            "[ ray order ] %-8s 1600x1200: worst level %.2f ms, all levels %.2f ms; "
-            "rays:ms per level%s\n",
-            std::string(to_string(k)).c_str(), worst_ms, total_ms, figures.c_str());
-    }
 }
 
 }  // namespace

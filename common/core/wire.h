@@ -1,0 +1,124 @@
+#pragma once
+// The byte format of every message: explicit little-endian fields, a version byte first, never raw
+// padded structs. Only trivially copyable scalars go in (a struct must be written field by field),
+// and a reader never trusts a length: every count is checked against the bytes left before
+// anything is allocated, so malformed or truncated input is an error, never a crash.
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace isowall {
+
+// Every decoding failure: the message names what was being read and what was wrong.
+class WireError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+template <class T>
+concept WireScalar = std::is_trivially_copyable_v<T> &&
+    (std::is_arithmetic_v<T> || std::is_enum_v<T>);
+
+class MessageWriter {
+  public:
+    explicit MessageWriter(std::uint8_t version) { put(version); }
+
+    template <WireScalar T>
+    void put(T value) {
+        auto raw = std::bit_cast<std::array<std::byte, sizeof(T)>>(value);
+        if constexpr (std::endian::native == std::endian::big) std::reverse(raw.begin(), raw.end());
+        bytes_.insert(bytes_.end(), raw.begin(), raw.end());
+    }
+    void put(glm::vec3 v) {
+        put(v.x);
+        put(v.y);
+        put(v.z);
+    }
+    // A length (u64) then the bytes.
+    void put_bytes(std::span<const std::byte> b) {
+        put(static_cast<std::uint64_t>(b.size()));
+        bytes_.insert(bytes_.end(), b.begin(), b.end());
+    }
+    void put_string(std::string_view s) { put_bytes(std::as_bytes(std::span(s.data(), s.size()))); }
+    // A count (u64) then each element as a scalar.
+    template <WireScalar T>
+    void put_array(std::span<const T> values) {
+        put(static_cast<std::uint64_t>(values.size()));
+        for (const T& v : values) put(v);
+    }
+
+    const std::vector<std::byte>& bytes() const { return bytes_; }
+    std::vector<std::byte> take() { return std::move(bytes_); }
+
+  private:
+    std::vector<std::byte> bytes_;
+};
+
+class MessageReader {
+  public:
+    // `what` names the message in errors, e.g. "view message".
+    MessageReader(std::span<const std::byte> bytes, std::uint8_t version, std::string what);
+
+    template <WireScalar T>
+    T get() {
+        need(sizeof(T));
+        std::array<std::byte, sizeof(T)> raw;
+        std::memcpy(raw.data(), bytes_.data() + pos_, sizeof(T));
+        if constexpr (std::endian::native == std::endian::big) std::reverse(raw.begin(), raw.end());
+        pos_ += sizeof(T);
+        return std::bit_cast<T>(raw);
+    }
+    glm::vec3 get_vec3() {
+        const float x = get<float>(), y = get<float>(), z = get<float>();
+        return {x, y, z};
+    }
+    // A bool stored as one byte; anything but 0 or 1 is an error.
+    bool get_bool();
+    // An enum stored as its underlying type; values above `max` are an error.
+    template <class E>
+    E get_enum(E max) {
+        const auto v = get<std::underlying_type_t<E>>();
+        if (v < 0 || v > static_cast<std::underlying_type_t<E>>(max))
+            fail("enum value " + std::to_string(v) + " out of range");
+        return static_cast<E>(v);
+    }
+    std::span<const std::byte> get_bytes();
+    std::string get_string();
+    template <WireScalar T>
+    std::vector<T> get_array() {
+        const std::uint64_t n = get<std::uint64_t>();
+        if (n > remaining() / sizeof(T))
+            fail("array of " + std::to_string(n) + " elements is longer than the message");
+        std::vector<T> out(static_cast<std::size_t>(n));
+        for (T& v : out) v = get<T>();
+        return out;
+    }
+    // A count of elements of at least `min_bytes_each`, checked against the bytes left.
+    std::size_t get_count(std::size_t min_bytes_each);
+    // Every byte must have been read: trailing bytes are an error too.
+    void finish() const;
+    std::size_t remaining() const { return bytes_.size() - pos_; }
+    [[noreturn]] void fail(const std::string& why) const;
+
+  private:
+    void need(std::size_t n) const {
+        if (n > remaining()) fail("truncated");
+    }
+    std::span<const std::byte> bytes_;
+    std::size_t pos_ = 0;
+    std::string what_;
+};
+
+}  // namespace isowall

@@ -1,0 +1,130 @@
+#pragma once
+// The three parts of a surface extractor, split by who may touch them once several threads
+// extract side by side (STYLE.md, "Threads"):
+//   ExtractionData<T>  shared, read-only after construction: the volume view and its octree.
+//                      Any number of workers read it at once without a lock.
+//   FrameState         per frame: the isovalue, the resolution, the visited cells and the
+//                      meta-cells refined this frame. One per extractor, reset by begin(), and
+//                      the one part the frame's workers write together (see the race below).
+//   ExtractWorker<T>   per thread: a ray caster and a propagator with their scratch (interpolant
+//                      cache, BFS queue, triangles under test) and the last-extract figure.
+//                      Never shared, so its statistics need no lock either (Embree's per-thread
+//                      g_stats); they are merged where they are read.
+//
+// The race, where it will happen: today one worker runs at a time. Two workers propagating at
+// once could both take one cell, since VisitedCells::insert reads and then writes a word of the
+// bitset, and both could refine one meta-cell through FrameState::claim_refinement. Before a
+// second worker runs, both must become atomic claims (a fetch_or on the word, a concurrent set),
+// or the volume be split between workers so that their passes never meet.
+#include <cstdint>
+#include <functional>
+#include <limits>
+
+#include "common/core/ray.h"
+#include "common/core/thread_budget.h"
+#include "common/extract/adaptive.h"
+#include "common/extract/edge_cache.h"
+#include "common/extract/group.h"
+#include "common/extract/propagator.h"
+#include "common/extract/raycaster.h"
+#include "common/extract/visited.h"
+#include "common/volume/octree.h"
+#include "common/volume/volume.h"
+
+namespace isowall {
+
+template <class T>
+struct ExtractionData {
+    // Builds the octree over `build` threads, or maps it from the cache.
+    ExtractionData(const Volume& v, const OctreeSource& source, OctreeStats* stats,
+                   ThreadBudget build)
+        : volume(v),
+          view(v.view<T>()),
+          octree(MinMaxOctree<T>::load_or_build(view, source, stats, build)) {}
+    // Workers hold references to the view and the octree, so the data never moves.
+    ExtractionData(const ExtractionData&) = delete;
+    ExtractionData& operator=(const ExtractionData&) = delete;
+
+    const Volume& volume;
+    const VolumeView<T> view;
+    const MinMaxOctree<T> octree;
+};
+
+struct FrameState {
+    explicit FrameState(glm::ivec3 cell_dims) : visited(cell_dims) {}
+
+    // Starts a frame at `frame_iso`: forgets every visited cell and refinement.
+    void begin(double frame_iso, const ResolutionMap& map, glm::ivec3 cell_dims) {
+        iso = frame_iso;
+        resolution = map;
+        visited.reset(cell_dims);
+        refined.reset(64);
+    }
+    // True when the meta-cell whose first cell is `unit` was not refined yet this frame; from
+    // now on it is.
+    bool claim_refinement(glm::ivec3 unit) {
+        return refined.find_or_insert(visited.index(unit)).second;
+    }
+
+    double iso = 0;
+    ResolutionMap resolution;  // default-constructed: full resolution
+    VisitedCells visited;
+    EdgeVertexCache refined{64};  // first cells of the meta-cells refined this frame
+};
+
+template <class T>
+class ExtractWorker {
+  public:
+    explicit ExtractWorker(const ExtractionData<T>& data)
+        : data_(data), caster_(data.view, data.octree), propagator_(data.view) {}
+
+    // Takes the frame's resolution; a copy per worker, so the hot paths read no shared state.
+    void begin_frame(const FrameState& frame) {
+        caster_.set_resolution(frame.resolution);
+        propagator_.set_resolution(frame.resolution);
+    }
+
+    // `ray` in object space; t is returned in the ray's own parameter.
+    RayHit cast(const FrameState& frame, const Ray& ray, IntersectMode mode, float t_max) {
+        return caster_.cast(to_voxel_space(ray, data_.view.spacing), frame.iso, mode, t_max);
+    }
+
+    Group propagate(FrameState& frame, glm::ivec3 seed, std::uint32_t group_id,
+                    const PropagationParams& p, const Ray& ray,
+                    const std::function<bool()>& interrupted) {
+        const Ray vr = to_voxel_space(ray, data_.view.spacing);
+        Group g = propagator_.propagate(seed, group_id, frame.iso, p, vr.o, vr.d, frame.visited,
+                                        interrupted);
+        extract_s_ = propagator_.last_extract_s();
+        return g;
+    }
+
+    // An empty group (no triangles) when this frame refined the meta-cell already.
+    Group refine(FrameState& frame, glm::ivec3 unit, int level, std::uint32_t group_id,
+                 const PropagationParams& p) {
+        extract_s_ = 0;
+        if (!frame.claim_refinement(unit)) {
+            Group none;
+            none.id = group_id;
+            none.seed = unit;
+            none.level = level;
+            none.iso = frame.iso;
+            none.refinement = true;
+            return none;
+        }
+        Group g = propagator_.refine(unit, level, group_id, frame.iso, p);
+        extract_s_ = propagator_.last_extract_s();
+        return g;
+    }
+
+    // Seconds of this worker's last propagate() or refine() spent in marching cubes.
+    double last_extract_s() const { return extract_s_; }
+
+  private:
+    const ExtractionData<T>& data_;
+    RayCaster<T> caster_;
+    Propagator<T> propagator_;
+    double extract_s_ = 0;
+};
+
+}  // namespace isowall

@@ -1,0 +1,255 @@
+#include "master/wall_master.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "common/core/error.h"
+#include "common/io/image_io.h"
+#include "master/wall_report.h"
+
+namespace isowall {
+namespace {
+
+// How long one receive waits before wait_until looks at its predicate and the silence again.
+constexpr double kReceiveSliceS = 0.05;
+
+std::string rank_label(const WallSpec& spec, int rank) {
+    return "rank " + std::to_string(rank) + " (tile " + std::to_string(tile_of_rank(spec, rank)) +
+           ")";
+}
+
+}  // namespace
+
+WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
+                       double iso, double value_min, double value_max)
+    : o_(o), comm_(comm), spec_(spec), bounds_(bounds), iso_(iso), lo_(value_min), hi_(value_max) {
+    const PixelSize vs = virtual_screen_size(spec);
+    aspect_ = float(vs.width) / float(vs.height);
+    camera_ = front_full_view(bounds, aspect_);
+    tiles_.resize(static_cast<std::size_t>(comm.size()));
+}
+
+void WallMaster::handle(const Envelope& e) {
+    const Stage left = trace_.switch_to(Stage::comm);
+    if (e.from < 1 || e.from >= comm_.size())
+        throw std::runtime_error("a message from unknown rank " + std::to_string(e.from));
+    TileState& t = tiles_[static_cast<std::size_t>(e.from)];
+    Message m;
+    try {
+        m = decode_message(e.tag, e.bytes);
+    } catch (const WireError& err) {
+        throw WireError(rank_label(spec_, e.from) + ": " + err.what());
+    }
+    if (auto* h = std::get_if<HelloMsg>(&m)) {
+        t.host = h->host;
+        t.hello = true;
+    } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
+        if (p->generation == generation_) {  // older generations: frames that were interrupted
+            t.rays = std::max(t.rays, p->rays);
+            t.done = t.done || p->done;
+        }
+    } else if (auto* img = std::get_if<ImageMsg>(&m)) {
+        const PixelRect r = tile_rect(spec_, tile_of_rank(spec_, e.from));
+        if (img->width != r.width || img->height != r.height)
+            throw std::runtime_error(
+                rank_label(spec_, e.from) + ": tile image of the wrong size (" +
+                std::to_string(img->width) + "x" + std::to_string(img->height) + ", expected " +
+                std::to_string(r.width) + "x" + std::to_string(r.height) + ")");
+        t.image = std::move(*img);
+    } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
+        t.result = std::move(*res);
+    } else {
+        throw WireError(rank_label(spec_, e.from) + " sent a " + to_string(e.tag) +
+                        " message, which only the master sends");
+    }
+    trace_.switch_to(left);
+}
+
+void WallMaster::wait_until(const std::function<bool()>& done) {
+    const Stage left = trace_.switch_to(Stage::idle);
+    Stopwatch silent;
+    while (!done()) {
+        if (auto e = comm_.receive(-1, kReceiveSliceS)) {
+            handle(*e);
+            silent.restart();
+        } else if (silent.seconds() > o_.timeout_s) {
+            char msg[96];
+            std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", o_.timeout_s);
+            throw std::runtime_error(std::string(msg) + " (waiting on " + waiting_on() +
+                                     "); ending the job");
+        }
+    }
+    trace_.switch_to(left);
+}
+
+bool WallMaster::all_tiles(const std::function<bool(const TileState&)>& pred) const {
+    for (std::size_t rank = 1; rank < tiles_.size(); ++rank)
+        if (!pred(tiles_[rank])) return false;
+    return true;
+}
+
+std::string WallMaster::waiting_on() const {
+    std::string list;
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        if (!t.hello || !t.done) list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
+    }
+    return list.empty() ? "all tiles" : list;
+}
+
+std::uint64_t WallMaster::total_rays() const {
+    std::uint64_t n = 0;
+    for (const TileState& t : tiles_) n += t.rays;
+    return n;
+}
+
+void WallMaster::start() {
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.hello; }); });
+    print_map();
+    send_views();
+    if (o_.throw_fault) throw std::runtime_error("test fault: the master throws");
+}
+
+void WallMaster::print_map() const {
+    const PixelSize vs = virtual_screen_size(spec_);
+    std::printf(
+        "wall: %s: %dx%d tiles of %dx%d, virtual screen %dx%d, %d tile ranks, master on %s\n",
+        o_.wall_name.c_str(), spec_.columns, spec_.rows, spec_.tile_width_px, spec_.tile_height_px,
+        vs.width, vs.height, comm_.size() - 1, comm_.host().c_str());
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const int tile = tile_of_rank(spec_, rank);
+        const PixelRect r = tile_rect(spec_, tile);
+        std::printf(
+            "  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d\n", rank,
+            tiles_[static_cast<std::size_t>(rank)].host.c_str(), tile, tile % spec_.columns,
+            tile / spec_.columns, r.x, r.y, r.width, r.height);
+    }
+    std::fflush(stdout);
+}
+
+// A new frame on every tile: bumps the generation, so progress of older frames is ignored.
+void WallMaster::send_views() {
+    const Stage left = trace_.switch_to(Stage::comm);
+    ++generation_;
+    const Camera cam = fit_depth_range(camera_, bounds_);
+    const Frustum wall = cam.frustum(aspect_);
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const int tile = tile_of_rank(spec_, rank);
+        const PixelRect r = tile_rect(spec_, tile);
+        ViewMsg v;
+        v.generation = generation_;
+        v.view = {cam, tile_frustum(wall, spec_, tile), r.width, r.height, iso_};
+        v.region = v.view.screen();
+        send_message(comm_, rank, v);
+        TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        t.rays = 0;
+        t.done = false;
+    }
+    frame_start_ = Stopwatch();
+    trace_.switch_to(left);
+}
+
+bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
+    if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
+        camera_ = orbit(camera_, c->yaw_deg, c->pitch_deg);
+    } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
+        camera_.eye = c->eye;
+        camera_.target = c->target;
+    } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
+        camera_ = zoom(camera_, c->factor);
+    } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
+        if (!(c->iso >= lo_ && c->iso <= hi_)) {
+            char msg[160];
+            std::snprintf(msg, sizeof(msg),
+                          "isovalue %g is outside the volume's value range [%g, %g]", c->iso, lo_,
+                          hi_);
+            throw InputError(where, "iso", msg);
+        }
+        iso_ = c->iso;
+    } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
+        wait(*c);
+        return true;
+    } else if (const auto* c = std::get_if<SnapshotCmd>(&cmd)) {
+        const auto path = std::filesystem::path(o_.out).parent_path() / (c->name + ".png");
+        write_image(path, gather_snapshot());
+        std::printf("snapshot: %s (frame %llu, %.3f s into it, %llu rays)\n", path.c_str(),
+                    (unsigned long long)generation_, frame_start_.seconds(),
+                    (unsigned long long)total_rays());
+        return true;
+    } else if (std::holds_alternative<QuitCmd>(cmd)) {
+        return false;
+    }
+    send_views();
+    return true;
+}
+
+void WallMaster::wait(const WaitCmd& w) {
+    Stopwatch t;
+    auto done = [&] {
+        // Every wait also ends when the frame is complete on every tile.
+        if (all_tiles([](const TileState& s) { return s.done; })) return true;
+        if (w.until == WaitCmd::Until::rays) return double(total_rays()) >= w.amount;
+        if (w.until == WaitCmd::Until::time) return t.seconds() >= w.amount;
+        return false;
+    };
+    wait_until(done);
+}
+
+Image WallMaster::gather_snapshot() {
+    for (TileState& t : tiles_) t.image.reset();
+    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, SnapshotMsg{});
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.image.has_value(); }); });
+    return compose().image;
+}
+
+Mosaic WallMaster::compose() {
+    const Stage left = trace_.switch_to(Stage::compose);
+    const PixelSize vs = virtual_screen_size(spec_);
+    Mosaic mosaic = empty_mosaic(vs.width, vs.height);
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const int tile = tile_of_rank(spec_, rank);
+        ImageMsg& m = *tiles_[static_cast<std::size_t>(rank)].image;
+        Image img;
+        img.width = m.width;
+        img.height = m.height;
+        img.rgba = std::move(m.rgba);
+        paste(mosaic, img, tile_rect(spec_, tile));
+        if (!o_.tiles_out.empty())
+            write_image(
+                std::filesystem::path(o_.tiles_out) / ("tile_" + std::to_string(tile) + ".png"),
+                img);
+    }
+    trace_.switch_to(left);
+    return mosaic;
+}
+
+int WallMaster::finish() {
+    for (TileState& t : tiles_) t.image.reset();
+    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.result && t.image; }); });
+    const Mosaic mosaic = compose();
+    trace_.switch_to(Stage::compose);
+    write_image(o_.out, mosaic.image);
+    report();
+    std::printf("wrote %s\n", o_.out.c_str());
+    return 0;
+}
+
+void WallMaster::report() {
+    std::vector<TileResultMsg> results(tiles_.size());
+    for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
+    print_rank_table(stdout, spec_, results);
+    if (o_.results_out) *o_.results_out = results;
+    trace_.close();
+    print_stage_table(stdout, trace_.spans(), results);
+    if (!o_.trace.empty()) {
+        write_wall_traces(o_.trace, spec_, trace_.spans(), results);
+        std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
+                    o_.trace.c_str());
+    }
+}
+
+}  // namespace isowall

@@ -1,0 +1,84 @@
+#pragma once
+// The master's side of a wall run, as one state machine: every message from any tile goes
+// through handle(), the one handler, and every wait is wait_until(), the one loop that receives,
+// so no message is dropped unread and a silent wall is noticed wherever the master waits.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "comm/comm.h"
+#include "common/core/util.h"
+#include "common/core/view.h"
+#include "common/progressive/trace.h"
+#include "common/wall/script.h"
+#include "common/wall/wall.h"
+#include "master/mosaic.h"
+
+namespace isowall {
+
+struct MasterOptions {
+    std::string wall_name;  // for the start-up line
+    std::string out = "mosaic.png";
+    std::string tiles_out;     // folder for per-tile images, or empty
+    std::string trace;         // PREFIX for PREFIX.json and PREFIX.csv, or empty
+    double timeout_s = 120;    // the wall silent this long ends the job
+    bool throw_fault = false;  // test hook: fail after the first views are out
+    std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
+};
+
+class WallMaster {
+  public:
+    WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
+               double iso, double value_min, double value_max);
+
+    // Waits for every tile's hello, prints the rank -> host -> tile map, sends the first views.
+    void start();
+    // Runs one command; false for quit. Throws InputError for a command that cannot apply
+    // (isovalue out of range), naming `where`.
+    bool execute(const ScriptCommand& cmd, const std::string& where);
+    // Quit: every tile's figures and final image; writes the mosaic, prints the tables.
+    int finish();
+
+    std::uint64_t generation() const { return generation_; }
+    std::uint64_t total_rays() const;
+
+  private:
+    struct TileState {
+        std::string host;
+        bool hello = false;
+        std::uint64_t rays = 0;         // of the current generation
+        bool done = false;              // the current generation's last ray is cast
+        std::optional<ImageMsg> image;  // the answer to the pending image request
+        std::optional<TileResultMsg> result;
+    };
+
+    void handle(const Envelope& e);
+    // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
+    // naming the tiles still awaited.
+    void wait_until(const std::function<bool()>& done);
+    bool all_tiles(const std::function<bool(const TileState&)>& pred) const;
+    std::string waiting_on() const;
+
+    void send_views();
+    void wait(const WaitCmd& w);
+    // Asks every tile for its image (snapshot) and composes the mosaic.
+    Image gather_snapshot();
+    Mosaic compose();
+    void print_map() const;
+    void report();
+
+    const MasterOptions& o_;
+    Comm& comm_;
+    const WallSpec& spec_;
+    Box3 bounds_;
+    double iso_, lo_, hi_;
+    float aspect_ = 1;
+    Camera camera_;
+    std::uint64_t generation_ = 0;
+    std::vector<TileState> tiles_;  // by rank; [0] is the master
+    Stopwatch frame_start_;
+    TraceRecorder trace_;
+};
+
+}  // namespace isowall

@@ -1,0 +1,91 @@
+// The in-process transport keeps MPI's rules (order per sender, any-source receive, barrier) and
+// ends every rank on abort; the tile inbox raises the stop flag for views and quit only.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "comm/inproc_comm.h"
+#include "tile/tile_inbox.h"
+
+namespace isowall {
+namespace {
+
+std::vector<std::byte> bytes_of(std::uint8_t v) {
+    return {std::byte{v}};
+}
+
+TEST(InProcComm, MessagesFromOneSenderArriveInOrderAndReceiveCanFilterBySource) {
+    const auto codes = run_in_process(3, [](Comm& comm) {
+        if (comm.rank() == 1)
+            for (std::uint8_t i = 0; i < 10; ++i) comm.send(0, Tag::progress, bytes_of(i));
+        if (comm.rank() == 2) comm.send(0, Tag::hello, bytes_of(99));
+        if (comm.rank() != 0) return 0;
+        auto from2 = comm.receive(2, kForever);
+        if (!from2 || from2->from != 2 || from2->tag != Tag::hello) return 1;
+        for (std::uint8_t i = 0; i < 10; ++i) {
+            auto e = comm.receive(1, kForever);
+            if (!e || e->bytes != bytes_of(i)) return 2;
+        }
+        return comm.receive(-1, 0.01) ? 3 : 0;  // nothing left: a timeout, not a block
+    });
+    EXPECT_EQ(codes, (std::vector<int>{0, 0, 0}));
+}
+
+TEST(InProcComm, BarrierWaitsForEveryRank) {
+    std::atomic<int> arrived{0};
+    const auto codes = run_in_process(4, [&](Comm& comm) {
+        if (comm.rank() == 3) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        ++arrived;
+        comm.barrier();
+        return arrived.load() == 4 ? 0 : 1;
+    });
+    EXPECT_EQ(codes, (std::vector<int>{0, 0, 0, 0}));
+}
+
+TEST(InProcComm, AbortWakesEveryBlockedRankWithItsCode) {
+    const auto codes = run_in_process(3, [](Comm& comm) -> int {
+        if (comm.rank() == 2) comm.abort(7);
+        if (comm.rank() == 1) comm.barrier();
+        comm.receive(-1, kForever);
+        return 0;
+    });
+    EXPECT_EQ(codes, (std::vector<int>{7, 7, 7}));
+}
+
+TEST(InProcComm, AnEscapingExceptionAbortsTheWorld) {
+    const auto codes = run_in_process(2, [](Comm& comm) -> int {
+        if (comm.rank() == 1) throw std::runtime_error("boom");
+        comm.receive(-1, kForever);
+        return 0;
+    });
+    EXPECT_EQ(codes, (std::vector<int>{1, 1}));
+}
+
+TEST(TileInbox, ViewsAndQuitRaiseStopSnapshotsDoNot) {
+    TileInbox inbox;
+    inbox.push(SnapshotMsg{});
+    EXPECT_FALSE(inbox.stop_flag());
+    EXPECT_FALSE(inbox.pop().has_value());  // only a snapshot request waits
+    EXPECT_EQ(inbox.take_snapshots(), 1);
+    inbox.push(ViewMsg{});
+    EXPECT_TRUE(inbox.stop_flag());
+    inbox.push(ViewMsg{});
+    ASSERT_TRUE(inbox.pop().has_value());
+    EXPECT_TRUE(inbox.stop_flag()) << "a second view is queued: the first frame must not run";
+    ASSERT_TRUE(inbox.pop().has_value());
+    EXPECT_FALSE(inbox.stop_flag());
+    inbox.push(QuitMsg{});
+    EXPECT_TRUE(inbox.stop_flag());
+}
+
+TEST(TileInbox, CloseWithAnErrorRethrowsItOnceTheQueueIsEmpty) {
+    TileInbox inbox;
+    inbox.push(ViewMsg{});
+    inbox.close(std::make_exception_ptr(WireError("view message: truncated")));
+    EXPECT_TRUE(inbox.stop_flag());
+    EXPECT_TRUE(inbox.pop().has_value());
+    EXPECT_THROW(inbox.pop(), WireError);
+}
+
+}  // namespace
+}  // namespace isowall

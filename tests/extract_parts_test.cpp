@@ -1,0 +1,74 @@
+// The extractor's parts: the group key caches find groups by, and the thread budget.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+#include <unordered_set>
+
+#include "common/extract/group.h"
+#include "common/extract/surface_extractor.h"
+#include "common/volume/phantom.h"
+
+namespace isowall {
+namespace {
+
+TEST(GroupKey, EqualKeysHashAlikeAndPrint) {
+    const GroupKey a{{1, 2, 3}, 1, 40.0};
+    GroupKey b = a;
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(std::hash<GroupKey>{}(a), std::hash<GroupKey>{}(b));
+    // -0.0 == 0.0, so they must hash alike.
+    const GroupKey z0{{0, 0, 0}, 0, 0.0}, z1{{0, 0, 0}, 0, -0.0};
+    EXPECT_EQ(z0, z1);
+    EXPECT_EQ(std::hash<GroupKey>{}(z0), std::hash<GroupKey>{}(z1));
+    b.refinement = true;
+    EXPECT_FALSE(a == b) << a << " vs " << b;
+    std::ostringstream os;
+    os << a;
+    EXPECT_EQ(os.str(), "GroupKey{seed=(1,2,3) level=1 iso=40}");
+}
+
+TEST(GroupKey, NeighbouringSeedsSpreadOverBuckets) {
+    std::unordered_set<GroupKey> keys;
+    for (int z = 0; z < 8; ++z)
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) keys.insert(GroupKey{{x, y, z}, 0, 40.0});
+    EXPECT_EQ(keys.size(), 512u);
+}
+
+TEST(GroupKey, PropagatedGroupRecordsItsIsovalue) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    EXPECT_EQ(ex->threads(), 1);
+    ex->begin_frame(kPhantomSkinIso);
+    const glm::vec3 c = p.bounds().center();
+    const Ray ray{c - glm::vec3(0, 0, 1000), glm::vec3(0, 0, 1)};
+    const RayHit hit = ex->cast(ray, IntersectMode::exact);
+    ASSERT_TRUE(hit.found);
+    const Group g = ex->propagate(hit.cell, 7, PropagationParams{}, ray);
+    EXPECT_EQ(g.iso, kPhantomSkinIso);
+    EXPECT_EQ(g.key(), (GroupKey{g.seed, g.level, kPhantomSkinIso}));
+}
+
+TEST(ThreadBudget, ZeroIsReadAsOneAndSetsTheWorkers) {
+    EXPECT_EQ(ThreadBudget{0}.usable(), 1);
+    EXPECT_GE(ThreadBudget::hardware().threads, 1);
+    const Volume p = make_phantom();
+    EXPECT_EQ(make_surface_extractor(p, {}, nullptr, ThreadBudget{3})->threads(), 3);
+    EXPECT_EQ(make_surface_extractor(p, {}, nullptr, ThreadBudget{0})->threads(), 1);
+}
+
+TEST(ThreadBudget, OctreeIsTheSameOnAnyNumberOfThreads) {
+    const Volume p = make_phantom();
+    const auto v = p.view<std::uint8_t>();
+    const auto one = MinMaxOctree<std::uint8_t>::build(v, ThreadBudget{1});
+    for (int t : {0, 2, 5, 1000}) {
+        const auto many = MinMaxOctree<std::uint8_t>::build(v, ThreadBudget{t});
+        ASSERT_EQ(one.nodes().size(), many.nodes().size()) << ThreadBudget{t};
+        EXPECT_TRUE(std::equal(one.nodes().begin(), one.nodes().end(), many.nodes().begin()))
+            << ThreadBudget{t};
+    }
+}
+
+}  // namespace
+}  // namespace isowall

@@ -1,0 +1,399 @@
+// The typed wire protocol, malformed input of every kind (truncated, another version, trailing
+// bytes, huge counts, bad bools, enums and sizes, unknown tags, random mutations) throws WireError
+// naming the message and the field; it never crashes nor allocates more than the message holds.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <new>
+#include <random>
+
+#include "tests/protocol_test_util.h"
+
+// ---- the largest single allocation, to show that a huge count is refused before allocating ----
+// Replacing the global operator new is why these tests are their own executable.
+namespace {
+std::atomic<std::size_t> g_largest_allocation{0};
+
+// The largest single allocation made while `f` runs.
+std::size_t largest_allocation_in(const std::function<void()>& f) {
+    g_largest_allocation = 0;
+    f();
+    return g_largest_allocation;
+}
+}  // namespace
+
+void* operator new(std::size_t n) {
+    std::size_t seen = g_largest_allocation.load(std::memory_order_relaxed);
+    while (n > seen && !g_largest_allocation.compare_exchange_weak(seen, n)) {
+    }
+    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    throw std::bad_alloc();
+}
+// Not inlined: GCC 12 would see free() meet a pointer from new and warn (-Wmismatched-new-delete).
+[[gnu::noinline]] void operator delete(void* p) noexcept {
+    std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace isowall {
+namespace {
+
+using namespace protocol_testing;
+
+// ---- malformed input common to every message -------------------------------------------------
+
+TEST(ProtocolMalformed, EveryTruncationThrows) {
+    for (const Sample& s : samples()) {
+        for (std::size_t n = 0; n < s.bytes.size(); ++n)
+            EXPECT_THROW(decode_message(s.tag, std::span(s.bytes).first(n)), WireError)
+                << s.name << " cut to " << n << " of " << s.bytes.size() << " bytes";
+    }
+}
+
+TEST(ProtocolMalformed, AnotherVersionThrows) {
+    for (const Sample& s : samples()) {
+        for (int delta : {-1, 1, 255}) {
+            Bytes bytes = s.bytes;
+            bytes[0] = static_cast<std::byte>(static_cast<int>(bytes[0]) + delta);
+            expect_wire_error(s.tag, bytes, "version");
+        }
+    }
+}
+
+TEST(ProtocolMalformed, TrailingByteThrows) {
+    for (const Sample& s : samples()) {
+        Bytes bytes = s.bytes;
+        bytes.push_back(std::byte{0});
+        expect_wire_error(s.tag, bytes, "trailing");
+    }
+}
+
+TEST(ProtocolMalformed, UnknownTagThrows) {
+    const Bytes bytes = encode(QuitMsg{});
+    for (std::int32_t tag : {0, 8, 16, 31, -1, std::numeric_limits<std::int32_t>::max()})
+        EXPECT_THROW(decode_message(static_cast<Tag>(tag), bytes), WireError) << "tag " << tag;
+}
+
+TEST(ProtocolMalformed, DecodeAsAnotherTypeThrows) {
+    const Bytes bytes = encode(sample_image());
+    try {
+        decode_as<ViewMsg>(Tag::image, bytes);
+        ADD_FAILURE() << "an image decoded as a view";
+    } catch (const WireError& e) {
+        EXPECT_STREQ(e.what(), "expected a view message, got image");
+    }
+    EXPECT_THROW(decode_as<HelloMsg>(Tag::quit, encode(QuitMsg{})), WireError);
+    EXPECT_EQ(decode_as<ImageMsg>(Tag::image, bytes), sample_image());
+}
+
+// ---- hello ----------------------------------------------------------------------------------
+
+TEST(ProtocolMalformed, AllocationsAreSeen) {
+    // The measure the "without allocating" tests rely on: a real 64x64 image's pixels show up.
+    ImageMsg m;
+    m.width = m.height = 64;
+    m.rgba.assign(64 * 64 * 4, 0x40);
+    const Bytes bytes = encode(m);
+    EXPECT_GE(largest_allocation_in([&] { EXPECT_EQ(decode_as<ImageMsg>(Tag::image, bytes), m); }),
+              m.rgba.size());
+}
+
+TEST(ProtocolMalformed, HelloWithAHugeLengthThrowsWithoutAllocating) {
+    for (std::uint64_t length :
+         {kHugeCount, std::numeric_limits<std::uint64_t>::max(), std::uint64_t{5}}) {
+        MessageWriter w(HelloMsg::kVersion);
+        w.put(length);
+        w.put(std::uint32_t{0x74736f68});  // 4 bytes of a host name, fewer than the length
+        const Bytes bytes = w.take();
+        const auto largest =
+            largest_allocation_in([&] { expect_wire_error(Tag::hello, bytes, "length"); });
+        EXPECT_LT(largest, 4096u) << "length " << length;
+    }
+}
+
+// ---- view ---------------------------------------------------------------------------------------
+
+struct ViewFault {
+    const char* field;  // what the error must name
+    void (*apply)(ViewMsg&);
+};
+
+TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
+    constexpr std::int32_t kIntMax = std::numeric_limits<std::int32_t>::max();
+    const ViewFault faults[] = {
+        {"camera.eye", [](ViewMsg& m) { m.view.camera.eye.y = kNaN; }},
+        {"camera.target", [](ViewMsg& m) { m.view.camera.target.z = -kInf; }},
+        {"camera.up", [](ViewMsg& m) { m.view.camera.up.x = kInf; }},
+        {"camera.projection", [](ViewMsg& m) { m.view.camera.projection = Projection{2}; }},
+        {"camera.projection", [](ViewMsg& m) { m.view.camera.projection = Projection{-1}; }},
+        {"camera.fovy_deg", [](ViewMsg& m) { m.view.camera.fovy_deg = kNaN; }},
+        {"camera.ortho_height", [](ViewMsg& m) { m.view.camera.ortho_height = kInf; }},
+        {"camera.near_z", [](ViewMsg& m) { m.view.camera.near_z = kNaN; }},
+        {"camera.far_z", [](ViewMsg& m) { m.view.camera.far_z = kInf; }},
+        {"frustum.left", [](ViewMsg& m) { m.view.frustum.left = kNaN; }},
+        {"frustum.right", [](ViewMsg& m) { m.view.frustum.right = kInf; }},
+        {"frustum.bottom", [](ViewMsg& m) { m.view.frustum.bottom = -kInf; }},
+        {"frustum.top", [](ViewMsg& m) { m.view.frustum.top = kNaN; }},
+        {"frustum.near_z", [](ViewMsg& m) { m.view.frustum.near_z = kNaN; }},
+        {"frustum.far_z", [](ViewMsg& m) { m.view.frustum.far_z = kInf; }},
+        {"frustum.projection", [](ViewMsg& m) { m.view.frustum.projection = Projection{7}; }},
+        {"view.width", [](ViewMsg& m) { m.view.width = 0; }},
+        {"view.width", [](ViewMsg& m) { m.view.width = -1920; }},
+        {"view.width", [](ViewMsg& m) { m.view.width = kMaxImageSide + 1; }},
+        {"view.height", [](ViewMsg& m) { m.view.height = 0; }},
+        {"view.height", [](ViewMsg& m) { m.view.height = kMaxImageSide + 1; }},
+        {"view.iso", [](ViewMsg& m) { m.view.iso = std::numeric_limits<double>::quiet_NaN(); }},
+        {"view.iso", [](ViewMsg& m) { m.view.iso = -std::numeric_limits<double>::infinity(); }},
+        {"region", [](ViewMsg& m) { m.region.x = -1; }},
+        {"region", [](ViewMsg& m) { m.region.y = -1; }},
+        {"region", [](ViewMsg& m) { m.region.width = -1; }},
+        {"region", [](ViewMsg& m) { m.region.height = -1; }},
+        {"region",
+         [](ViewMsg& m) {
+             m.region = {1601, 0, 320, 240};
+         }},  // one past the right
+        {"region",
+         [](ViewMsg& m) {
+             m.region = {0, 841, 320, 240};
+         }},  // one past the bottom
+        {"region",
+         [](ViewMsg& m) {
+             m.region = {1921, 0, 0, 0};
+         }},
+        // x + width wraps around in 32 bits and would pass a naive check
+        {"region",
+         [](ViewMsg& m) {
+             m.region = {10, 0, kIntMax, 240};
+         }},
+        {"region",
+         [](ViewMsg& m) {
+             m.region = {0, 10, 320, kIntMax};
+         }},
+    };
+    for (const ViewFault& f : faults) {
+        ViewMsg m = sample_view();
+        f.apply(m);
+        SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
+        expect_wire_error(Tag::view, encode(m), f.field);
+    }
+}
+
+TEST(ProtocolMalformed, ViewRegionOnTheEdgeIsInside) {
+    ViewMsg m = sample_view();
+    m.region = {1600, 840, 320, 240};  // touches the right and bottom edges
+    expect_round_trip(m);
+}
+
+// ---- progress -----------------------------------------------------------------------------------
+
+TEST(ProtocolMalformed, ProgressWithABadBoolThrows) {
+    // The byte of `done` is where the encodings of done=false and done=true differ.
+    ProgressMsg m = sample_progress();
+    m.done = false;
+    const Bytes no = encode(m);
+    m.done = true;
+    const Bytes yes = encode(m);
+    ASSERT_EQ(no.size(), yes.size());
+    std::size_t at = 0;
+    while (at < no.size() && no[at] == yes[at]) ++at;
+    ASSERT_LT(at, no.size());
+    for (int value : {2, 0x80, 0xff}) {
+        Bytes bytes = yes;
+        bytes[at] = static_cast<std::byte>(value);
+        SCOPED_TRACE(testing::Message() << "bool byte " << value);
+        expect_wire_error(Tag::progress, bytes, "bool");
+    }
+}
+
+// ---- image --------------------------------------------------------------------------------------
+
+struct ImageFault {
+    const char* field;
+    void (*apply)(ImageMsg&);
+};
+
+TEST(ProtocolMalformed, ImageFaultsThrowNamingTheField) {
+    const ImageFault faults[] = {
+        {"width", [](ImageMsg& m) { m.width = -1; }},
+        {"width", [](ImageMsg& m) { m.width = kMaxImageSide + 1; }},
+        {"height", [](ImageMsg& m) { m.height = -3; }},
+        {"height", [](ImageMsg& m) { m.height = std::numeric_limits<std::int32_t>::max(); }},
+        {"rgba", [](ImageMsg& m) { m.rgba.pop_back(); }},
+        {"rgba", [](ImageMsg& m) { m.rgba.push_back(0); }},
+        {"rgba", [](ImageMsg& m) { m.rgba.clear(); }},
+        {"rgba", [](ImageMsg& m) { m.width = 2; }},  // sizes no longer match the pixels
+        {"depth", [](ImageMsg& m) { m.depth.pop_back(); }},
+        {"depth", [](ImageMsg& m) { m.depth.push_back(1.0f); }},
+        {"depth", [](ImageMsg& m) { m.depth.resize(m.rgba.size()); }},  // a count of bytes
+    };
+    for (const ImageFault& f : faults) {
+        ImageMsg m = sample_image();
+        f.apply(m);
+        SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
+        expect_wire_error(Tag::image, encode(m), f.field);
+    }
+}
+
+// The image layout, written by hand so a count can lie: generation, width, height, then the
+// rgba length and bytes, then the depth count and floats.
+Bytes image_bytes(std::int32_t width, std::int32_t height, std::uint64_t rgba_count,
+                  std::size_t rgba_bytes_present, std::uint64_t depth_count) {
+    MessageWriter w(ImageMsg::kVersion);
+    w.put(std::uint64_t{1});
+    w.put(width);
+    w.put(height);
+    w.put(rgba_count);
+    for (std::size_t i = 0; i < rgba_bytes_present; ++i) w.put(std::uint8_t{0x7f});
+    w.put(depth_count);
+    w.put(1.0f);  // one float present, whatever the count says
+    return w.take();
+}
+
+TEST(ProtocolMalformed, ImageWithAHugeCountThrowsWithoutAllocating) {
+    struct Case {
+        const char* field;
+        Bytes bytes;
+    };
+    const std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+    const Case cases[] = {
+        {"length", image_bytes(1, 1, kHugeCount, 4, 0)},
+        {"length", image_bytes(1, 1, kMax, 4, 0)},
+        // a count that fits a 32768x32768 image but not the message
+        {"length", image_bytes(kMaxImageSide, kMaxImageSide, 4ull << 30, 4, 0)},
+        {"array", image_bytes(1, 1, 4, 4, kHugeCount)},
+        {"array", image_bytes(1, 1, 4, 4, kMax)},
+        {"array", image_bytes(1, 1, 4, 4, kMax / 4 + 1)},  // count * 4 wraps to a small number
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(hex(c.bytes));
+        const auto largest =
+            largest_allocation_in([&] { expect_wire_error(Tag::image, c.bytes, c.field); });
+        EXPECT_LT(largest, 4096u);
+    }
+}
+
+// ---- tile result --------------------------------------------------------------------------------
+
+TEST(ProtocolMalformed, TileResultWithABadStageThrows) {
+    for (std::uint8_t stage :
+         {static_cast<std::uint8_t>(std::size(kTraceStages)), std::uint8_t{255}}) {
+        TileResultMsg m = sample_tile_result();
+        m.spans[1].stage = stage;
+        SCOPED_TRACE(testing::Message() << "stage " << int{stage});
+        expect_wire_error(Tag::tile_result, encode(m), "spans.stage");
+    }
+}
+
+TEST(ProtocolMalformed, TileResultWithAHugeSpanCountThrowsWithoutAllocating) {
+    // One span is 25 bytes on the wire: a count of 2 with 49 bytes left must fail too.
+    for (std::uint64_t count :
+         {kHugeCount, std::numeric_limits<std::uint64_t>::max(), std::uint64_t{2}}) {
+        TileResultMsg m = sample_tile_result();
+        m.spans.clear();
+        Bytes bytes = encode(m);
+        // Replace the span count, the last 8 bytes of a message with no spans.
+        MessageWriter tail(0);
+        tail.put(count);
+        for (int i = 0; i < 49; ++i) tail.put(std::uint8_t{0});
+        bytes.resize(bytes.size() - 8);
+        bytes.insert(bytes.end(), tail.bytes().begin() + 1, tail.bytes().end());
+        SCOPED_TRACE(testing::Message() << "count " << count);
+        const auto largest =
+            largest_allocation_in([&] { expect_wire_error(Tag::tile_result, bytes, "count"); });
+        EXPECT_LT(largest, 4096u);
+    }
+}
+
+// ---- mutation fuzz ------------------------------------------------------------------------------
+
+// Counts are where a decoder allocates, so a mutation sometimes writes one of these over 8 bytes.
+constexpr std::uint64_t kInterestingWords[] = {0,
+                                               1,
+                                               4,
+                                               25,
+                                               std::uint64_t{1} << 31,
+                                               std::uint64_t{1} << 32,
+                                               kHugeCount,
+                                               std::numeric_limits<std::uint64_t>::max()};
+
+// One random change: a bit flip, a byte set, a cut, an inserted byte, an 8-byte word or the tag.
+std::string mutate(Bytes& b, Tag& tag, std::mt19937_64& rng) {
+    switch (rng() % 6) {
+        case 0:
+            if (b.empty()) return "flip (empty)";
+            {
+                const std::size_t at = rng() % b.size();
+                b[at] ^= static_cast<std::byte>(1u << (rng() % 8));
+                return "flip at " + std::to_string(at);
+            }
+        case 1:
+            if (b.empty()) return "set (empty)";
+            {
+                const std::size_t at = rng() % b.size();
+                b[at] = static_cast<std::byte>(rng() & 0xff);
+                return "set at " + std::to_string(at);
+            }
+        case 2: {
+            b.resize(rng() % (b.size() + 1));
+            return "cut to " + std::to_string(b.size());
+        }
+        case 3: {
+            const std::size_t at = rng() % (b.size() + 1);
+            b.insert(b.begin() + static_cast<std::ptrdiff_t>(at),
+                     static_cast<std::byte>(rng() & 0xff));
+            return "insert at " + std::to_string(at);
+        }
+        case 4: {
+            if (b.size() < 8) return "word (short)";
+            const std::size_t at = rng() % (b.size() - 7);
+            std::uint64_t word = kInterestingWords[rng() % std::size(kInterestingWords)];
+            for (std::size_t i = 0; i < 8; ++i, word >>= 8)
+                b[at + i] = static_cast<std::byte>(word & 0xff);
+            return "word at " + std::to_string(at);
+        }
+        default: {
+            // 1..8: every tag and one unknown one
+            tag = static_cast<Tag>(1 + rng() % 8);
+            return "tag " + std::to_string(static_cast<int>(tag));
+        }
+    }
+}
+
+TEST(ProtocolFuzz, MutatedMessagesDecodeOrThrowWireError) {
+    constexpr int kIterations = 20000;
+    std::mt19937_64 rng(0x15011a11);  // fixed: a failure names its iteration and replays
+    const std::vector<Sample> base = samples();
+    int decoded = 0, rejected = 0;
+    for (int i = 0; i < kIterations; ++i) {
+        const Sample& s = base[rng() % base.size()];
+        Tag tag = s.tag;
+        Bytes bytes = s.bytes;
+        std::string what = s.name;
+        const int mutations = 1 + static_cast<int>(rng() % 3);
+        for (int k = 0; k < mutations; ++k) what += ", " + mutate(bytes, tag, rng);
+        try {
+            const Message m = decode_message(tag, bytes);
+            ++decoded;
+            // Decoding is canonical: whatever decodes encodes back to the very same bytes.
+            EXPECT_EQ(tag_of(m), tag) << "iteration " << i << ": " << what;
+            EXPECT_EQ(hex(encode(m)), hex(bytes)) << "iteration " << i << ": " << what;
+        } catch (const WireError&) {
+            ++rejected;
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "iteration " << i << " (" << what << "): not a WireError: " << e.what()
+                          << "; bytes: " << hex(bytes);
+        }
+    }
+    // Both outcomes must occur, or the mutations are too timid or too wild to test anything.
+    EXPECT_GT(decoded, kIterations / 20);
+    EXPECT_GT(rejected, kIterations / 20);
+    std::printf("fuzz: %d decoded, %d rejected\n", decoded, rejected);
+}
+
+}  // namespace
+}  // namespace isowall

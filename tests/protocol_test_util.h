@@ -1,0 +1,230 @@
+// Shared by the protocol tests (protocol_roundtrip_test.cpp, protocol_malformed_test.cpp):
+// equality and printing for the wire messages, a sample of each message with every field set,
+// hex dumps, and the two checks: expect_round_trip and expect_wire_error. Everything is inline and
+// in a named namespace, so a test file that uses only some of it draws no unused-function warning.
+#pragma once
+
+#include "comm/protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <iterator>
+#include <limits>
+#include <ostream>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace isowall {
+
+// ---- equality and printing for the tests only (comm/protocol.h stays free of them) ----------
+
+inline bool operator==(const Camera& a, const Camera& b) {
+    return a.eye == b.eye && a.target == b.target && a.up == b.up && a.projection == b.projection &&
+           a.fovy_deg == b.fovy_deg && a.ortho_height == b.ortho_height && a.near_z == b.near_z &&
+           a.far_z == b.far_z;
+}
+inline bool operator==(const Frustum& a, const Frustum& b) {
+    return a.left == b.left && a.right == b.right && a.bottom == b.bottom && a.top == b.top &&
+           a.near_z == b.near_z && a.far_z == b.far_z && a.projection == b.projection;
+}
+inline bool operator==(const FrameView& a, const FrameView& b) {
+    return a.camera == b.camera && a.frustum == b.frustum && a.width == b.width &&
+           a.height == b.height && a.iso == b.iso;
+}
+inline bool operator==(const PixelRect& a, const PixelRect& b) {
+    return a.x == b.x && a.y == b.y && a.width == b.width && a.height == b.height;
+}
+inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
+    return a.stage == b.stage && a.start_s == b.start_s && a.wall_s == b.wall_s &&
+           a.cpu_s == b.cpu_s;
+}
+inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
+    return a.host == b.host;
+}
+inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
+    return a.generation == b.generation && a.view == b.view && a.region == b.region;
+}
+inline bool operator==(const ProgressMsg& a, const ProgressMsg& b) {
+    return a.generation == b.generation && a.rays == b.rays && a.done == b.done &&
+           a.cpu_s == b.cpu_s;
+}
+inline bool operator==(const SnapshotMsg&, const SnapshotMsg&) {
+    return true;
+}
+inline bool operator==(const ImageMsg& a, const ImageMsg& b) {
+    return a.generation == b.generation && a.width == b.width && a.height == b.height &&
+           a.rgba == b.rgba && a.depth == b.depth;
+}
+inline bool operator==(const QuitMsg&, const QuitMsg&) {
+    return true;
+}
+inline bool operator==(const TileResultMsg& a, const TileResultMsg& b) {
+    return a.host == b.host && a.cpu_s == b.cpu_s && a.frame_s == b.frame_s &&
+           a.rss_mib == b.rss_mib && a.rays == b.rays && a.groups == b.groups &&
+           a.triangles == b.triangles && a.frames == b.frames && a.interrupted == b.interrupted &&
+           a.spans == b.spans;
+}
+
+inline std::ostream& operator<<(std::ostream& os, const PixelRect& p) {
+    return os << "PixelRect{" << p.x << ", " << p.y << ", " << p.width << "x" << p.height << "}";
+}
+inline std::ostream& operator<<(std::ostream& os, const TraceSpan& s) {
+    return os << "TraceSpan{stage " << int{s.stage} << ", start " << s.start_s << ", wall "
+              << s.wall_s << ", cpu " << s.cpu_s << "}";
+}
+inline void PrintTo(const HelloMsg& m, std::ostream* os) {
+    *os << "HelloMsg{" << m.host << "}";
+}
+inline void PrintTo(const ViewMsg& m, std::ostream* os) {
+    *os << "ViewMsg{generation " << m.generation << ", " << m.view << ", region " << m.region
+        << "}";
+}
+inline void PrintTo(const ProgressMsg& m, std::ostream* os) {
+    *os << "ProgressMsg{generation " << m.generation << ", rays " << m.rays << ", done " << m.done
+        << ", cpu_s " << m.cpu_s << "}";
+}
+inline void PrintTo(const SnapshotMsg&, std::ostream* os) {
+    *os << "SnapshotMsg{}";
+}
+inline void PrintTo(const ImageMsg& m, std::ostream* os) {
+    *os << "ImageMsg{generation " << m.generation << ", " << m.width << "x" << m.height << ", "
+        << m.rgba.size() << " rgba bytes, " << m.depth.size() << " depths}";
+}
+inline void PrintTo(const QuitMsg&, std::ostream* os) {
+    *os << "QuitMsg{}";
+}
+inline void PrintTo(const TileResultMsg& m, std::ostream* os) {
+    *os << "TileResultMsg{" << m.host << ", cpu_s " << m.cpu_s << ", frame_s " << m.frame_s
+        << ", rss_mib " << m.rss_mib << ", rays " << m.rays << ", groups " << m.groups
+        << ", triangles " << m.triangles << ", frames " << m.frames << ", interrupted "
+        << m.interrupted << ", spans";
+    for (const TraceSpan& s : m.spans) *os << " " << s;
+    *os << "}";
+}
+
+namespace protocol_testing {
+
+using Bytes = std::vector<std::byte>;
+
+inline std::string hex(std::span<const std::byte> bytes) {
+    std::string s;
+    char buf[4];
+    for (std::byte b : bytes) {
+        std::snprintf(buf, sizeof buf, "%02x ", static_cast<unsigned>(b));
+        s += buf;
+    }
+    return s;
+}
+
+// ---- samples with a value other than the default in every field -----------------------------
+
+inline HelloMsg sample_hello() {
+    using namespace std::string_literals;
+    return {"rank\0host-\xc3\xa9"s};  // an inner NUL and UTF-8: the length is on the wire
+}
+
+inline ViewMsg sample_view() {
+    ViewMsg m;
+    m.generation = 0x0123456789abcdefULL;  // every byte differs, so byte order shows
+    m.view.camera.eye = {1.5f, -2.25f, 30.0f};
+    m.view.camera.target = {0.5f, 0.25f, -1.0f};
+    m.view.camera.up = {0.1f, 0.2f, 0.97f};
+    m.view.camera.projection = Projection::orthographic;
+    m.view.camera.fovy_deg = 47.5f;
+    m.view.camera.ortho_height = 3.75f;
+    m.view.camera.near_z = 0.5f;
+    m.view.camera.far_z = 250.0f;
+    m.view.frustum = {-0.3f, 0.7f, -0.2f, 0.45f, 0.25f, 500.0f, Projection::orthographic};
+    m.view.width = 1920;
+    m.view.height = 1080;
+    m.view.iso = 117.25;
+    m.region = {640, 360, 320, 240};
+    return m;
+}
+
+inline ProgressMsg sample_progress() {
+    return {42, 1234567890123ULL, true, 3.25};
+}
+
+inline ImageMsg sample_image() {
+    ImageMsg m;
+    m.generation = 7;
+    m.width = 3;
+    m.height = 2;
+    for (int i = 0; i < 3 * 2 * 4; ++i) m.rgba.push_back(static_cast<std::uint8_t>(11 * i + 3));
+    m.depth = {0.0f, 0.125f, 0.5f, 0.75f, 0.999f, 1.0f};
+    return m;
+}
+
+inline TileResultMsg sample_tile_result() {
+    TileResultMsg m;
+    m.host = "tile-07.cluster";
+    m.cpu_s = 12.5;
+    m.frame_s = 20.25;
+    m.rss_mib = 512.75;
+    m.rays = 9000000001ULL;
+    m.groups = 17;
+    m.triangles = 123456;
+    m.frames = 3;
+    m.interrupted = 2;
+    const std::uint8_t last_stage = std::size(kTraceStages) - 1;
+    m.spans = {
+        {0, 1.7e9, 0.5, 0.25}, {3, 1.7e9 + 0.5, 0.125, 0.0625}, {last_stage, 1.7e9 + 1, 2, 1}};
+    return m;
+}
+
+struct Sample {
+    const char* name;
+    Tag tag;
+    Bytes bytes;
+};
+
+inline std::vector<Sample> samples() {
+    return {{"hello", Tag::hello, encode(sample_hello())},
+            {"view", Tag::view, encode(sample_view())},
+            {"progress", Tag::progress, encode(sample_progress())},
+            {"snapshot", Tag::snapshot, encode(SnapshotMsg{})},
+            {"image", Tag::image, encode(sample_image())},
+            {"quit", Tag::quit, encode(QuitMsg{})},
+            {"tile_result", Tag::tile_result, encode(sample_tile_result())}};
+}
+
+// decode_message must throw a WireError whose text names the message and `field`.
+inline void expect_wire_error(Tag tag, std::span<const std::byte> bytes, const std::string& field) {
+    const std::string message = std::string(to_string(tag)) + " message";
+    try {
+        decode_message(tag, bytes);
+        ADD_FAILURE() << message << " decoded, expected a WireError naming " << field
+                      << "; bytes: " << hex(bytes);
+    } catch (const WireError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(message), std::string::npos) << what;
+        EXPECT_NE(what.find(field), std::string::npos) << "expected " << field << " in: " << what;
+    }
+}
+
+inline constexpr std::uint64_t kHugeCount = std::uint64_t{1} << 62;
+inline constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+inline constexpr float kInf = std::numeric_limits<float>::infinity();
+
+template <class T>
+void expect_round_trip(const T& m) {
+    const Bytes bytes = encode(m);
+    const T back = decode_as<T>(T::kTag, bytes);
+    EXPECT_EQ(back, m) << "bytes: " << hex(bytes);
+    // The variant path gives the same bytes and the same message.
+    const Message as_variant = m;
+    EXPECT_EQ(tag_of(as_variant), T::kTag);
+    EXPECT_EQ(encode(as_variant), bytes);
+    const Message decoded = decode_message(T::kTag, bytes);
+    ASSERT_TRUE(std::holds_alternative<T>(decoded)) << "index " << decoded.index();
+    EXPECT_EQ(std::get<T>(decoded), m);
+}
+
+}  // namespace protocol_testing
+}  // namespace isowall

@@ -1,0 +1,189 @@
+// The wall with every rank a thread of this process (comm/inproc_comm.h): the master's state
+// machine and the tile loop are exercised in seconds, without mpirun. A 2x2 wall of small tiles on
+// the phantom; each test runs five ranks: an interrupt mid-frame, a snapshot, a silent tile, and
+// failures on either side, each ending every rank.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include "comm/inproc_comm.h"
+#include "common/core/wire.h"
+#include "common/io/image_io.h"
+#include "master/wall_run.h"
+#include "tests/image_compare.h"
+#include "tests/test_util.h"
+
+namespace isowall {
+namespace {
+
+struct WallRun {
+    std::vector<int> codes;
+    std::vector<TileResultMsg> results;
+    std::string err;
+    double seconds = 0;
+};
+
+WallOptions small_wall(const std::filesystem::path& dir) {
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [80, 60]\n";
+    WallOptions o;
+    o.wall = (dir / "2x2.toml").string();
+    o.out = (dir / "mosaic.png").string();
+    o.volume.no_cache = true;
+    return o;
+}
+
+WallRun run_wall_in_process(WallOptions o, int ranks = 5) {
+    WallRun r;
+    o.results_out = &r.results;
+    testing::internal::CaptureStderr();
+    const auto t0 = std::chrono::steady_clock::now();
+    r.codes = run_in_process(ranks, [&](Comm& comm) { return run_wall(o, comm); });
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.err = testing::internal::GetCapturedStderr();
+    return r;
+}
+
+std::filesystem::path write_script(const std::filesystem::path& dir, const std::string& text) {
+    std::ofstream(dir / "script.txt") << text;
+    return dir / "script.txt";
+}
+
+TEST(WallInProcess, OneFrameOnEveryTileAndAMosaic) {
+    const auto dir = test::scratch_dir("inproc_one");
+    const WallRun r = run_wall_in_process(small_wall(dir));
+    for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
+    ASSERT_EQ(r.results.size(), 5u);
+    for (int rank = 1; rank <= 4; ++rank) {
+        EXPECT_EQ(r.results[rank].frames, 1u) << "rank " << rank;
+        EXPECT_GT(r.results[rank].rays, 0u) << "rank " << rank;
+        EXPECT_FALSE(r.results[rank].spans.empty()) << "rank " << rank;
+    }
+    const Image mosaic = read_image(dir / "mosaic.png");
+    EXPECT_EQ(mosaic.width, 160);
+    EXPECT_EQ(mosaic.height, 120);
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+TEST(WallInProcess, AChangeMidFrameInterruptsEveryTileAndTheMosaicIsTheLastView) {
+    const auto dir = test::scratch_dir("inproc_interrupt");
+    WallOptions o = small_wall(dir);
+    // One ray per tile is mid-frame on every tile (each has thousands to cast).
+    o.script = write_script(dir, "wait rays 4\norbit 60 -20\niso 160\nwait done\n").string();
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
+    ASSERT_EQ(r.results.size(), 5u);
+    for (int rank = 1; rank <= 4; ++rank) {
+        EXPECT_EQ(r.results[rank].frames, 3u) << "rank " << rank;
+        EXPECT_GE(r.results[rank].interrupted, 1u) << "rank " << rank;
+    }
+    // The mosaic is the last view only: equal to the same wall run with that view from the start.
+    WallOptions direct = small_wall(test::scratch_dir("inproc_interrupt_direct"));
+    direct.script = write_script(dir, "orbit 60 -20\niso 160\nwait done\n").string();
+    const WallRun d = run_wall_in_process(direct);
+    for (int code : d.codes) ASSERT_EQ(code, 0) << d.err;
+    const test::ImageComparison m =
+        test::compare_images(read_image(dir / "mosaic.png"), read_image(direct.out));
+    EXPECT_GE(m.mask_iou, 0.999) << m;
+    EXPECT_GE(m.equal_share, 0.999) << m;
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+TEST(WallInProcess, ASnapshotMidFrameShowsTheFrameInFlight) {
+    const auto dir = test::scratch_dir("inproc_snapshot");
+    WallOptions o = small_wall(dir);
+    o.script = write_script(dir, "iso 160\nwait rays 8\nsnapshot early\nwait done\nsnapshot late\n")
+                   .string();
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
+    const Image early = read_image(dir / "early.png");
+    const Image late = read_image(dir / "late.png");
+    const Image final_mosaic = read_image(dir / "mosaic.png");
+    ASSERT_EQ(early.width, 160);
+    ASSERT_EQ(early.height, 120);
+    // After the frame completes, a snapshot is the final mosaic; before, it is a part of it.
+    const test::ImageComparison done = test::compare_images(late, final_mosaic);
+    EXPECT_EQ(done.differing_pixels, 0u) << done;
+    // Groups only ever add to a frame, so every pixel the early snapshot shows stays covered.
+    const test::ImageComparison part = test::compare_images(early, final_mosaic);
+    const std::size_t covered_early = test::compare_images(early, early).covered_both;
+    EXPECT_GT(covered_early, 0u);
+    EXPECT_EQ(part.covered_both, covered_early) << part;
+    std::printf("early snapshot: %zu covered pixels, final: %zu\n", covered_early,
+                test::compare_images(final_mosaic, final_mosaic).covered_both);
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+TEST(WallInProcess, ASilentTileIsNamedAfterTheTimeoutAndEveryRankEnds) {
+    const auto dir = test::scratch_dir("inproc_silent");
+    WallOptions o = small_wall(dir);
+    o.timeout_s = 2;
+    o.fault_kind = "hang";
+    o.fault_rank = 2;
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
+    EXPECT_NE(r.err.find("isowall: error: rank 0 (master): no tile rank has answered for 2 s"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("waiting on rank 2 (tile 1)"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(o.out));
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+std::size_t count_lines(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+TEST(WallInProcess, ATileThatThrowsEndsEveryRankWithOneLine) {
+    const auto dir = test::scratch_dir("inproc_tile_throws");
+    WallOptions o = small_wall(dir);
+    o.fault_kind = "throw";
+    o.fault_rank = 3;
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
+    EXPECT_EQ(count_lines(r.err, "isowall: error:"), 1u) << r.err;
+    EXPECT_NE(r.err.find("isowall: error: rank 3 (tile 2): test fault: a tile throws"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(std::filesystem::exists(o.out));
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+TEST(WallInProcess, AMasterThatThrowsEndsEveryRankWithOneLine) {
+    const auto dir = test::scratch_dir("inproc_master_throws");
+    WallOptions o = small_wall(dir);
+    o.fault_kind = "throw";
+    o.fault_rank = 0;
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
+    EXPECT_EQ(count_lines(r.err, "isowall: error:"), 1u) << r.err;
+    EXPECT_NE(r.err.find("isowall: error: rank 0 (master): test fault: the master throws"),
+              std::string::npos)
+        << r.err;
+    std::printf("wall run: %.2f s\n", r.seconds);
+}
+
+// A rank that speaks garbage: the master names it and the job ends, on every rank.
+TEST(WallInProcess, AMalformedMessageToTheMasterEndsTheJobNamingTheRank) {
+    const auto dir = test::scratch_dir("inproc_malformed");
+    WallOptions o = small_wall(dir);
+    testing::internal::CaptureStderr();
+    const std::vector<int> codes = run_in_process(5, [&](Comm& comm) {
+        if (comm.rank() != 4) return run_wall(o, comm);
+        comm.barrier();
+        const std::byte junk[] = {std::byte{1}, std::byte{9}};  // a hello that is cut short
+        comm.send(kMasterRank, Tag::hello, junk);
+        for (;;) comm.receive(-1, kForever);  // until the job ends
+    });
+    const std::string err = testing::internal::GetCapturedStderr();
+    for (int code : codes) EXPECT_NE(code, 0) << err;
+    EXPECT_NE(err.find("isowall: error: rank 0 (master): rank 4 (tile 3): hello message: "),
+              std::string::npos)
+        << err;
+}
+
+}  // namespace
+}  // namespace isowall

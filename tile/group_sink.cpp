@@ -1,0 +1,56 @@
+#include "tile/group_sink.h"
+
+#include <chrono>
+
+namespace isowall {
+
+void RendererSink::begin(const FrameView& view) {
+    view_m_ = view.camera.view();
+    proj_m_ = view.frustum.matrix();
+    renderer_.resize(view.width, view.height);
+    renderer_.clear();
+}
+
+void RendererSink::add(const Group& group) {
+    renderer_.draw(group.mesh, view_m_, proj_m_);
+}
+
+double RendererSink::present() {
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer_.finish();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+bool RendererSink::coverage(std::vector<std::uint8_t>& covered) {
+    renderer_.read_back(scratch_);
+    covered.resize(scratch_.depth.size());
+    for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = scratch_.depth[i] < 1.0f;
+    return true;
+}
+
+void RendererSink::read_back(Image& out) {
+    renderer_.finish();
+    renderer_.read_back(out);
+}
+
+void TeeSink::begin(const FrameView& view) {
+    for (GroupSink* s : sinks_) s->begin(view);
+}
+
+void TeeSink::add(const Group& group) {
+    for (GroupSink* s : sinks_) s->add(group);
+}
+
+double TeeSink::present() {
+    double seconds = 0;
+    for (GroupSink* s : sinks_) seconds += s->present();
+    return seconds;
+}
+
+bool TeeSink::coverage(std::vector<std::uint8_t>& covered) {
+    for (GroupSink* s : sinks_)
+        if (s->coverage(covered)) return true;
+    return false;
+}
+
+}  // namespace isowall

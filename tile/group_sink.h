@@ -1,0 +1,69 @@
+#pragma once
+// Where a frame's groups go. The engine hands every new group to a sink as soon as it is made:
+// the renderer sink draws it into the frame being built, the recording sink keeps it for the
+// correctness replay, and later a network sink will stream it to a remote client. A frame may
+// feed several sinks at once through TeeSink.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "common/core/image.h"
+#include "common/core/view.h"
+#include "common/extract/surface_extractor.h"
+#include "tile/renderer.h"
+
+namespace isowall {
+
+class GroupSink {
+  public:
+    virtual ~GroupSink() = default;
+    // A new frame of `view` (the whole screen); nothing of an earlier frame shows any more.
+    virtual void begin(const FrameView& /*view*/) {}
+    virtual void add(const Group& group) = 0;
+    // Makes every group added so far visible, as a display does at its next refresh. Called at
+    // most once per refresh and at the end of each ray-order level; returns the seconds it took.
+    virtual double present() { return 0; }
+    // Writes covered[y * width + x] != 0 for every screen pixel that shows the surface now; false
+    // when this sink cannot tell (the readback ray orders then see nothing covered).
+    virtual bool coverage(std::vector<std::uint8_t>& /*covered*/) { return false; }
+};
+
+// Draws every group into a renderer's frame, which begin() resizes and clears.
+class RendererSink final : public GroupSink {
+  public:
+    explicit RendererSink(Renderer& renderer) : renderer_(renderer) {}
+    void begin(const FrameView& view) override;
+    void add(const Group& group) override;
+    double present() override;
+    bool coverage(std::vector<std::uint8_t>& covered) override;
+    // The frame as drawn so far (finishes pending draws first).
+    void read_back(Image& out);
+
+  private:
+    Renderer& renderer_;
+    glm::mat4 view_m_{1.0f}, proj_m_{1.0f};
+    Image scratch_;
+};
+
+// Keeps every group, in order: the replay that measures correctness redraws them.
+class RecordingSink final : public GroupSink {
+  public:
+    void begin(const FrameView&) override { groups.clear(); }
+    void add(const Group& group) override { groups.push_back(group); }
+    std::vector<Group> groups;
+};
+
+// Forwards to each sink in turn; coverage comes from the first that can tell.
+class TeeSink final : public GroupSink {
+  public:
+    explicit TeeSink(std::vector<GroupSink*> sinks) : sinks_(std::move(sinks)) {}
+    void begin(const FrameView& view) override;
+    void add(const Group& group) override;
+    double present() override;
+    bool coverage(std::vector<std::uint8_t>& covered) override;
+
+  private:
+    std::vector<GroupSink*> sinks_;
+};
+
+}  // namespace isowall

@@ -1,0 +1,53 @@
+#include "tile/tile_inbox.h"
+
+#include <stdexcept>
+#include <utility>
+
+namespace isowall {
+
+void TileInbox::push(Message message) {
+    std::lock_guard lock(mutex_);
+    if (std::holds_alternative<SnapshotMsg>(message)) {
+        ++snapshots_;
+    } else {
+        // Raised under the lock, so a pop() that lowers it cannot miss this message.
+        if (std::holds_alternative<ViewMsg>(message) || std::holds_alternative<QuitMsg>(message))
+            stop_ = true;
+        queue_.push_back(std::move(message));
+    }
+    changed_.notify_all();
+}
+
+void TileInbox::close(std::exception_ptr error) {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    if (!error_) error_ = error;
+    stop_ = true;
+    changed_.notify_all();
+}
+
+std::optional<Message> TileInbox::pop() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return !queue_.empty() || snapshots_ > 0 || closed_; });
+    if (closed_ && queue_.empty()) {
+        if (error_) std::rethrow_exception(error_);
+        throw std::runtime_error("the communication thread ended");
+    }
+    if (queue_.empty()) return std::nullopt;  // snapshot requests only
+    Message m = std::move(queue_.front());
+    queue_.pop_front();
+    stop_ = closed_ || !queue_.empty();
+    return m;
+}
+
+int TileInbox::take_snapshots() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(snapshots_, 0);
+}
+
+void TileInbox::wait_closed() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return closed_; });
+}
+
+}  // namespace isowall
