@@ -16,10 +16,9 @@ namespace isowall {
 namespace {
 
 // Runs a command under `timeout` (the test guards against hangs itself) and returns its exit code.
-int run(const std::string& cmd, const std::filesystem::path& log) {
-    const std::string full =
-        "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 " + cmd + " > '" +
-        log.string() + "' 2>&1";
+int run(const std::string& cmd, const std::filesystem::path& log, int guard_s = 120) {
+    const std::string full = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout " +
+                             std::to_string(guard_s) + " " + cmd + " > '" + log.string() + "' 2>&1";
     const int status = std::system(full.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -188,6 +187,43 @@ TEST(WallRun, ATileThatStopsAnsweringOrDiesEndsTheJobInBoundedTime) {
     EXPECT_NE(rc, 0) << log;
     EXPECT_NE(rc, 124) << "timed out: " << log;
     EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+// The single failure path under MPI: whichever rank throws prints one line naming itself and the
+// cause, and every rank of the job ends non-zero within the 60 s guard.
+TEST(WallRun, ARankThatThrowsEndsEveryRankWithOneLine) {
+    const auto dir = test::scratch_dir("wall_throw");
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";
+    const std::string wall = "wall --wall '" + (dir / "2x2.toml").string() + "' --out '" +
+                             (dir / "m.png").string() + "'";
+    struct Case {
+        const char* fault;
+        const char* line;
+    } cases[] = {{"throw:0", "isowall: error: rank 0 (master): test fault: the master throws"},
+                 {"throw:2", "isowall: error: rank 2 (tile 1): test fault: a tile throws"}};
+    for (const Case& c : cases) {
+        const auto log_path = dir / (std::string(c.fault).substr(6) + ".log");
+        const int rc =
+            run(std::string("env ISOWALL_TEST_FAULT=") + c.fault + " " + mpirun(5) + wall, log_path,
+                60);
+        const std::string log = slurp(log_path);
+        EXPECT_NE(rc, 0) << c.fault << ": " << log;
+        EXPECT_NE(rc, 124) << c.fault << " timed out: " << log;
+        EXPECT_EQ(count_of(log, "isowall: error:"), 1u) << c.fault << ": " << log;
+        EXPECT_NE(log.find(c.line), std::string::npos) << c.fault << ": " << log;
+        // No rank outlives mpirun: every process of this job (its wall file names it) is gone.
+        // ("[w]all" keeps pgrep from matching the shell that runs it.)
+        const std::string still =
+            "pgrep -f '[w]all --wall " + (dir / "2x2.toml").string() + "' > /dev/null";
+        EXPECT_NE(std::system(still.c_str()), 0) << c.fault << ": a rank is still running";
+        EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
+    }
 }
 
 TEST(WallRun, ConsoleCommandsDriveTheWall) {
