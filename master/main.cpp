@@ -84,6 +84,12 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
                      "Seconds a silent tile rank may take before the job ends")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
+    wall_cmd
+        ->add_option("--threads", wall.threads,
+                     "Threads each rank may use (octree build, extraction); on a cluster, the "
+                     "cores of a display node")
+        ->check(CLI::Range(1, 1024))
+        ->capture_default_str();
     wall_cmd->add_option("--trace", wall.trace,
                          "Write per-rank spans by stage with thread CPU time: PREFIX.json (Chrome "
                          "trace, opens in Perfetto) and PREFIX.csv");

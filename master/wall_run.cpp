@@ -20,11 +20,11 @@
 namespace isowall {
 namespace {
 
-std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov) {
+std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadBudget budget) {
     OctreeSource src;
     if (ov.file) src.volume_path = *ov.file;
     src.cache_dir = ov.cache_dir;
-    return make_surface_extractor(ov.volume, src);
+    return make_surface_extractor(ov.volume, src, nullptr, budget);
 }
 
 // What the master checks before any frame starts: a bad volume, isovalue, output folder, engine
@@ -40,7 +40,7 @@ MasterInput check_master_input(const WallOptions& o) {
     MasterInput in;
     in.volume.emplace(open_volume(o.volume));
     const OpenedVolume& ov = *in.volume;
-    in.extractor = open_extractor(ov);
+    in.extractor = open_extractor(ov, ThreadBudget{o.threads});
     in.iso = o.iso.value_or(kPhantomSkinIso);
     if (!o.iso && ov.file)
         throw InputError(ov.file->string(), "--iso",
@@ -92,7 +92,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
 
 int run_tile_rank(const WallOptions& o, Comm& comm) {
     const OpenedVolume ov = open_volume(o.volume, /*quiet=*/true);
-    auto extractor = open_extractor(ov);
+    auto extractor = open_extractor(ov, ThreadBudget{o.threads});
     auto renderer = make_renderer(o.gl);
     TileSetup setup{*extractor, *renderer, to_engine_options(o.engine), {}};
     if (o.fault_rank == comm.rank()) setup.fault.kind = o.fault_kind;

@@ -24,6 +24,9 @@ struct WallOptions {
     std::string script;      // script file, "-" for the master's console, empty: one frame
     double timeout_s = 120;  // a wall silent this long ends the job
     std::string trace;       // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
+    // so this is the rank's budget, not the machine's core count.
+    int threads = 1;
     // Test hook (ISOWALL_TEST_FAULT=KIND:RANK): the rank named fails in the way named (tile:
     // hang, exit, throw; master: throw).
     std::string fault_kind;

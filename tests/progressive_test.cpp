@@ -218,3 +218,42 @@ TEST(Engine, TimelineIsMonotoneAndReachesFullCorrectness) {
 
 }  // namespace
 }  // namespace isowall
+
+namespace isowall {
+namespace {
+
+// The stages of a frame are named steps, each charged to its own trace span: the frame's set-up
+// (the adaptive D[] table, clearing visited cells) is "setup", never another stage, and the
+// engine alone never charges anything to communication or idle.
+TEST(Engine, EveryStepOfAFrameIsChargedToItsOwnStage) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    for (bool adaptive : {false, true}) {
+        TraceRecorder trace;
+        EngineOptions opt;
+        opt.adaptive = adaptive;
+        opt.trace = &trace;
+        ProgressiveEngine engine(*ex, *renderer, opt);
+        trace.switch_to(Stage::idle);  // what a tile was doing before the view arrived
+        const std::size_t first = trace.spans().size();  // the idle span, once closed
+        const FrameResult fr = engine.run(test::make_view(p, 160, 120, kPhantomSkinIso));
+        ASSERT_TRUE(fr.completed);
+        trace.close();
+        const auto& spans = trace.spans();
+        ASSERT_GE(spans.size(), first + 3);
+        EXPECT_EQ(spans[first].stage, std::uint8_t(Stage::idle)) << "adaptive " << adaptive;
+        EXPECT_EQ(spans[first + 1].stage, std::uint8_t(Stage::setup)) << "adaptive " << adaptive;
+        std::set<std::uint8_t> seen;
+        for (std::size_t i = first + 1; i < spans.size(); ++i) seen.insert(spans[i].stage);
+        for (Stage s : {Stage::intersection, Stage::propagation, Stage::render})
+            EXPECT_TRUE(seen.count(std::uint8_t(s)))
+                << kTraceStages[int(s)] << ", adaptive " << adaptive;
+        for (Stage s : {Stage::comm, Stage::idle, Stage::compose})
+            EXPECT_FALSE(seen.count(std::uint8_t(s)))
+                << kTraceStages[int(s)] << ", adaptive " << adaptive;
+    }
+}
+
+}  // namespace
+}  // namespace isowall
