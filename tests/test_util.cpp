@@ -22,4 +22,10 @@ std::filesystem::path scratch_dir(const std::string& name) {
     return dir;
 }
 
+std::size_t count_of(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
 }  // namespace isowall::test

@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the tests: where the shared data lives, temporary folders.
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -12,5 +13,8 @@ std::optional<std::filesystem::path> shared_data_dir();
 
 // A fresh, empty folder under the build tree for one test's files.
 std::filesystem::path scratch_dir(const std::string& name);
+
+// How many times `what` occurs in `text` (e.g. error lines in a log).
+std::size_t count_of(const std::string& text, const std::string& what);
 
 }  // namespace isowall::test

@@ -131,39 +131,24 @@ TEST(WallInProcess, ASilentTileIsNamedAfterTheTimeoutAndEveryRankEnds) {
     std::printf("wall run: %.2f s\n", r.seconds);
 }
 
-std::size_t count_lines(const std::string& text, const std::string& what) {
-    std::size_t n = 0;
-    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-    return n;
-}
-
-TEST(WallInProcess, ATileThatThrowsEndsEveryRankWithOneLine) {
-    const auto dir = test::scratch_dir("inproc_tile_throws");
-    WallOptions o = small_wall(dir);
-    o.fault_kind = "throw";
-    o.fault_rank = 3;
-    const WallRun r = run_wall_in_process(o);
-    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
-    EXPECT_EQ(count_lines(r.err, "isowall: error:"), 1u) << r.err;
-    EXPECT_NE(r.err.find("isowall: error: rank 3 (tile 2): test fault: a tile throws"),
-              std::string::npos)
-        << r.err;
-    EXPECT_FALSE(std::filesystem::exists(o.out));
-    std::printf("wall run: %.2f s\n", r.seconds);
-}
-
-TEST(WallInProcess, AMasterThatThrowsEndsEveryRankWithOneLine) {
-    const auto dir = test::scratch_dir("inproc_master_throws");
-    WallOptions o = small_wall(dir);
-    o.fault_kind = "throw";
-    o.fault_rank = 0;
-    const WallRun r = run_wall_in_process(o);
-    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
-    EXPECT_EQ(count_lines(r.err, "isowall: error:"), 1u) << r.err;
-    EXPECT_NE(r.err.find("isowall: error: rank 0 (master): test fault: the master throws"),
-              std::string::npos)
-        << r.err;
-    std::printf("wall run: %.2f s\n", r.seconds);
+// Whichever rank throws, tile or master, prints one line naming itself and every rank ends.
+TEST(WallInProcess, ARankThatThrowsEndsEveryRankWithOneLine) {
+    const struct {
+        int rank;
+        const char* line;
+    } cases[] = {{3, "isowall: error: rank 3 (tile 2): test fault: a tile throws"},
+                 {0, "isowall: error: rank 0 (master): test fault: the master throws"}};
+    for (const auto& c : cases) {
+        WallOptions o = small_wall(test::scratch_dir("inproc_throws_" + std::to_string(c.rank)));
+        o.fault_kind = "throw";
+        o.fault_rank = c.rank;
+        const WallRun r = run_wall_in_process(o);
+        for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
+        EXPECT_EQ(test::count_of(r.err, "isowall: error:"), 1u) << r.err;
+        EXPECT_NE(r.err.find(c.line), std::string::npos) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(o.out));
+        std::printf("wall run: %.2f s\n", r.seconds);
+    }
 }
 
 // A rank that speaks garbage: the master names it and the job ends, on every rank.

@@ -189,12 +189,6 @@ TEST(WallRun, ATileThatStopsAnsweringOrDiesEndsTheJobInBoundedTime) {
     EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
 }
 
-std::size_t count_of(const std::string& text, const std::string& what) {
-    std::size_t n = 0;
-    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-    return n;
-}
-
 // The single failure path under MPI: whichever rank throws prints one line naming itself and the
 // cause, and every rank of the job ends non-zero within the 60 s guard.
 TEST(WallRun, ARankThatThrowsEndsEveryRankWithOneLine) {
@@ -215,7 +209,7 @@ TEST(WallRun, ARankThatThrowsEndsEveryRankWithOneLine) {
         const std::string log = slurp(log_path);
         EXPECT_NE(rc, 0) << c.fault << ": " << log;
         EXPECT_NE(rc, 124) << c.fault << " timed out: " << log;
-        EXPECT_EQ(count_of(log, "isowall: error:"), 1u) << c.fault << ": " << log;
+        EXPECT_EQ(test::count_of(log, "isowall: error:"), 1u) << c.fault << ": " << log;
         EXPECT_NE(log.find(c.line), std::string::npos) << c.fault << ": " << log;
         // No rank outlives mpirun: every process of this job (its wall file names it) is gone.
         // ("[w]all" keeps pgrep from matching the shell that runs it.)
