@@ -86,14 +86,6 @@ class MessageReader {
     }
     // A bool stored as one byte; anything but 0 or 1 is an error.
     bool get_bool();
-    // An enum stored as its underlying type; values above `max` are an error.
-    template <class E>
-    E get_enum(E max) {
-        const auto v = get<std::underlying_type_t<E>>();
-        if (v < 0 || v > static_cast<std::underlying_type_t<E>>(max))
-            fail("enum value " + std::to_string(v) + " out of range");
-        return static_cast<E>(v);
-    }
     std::span<const std::byte> get_bytes();
     std::string get_string();
     template <WireScalar T>
