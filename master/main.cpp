@@ -85,6 +85,11 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     wall_cmd
+        ->add_option("--startup-timeout", wall.startup_timeout_s,
+                     "Seconds the tile ranks may take to load the volume and start")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    wall_cmd
         ->add_option("--threads", wall.threads,
                      "Threads each rank may use (octree build, extraction); on a cluster, the "
                      "cores of a display node")

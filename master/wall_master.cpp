@@ -68,16 +68,16 @@ void WallMaster::handle(const Envelope& e) {
     trace_.switch_to(left);
 }
 
-void WallMaster::wait_until(const std::function<bool()>& done) {
+void WallMaster::wait_until(const std::function<bool()>& done, double timeout_s) {
     const Stage left = trace_.switch_to(Stage::idle);
     Stopwatch silent;
     while (!done()) {
         if (auto e = comm_.receive(-1, kReceiveSliceS)) {
             handle(*e);
             silent.restart();
-        } else if (silent.seconds() > o_.timeout_s) {
+        } else if (silent.seconds() > timeout_s) {
             char msg[96];
-            std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", o_.timeout_s);
+            std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", timeout_s);
             throw std::runtime_error(std::string(msg) + " (waiting on " + waiting_on() +
                                      "); ending the job");
         }
@@ -107,7 +107,10 @@ std::uint64_t WallMaster::total_rays() const {
 }
 
 void WallMaster::start() {
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.hello; }); });
+    // Tiles load the volume and build their renderer before their hello: a start-up of its own
+    // length, so a short --timeout for a running wall does not cut a slow load short.
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.hello; }); },
+               o_.startup_timeout_s);
     print_map();
     send_views();
     if (o_.throw_fault) throw std::runtime_error("test fault: the master throws");
@@ -195,13 +198,14 @@ void WallMaster::wait(const WaitCmd& w) {
         if (w.until == WaitCmd::Until::time) return t.seconds() >= w.amount;
         return false;
     };
-    wait_until(done);
+    wait_until(done, o_.timeout_s);
 }
 
 Image WallMaster::gather_snapshot() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, SnapshotMsg{});
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.image.has_value(); }); });
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.image.has_value(); }); },
+               o_.timeout_s);
     return compose().image;
 }
 
@@ -229,7 +233,8 @@ Mosaic WallMaster::compose() {
 int WallMaster::finish() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.result && t.image; }); });
+    wait_until([&] { return all_tiles([](const TileState& t) { return t.result && t.image; }); },
+               o_.timeout_s);
     const Mosaic mosaic = compose();
     trace_.switch_to(Stage::compose);
     write_image(o_.out, mosaic.image);

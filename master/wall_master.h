@@ -20,10 +20,11 @@ namespace isowall {
 struct MasterOptions {
     std::string wall_name;  // for the start-up line
     std::string out = "mosaic.png";
-    std::string tiles_out;     // folder for per-tile images, or empty
-    std::string trace;         // PREFIX for PREFIX.json and PREFIX.csv, or empty
-    double timeout_s = 120;    // the wall silent this long ends the job
-    bool throw_fault = false;  // test hook: fail after the first views are out
+    std::string tiles_out;           // folder for per-tile images, or empty
+    std::string trace;               // PREFIX for PREFIX.json and PREFIX.csv, or empty
+    double timeout_s = 120;          // the wall silent this long ends the job
+    double startup_timeout_s = 600;  // the same, while the tiles start (load, say hello)
+    bool throw_fault = false;        // test hook: fail after the first views are out
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
 };
 
@@ -56,7 +57,7 @@ class WallMaster {
     void handle(const Envelope& e);
     // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
     // naming the tiles still awaited.
-    void wait_until(const std::function<bool()>& done);
+    void wait_until(const std::function<bool()>& done, double timeout_s);
     bool all_tiles(const std::function<bool(const TileState&)>& pred) const;
     std::string waiting_on() const;
 

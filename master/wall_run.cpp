@@ -72,6 +72,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.tiles_out = o.tiles_out;
     mo.trace = o.trace;
     mo.timeout_s = o.timeout_s;
+    mo.startup_timeout_s = o.startup_timeout_s;
     mo.throw_fault = o.fault_kind == "throw" && o.fault_rank == kMasterRank;
     mo.results_out = o.results_out;
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),

@@ -21,9 +21,10 @@ struct WallOptions {
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";
     EngineCli engine;
-    std::string script;      // script file, "-" for the master's console, empty: one frame
-    double timeout_s = 120;  // a wall silent this long ends the job
-    std::string trace;       // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    std::string script;              // script file, "-" for the master's console, empty: one frame
+    double timeout_s = 120;          // a wall silent this long ends the job
+    double startup_timeout_s = 600;  // the same while the tiles load the volume and start
+    std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
     // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
     // so this is the rank's budget, not the machine's core count.
     int threads = 1;

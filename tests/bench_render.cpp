@@ -58,7 +58,8 @@ Mesh read_mesh(const std::string& path) {
         throw std::runtime_error(path + ": header: expected vertex and face elements");
     Mesh m;
     std::vector<float> v(vertices * 6);
-    in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(float)));
+    in.read(reinterpret_cast<char*>(v.data()),
+            static_cast<std::streamsize>(v.size() * sizeof(float)));
     for (std::size_t i = 0; i < vertices; ++i) {
         m.positions.emplace_back(v[6 * i], v[6 * i + 1], v[6 * i + 2]);
         m.normals.emplace_back(v[6 * i + 3], v[6 * i + 4], v[6 * i + 5]);
@@ -115,24 +116,31 @@ void print_driver() {
 }
 
 int run(int argc, char** argv) {
-    if (argc < 2) throw std::runtime_error("usage: isowall_bench_render MESH.ply [--gl osmesa|egl] "
-                                           "[--size WxH] [--reps N] [--group T]");
+    if (argc < 2)
+        throw std::runtime_error(
+            "usage: isowall_bench_render MESH.ply [--gl osmesa|egl] "
+            "[--size WxH] [--reps N] [--group T]");
     std::string gl = "egl";
     int width = 1600, height = 1200, reps = 7;
     std::size_t group = 2000;
     for (int i = 2; i + 1 < argc; i += 2) {
         const std::string k = argv[i], v = argv[i + 1];
-        if (k == "--gl") gl = v;
-        else if (k == "--size" && std::sscanf(v.c_str(), "%dx%d", &width, &height) == 2) {}
-        else if (k == "--reps") reps = std::max(1, std::atoi(v.c_str()));
-        else if (k == "--group") group = std::max(1, std::atoi(v.c_str()));
-        else throw std::runtime_error("option " + k + ": unknown or bad value " + v);
+        if (k == "--gl")
+            gl = v;
+        else if (k == "--size" && std::sscanf(v.c_str(), "%dx%d", &width, &height) == 2) {
+        } else if (k == "--reps")
+            reps = std::max(1, std::atoi(v.c_str()));
+        else if (k == "--group")
+            group = std::max(1, std::atoi(v.c_str()));
+        else
+            throw std::runtime_error("option " + k + ": unknown or bad value " + v);
     }
     const Mesh mesh = read_mesh(argv[1]);
     const auto r = make_renderer(gl);
     r->resize(width, height);
     if (gl == "egl") print_driver();
-    const Camera cam = fit_depth_range(front_full_view(mesh.bounds(), float(width) / float(height)), mesh.bounds());
+    const Camera cam = fit_depth_range(front_full_view(mesh.bounds(), float(width) / float(height)),
+                                       mesh.bounds());
     const glm::mat4 view = cam.view(), proj = cam.frustum(float(width) / float(height)).matrix();
     const std::vector<Mesh> groups = split(mesh, group);
     std::vector<double> whole, grouped, readback;
@@ -161,11 +169,14 @@ int run(int argc, char** argv) {
     std::size_t covered = 0;
     for (float d : img.depth) covered += d < 1.0f;
     const double tri = double(mesh.triangle_count());
-    std::printf("%s %dx%d, %zu triangles, %zu groups of %zu, %.1f%% of pixels covered; median of %d:\n",
-                gl.c_str(), width, height, mesh.triangle_count(), groups.size(), group,
-                100.0 * double(covered) / double(img.pixel_count()), reps);
-    std::printf("  whole mesh   %8.4f s  (%6.1f M triangles/s)\n", median(whole), tri / median(whole) / 1e6);
-    std::printf("  in groups    %8.4f s  (%6.1f M triangles/s)\n", median(grouped), tri / median(grouped) / 1e6);
+    std::printf(
+        "%s %dx%d, %zu triangles, %zu groups of %zu, %.1f%% of pixels covered; median of %d:\n",
+        gl.c_str(), width, height, mesh.triangle_count(), groups.size(), group,
+        100.0 * double(covered) / double(img.pixel_count()), reps);
+    std::printf("  whole mesh   %8.4f s  (%6.1f M triangles/s)\n", median(whole),
+                tri / median(whole) / 1e6);
+    std::printf("  in groups    %8.4f s  (%6.1f M triangles/s)\n", median(grouped),
+                tri / median(grouped) / 1e6);
     std::printf("  read-back    %8.4f s  (colour and depth)\n", median(readback));
     return 0;
 }
