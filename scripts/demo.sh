@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Quick start, first command: install, build, and render the built-in phantom to out/phantom.png.
+# Quick start, first command: install, build, and run the main job, the display wall emulated on
+# this machine (walls/2x2.toml: a master and four tile ranks under mpirun) on the built-in phantom,
+# writing the mosaic to out/mosaic.png. Extra arguments go to `isowall wall`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-mkdir -p out
-./build/master/isowall render --out out/phantom.png "$@"
+bash scripts/wall_demo.sh walls/2x2.toml "$@"
