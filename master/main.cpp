@@ -1,4 +1,5 @@
 // isowall: progressive view-dependent isosurfaces for display walls.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -13,6 +14,23 @@
 namespace {
 
 using namespace isowall;
+
+// CLI::PositiveNumber lets "nan" and "inf" through; a limit in seconds must be a finite number > 0.
+const CLI::Validator kPositiveSeconds(
+    [](std::string& text) {
+        double v = 0;
+        try {
+            std::size_t used = 0;
+            v = std::stod(text, &used);
+            if (used != text.size()) return "expected a number of seconds, got \"" + text + "\"";
+        } catch (const std::exception&) {
+            return "expected a number of seconds, got \"" + text + "\"";
+        }
+        if (!std::isfinite(v) || v <= 0)
+            return "expected a finite number of seconds > 0, got " + text;
+        return std::string();
+    },
+    "SECONDS > 0");
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
@@ -82,12 +100,12 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     wall_cmd
         ->add_option("--timeout", wall.timeout_s,
                      "Seconds a silent tile rank may take before the job ends")
-        ->check(CLI::PositiveNumber)
+        ->check(kPositiveSeconds)
         ->capture_default_str();
     wall_cmd
         ->add_option("--startup-timeout", wall.startup_timeout_s,
                      "Seconds the tile ranks may take to load the volume and start")
-        ->check(CLI::PositiveNumber)
+        ->check(kPositiveSeconds)
         ->capture_default_str();
     wall_cmd
         ->add_option("--threads", wall.threads,

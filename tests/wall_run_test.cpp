@@ -260,6 +260,8 @@ TEST(WallRun, BadInputEndsEveryRank) {
         {"isovalue out of range in a script",
          mpirun(5) + wall + " --script '" + (dir / "iso.txt").string() + "'",
          "iso.txt:1: iso: isovalue 999"},
+        {"a timeout that is not a number", mpirun(5) + wall + " --timeout nan",
+         "--timeout: expected a finite number of seconds > 0, got nan"},
     };
     for (const Case& c : cases) {
         const int rc = run(c.cmd, dir / "log.txt");
