@@ -115,6 +115,22 @@ TEST(WallInProcess, ASnapshotMidFrameShowsTheFrameInFlight) {
     std::printf("wall run: %.2f s\n", r.seconds);
 }
 
+// The master asks for a snapshot right after the first views: a tile may hold both before it
+// starts its frame, and must answer from that frame (once it answered with its warm-up frame).
+TEST(WallInProcess, ASnapshotAsTheFirstCommandShowsTheFirstFrame) {
+    const auto dir = test::scratch_dir("inproc_first_snapshot");
+    WallOptions o = small_wall(dir);
+    o.script = write_script(dir, "snapshot first\nwait done\nsnapshot done\n").string();
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
+    const Image first = read_image(dir / "first.png");
+    EXPECT_EQ(first.width, 160);
+    EXPECT_EQ(first.height, 120);
+    const test::ImageComparison done =
+        test::compare_images(read_image(dir / "done.png"), read_image(o.out));
+    EXPECT_EQ(done.differing_pixels, 0u) << done;
+}
+
 TEST(WallInProcess, ASilentTileIsNamedAfterTheTimeoutAndEveryRankEnds) {
     const auto dir = test::scratch_dir("inproc_silent");
     WallOptions o = small_wall(dir);

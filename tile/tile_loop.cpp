@@ -63,18 +63,20 @@ class TileRank {
             trace_.switch_to(Stage::idle);
             std::optional<Message> m = inbox_.pop();
             trace_.switch_to(Stage::comm);
-            answer_snapshots();
-            if (!m) continue;
-            if (const auto* v = std::get_if<ViewMsg>(&*m)) {
-                frame(*v);
-            } else if (std::holds_alternative<QuitMsg>(*m)) {
+            // A view first, snapshots after: a request that came with the view is about that
+            // view's frame (answered from it in flight), never about the frame before it, which
+            // before the first view is the renderer's 16x16 warm-up.
+            if (m && std::holds_alternative<ViewMsg>(*m)) {
+                frame(std::get<ViewMsg>(*m));
+            } else if (m && std::holds_alternative<QuitMsg>(*m)) {
                 send_result();
                 send_image();
                 return 0;
-            } else {
+            } else if (m) {
                 throw WireError(std::string("a tile does not take ") + to_string(tag_of(*m)) +
                                 " messages");
             }
+            answer_snapshots();
         }
     }
 
