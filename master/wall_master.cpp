@@ -1,7 +1,6 @@
 #include "master/wall_master.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>

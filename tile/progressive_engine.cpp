@@ -117,9 +117,8 @@ class FrameRun {
         stage(Stage::propagation);
         const auto t0 = Clock::now();
         const auto id = static_cast<std::uint32_t>(frame_.group_count);
-        const std::function<bool()> interrupted = [this] { return stopped(); };
         Group g = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
-                             : ex_.propagate(hit.cell, id, opt_.propagation, ray, interrupted);
+                             : ex_.propagate(hit.cell, id, opt_.propagation, ray, interrupted_);
         const double pass_s = since(t0);
         const double extract_s = ex_.last_extract_s();
         now_.t_extract_s += extract_s;
@@ -189,6 +188,8 @@ class FrameRun {
     GroupSink& sink_;
     const std::atomic<bool>& stop_;
     const ProgressiveEngine::Progress& progress_;
+    // What propagation polls; made once per frame, not once per pass.
+    const std::function<bool()> interrupted_ = [this] { return stopped(); };
 
     FrameResult frame_;
     TimelineSample now_;
