@@ -4,9 +4,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <iterator>
+#include <list>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "comm/comm.h"
 
@@ -24,6 +27,8 @@ namespace {
 // Waiting polls with a short sleep instead of blocking in MPI_Probe: Open MPI spins inside a
 // blocking call, and with 25 ranks on 2 cores a spinning idle rank steals the busy ranks' core.
 constexpr auto kPollSleep = std::chrono::microseconds(200);
+// How long a rank that ends waits for its last sends to be taken.
+constexpr auto kFinalSendWait = std::chrono::seconds(10);
 
 class MpiComm final : public Comm {
   public:
@@ -44,6 +49,18 @@ class MpiComm final : public Comm {
         ISOWALL_MPI_CALL(MPI_Comm_size(comm_, &size_));
     }
     ~MpiComm() override {
+        // Sends still in flight complete before MPI ends; a peer that is gone cannot take them,
+        // so the wait is bounded (the master releases tiles only once every result is in).
+        const auto start = std::chrono::steady_clock::now();
+        while (true) {
+            {
+                std::lock_guard lock(mutex_);
+                progress_sends();
+                if (pending_.empty()) break;
+            }
+            if (std::chrono::steady_clock::now() - start > kFinalSendWait) break;
+            std::this_thread::sleep_for(kPollSleep);
+        }
         MPI_Comm_free(&comm_);
         MPI_Finalize();
     }
@@ -57,24 +74,18 @@ class MpiComm final : public Comm {
         return std::string(name, static_cast<std::size_t>(len));
     }
 
-    // Two ranks that send each other large messages at once must not deadlock: the lock is
-    // released between tests, so this rank's receiving thread can still take the peer's message.
+    // The caller never waits for the peer: the bytes are copied and sent with MPI_Isend, and
+    // every later call (either thread's) tests the sends in flight. So two ranks that send each
+    // other large messages cannot deadlock, and a frame thread does not spend its CPU polling
+    // for a peer that is scheduled late (with 25 ranks on 2 cores, tens of milliseconds).
+    // Messages to one peer still arrive in order (MPI does not let them overtake).
     void send(int dest, Tag tag, std::span<const std::byte> bytes) override {
-        MPI_Request request;
-        {
-            std::lock_guard lock(mutex_);
-            ISOWALL_MPI_CALL(MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, dest,
-                                       static_cast<int>(tag), comm_, &request));
-        }
-        for (;;) {
-            int done = 0;
-            {
-                std::lock_guard lock(mutex_);
-                ISOWALL_MPI_CALL(MPI_Test(&request, &done, MPI_STATUS_IGNORE));
-            }
-            if (done) return;
-            std::this_thread::sleep_for(kPollSleep);
-        }
+        std::lock_guard lock(mutex_);
+        PendingSend& p = pending_.emplace_back();
+        p.bytes.assign(bytes.begin(), bytes.end());
+        ISOWALL_MPI_CALL(MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, dest,
+                                   static_cast<int>(tag), comm_, &p.request));
+        progress_sends();
     }
 
     std::optional<Envelope> receive(int source, double timeout_s) override {
@@ -87,6 +98,7 @@ class MpiComm final : public Comm {
                 ISOWALL_MPI_CALL(MPI_Iprobe(source < 0 ? MPI_ANY_SOURCE : source, MPI_ANY_TAG,
                                             comm_, &flag, &status));
                 if (flag) return take(status);
+                progress_sends();
             }
             const double waited =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -105,6 +117,7 @@ class MpiComm final : public Comm {
             {
                 std::lock_guard lock(mutex_);
                 ISOWALL_MPI_CALL(MPI_Test(&request, &done, MPI_STATUS_IGNORE));
+                progress_sends();
             }
             if (!done) std::this_thread::sleep_for(kPollSleep);
         }
@@ -118,6 +131,20 @@ class MpiComm final : public Comm {
     }
 
   private:
+    struct PendingSend {
+        MPI_Request request = MPI_REQUEST_NULL;
+        std::vector<std::byte> bytes;
+    };
+
+    // Drops the sends that have completed (mutex_ held).
+    void progress_sends() {
+        for (auto it = pending_.begin(); it != pending_.end();) {
+            int done = 0;
+            ISOWALL_MPI_CALL(MPI_Test(&it->request, &done, MPI_STATUS_IGNORE));
+            it = done ? pending_.erase(it) : std::next(it);
+        }
+    }
+
     // Receives the message `status` describes (mutex_ held).
     Envelope take(const MPI_Status& status) {
         int count = 0;
@@ -132,6 +159,7 @@ class MpiComm final : public Comm {
     }
 
     mutable std::mutex mutex_;
+    std::list<PendingSend> pending_;
     MPI_Comm comm_ = MPI_COMM_NULL;
     int rank_ = 0;
     int size_ = 1;

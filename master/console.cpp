@@ -9,7 +9,7 @@ namespace isowall {
 void run_console(
     std::istream& in,
     const std::function<bool(const ScriptCommand&, const std::string& where)>& execute) {
-    std::printf("console: orbit, look-at, zoom, iso, wait, snapshot, quit\n> ");
+    std::printf("console: orbit, look-at, zoom, pan, iso, wait, snapshot, quit\n> ");
     std::fflush(stdout);
     int line = 0;
     for (std::string text; std::getline(in, text);) {

@@ -32,6 +32,19 @@ const CLI::Validator kPositiveSeconds(
     },
     "SECONDS > 0");
 
+// A finite number (NaN and infinity turn a camera into garbage with no error).
+const CLI::Validator kFiniteNumber(
+    [](std::string& text) {
+        try {
+            std::size_t used = 0;
+            const double v = std::stod(text, &used);
+            if (used == text.size() && std::isfinite(v)) return std::string();
+        } catch (const std::exception&) {
+        }
+        return "expected a finite number, got \"" + text + "\"";
+    },
+    "FINITE");
+
 CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
         "render", "Render one view progressively (or the full surface with --full) to an image");
@@ -95,7 +108,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     add_engine_options(*wall_cmd, wall.engine);
     wall_cmd->add_option(
         "--script", wall.script,
-        "Commands (orbit, look-at, zoom, iso, wait, snapshot, quit), one per line; "
+        "Commands (orbit, look-at, zoom, pan, iso, wait, snapshot, quit), one per line; "
         "- reads them from the master's console");
     wall_cmd
         ->add_option("--timeout", wall.timeout_s,
@@ -115,7 +128,43 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->capture_default_str();
     wall_cmd->add_option("--trace", wall.trace,
                          "Write per-rank spans by stage with thread CPU time: PREFIX.json (Chrome "
-                         "trace, opens in Perfetto) and PREFIX.csv");
+                         "trace, opens in Perfetto) and PREFIX.csv; migrated jobs show as flows");
+    wall_cmd->add_option("--orbit", wall.orbit, "Start turned: YAW PITCH in degrees")
+        ->expected(2)
+        ->check(kFiniteNumber);
+    wall_cmd->add_option("--zoom", wall.zoom, "Start zoomed (>1 moves closer)")
+        ->check(kFiniteNumber & CLI::PositiveNumber)
+        ->capture_default_str();
+    wall_cmd
+        ->add_option("--pan", wall.pan,
+                     "Start panned: DX DY in screen widths and heights (the view moves right, up)")
+        ->expected(2)
+        ->check(kFiniteNumber);
+    wall_cmd
+        ->add_option("--balance", wall.balance,
+                     "Screen-region scheduler: on, idle ranks take regions of busy tiles; off, "
+                     "every tile casts its own screen (the static wall)")
+        ->transform(
+            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+        ->default_str("on");
+    wall_cmd
+        ->add_option("--region", wall.region,
+                     "Size WxH of the screen regions the scheduler hands out (balancing on); "
+                     "'tile' for one region per tile")
+        ->check([](const std::string& s) {
+            return parse_region(s) ? std::string() : "expected WxH (e.g. 256x192) or 'tile'";
+        })
+        ->capture_default_str();
+    wall_cmd
+        ->add_option("--region-clip", wall.region_clip,
+                     "Propagation stays within the screen region of each job (or tile): on, no "
+                     "pass extracts surface its region cannot show; off, as in the text")
+        ->transform(
+            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+        ->default_str("on");
+    wall_cmd->add_flag("--measure", wall.measure,
+                       "Measure wall-wide correctness against emulated time (each rank on its own "
+                       "core, from thread CPU time); costs a read-back per job");
     return wall_cmd;
 }
 

@@ -7,6 +7,7 @@
 
 #include "common/core/camera.h"
 #include "common/core/image.h"
+#include "common/core/image_ops.h"  // composite_by_depth, for callers of the mosaic
 
 namespace isowall {
 
@@ -23,10 +24,5 @@ Mosaic empty_mosaic(int width, int height);
 // Places `tile` with its top-left at (where.x, where.y); pixels outside the mosaic are skipped.
 // A pixel lit by n tiles shows the mean of their colours.
 void paste(Mosaic& mosaic, const Image& tile, const PixelRect& where);
-
-// Depth compositing of two renderings of the same screen pixels (the owner of a screen region and
-// a helper that rendered part of it): where `src` is nearer than `dst`, dst takes its colour and
-// depth. `src` covers `where` of dst; both must carry depth.
-void composite_by_depth(Image& dst, const Image& src, const PixelRect& where);
 
 }  // namespace isowall

@@ -28,6 +28,9 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     const PixelSize vs = virtual_screen_size(spec);
     aspect_ = float(vs.width) / float(vs.height);
     camera_ = front_full_view(bounds, aspect_);
+    camera_ = orbit(camera_, o.orbit.first, o.orbit.second);
+    camera_ = zoom(camera_, o.zoom);
+    camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
     tiles_.resize(static_cast<std::size_t>(comm.size()));
 }
 
@@ -46,10 +49,10 @@ void WallMaster::handle(const Envelope& e) {
         t.host = h->host;
         t.hello = true;
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
-        if (p->generation == generation_) {  // older generations: frames that were interrupted
+        if (p->generation == generation_)  // older generations: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);
-            t.done = t.done || p->done;
-        }
+    } else if (std::holds_alternative<JobDoneMsg>(m) || std::holds_alternative<LandedMsg>(m)) {
+        handle_job(e.from, m);
     } else if (auto* img = std::get_if<ImageMsg>(&m)) {
         const PixelRect r = tile_rect(spec_, tile_of_rank(spec_, e.from));
         if (img->width != r.width || img->height != r.height)
@@ -94,7 +97,8 @@ std::string WallMaster::waiting_on() const {
     std::string list;
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
-        if (!t.hello || !t.done) list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
+        const bool busy = board_ && !board_->complete() && board_->in_hand(rank) > 0;
+        if (!t.hello || busy) list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
     }
     return list.empty() ? "all tiles" : list;
 }
@@ -132,26 +136,78 @@ void WallMaster::print_map() const {
     std::fflush(stdout);
 }
 
-// A new frame on every tile: bumps the generation, so progress of older frames is ignored.
+// A new frame on every tile: bumps the generation, so progress and results of older frames are
+// ignored, cuts the screen into jobs and hands every rank its first ones.
 void WallMaster::send_views() {
     const Stage left = trace_.switch_to(Stage::comm);
     ++generation_;
     const Camera cam = fit_depth_range(camera_, bounds_);
     const Frustum wall = cam.frustum(aspect_);
+    std::vector<std::vector<PixelRect>> regions(tiles_.size());
+    std::vector<std::vector<double>> rays(tiles_.size());
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         const PixelRect r = tile_rect(spec_, tile);
         ViewMsg v;
         v.generation = generation_;
         v.view = {cam, tile_frustum(wall, spec_, tile), r.width, r.height, iso_};
-        v.region = v.view.screen();
         send_message(comm_, rank, v);
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
-        t.done = false;
+        t.view = v.view;
+        const auto k = static_cast<std::size_t>(rank);
+        regions[k] = o_.balance ? cut_into_regions(r.width, r.height, o_.region_w, o_.region_h)
+                                : cut_into_regions(r.width, r.height, 0, 0);
+        rays[k] = estimated_rays(v.view, regions[k], bounds_, o_.screen_box);
     }
+    board_.emplace(regions, rays, o_.balance);
+    migrations_.clear();
+    for (int rank = 1; rank < comm_.size(); ++rank) fill(rank);
     frame_start_ = Stopwatch();
     trace_.switch_to(left);
+}
+
+void WallMaster::fill(int rank) {
+    while (auto id = board_->next_for(rank)) {
+        const BoardJob& j = board_->job(*id);
+        JobMsg m;
+        m.generation = generation_;
+        m.job = *id;
+        m.owner = j.owner;
+        m.band = j.band;
+        m.view = tiles_[static_cast<std::size_t>(j.owner)].view;
+        m.rect = j.rect;
+        send_message(comm_, rank, m);
+    }
+}
+
+void WallMaster::handle_job(int from, const Message& m) {
+    const std::uint64_t generation = std::visit(
+        [](const auto& msg) -> std::uint64_t {
+            if constexpr (requires { msg.generation; }) return msg.generation;
+            return 0;
+        },
+        m);
+    if (generation != generation_ || !board_) return;  // an interrupted frame's
+    const std::uint32_t id = std::holds_alternative<JobDoneMsg>(m) ? std::get<JobDoneMsg>(m).job
+                                                                   : std::get<LandedMsg>(m).job;
+    if (id >= board_->size())
+        throw WireError(rank_label(spec_, from) + ": no job " + std::to_string(id) +
+                        " in this frame");
+    const BoardJob& j = board_->job(id);
+    if (auto* d = std::get_if<JobDoneMsg>(&m)) {
+        if (j.worker != from || j.state != BoardJob::State::running)
+            throw WireError(rank_label(spec_, from) + ": job " + std::to_string(id) +
+                            " was not running on it");
+        board_->done(id, d->rays, d->cpu_s);
+        if (j.owner != from) migrations_.push_back({j.owner, from, d->start_s, d->end_s, d->bytes});
+        fill(from);
+    } else {
+        if (j.owner != from || j.worker == from || j.arrived || j.state == BoardJob::State::queued)
+            throw WireError(rank_label(spec_, from) + ": landed job " + std::to_string(id) +
+                            ", which no helper ran for it");
+        board_->landed(id);
+    }
 }
 
 bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
@@ -162,6 +218,8 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
         camera_.target = c->target;
     } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
         camera_ = zoom(camera_, c->factor);
+    } else if (const auto* c = std::get_if<PanCmd>(&cmd)) {
+        camera_ = pan(camera_, c->dx, c->dy, aspect_);
     } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
         if (!(c->iso >= lo_ && c->iso <= hi_)) {
             char msg[160];
@@ -192,7 +250,7 @@ void WallMaster::wait(const WaitCmd& w) {
     Stopwatch t;
     auto done = [&] {
         // Every wait also ends when the frame is complete on every tile.
-        if (all_tiles([](const TileState& s) { return s.done; })) return true;
+        if (frame_done()) return true;
         if (w.until == WaitCmd::Until::rays) return double(total_rays()) >= w.amount;
         if (w.until == WaitCmd::Until::time) return t.seconds() >= w.amount;
         return false;
@@ -234,6 +292,8 @@ int WallMaster::finish() {
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
     wait_until([&] { return all_tiles([](const TileState& t) { return t.result && t.image; }); },
                o_.timeout_s);
+    // Every rank has stopped working, so no helper's result is on its way any more.
+    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
     const Mosaic mosaic = compose();
     trace_.switch_to(Stage::compose);
     write_image(o_.out, mosaic.image);
@@ -246,11 +306,12 @@ void WallMaster::report() {
     std::vector<TileResultMsg> results(tiles_.size());
     for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
     print_rank_table(stdout, spec_, results);
+    print_scheduler(stdout, o_.balance, frame_done(), *board_, migrations_, results);
     if (o_.results_out) *o_.results_out = results;
     trace_.close();
     print_stage_table(stdout, trace_.spans(), results);
     if (!o_.trace.empty()) {
-        write_wall_traces(o_.trace, spec_, trace_.spans(), results);
+        write_wall_traces(o_.trace, spec_, trace_.spans(), results, migrations_);
         std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
                     o_.trace.c_str());
     }

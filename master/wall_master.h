@@ -13,7 +13,9 @@
 #include "common/progressive/trace.h"
 #include "common/wall/script.h"
 #include "common/wall/wall.h"
+#include "master/job_board.h"
 #include "master/mosaic.h"
+#include "master/wall_report.h"
 
 namespace isowall {
 
@@ -25,6 +27,15 @@ struct MasterOptions {
     double timeout_s = 120;          // the wall silent this long ends the job
     double startup_timeout_s = 600;  // the same, while the tiles start (load, say hello)
     bool throw_fault = false;        // test hook: fail after the first views are out
+    // The screen-region scheduler: off, every tile casts its own screen (one job per band);
+    // on, tiles are cut into regions of region_w x region_h and idle ranks take others' regions.
+    // The first view: the front full view turned, zoomed and panned by these.
+    std::pair<float, float> orbit{0, 0}, pan{0, 0};
+    float zoom = 1;
+    bool balance = true;
+    int region_w = 256, region_h = 192;
+    bool screen_box = true;  // the engine casts no ray outside the volume's screen box
+    bool measure = false;    // tiles report emulated correctness curves
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
 };
 
@@ -49,12 +60,16 @@ class WallMaster {
         std::string host;
         bool hello = false;
         std::uint64_t rays = 0;         // of the current generation
-        bool done = false;              // the current generation's last ray is cast
+        FrameView view;                 // of the current generation
         std::optional<ImageMsg> image;  // the answer to the pending image request
         std::optional<TileResultMsg> result;
     };
 
     void handle(const Envelope& e);
+    void handle_job(int from, const Message& m);
+    // Hands `rank` jobs until it holds as many as the board allows.
+    void fill(int rank);
+    bool frame_done() const { return board_ && board_->complete(); }
     // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
     // naming the tiles still awaited.
     void wait_until(const std::function<bool()>& done, double timeout_s);
@@ -80,6 +95,8 @@ class WallMaster {
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;
     TraceRecorder trace_;
+    std::optional<JobBoard> board_;      // the current generation's jobs
+    std::vector<Migration> migrations_;  // of the current generation
 };
 
 }  // namespace isowall

@@ -1,6 +1,7 @@
 #include "master/wall_report.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace isowall {
 
@@ -20,19 +21,82 @@ void print_rank_table(std::FILE* out, const WallSpec& spec,
     std::fprintf(out,
                  "per rank (CPU seconds of each tile's frame thread, all frames; makespan = the "
                  "largest):\n");
-    std::fprintf(out, "  %4s %-12s %4s %8s %8s %7s %6s %10s %7s %10s %8s\n", "rank", "host", "tile",
-                 "cpu s", "frame s", "frames", "intr", "rays", "groups", "triangles", "RSS MiB");
+    std::fprintf(out, "  %4s %-12s %4s %8s %8s %7s %6s %10s %7s %10s %8s %5s %6s %8s\n", "rank",
+                 "host", "tile", "cpu s", "frame s", "frames", "intr", "rays", "groups",
+                 "triangles", "RSS MiB", "jobs", "helped", "MB sent");
     for (std::size_t rank = 1; rank < results.size(); ++rank) {
         const TileResultMsg& s = results[rank];
-        std::fprintf(out, "  %4zu %-12s %4d %8.3f %8.3f %7llu %6llu %10llu %7llu %10llu %8.1f\n",
+        std::fprintf(out,
+                     "  %4zu %-12s %4d %8.3f %8.3f %7llu %6llu %10llu %7llu %10llu %8.1f %5llu "
+                     "%6llu %8.2f\n",
                      rank, s.host.c_str(), tile_of_rank(spec, static_cast<int>(rank)), s.cpu_s,
                      s.frame_s, (unsigned long long)s.frames, (unsigned long long)s.interrupted,
                      (unsigned long long)s.rays, (unsigned long long)s.groups,
-                     (unsigned long long)s.triangles, s.rss_mib);
+                     (unsigned long long)s.triangles, s.rss_mib,
+                     (unsigned long long)(s.jobs_own + s.jobs_helped),
+                     (unsigned long long)s.jobs_helped, double(s.bytes_sent) / 1e6);
     }
     const WallFigures f = wall_figures(results);
     std::fprintf(out, "makespan %.3f s (CPU), total %.3f s, balance %.2f (mean/max)\n",
                  f.makespan_s, f.total_s, f.balance);
+}
+
+std::vector<WallCurvePoint> wall_curve(const std::vector<TileResultMsg>& results) {
+    std::vector<double> times;
+    double significant = 0;
+    for (std::size_t rank = 1; rank < results.size(); ++rank) {
+        significant += double(results[rank].significant);
+        for (const CurvePoint& p : results[rank].curve) times.push_back(p.emulated_s);
+    }
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    std::vector<WallCurvePoint> out;
+    if (significant <= 0) return out;
+    for (double t : times) {
+        double final_px = 0, squared = 0;
+        for (std::size_t rank = 1; rank < results.size(); ++rank) {
+            const TileResultMsg& r = results[rank];
+            // Before a tile's first point nothing of it shows: every significant pixel is wrong.
+            double tile_px = 0, tile_sq = double(r.significant);
+            for (const CurvePoint& p : r.curve)
+                if (p.emulated_s <= t) tile_px = double(p.final_px), tile_sq = p.squared_error;
+            final_px += tile_px;
+            squared += tile_sq;
+        }
+        out.push_back({t, final_px / significant, 1.0 - std::sqrt(squared / significant)});
+    }
+    return out;
+}
+
+double time_to(const std::vector<WallCurvePoint>& curve, double level, bool final_pixels) {
+    for (const WallCurvePoint& p : curve)
+        if ((final_pixels ? p.final_pixels : p.c) >= level - 1e-12) return p.emulated_s;
+    return -1;
+}
+
+void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
+                     const std::vector<Migration>& migrations,
+                     const std::vector<TileResultMsg>& results) {
+    std::uint64_t bytes = 0;
+    for (const Migration& m : migrations) bytes += m.bytes;
+    std::fprintf(out,
+                 "scheduler: balancing %s, last frame %s: %zu jobs, %zu migrated, %.2f MB of "
+                 "region results moved\n",
+                 balance ? "on" : "off", complete ? "complete" : "interrupted", board.size(),
+                 board.migrated(), double(bytes) / 1e6);
+    const auto curve = wall_curve(results);
+    if (curve.empty()) return;
+    auto at = [&](double level, bool px) {
+        const double t = time_to(curve, level, px);
+        char buf[32];
+        std::snprintf(buf, sizeof(buf), t < 0 ? "never" : "%.3f", t);
+        return std::string(buf);
+    };
+    std::fprintf(out,
+                 "emulated time (each rank on its own core, CPU-derived) to wall-wide C = "
+                 "90/99/100%%: %s / %s / %s s; final pixels 90/99/100%%: %s / %s / %s s\n",
+                 at(0.90, false).c_str(), at(0.99, false).c_str(), at(1.0, false).c_str(),
+                 at(0.90, true).c_str(), at(0.99, true).c_str(), at(1.0, true).c_str());
 }
 
 void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
@@ -55,13 +119,19 @@ void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
 
 void write_wall_traces(const std::string& prefix, const WallSpec& spec,
                        const std::vector<TraceSpan>& master,
-                       const std::vector<TileResultMsg>& results) {
+                       const std::vector<TileResultMsg>& results,
+                       const std::vector<Migration>& migrations) {
     std::vector<RankTrace> ranks{{kMasterRank, "master", master}};
     for (std::size_t rank = 1; rank < results.size(); ++rank)
         ranks.push_back({static_cast<int>(rank),
                          "tile " + std::to_string(tile_of_rank(spec, static_cast<int>(rank))),
                          results[rank].spans});
-    write_chrome_trace(prefix + ".json", ranks);
+    std::vector<TraceFlow> flows;
+    for (const Migration& m : migrations) {
+        flows.push_back({m.owner, m.helper, m.start_s, m.start_s, "job", 0});
+        flows.push_back({m.helper, m.owner, m.end_s, m.end_s, "region result", m.bytes});
+    }
+    write_chrome_trace(prefix + ".json", ranks, flows);
     write_trace_csv(prefix + ".csv", ranks);
 }
 

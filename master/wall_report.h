@@ -8,8 +8,27 @@
 #include "comm/protocol.h"
 #include "common/progressive/trace.h"
 #include "common/wall/wall.h"
+#include "master/job_board.h"
 
 namespace isowall {
+
+// A job a helper ran for another tile: a flow from owner to helper in the trace.
+struct Migration {
+    int owner = 0, helper = 0;
+    double start_s = 0, end_s = 0;  // wall clock (trace time base)
+    std::uint64_t bytes = 0;        // the region result sent back
+};
+
+// Wall-wide correctness against emulated time, merged from the tiles' curves: at each time, the
+// share of the wall's significant pixels with their final colour and C = 1 - E over the wall.
+struct WallCurvePoint {
+    double emulated_s = 0;
+    double final_pixels = 0;
+    double c = 0;
+};
+std::vector<WallCurvePoint> wall_curve(const std::vector<TileResultMsg>& results);
+// The first emulated time at which `level` is reached (final pixels or C); negative if never.
+double time_to(const std::vector<WallCurvePoint>& curve, double level, bool final_pixels);
 
 struct WallFigures {
     double makespan_s = 0;  // the largest CPU time of any tile's frame thread
@@ -23,12 +42,18 @@ WallFigures wall_figures(const std::vector<TileResultMsg>& results);
 // The table of tiles, then `makespan X s (CPU), total Y s, balance Z (mean/max)`.
 void print_rank_table(std::FILE* out, const WallSpec& spec,
                       const std::vector<TileResultMsg>& results);
+// The scheduler's figures: jobs, migrations, bytes moved, and with curves the emulated time to
+// wall-wide C = 90/99/100%.
+void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
+                     const std::vector<Migration>& migrations,
+                     const std::vector<TileResultMsg>& results);
 // CPU seconds by stage, one row per rank (the master's first).
 void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results);
 // PREFIX.json and PREFIX.csv.
 void write_wall_traces(const std::string& prefix, const WallSpec& spec,
                        const std::vector<TraceSpan>& master,
-                       const std::vector<TileResultMsg>& results);
+                       const std::vector<TileResultMsg>& results,
+                       const std::vector<Migration>& migrations = {});
 
 }  // namespace isowall

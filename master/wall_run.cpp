@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <tuple>
 
 #include "common/core/error.h"
 #include "common/extract/surface_extractor.h"
@@ -75,6 +76,13 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.startup_timeout_s = o.startup_timeout_s;
     mo.throw_fault = o.fault_kind == "throw" && o.fault_rank == kMasterRank;
     mo.results_out = o.results_out;
+    mo.balance = o.balance;
+    if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
+    mo.zoom = o.zoom;
+    if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
+    std::tie(mo.region_w, mo.region_h) = parse_region(o.region).value_or(std::pair{0, 0});
+    mo.screen_box = to_engine_options(o.engine).screen_box;
+    mo.measure = o.measure;
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),
                       in.extractor->value_max());
     master.start();
@@ -91,12 +99,18 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     return master.finish();
 }
 
-int run_tile_rank(const WallOptions& o, Comm& comm) {
+int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
     const OpenedVolume ov = open_volume(o.volume, /*quiet=*/true);
     auto extractor = open_extractor(ov, ThreadBudget{o.threads});
     auto renderer = make_renderer(o.gl);
-    TileSetup setup{*extractor, *renderer, to_engine_options(o.engine), {}};
+    auto help_renderer = make_renderer(o.gl);
+    TileSetup setup{*extractor, *renderer, *help_renderer, to_engine_options(o.engine),
+                    {},         o.measure};
+    setup.engine.region_clip = o.region_clip;
     if (o.fault_rank == comm.rank()) setup.fault.kind = o.fault_kind;
+    const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
+    setup.tile_width = tile.width;
+    setup.tile_height = tile.height;
     return run_tile(comm, setup);
 }
 
@@ -120,6 +134,16 @@ std::string role(const WallSpec& spec, int rank) {
 }
 
 }  // namespace
+
+std::optional<std::pair<int, int>> parse_region(const std::string& spec) {
+    if (spec == "tile") return std::pair{0, 0};
+    int w = 0, h = 0, used = 0;
+    if (std::sscanf(spec.c_str(), "%dx%d%n", &w, &h, &used) != 2 ||
+        used != static_cast<int>(spec.size()))
+        return std::nullopt;
+    if (w < 1 || h < 1 || w > 32768 || h > 32768) return std::nullopt;
+    return std::pair{w, h};
+}
 
 std::pair<std::string, int> parse_test_fault(const char* spec) {
     if (!spec) return {"", -1};
@@ -159,7 +183,7 @@ int run_wall(const WallOptions& o, Comm& comm) {
             }
         }
         comm.barrier();
-        return comm.is_master() ? run_master(o, comm, spec, *input) : run_tile_rank(o, comm);
+        return comm.is_master() ? run_master(o, comm, spec, *input) : run_tile_rank(o, comm, spec);
     } catch (const CommAborted&) {
         throw;  // another rank failed and has said why
     } catch (const InputError& e) {

@@ -25,6 +25,12 @@ struct WallOptions {
     double timeout_s = 120;          // a wall silent this long ends the job
     double startup_timeout_s = 600;  // the same while the tiles load the volume and start
     std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    std::vector<float> orbit, pan;   // the first view: yaw pitch; dx dy (empty: none)
+    float zoom = 1;
+    bool balance = true;             // the screen-region scheduler migrates jobs
+    std::string region = "256x192";  // region size WxH, or "tile"
+    bool measure = false;            // emulated wall-wide correctness curves
+    bool region_clip = true;         // propagation stays within each job's region
     // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
     // so this is the rank's budget, not the machine's core count.
     int threads = 1;
@@ -40,6 +46,9 @@ struct WallOptions {
 // on stderr naming the rank and the cause, then comm.abort() (which under MPI ends every rank,
 // and in process wakes every rank with CommAborted). Returns the rank's exit code otherwise.
 int run_wall(const WallOptions& o, Comm& comm);
+
+// "WxH" (each side 1..32768) or "tile" (0x0: one region per tile); nullopt when malformed.
+std::optional<std::pair<int, int>> parse_region(const std::string& spec);
 
 // "KIND:RANK" -> (kind, rank); empty kind when `spec` is empty or malformed.
 std::pair<std::string, int> parse_test_fault(const char* spec);

@@ -75,7 +75,7 @@ TEST(ProtocolMalformed, TrailingByteThrows) {
 
 TEST(ProtocolMalformed, UnknownTagThrows) {
     const Bytes bytes = encode(QuitMsg{});
-    for (std::int32_t tag : {0, 8, 16, 31, -1, std::numeric_limits<std::int32_t>::max()})
+    for (std::int32_t tag : {0, 9, 15, 20, 31, -1, std::numeric_limits<std::int32_t>::max()})
         EXPECT_THROW(decode_message(static_cast<Tag>(tag), bytes), WireError) << "tag " << tag;
 }
 
@@ -124,7 +124,6 @@ struct ViewFault {
 };
 
 TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
-    constexpr std::int32_t kIntMax = std::numeric_limits<std::int32_t>::max();
     const ViewFault faults[] = {
         {"camera.eye", [](ViewMsg& m) { m.view.camera.eye.y = kNaN; }},
         {"camera.target", [](ViewMsg& m) { m.view.camera.target.z = -kInf; }},
@@ -149,64 +148,12 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
         {"view.height", [](ViewMsg& m) { m.view.height = kMaxImageSide + 1; }},
         {"view.iso", [](ViewMsg& m) { m.view.iso = std::numeric_limits<double>::quiet_NaN(); }},
         {"view.iso", [](ViewMsg& m) { m.view.iso = -std::numeric_limits<double>::infinity(); }},
-        {"region", [](ViewMsg& m) { m.region.x = -1; }},
-        {"region", [](ViewMsg& m) { m.region.y = -1; }},
-        {"region", [](ViewMsg& m) { m.region.width = -1; }},
-        {"region", [](ViewMsg& m) { m.region.height = -1; }},
-        {"region",
-         [](ViewMsg& m) {
-             m.region = {1601, 0, 320, 240};
-         }},  // one past the right
-        {"region",
-         [](ViewMsg& m) {
-             m.region = {0, 841, 320, 240};
-         }},  // one past the bottom
-        {"region",
-         [](ViewMsg& m) {
-             m.region = {1921, 0, 0, 0};
-         }},
-        // x + width wraps around in 32 bits and would pass a naive check
-        {"region",
-         [](ViewMsg& m) {
-             m.region = {10, 0, kIntMax, 240};
-         }},
-        {"region",
-         [](ViewMsg& m) {
-             m.region = {0, 10, 320, kIntMax};
-         }},
     };
     for (const ViewFault& f : faults) {
         ViewMsg m = sample_view();
         f.apply(m);
         SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
         expect_wire_error(Tag::view, encode(m), f.field);
-    }
-}
-
-TEST(ProtocolMalformed, ViewRegionOnTheEdgeIsInside) {
-    ViewMsg m = sample_view();
-    m.region = {1600, 840, 320, 240};  // touches the right and bottom edges
-    expect_round_trip(m);
-}
-
-// ---- progress -----------------------------------------------------------------------------------
-
-TEST(ProtocolMalformed, ProgressWithABadBoolThrows) {
-    // The byte of `done` is where the encodings of done=false and done=true differ.
-    ProgressMsg m = sample_progress();
-    m.done = false;
-    const Bytes no = encode(m);
-    m.done = true;
-    const Bytes yes = encode(m);
-    ASSERT_EQ(no.size(), yes.size());
-    std::size_t at = 0;
-    while (at < no.size() && no[at] == yes[at]) ++at;
-    ASSERT_LT(at, no.size());
-    for (int value : {2, 0x80, 0xff}) {
-        Bytes bytes = yes;
-        bytes[at] = static_cast<std::byte>(value);
-        SCOPED_TRACE(testing::Message() << "bool byte " << value);
-        expect_wire_error(Tag::progress, bytes, "bool");
     }
 }
 

@@ -29,15 +29,16 @@ TEST(Protocol, DegenerateMessagesRoundTrip) {
     ViewMsg one_pixel = sample_view();
     one_pixel.view.width = 1;
     one_pixel.view.height = 1;
-    one_pixel.region = {1, 1, 0, 0};  // an empty region on the far corner is still inside
     expect_round_trip(one_pixel);
+    expect_round_trip(ReleaseMsg{});
+    expect_round_trip(JobDoneMsg{});
+    expect_round_trip(LandedMsg{});
 }
 
 TEST(Protocol, ViewAtTheLimitsRoundTrips) {
     ViewMsg m = sample_view();
     m.view.width = kMaxImageSide;
     m.view.height = kMaxImageSide;
-    m.region = {0, 0, kMaxImageSide, kMaxImageSide};
     expect_round_trip(m);
 }
 
@@ -69,6 +70,22 @@ TEST(Protocol, QuitRoundTrips) {
 TEST(Protocol, TileResultRoundTrips) {
     expect_round_trip(sample_tile_result());
 }
+TEST(Protocol, JobRoundTrips) {
+    expect_round_trip(sample_job());
+    JobMsg coarse = sample_job();
+    coarse.band = Band::coarse;
+    coarse.rect = {1600, 840, 320, 240};  // touches the right and bottom edges
+    expect_round_trip(coarse);
+}
+TEST(Protocol, JobDoneRoundTrips) {
+    expect_round_trip(sample_job_done());
+}
+TEST(Protocol, RegionRoundTrips) {
+    expect_round_trip(sample_region());
+}
+TEST(Protocol, LandedRoundTrips) {
+    expect_round_trip(LandedMsg{0xfedcba9876543210ULL, 0xffffffffu});
+}
 
 TEST(Protocol, PerspectiveProjectionRoundTrips) {
     ViewMsg m = sample_view();
@@ -80,21 +97,20 @@ TEST(Protocol, PerspectiveProjectionRoundTrips) {
 // ---- the byte format itself -------------------------------------------------------------------
 
 TEST(Protocol, ProgressBytesAreLittleEndianWithTheVersionFirst) {
-    const Bytes bytes = encode(ProgressMsg{0x0102030405060708ULL, 9, true, 1.5});
+    const Bytes bytes = encode(ProgressMsg{0x0102030405060708ULL, 9, 1.5});
     const std::string expected =
-        "02 "                        // version
+        "03 "                        // version
         "08 07 06 05 04 03 02 01 "   // generation, low byte first
         "09 00 00 00 00 00 00 00 "   // rays
-        "01 "                        // done
         "00 00 00 00 00 00 f8 3f ";  // cpu_s: 1.5 is 0x3ff8000000000000
     EXPECT_EQ(hex(bytes), expected);
 }
 
 TEST(Protocol, ViewHasAFixedSize) {
     // version 1 + generation 8 + camera (3 vec3 36, projection 4, 4 floats 16) 56 + frustum
-    // (6 floats 24, projection 4) 28 + width, height 8 + iso 8 + region 16: a change here is a
-    // change of the wire format and needs a new ViewMsg::kVersion.
-    EXPECT_EQ(encode(sample_view()).size(), 1u + 8 + 56 + 28 + 8 + 8 + 16);
+    // (6 floats 24, projection 4) 28 + width, height 8 + iso 8: a change here is a change of the
+    // wire format and needs a new ViewMsg::kVersion.
+    EXPECT_EQ(encode(sample_view()).size(), 1u + 8 + 56 + 28 + 8 + 8);
 }
 
 TEST(Protocol, TagNames) {
@@ -105,8 +121,14 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::image), "image");
     EXPECT_STREQ(to_string(Tag::quit), "quit");
     EXPECT_STREQ(to_string(Tag::tile_result), "tile_result");
+    EXPECT_STREQ(to_string(Tag::release), "release");
+    EXPECT_STREQ(to_string(Tag::job), "job");
+    EXPECT_STREQ(to_string(Tag::job_done), "job_done");
+    EXPECT_STREQ(to_string(Tag::region), "region");
+    EXPECT_STREQ(to_string(Tag::landed), "landed");
     EXPECT_STREQ(to_string(static_cast<Tag>(0)), "unknown");
-    EXPECT_STREQ(to_string(static_cast<Tag>(16)), "unknown");
+    EXPECT_STREQ(to_string(static_cast<Tag>(9)), "unknown");
+    EXPECT_STREQ(to_string(static_cast<Tag>(20)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }
 

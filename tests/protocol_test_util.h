@@ -39,6 +39,10 @@ inline bool operator==(const FrameView& a, const FrameView& b) {
 inline bool operator==(const PixelRect& a, const PixelRect& b) {
     return a.x == b.x && a.y == b.y && a.width == b.width && a.height == b.height;
 }
+inline bool operator==(const CurvePoint& a, const CurvePoint& b) {
+    return a.emulated_s == b.emulated_s && a.final_px == b.final_px &&
+           a.squared_error == b.squared_error;
+}
 inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
     return a.stage == b.stage && a.start_s == b.start_s && a.wall_s == b.wall_s &&
            a.cpu_s == b.cpu_s;
@@ -47,11 +51,10 @@ inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
     return a.host == b.host;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
-    return a.generation == b.generation && a.view == b.view && a.region == b.region;
+    return a.generation == b.generation && a.view == b.view;
 }
 inline bool operator==(const ProgressMsg& a, const ProgressMsg& b) {
-    return a.generation == b.generation && a.rays == b.rays && a.done == b.done &&
-           a.cpu_s == b.cpu_s;
+    return a.generation == b.generation && a.rays == b.rays && a.cpu_s == b.cpu_s;
 }
 inline bool operator==(const SnapshotMsg&, const SnapshotMsg&) {
     return true;
@@ -67,7 +70,29 @@ inline bool operator==(const TileResultMsg& a, const TileResultMsg& b) {
     return a.host == b.host && a.cpu_s == b.cpu_s && a.frame_s == b.frame_s &&
            a.rss_mib == b.rss_mib && a.rays == b.rays && a.groups == b.groups &&
            a.triangles == b.triangles && a.frames == b.frames && a.interrupted == b.interrupted &&
+           a.jobs_own == b.jobs_own && a.jobs_helped == b.jobs_helped &&
+           a.bytes_sent == b.bytes_sent && a.significant == b.significant && a.curve == b.curve &&
            a.spans == b.spans;
+}
+inline bool operator==(const ReleaseMsg&, const ReleaseMsg&) {
+    return true;
+}
+inline bool operator==(const JobMsg& a, const JobMsg& b) {
+    return a.generation == b.generation && a.job == b.job && a.owner == b.owner &&
+           a.band == b.band && a.view == b.view && a.rect == b.rect;
+}
+inline bool operator==(const JobDoneMsg& a, const JobDoneMsg& b) {
+    return a.generation == b.generation && a.job == b.job && a.rays == b.rays &&
+           a.groups == b.groups && a.triangles == b.triangles && a.cpu_s == b.cpu_s &&
+           a.cpu_end_s == b.cpu_end_s && a.start_s == b.start_s && a.end_s == b.end_s &&
+           a.bytes == b.bytes;
+}
+inline bool operator==(const RegionMsg& a, const RegionMsg& b) {
+    return a.generation == b.generation && a.job == b.job && a.rect == b.rect &&
+           a.cpu_end_s == b.cpu_end_s && a.rgba == b.rgba && a.depth == b.depth;
+}
+inline bool operator==(const LandedMsg& a, const LandedMsg& b) {
+    return a.generation == b.generation && a.job == b.job;
 }
 
 inline std::ostream& operator<<(std::ostream& os, const PixelRect& p) {
@@ -81,12 +106,11 @@ inline void PrintTo(const HelloMsg& m, std::ostream* os) {
     *os << "HelloMsg{" << m.host << "}";
 }
 inline void PrintTo(const ViewMsg& m, std::ostream* os) {
-    *os << "ViewMsg{generation " << m.generation << ", " << m.view << ", region " << m.region
-        << "}";
+    *os << "ViewMsg{generation " << m.generation << ", " << m.view << "}";
 }
 inline void PrintTo(const ProgressMsg& m, std::ostream* os) {
-    *os << "ProgressMsg{generation " << m.generation << ", rays " << m.rays << ", done " << m.done
-        << ", cpu_s " << m.cpu_s << "}";
+    *os << "ProgressMsg{generation " << m.generation << ", rays " << m.rays << ", cpu_s " << m.cpu_s
+        << "}";
 }
 inline void PrintTo(const SnapshotMsg&, std::ostream* os) {
     *os << "SnapshotMsg{}";
@@ -104,7 +128,26 @@ inline void PrintTo(const TileResultMsg& m, std::ostream* os) {
         << ", triangles " << m.triangles << ", frames " << m.frames << ", interrupted "
         << m.interrupted << ", spans";
     for (const TraceSpan& s : m.spans) *os << " " << s;
-    *os << "}";
+    *os << ", jobs " << m.jobs_own << "+" << m.jobs_helped << ", bytes " << m.bytes_sent
+        << ", significant " << m.significant << ", " << m.curve.size() << " curve points}";
+}
+inline void PrintTo(const ReleaseMsg&, std::ostream* os) {
+    *os << "ReleaseMsg{}";
+}
+inline void PrintTo(const JobMsg& m, std::ostream* os) {
+    *os << "JobMsg{generation " << m.generation << ", job " << m.job << ", owner " << m.owner
+        << ", band " << int(m.band) << ", " << m.view << ", rect " << m.rect << "}";
+}
+inline void PrintTo(const JobDoneMsg& m, std::ostream* os) {
+    *os << "JobDoneMsg{generation " << m.generation << ", job " << m.job << ", rays " << m.rays
+        << ", cpu " << m.cpu_s << ", cpu_end " << m.cpu_end_s << ", bytes " << m.bytes << "}";
+}
+inline void PrintTo(const RegionMsg& m, std::ostream* os) {
+    *os << "RegionMsg{generation " << m.generation << ", job " << m.job << ", rect " << m.rect
+        << ", " << m.rgba.size() << " rgba bytes, " << m.depth.size() << " depths}";
+}
+inline void PrintTo(const LandedMsg& m, std::ostream* os) {
+    *os << "LandedMsg{generation " << m.generation << ", job " << m.job << "}";
 }
 
 namespace protocol_testing {
@@ -143,12 +186,37 @@ inline ViewMsg sample_view() {
     m.view.width = 1920;
     m.view.height = 1080;
     m.view.iso = 117.25;
-    m.region = {640, 360, 320, 240};
     return m;
 }
 
 inline ProgressMsg sample_progress() {
-    return {42, 1234567890123ULL, true, 3.25};
+    return {42, 1234567890123ULL, 3.25};
+}
+
+inline JobMsg sample_job() {
+    JobMsg m;
+    m.generation = 0x1122334455667788ULL;
+    m.job = 0xa1b2c3d4u;
+    m.owner = 17;
+    m.band = Band::fine;
+    m.view = sample_view().view;
+    m.rect = {640, 360, 320, 240};
+    return m;
+}
+
+inline JobDoneMsg sample_job_done() {
+    return {9, 77, 123456789012ULL, 33, 44444, 0.125, 2.5, 1.7e9, 1.7e9 + 0.25, 98765};
+}
+
+inline RegionMsg sample_region() {
+    RegionMsg m;
+    m.generation = 11;
+    m.job = 5;
+    m.rect = {100, 50, 3, 2};
+    m.cpu_end_s = 0.75;
+    for (int i = 0; i < 3 * 2 * 4; ++i) m.rgba.push_back(static_cast<std::uint8_t>(7 * i + 1));
+    m.depth = {0.0f, 0.25f, 0.5f, 0.75f, 0.875f, 1.0f};
+    return m;
 }
 
 inline ImageMsg sample_image() {
@@ -172,6 +240,11 @@ inline TileResultMsg sample_tile_result() {
     m.triangles = 123456;
     m.frames = 3;
     m.interrupted = 2;
+    m.jobs_own = 31;
+    m.jobs_helped = 12;
+    m.bytes_sent = 1u << 30;
+    m.significant = 209000;
+    m.curve = {{0.125, 1000, 512.5}, {0.5, 208000, 3.25}};
     const std::uint8_t last_stage = std::size(kTraceStages) - 1;
     m.spans = {
         {0, 1.7e9, 0.5, 0.25}, {3, 1.7e9 + 0.5, 0.125, 0.0625}, {last_stage, 1.7e9 + 1, 2, 1}};
@@ -191,7 +264,12 @@ inline std::vector<Sample> samples() {
             {"snapshot", Tag::snapshot, encode(SnapshotMsg{})},
             {"image", Tag::image, encode(sample_image())},
             {"quit", Tag::quit, encode(QuitMsg{})},
-            {"tile_result", Tag::tile_result, encode(sample_tile_result())}};
+            {"tile_result", Tag::tile_result, encode(sample_tile_result())},
+            {"release", Tag::release, encode(ReleaseMsg{})},
+            {"job", Tag::job, encode(sample_job())},
+            {"job_done", Tag::job_done, encode(sample_job_done())},
+            {"region", Tag::region, encode(sample_region())},
+            {"landed", Tag::landed, encode(LandedMsg{3, 4})}};
 }
 
 // decode_message must throw a WireError whose text names the message and `field`.

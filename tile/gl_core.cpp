@@ -284,20 +284,27 @@ void GlCore::finish() {
     check("glFinish");
 }
 
-void GlCore::read_back(Image& out) {
+void GlCore::read_back(Image& out, const PixelRect& rect) {
     require_size("read_back");
+    if (rect.x < 0 || rect.y < 0 || rect.width < 0 || rect.height < 0 ||
+        rect.x + rect.width > width_ || rect.y + rect.height > height_)
+        fail("read_back", "the rect lies outside the frame");
     bind_frame();
-    if (out.width != width_ || out.height != height_ || out.pixel_count() != out.depth.size() ||
-        out.pixel_count() * 4 != out.rgba.size()) {
-        out.resize(width_, height_);
+    if (out.width != rect.width || out.height != rect.height ||
+        out.pixel_count() != out.depth.size() || out.pixel_count() * 4 != out.rgba.size()) {
+        out.resize(rect.width, rect.height);
     }
+    // GL counts rows from the bottom.
+    const int gl_y = height_ - rect.y - rect.height;
     gl_->PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl_->ReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
+    gl_->ReadPixels(rect.x, gl_y, rect.width, rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                    out.rgba.data());
     check("glReadPixels(GL_RGBA)");
-    gl_->ReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
+    gl_->ReadPixels(rect.x, gl_y, rect.width, rect.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+                    out.depth.data());
     check("glReadPixels(GL_DEPTH_COMPONENT)");
-    flip_rows(out.rgba, static_cast<std::size_t>(width_) * 4, height_);
-    flip_rows(out.depth, static_cast<std::size_t>(width_), height_);
+    flip_rows(out.rgba, static_cast<std::size_t>(rect.width) * 4, rect.height);
+    flip_rows(out.depth, static_cast<std::size_t>(rect.width), rect.height);
 }
 
 }  // namespace isowall

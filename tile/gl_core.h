@@ -30,9 +30,11 @@ class GlCore {
     GlCore& operator=(const GlCore&) = delete;
 
     void resize(int width, int height);
+    int width() const { return width_; }
+    int height() const { return height_; }
     void clear();
     void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection);
-    void read_back(Image& out);
+    void read_back(Image& out, const PixelRect& rect);
     void finish();
 
   private:
@@ -79,7 +81,11 @@ class GlRenderer : public Renderer {
     }
     void read_back(Image& out) override {
         make_current();
-        core_->read_back(out);
+        core_->read_back(out, core_frame());
+    }
+    void read_back(Image& out, const PixelRect& rect) override {
+        make_current();
+        core_->read_back(out, rect);
     }
     void finish() override {
         make_current();
@@ -88,6 +94,7 @@ class GlRenderer : public Renderer {
 
   protected:
     virtual void make_current() = 0;
+    PixelRect core_frame() const { return {0, 0, core_->width(), core_->height()}; }
     std::unique_ptr<GlCore> core_;
 };
 

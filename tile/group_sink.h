@@ -23,9 +23,12 @@ class GroupSink {
     // Makes every group added so far visible, as a display does at its next refresh. Called at
     // most once per refresh and at the end of each ray-order level; returns the seconds it took.
     virtual double present() { return 0; }
-    // Writes covered[y * width + x] != 0 for every screen pixel that shows the surface now; false
-    // when this sink cannot tell (the readback ray orders then see nothing covered).
-    virtual bool coverage(std::vector<std::uint8_t>& /*covered*/) { return false; }
+    // Sizes `covered` to the whole screen and writes covered[y * width + x] != 0 for every pixel
+    // of `rect` that shows the surface now (0 outside rect); false when this sink cannot tell
+    // (the readback ray orders then see nothing covered).
+    virtual bool coverage(std::vector<std::uint8_t>& /*covered*/, const PixelRect& /*rect*/) {
+        return false;
+    }
 };
 
 // Draws every group into a renderer's frame, which begin() resizes and clears.
@@ -35,12 +38,14 @@ class RendererSink final : public GroupSink {
     void begin(const FrameView& view) override;
     void add(const Group& group) override;
     double present() override;
-    bool coverage(std::vector<std::uint8_t>& covered) override;
+    bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
     // The frame as drawn so far (finishes pending draws first).
     void read_back(Image& out);
+    void read_back(Image& out, const PixelRect& rect);
 
   private:
     Renderer& renderer_;
+    int width_ = 0, height_ = 0;
     glm::mat4 view_m_{1.0f}, proj_m_{1.0f};
     Image scratch_;
 };
@@ -60,7 +65,7 @@ class TeeSink final : public GroupSink {
     void begin(const FrameView& view) override;
     void add(const Group& group) override;
     double present() override;
-    bool coverage(std::vector<std::uint8_t>& covered) override;
+    bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
 
   private:
     std::vector<GroupSink*> sinks_;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
 
 #include "common/core/ray.h"
@@ -29,27 +31,68 @@ PixelRect intersect(const PixelRect& a, const PixelRect& b) {
 // One frame, as named steps: begin (setup), then per ray-order level cast each ray
 // (intersection), seed a propagation pass where it hits (propagation), hand the group to the sink
 // (render), and between levels give the order the coverage (render). Each step switches the trace
-// span, so a rank's CPU time is charged to the step that spent it.
+// span, so a rank's CPU time is charged to the step that spent it. One frame may cast several
+// regions, of several views of one camera and isovalue (the jobs of a wall rank): they share the
+// extractor's visited cells, so a group found in one region is not extracted again in another.
 class FrameRun {
   public:
-    FrameRun(SurfaceExtractor& ex, const EngineOptions& opt, const FrameView& view, GroupSink& sink,
+    FrameRun(SurfaceExtractor& ex, const EngineOptions& opt, const FrameView& view,
              const std::atomic<bool>& stop, const ProgressiveEngine::Progress& progress)
-        : ex_(ex), opt_(opt), view_(view), sink_(sink), stop_(stop), progress_(progress) {}
+        : ex_(ex), opt_(opt), stop_(stop), progress_(progress) {
+        begin(view);
+    }
 
-    FrameResult run(const PixelRect& region) {
-        begin(region);
-        bool done = cast_pass(opt_.intersect, false);
-        // Approximate seeds can miss a pixel whose first active cell's triangles do not cover it
-        // (Figure 2.2): a second, exact pass over every pixel restores the guarantee
-        // (section 3.1.1).
-        if (done && opt_.intersect == IntersectMode::approximate)
-            done = cast_pass(IntersectMode::exact, true);
-        frame_.completed = done;
+    RegionCursor cursor(const FrameView& view, const PixelRect& region) const {
+        RegionCursor c;
+        const PixelRect clipped = intersect(region, view.screen());
+        c.rect = opt_.screen_box
+                     ? intersect(clipped, screen_box(ex_.volume().bounds(), view.camera.view(),
+                                                     view.frustum, view.width, view.height))
+                     : clipped;
+        c.done = c.rect.width <= 0 || c.rect.height <= 0;
+        return c;
+    }
+
+    bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink, std::size_t ray_limit) {
+        view_ = &view;
+        sink_ = &sink;
+        view_inv_ = glm::inverse(view.camera.view());
+        rect_ = c.rect;
+        params_ = opt_.propagation;
+        if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
+        const std::size_t limit = c.rays + ray_limit;
+        while (!c.done && c.rays < limit) {
+            if (!c.order) c.order = make_ray_order(opt_.order, view.width, view.height, c.rect);
+            const std::size_t before = now_.rays;
+            const bool level = c.order->next_level(pixels_);
+            if (level && !cast_level(*c.order, c.pass == 1)) {
+                c.rays += now_.rays - before;
+                return false;
+            }
+            c.rays += now_.rays - before;
+            if (level) continue;
+            // Approximate seeds can miss a pixel whose first active cell's triangles do not cover
+            // it (Figure 2.2): a second, exact pass over every pixel restores the guarantee
+            // (section 3.1.1).
+            c.order.reset();
+            if (c.pass == 0 && opt_.intersect == IntersectMode::approximate)
+                c.pass = 1;
+            else
+                c.done = true;
+        }
+        record(true);
+        return true;
+    }
+
+    FrameResult finish(bool completed) {
+        frame_.completed = completed;
         record(true);
         frame_.rays_cast = now_.rays;
         frame_.elapsed_s = since(start_);
         return std::move(frame_);
     }
+
+    const TimelineSample& now() const { return now_; }
 
   private:
     void stage(Stage s) {
@@ -57,51 +100,52 @@ class FrameRun {
     }
     bool stopped() const { return stop_.load(std::memory_order_relaxed); }
 
-    void begin(const PixelRect& region) {
+    // The clip of `rect` of `view`: its own frustum, from the volume's voxel space.
+    ScreenClip region_clip(const FrameView& view, const PixelRect& rect) const {
+        ScreenClip clip;
+        if (rect.width <= 0 || rect.height <= 0) return clip;
+        const glm::mat4 proj = sub_frustum(view.frustum, view.width, view.height, rect).matrix();
+        const glm::vec3 spacing = ex_.volume().spacing();
+        clip.active = true;
+        clip.clip_from_voxel = proj * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
+        clip.ndc_per_unit = std::max(std::abs(proj[0][0]), std::abs(proj[1][1]));
+        clip.half_diagonal = 0.5f * glm::length(spacing);
+        return clip;
+    }
+
+    void begin(const FrameView& view) {
         stage(Stage::setup);
         start_ = Clock::now();
-        view_m_ = view_.camera.view();
-        view_inv_ = glm::inverse(view_m_);
-        frame_.rays_screen =
-            static_cast<std::size_t>(region.width) * static_cast<std::size_t>(region.height);
-        const PixelRect clipped = intersect(region, view_.screen());
-        frame_.screen_rect =
-            opt_.screen_box
-                ? intersect(clipped, screen_box(ex_.volume().bounds(), view_m_, view_.frustum,
-                                                view_.width, view_.height))
-                : clipped;
         ResolutionLevels levels;
         if (opt_.adaptive) {
-            // D[] depends on the eye, the frustum and the pixel size only: once per frame.
-            levels = resolution_levels(view_.camera, view_.frustum, view_.height,
+            // D[] depends on the eye, the frustum and the pixel size only: once per frame (every
+            // tile of a wall has the same pixel size, so one frame serves all of them).
+            levels = resolution_levels(view.camera, view.frustum, view.height,
                                        ex_.volume().spacing(), opt_.adaptive_max_level);
             levels.refine = opt_.adaptive_refine;
         }
-        ex_.begin_frame(view_.iso, levels);
-        sink_.begin(view_);
+        ex_.begin_frame(view.iso, levels);
         extra_ = opt_.sample_at_rays;
         std::sort(extra_.begin(), extra_.end());
         stage(Stage::intersection);
     }
 
-    bool cast_pass(IntersectMode mode, bool second_pass) {
-        auto order = make_ray_order(opt_.order, view_.width, view_.height, frame_.screen_rect);
-        while (order->next_level(pixels_)) {
-            now_.level = order->level();
-            for (const glm::ivec2 px : pixels_) {
-                if (stopped()) return false;
-                if (!cast_ray(px, mode, second_pass)) return false;
-                record(false);
-            }
-            if (order->wants_coverage()) give_coverage(*order);
-            record(true);
+    bool cast_level(RayOrder& order, bool second_pass) {
+        const IntersectMode mode = second_pass ? IntersectMode::exact : opt_.intersect;
+        now_.level = order.level();
+        for (const glm::ivec2 px : pixels_) {
+            if (stopped()) return false;
+            if (!cast_ray(px, mode, second_pass)) return false;
+            record(false);
         }
+        if (order.wants_coverage()) give_coverage(order);
+        record(true);
         return true;
     }
 
     // One ray; false when the frame was stopped inside its propagation pass.
     bool cast_ray(glm::ivec2 px, IntersectMode mode, bool second_pass) {
-        const Ray ray = pixel_ray(view_inv_, view_.frustum, view_.width, view_.height, px);
+        const Ray ray = pixel_ray(view_inv_, view_->frustum, view_->width, view_->height, px);
         const auto t0 = Clock::now();
         const RayHit hit = ex_.cast(ray, mode);
         now_.t_intersect_s += since(t0);
@@ -118,7 +162,7 @@ class FrameRun {
         const auto t0 = Clock::now();
         const auto id = static_cast<std::uint32_t>(frame_.group_count);
         Group g = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
-                             : ex_.propagate(hit.cell, id, opt_.propagation, ray, interrupted_);
+                             : ex_.propagate(hit.cell, id, params_, ray, interrupted_);
         const double pass_s = since(t0);
         const double extract_s = ex_.last_extract_s();
         now_.t_extract_s += extract_s;
@@ -127,7 +171,7 @@ class FrameRun {
         if (!g.mesh.indices.empty() || !g.refinement) {
             stage(Stage::render);
             const auto t1 = Clock::now();
-            sink_.add(g);
+            sink_->add(g);
             now_.t_render_s += since(t1);
             dirty_ = true;
             now_.triangles += g.mesh.triangle_count();
@@ -140,9 +184,10 @@ class FrameRun {
     void give_coverage(RayOrder& order) {
         stage(Stage::render);
         const auto t0 = Clock::now();
-        if (!sink_.coverage(covered_))
+        if (!sink_->coverage(covered_, rect_))
             covered_.assign(
-                static_cast<std::size_t>(view_.width) * static_cast<std::size_t>(view_.height), 0);
+                static_cast<std::size_t>(view_->width) * static_cast<std::size_t>(view_->height),
+                0);
         order.set_coverage(covered_);
         now_.t_render_s += since(t0);
         stage(Stage::intersection);
@@ -160,9 +205,9 @@ class FrameRun {
         // next refresh. Presenting after every group would cost a full-screen flush each time
         // (about 7 ms at 1600x1200 in llvmpipe), so between refreshes a sample may count groups
         // still in flight: sample times are exact to one refresh (1/60 s).
-        if (dirty_ && (force || now_.time_s - last_present_s_ >= kRefreshS)) {
+        if (dirty_ && sink_ && (force || now_.time_s - last_present_s_ >= kRefreshS)) {
             stage(Stage::render);
-            now_.t_render_s += sink_.present();
+            now_.t_render_s += sink_->present();
             stage(Stage::intersection);
             now_.time_s = since(start_);
             last_present_s_ = now_.time_s;
@@ -184,17 +229,19 @@ class FrameRun {
 
     SurfaceExtractor& ex_;
     const EngineOptions& opt_;
-    const FrameView& view_;
-    GroupSink& sink_;
+    const FrameView* view_ = nullptr;
+    GroupSink* sink_ = nullptr;
     const std::atomic<bool>& stop_;
-    const ProgressiveEngine::Progress& progress_;
+    const ProgressiveEngine::Progress progress_;  // a copy: callers pass temporaries
     // What propagation polls; made once per frame, not once per pass.
     const std::function<bool()> interrupted_ = [this] { return stopped(); };
 
     FrameResult frame_;
     TimelineSample now_;
     Clock::time_point start_;
-    glm::mat4 view_m_{1.0f}, view_inv_{1.0f};
+    glm::mat4 view_inv_{1.0f};
+    PixelRect rect_;            // the region being cast
+    PropagationParams params_;  // the options, with the clip of the region being cast
     std::vector<std::size_t> extra_;
     std::size_t next_extra_ = 0, next_sample_rays_ = 1;
     // The first progress report comes at the first ray: a wall master then knows the frame began.
@@ -204,25 +251,57 @@ class FrameRun {
     std::vector<std::uint8_t> covered_;
 };
 
-ProgressiveEngine::ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer,
-                                     EngineOptions options)
-    : extractor_(extractor), renderer_(renderer), options_(options) {
-    // Mesa compiles its shader variants on the first draw (about 25 ms in llvmpipe). An
-    // interactive viewer pays that once at start-up, not in every frame, so pay it here, before
-    // any frame is timed. (scripts/vtk_reference.py warms VTK the same way.)
+void warm_up(Renderer& renderer) {
     Mesh tiny;
     tiny.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     tiny.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
     tiny.indices = {0, 1, 2};
-    renderer_.resize(16, 16);
-    renderer_.clear();
-    renderer_.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
-    renderer_.finish();
+    renderer.resize(16, 16);
+    renderer.clear();
+    renderer.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
+    renderer.finish();
+}
+
+ProgressiveEngine::ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer,
+                                     EngineOptions options)
+    : extractor_(extractor), renderer_(renderer), options_(options) {
+    warm_up(renderer_);
 }
 
 FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& region, GroupSink& sink,
                                    const std::atomic<bool>& stop, const Progress& progress) {
-    return FrameRun(extractor_, options_, view, sink, stop, progress).run(region);
+    EngineFrame frame(*this, view, stop, progress);
+    sink.begin(view);
+    RegionCursor c = frame.cursor(view, region);
+    const bool done = frame.cast(view, c, sink);
+    FrameResult result = frame.finish(done);
+    result.rays_screen =
+        static_cast<std::size_t>(region.width) * static_cast<std::size_t>(region.height);
+    result.screen_rect = c.rect;
+    return result;
+}
+
+EngineFrame::EngineFrame(ProgressiveEngine& engine, const FrameView& view,
+                         const std::atomic<bool>& stop, const ProgressiveEngine::Progress& progress)
+    : run_(std::make_unique<FrameRun>(engine.extractor_, engine.options_, view, stop, progress)) {}
+
+EngineFrame::~EngineFrame() = default;
+
+RegionCursor EngineFrame::cursor(const FrameView& view, const PixelRect& region) const {
+    return run_->cursor(view, region);
+}
+
+bool EngineFrame::cast(const FrameView& view, RegionCursor& c, GroupSink& sink,
+                       std::size_t ray_limit) {
+    return run_->cast(view, c, sink, ray_limit);
+}
+
+FrameResult EngineFrame::finish(bool completed) {
+    return run_->finish(completed);
+}
+
+const TimelineSample& EngineFrame::now() const {
+    return run_->now();
 }
 
 FrameResult ProgressiveEngine::run(const FrameView& view, const std::atomic<bool>* stop,

@@ -6,8 +6,10 @@
 // into the frame being built: no clear, no redraw of older groups, so drawing cost follows new
 // triangles only; recorded for the replay; later streamed).
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "common/core/camera.h"
@@ -29,6 +31,10 @@ struct EngineOptions {
     IntersectMode intersect = IntersectMode::exact;
     PropagationParams propagation;
     bool screen_box = true;  // cast no ray outside the volume's projected bounding box
+    // Propagation enters only cells that may project into the region being cast (ScreenClip):
+    // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
+    // whole surface within their limits, as in the text.
+    bool region_clip = false;
     // Adaptive resolution (chapter 2.1.3): where a meta-cell of 2^i cells per side projects to
     // less than a pixel, extract it as one cell, up to 2^adaptive_max_level cells per side. Off:
     // every cell at full resolution, exactly as without the option. adaptive_refine: draw a
@@ -62,6 +68,23 @@ struct FrameResult {
     PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
 };
 
+// Mesa compiles its shader variants on the first draw (about 25 ms in llvmpipe). An interactive
+// viewer pays that once at start-up, not in every frame: this draws one triangle, before any
+// frame is timed (the engine does it for its renderer; scripts/vtk_reference.py warms VTK alike).
+void warm_up(Renderer& renderer);
+
+// A region's place in its progressive ray order, kept between the calls that cast it (the coarse
+// and the fine band of a wall job).
+struct RegionCursor {
+    PixelRect rect;  // the pixels to cast: the region clipped to the screen and the screen box
+    std::unique_ptr<RayOrder> order;  // null before the first level and between passes
+    int pass = 0;                     // 1: the exact second pass of approximate mode
+    std::size_t rays = 0;             // cast so far
+    bool done = false;                // every pixel of rect has had its ray
+};
+
+class FrameRun;
+
 class ProgressiveEngine {
   public:
     ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer, EngineOptions options = {});
@@ -89,9 +112,39 @@ class ProgressiveEngine {
     const EngineOptions& options() const { return options_; }
 
   private:
+    friend class EngineFrame;
     SurfaceExtractor& extractor_;
     Renderer& renderer_;
     EngineOptions options_;
+};
+
+// One frame cast region by region, for callers that split the screen into jobs (a wall rank).
+// Every region cast in it, of any view of the frame's camera and isovalue, shares one set of
+// visited cells: a sink that is to show a region must therefore also hold the groups found
+// earlier in the frame for other regions (see tile/tile_loop.cpp).
+class EngineFrame {
+  public:
+    // Begins the extractor's frame for `view`'s isovalue (and its pixel size, for adaptive
+    // resolution). The engine must outlive the frame.
+    EngineFrame(ProgressiveEngine& engine, const FrameView& view, const std::atomic<bool>& stop,
+                const ProgressiveEngine::Progress& progress = {});
+    ~EngineFrame();
+    EngineFrame(const EngineFrame&) = delete;
+    EngineFrame& operator=(const EngineFrame&) = delete;
+
+    // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box.
+    RegionCursor cursor(const FrameView& view, const PixelRect& region) const;
+    // Casts whole levels of `c` into `sink` until it has cast `ray_limit` more rays or is done;
+    // `view` must be the one the cursor was made for. False when stopped (c stays where it was).
+    bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink,
+              std::size_t ray_limit = SIZE_MAX);
+    // The frame's figures and timeline (groups and the final image are not kept here).
+    FrameResult finish(bool completed);
+    // The latest sample: rays, groups, triangles of the frame so far.
+    const TimelineSample& now() const;
+
+  private:
+    std::unique_ptr<FrameRun> run_;
 };
 
 }  // namespace isowall

@@ -7,6 +7,7 @@
 
 #include <glm/mat4x4.hpp>
 
+#include "common/core/camera.h"
 #include "common/core/image.h"
 #include "common/core/mesh.h"
 
@@ -32,6 +33,9 @@ class Renderer {
     virtual void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) = 0;
     // Colour (RGBA8) and window depth of the frame, row 0 at the top.
     virtual void read_back(Image& out) = 0;
+    // The same for `rect` of the frame only (x, y from the top-left; inside the frame), so a
+    // caller that needs a region does not copy the whole frame.
+    virtual void read_back(Image& out, const PixelRect& rect) = 0;
     // Waits until everything drawn so far is in the frame (for honest stage timings).
     virtual void finish() = 0;
     virtual std::string_view name() const = 0;

@@ -4,6 +4,14 @@
 #include <utility>
 
 namespace isowall {
+namespace {
+
+// A new view or quit ends the frame being built; jobs and results queue behind it.
+bool interrupts(const Message& m) {
+    return std::holds_alternative<ViewMsg>(m) || std::holds_alternative<QuitMsg>(m);
+}
+
+}  // namespace
 
 void TileInbox::push(Message message) {
     std::lock_guard lock(mutex_);
@@ -11,8 +19,10 @@ void TileInbox::push(Message message) {
         ++snapshots_;
     } else {
         // Raised under the lock, so a pop() that lowers it cannot miss this message.
-        if (std::holds_alternative<ViewMsg>(message) || std::holds_alternative<QuitMsg>(message))
+        if (interrupts(message)) {
+            ++interrupts_;
             stop_ = true;
+        }
         queue_.push_back(std::move(message));
     }
     changed_.notify_all();
@@ -36,7 +46,8 @@ std::optional<Message> TileInbox::pop() {
     if (queue_.empty()) return std::nullopt;  // snapshot requests only
     Message m = std::move(queue_.front());
     queue_.pop_front();
-    stop_ = closed_ || !queue_.empty();
+    if (interrupts(m)) --interrupts_;
+    stop_ = closed_ || interrupts_ > 0;
     return m;
 }
 

@@ -1,9 +1,10 @@
 #pragma once
 // A tile rank's mailbox between its two threads. The communication thread puts every message
-// from the master here and, when a new view or quit arrives, raises the stop flag that the frame
-// being built reads between rays: the frame thread never makes a transport call to learn that it
-// must stop. Snapshot requests are counted rather than queued, so the frame thread can answer
-// them from inside a frame (at its progress points) or between frames.
+// from the master (and every region result from a helper) here and, when a new view or quit
+// arrives, raises the stop flag that the frame being built reads between rays: the frame thread
+// never makes a transport call to learn that it must stop. Snapshot requests are counted rather
+// than queued, so the frame thread can answer them from inside a frame (at its progress points) or
+// between frames.
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -23,10 +24,10 @@ class TileInbox {
     // rises so a frame in progress ends too.
     void close(std::exception_ptr error = nullptr);
 
-    // Called by the frame thread. The next view or quit, or nullopt when only snapshot requests
-    // are waiting (answer them with take_snapshots()). Blocks while there is nothing; once closed,
-    // throws the close() error (or a runtime_error when there was none). Popping a
-    // view lowers the stop flag unless another view or quit is already queued behind it.
+    // Called by the frame thread. The next message in order, or nullopt when only snapshot
+    // requests are waiting (answer them with take_snapshots()). Blocks while there is nothing;
+    // once closed, throws the close() error (or a runtime_error when there was none). The stop
+    // flag is up while a view or quit is queued: jobs popped before it end at once.
     std::optional<Message> pop();
     // The number of snapshot requests waiting, which are then taken.
     int take_snapshots();
@@ -40,6 +41,7 @@ class TileInbox {
     std::condition_variable changed_;
     std::deque<Message> queue_;
     int snapshots_ = 0;
+    int interrupts_ = 0;  // views and quits in the queue
     bool closed_ = false;
     std::exception_ptr error_;
     std::atomic<bool> stop_{false};

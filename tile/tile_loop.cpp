@@ -7,6 +7,7 @@
 #include "common/core/util.h"
 #include "common/progressive/trace.h"
 #include "tile/tile_inbox.h"
+#include "tile/tile_jobs.h"
 
 namespace isowall {
 namespace {
@@ -14,9 +15,10 @@ namespace {
 // How long the communication thread waits for a message before it looks at its stop request.
 constexpr double kReceivePollS = 0.05;
 
-// The communication thread: every message from the master into the inbox, until quit (the last
-// message a master sends a tile) or until told to end. A transport error or a malformed message
-// closes the inbox with that error, so the frame thread reports it.
+// The communication thread: every message for this rank into the inbox, until release (the last
+// message a master sends a tile) or until told to end. A transport error, a malformed message or
+// one from a rank that may not send it closes the inbox with that error, so the frame thread
+// reports it.
 class Receiver {
   public:
     Receiver(Comm& comm, TileInbox& inbox)
@@ -30,12 +32,17 @@ class Receiver {
     void loop() {
         try {
             while (!ending_) {
-                auto e = comm_.receive(kMasterRank, kReceivePollS);
+                auto e = comm_.receive(-1, kReceivePollS);
                 if (!e) continue;
                 Message m = decode_message(e->tag, e->bytes);
-                const bool quit = std::holds_alternative<QuitMsg>(m);
+                // Region results come from helpers (tile ranks); everything else from the master.
+                const bool from_helper = std::holds_alternative<RegionMsg>(m);
+                if (from_helper == (e->from == kMasterRank))
+                    throw WireError(std::string("a ") + to_string(e->tag) + " message from rank " +
+                                    std::to_string(e->from) + ", which does not send them");
+                const bool release = std::holds_alternative<ReleaseMsg>(m);
                 inbox_.push(std::move(m));
-                if (quit) return;
+                if (release) return;
             }
         } catch (...) {
             inbox_.close(std::current_exception());
@@ -53,30 +60,40 @@ class TileRank {
     TileRank(Comm& comm, TileSetup& setup)
         : comm_(comm),
           setup_(setup),
-          sink_(setup.renderer),
-          engine_(setup.extractor, setup.renderer, options()) {}
+          engine_(setup.extractor, setup.renderer, options()),
+          jobs_(engine_, setup.renderer, setup.help_renderer, setup.measure) {}
 
     int run() {
+        if (setup_.tile_width > 0) jobs_.prepare(setup_.tile_width, setup_.tile_height);
         send_message(comm_, kMasterRank, HelloMsg{comm_.host()});
         Receiver receiver(comm_, inbox_);
+        bool quit = false;
         for (;;) {
             trace_.switch_to(Stage::idle);
             std::optional<Message> m = inbox_.pop();
             trace_.switch_to(Stage::comm);
+            if (!m) {
+                // snapshot requests only: answered below
+            } else if (auto* v = std::get_if<ViewMsg>(&*m)) {
+                begin(*v);
+            } else if (auto* j = std::get_if<JobMsg>(&*m)) {
+                if (!quit) job(*j);
+            } else if (auto* r = std::get_if<RegionMsg>(&*m)) {
+                if (!quit) land(*r);
+            } else if (std::holds_alternative<QuitMsg>(*m)) {
+                quit = true;
+                send_result();
+                send_image();
+            } else if (std::holds_alternative<ReleaseMsg>(*m) && quit) {
+                return 0;
+            } else {
+                throw WireError(std::string("a tile does not take ") + to_string(tag_of(*m)) +
+                                " messages" + (quit ? " after quit" : ""));
+            }
             // A view first, snapshots after: a request that came with the view is about that
             // view's frame (answered from it in flight), never about the frame before it, which
             // before the first view is the renderer's 16x16 warm-up.
-            if (m && std::holds_alternative<ViewMsg>(*m)) {
-                frame(std::get<ViewMsg>(*m));
-            } else if (m && std::holds_alternative<QuitMsg>(*m)) {
-                send_result();
-                send_image();
-                return 0;
-            } else if (m) {
-                throw WireError(std::string("a tile does not take ") + to_string(tag_of(*m)) +
-                                " messages");
-            }
-            answer_snapshots();
+            if (jobs_.started()) answer_snapshots();
         }
     }
 
@@ -88,32 +105,58 @@ class TileRank {
         return opt;
     }
 
-    void frame(const ViewMsg& v) {
+    void begin(const ViewMsg& v) {
         if (setup_.fault.kind == "hang") inbox_.wait_closed();
         if (setup_.fault.kind == "exit") std::_Exit(3);
         if (setup_.fault.kind == "throw") throw std::runtime_error("test fault: a tile throws");
-        generation_ = v.generation;
-        const double cpu0 = thread_cpu_seconds();
-        FrameResult fr =
-            engine_.run(v.view, v.region, sink_, inbox_.stop_flag(), [&](const TimelineSample& s) {
-                const Stage left = trace_.switch_to(Stage::comm);
-                send_message(comm_, kMasterRank,
-                             ProgressMsg{generation_, s.rays, false, thread_cpu_seconds() - cpu0});
-                answer_snapshots();
-                trace_.switch_to(left);
-            });
-        result_.cpu_s += thread_cpu_seconds() - cpu0;
-        result_.frame_s += fr.elapsed_s;
-        ++result_.frames;
-        result_.rays += fr.rays_cast;
-        result_.groups += fr.group_count;
-        result_.triangles = fr.timeline.empty() ? 0 : fr.timeline.back().triangles;
-        trace_.switch_to(Stage::comm);
-        if (fr.completed)
+        close_frame();
+        jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
+            const Stage left = trace_.switch_to(Stage::comm);
             send_message(comm_, kMasterRank,
-                         ProgressMsg{generation_, fr.rays_cast, true, thread_cpu_seconds() - cpu0});
-        else
-            ++result_.interrupted;
+                         ProgressMsg{jobs_.generation(), s.rays, thread_cpu_seconds() - cpu0_});
+            answer_snapshots();
+            trace_.switch_to(left);
+        });
+        cpu0_ = thread_cpu_seconds();
+        ++result_.frames;
+    }
+
+    // The figures of the frame that ends (a new view or quit).
+    void close_frame() {
+        if (!jobs_.started()) return;
+        result_.cpu_s += jobs_.busy_cpu_s();
+        result_.rays += jobs_.now().rays;
+        result_.groups += jobs_.now().groups;
+        result_.triangles = jobs_.now().triangles;
+        if (interrupted_) ++result_.interrupted;
+        interrupted_ = false;
+    }
+
+    void job(const JobMsg& j) {
+        // Jobs of an older frame are dropped: the master no longer counts on them.
+        if (!jobs_.started() || j.generation != jobs_.generation()) return;
+        TileJobs::Outcome out = jobs_.run(j, comm_.rank());
+        trace_.switch_to(Stage::comm);
+        if (!out.completed) {
+            interrupted_ = true;
+            return;
+        }
+        if (out.result) {
+            const auto bytes = encode(*out.result);
+            out.done.bytes = bytes.size();
+            result_.bytes_sent += bytes.size();
+            comm_.send(j.owner, Tag::region, bytes);
+            ++result_.jobs_helped;
+        } else {
+            ++result_.jobs_own;
+        }
+        send_message(comm_, kMasterRank, out.done);
+    }
+
+    void land(const RegionMsg& r) {
+        if (!jobs_.started() || r.generation != jobs_.generation()) return;  // an older frame's
+        jobs_.land(r);
+        send_message(comm_, kMasterRank, LandedMsg{r.generation, r.job});
     }
 
     void answer_snapshots() {
@@ -121,10 +164,9 @@ class TileRank {
     }
 
     void send_image() {
-        Image img;
-        sink_.read_back(img);
+        Image img = jobs_.started() ? jobs_.image() : Image{};
         ImageMsg m;
-        m.generation = generation_;
+        m.generation = jobs_.generation();
         m.width = img.width;
         m.height = img.height;
         m.rgba = std::move(img.rgba);
@@ -132,6 +174,8 @@ class TileRank {
     }
 
     void send_result() {
+        if (setup_.measure && jobs_.started()) result_.curve = jobs_.curve(result_.significant);
+        close_frame();
         result_.host = comm_.host();
         result_.rss_mib = current_rss_mib();
         trace_.close();
@@ -142,11 +186,12 @@ class TileRank {
     Comm& comm_;
     TileSetup& setup_;
     TraceRecorder trace_;
-    RendererSink sink_;
     ProgressiveEngine engine_;
+    TileJobs jobs_;
     TileInbox inbox_;
-    std::uint64_t generation_ = 0;
     TileResultMsg result_;
+    double cpu0_ = 0;
+    bool interrupted_ = false;
 };
 
 }  // namespace

@@ -1,9 +1,11 @@
 #pragma once
 // A tile rank of a wall run: frames of its own frustum until the master says quit. Two threads:
-// the communication thread receives from the master into a TileInbox (raising the stop flag when
-// a new view or quit arrives); the frame thread (the caller's) runs the engine, sends progress at
-// every progress point, answers snapshot requests from the frame being built, and at quit sends
-// its figures, trace and final image.
+// the communication thread receives from the master and from helpers into a TileInbox (raising
+// the stop flag when a new view or quit arrives); the frame thread (the caller's) runs the jobs
+// the master hands it (tile/tile_jobs.h), for its own tile or another's, sends progress at every
+// progress point, lands helpers' results, answers snapshot requests from the frame being built,
+// and at quit sends its figures, trace and final image, then stays until the master releases it
+// (a helper's result may still be on its way to it).
 #include <string>
 
 #include "comm/comm.h"
@@ -22,9 +24,12 @@ struct TileFault {
 
 struct TileSetup {
     SurfaceExtractor& extractor;
-    Renderer& renderer;
+    Renderer& renderer;       // the tile's own frame
+    Renderer& help_renderer;  // the regions it fills for other tiles
     EngineOptions engine;
     TileFault fault;
+    bool measure = false;  // keep each job's result for the emulated correctness curve
+    int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up
 };
 
 // Returns 0 after quit; throws on any failure (the caller's single failure path reports it).

@@ -95,6 +95,20 @@ Camera orbit(const Camera& c, float yaw_deg, float pitch_deg) {
     return out;
 }
 
+Camera pan(const Camera& c, float dx, float dy, float aspect) {
+    const glm::vec3 forward = glm::normalize(c.target - c.eye);
+    const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+    const glm::vec3 up = glm::cross(right, forward);
+    const float height = c.projection == Projection::perspective
+                             ? 2.0f * c.distance() * std::tan(glm::radians(c.fovy_deg) * 0.5f)
+                             : c.ortho_height;
+    const glm::vec3 offset = right * (dx * height * aspect) + up * (dy * height);
+    Camera out = c;
+    out.eye += offset;
+    out.target += offset;
+    return out;
+}
+
 Camera zoom(const Camera& c, float factor) {
     Camera out = c;
     if (c.projection == Projection::perspective) {

@@ -54,6 +54,10 @@ Camera front_full_view(const Box3& bounds, float aspect,
 
 // Rotate the eye around the target: yaw about the up vector, pitch about the right vector.
 Camera orbit(const Camera& c, float yaw_deg, float pitch_deg);
+// Moves eye and target together in the view plane by dx screen widths (positive: the view moves
+// right, so the scene moves left) and dy screen heights (positive: the view moves up), measured
+// at the target's distance on a screen of the given aspect (width / height).
+Camera pan(const Camera& c, float dx, float dy, float aspect);
 // factor > 1 moves closer (perspective) or narrows the view (orthographic).
 Camera zoom(const Camera& c, float factor);
 

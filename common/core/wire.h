@@ -33,7 +33,12 @@ concept WireScalar = std::is_trivially_copyable_v<T> &&
 
 class MessageWriter {
   public:
-    explicit MessageWriter(std::uint8_t version) { put(version); }
+    // The first bytes are reserved at once: besides saving regrowth, it keeps GCC 12 from a
+    // false -Wstringop-overflow when many encoders are inlined into one std::visit.
+    explicit MessageWriter(std::uint8_t version) {
+        bytes_.reserve(64);
+        put(version);
+    }
 
     template <WireScalar T>
     void put(T value) {

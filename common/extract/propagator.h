@@ -23,6 +23,8 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
 
 #include "common/extract/adaptive.h"
 #include "common/extract/group.h"
@@ -33,12 +35,32 @@ namespace isowall {
 
 enum class PropagationMode { max_count, cutoff_angle };
 
+// Keeps a pass to the cells whose projection may touch one screen region (a wall job's region,
+// or a tile): `clip_from_voxel` maps voxel space to the clip space of that region's own frustum,
+// and a cell is entered when its centre, widened by its projected half-diagonal, falls inside
+// NDC [-1, 1]^2. A cell left out stays unvisited, so a later ray that hits it seeds it then: the
+// image is the same, but no pass extracts surface that its region cannot show.
+struct ScreenClip {
+    bool active = false;
+    glm::mat4 clip_from_voxel{1.0f};
+    float ndc_per_unit = 1;       // max(|P00|, |P11|) of the projection: NDC per view unit at w = 1
+    float half_diagonal = 0.87f;  // half the diagonal of one cell, in object units
+
+    bool may_touch(glm::vec3 centre, int stride) const {
+        const glm::vec4 c = clip_from_voxel * glm::vec4(centre, 1.0f);
+        if (c.w <= 1e-6f) return true;  // at or behind the eye: no bound
+        const float r = half_diagonal * float(stride) * ndc_per_unit / c.w;
+        return std::abs(c.x / c.w) - r <= 1.0f && std::abs(c.y / c.w) - r <= 1.0f;
+    }
+};
+
 struct PropagationParams {
     PropagationMode mode = PropagationMode::max_count;
     int max_count = 2000;        // measured best on vhp_ct_head skin and bone (README, Benchmarks)
     float cutoff_rad = 0.0349f;  // 2 degrees
     float foldback_rad = 0.0087f;  // 0.5 degree
     bool interpolant_cache = true;
+    ScreenClip clip;  // inactive: no limit on screen
 };
 
 // Without the interpolant cache every triangle gets its own three vertices (the "caching off"
@@ -109,6 +131,7 @@ class Propagator {
                 if (visited.contains(nb)) continue;
                 if (resolution_.max_level() > 0 && resolution_.level_of(nb) != level)
                     continue;  // the resolution boundary
+                if (p.clip.active && !p.clip.may_touch(glm::vec3(nb) + half, stride)) continue;
                 float max_angle = item.max_angle;
                 if (p.mode == PropagationMode::max_count) {
                     if (taken >= p.max_count) continue;

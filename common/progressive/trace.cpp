@@ -8,14 +8,11 @@
 #include <stdexcept>
 
 namespace isowall {
-namespace {
 
 double wall_now_s() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
         .count();
 }
-
-}  // namespace
 
 double thread_cpu_seconds() {
     timespec ts{};
@@ -59,7 +56,8 @@ std::vector<double> TraceRecorder::cpu_by_stage() const {
     return sum;
 }
 
-void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks) {
+void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks,
+                        const std::vector<TraceFlow>& flows) {
     std::ofstream out(path);
     if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
     double t0 = 0;
@@ -89,6 +87,19 @@ void write_chrome_trace(const std::filesystem::path& path, const std::vector<Ran
                 s.cpu_s * 1e3);
             out << line;
         }
+    }
+    // Flow events bind to the slice that encloses them on each track ("bp": "e" at the end).
+    for (std::size_t i = 0; i < flows.size(); ++i) {
+        const TraceFlow& f = flows[i];
+        std::snprintf(line, sizeof(line),
+                      ",\n{\"name\": \"%s\", \"cat\": \"job\", \"ph\": \"s\", \"id\": %zu, "
+                      "\"pid\": %d, \"tid\": 0, \"ts\": %.1f, \"args\": {\"bytes\": %llu}}"
+                      ",\n{\"name\": \"%s\", \"cat\": \"job\", \"ph\": \"f\", \"bp\": \"e\", "
+                      "\"id\": %zu, \"pid\": %d, \"tid\": 0, \"ts\": %.1f}",
+                      f.name.c_str(), i, f.from_rank, (f.start_s - t0) * 1e6,
+                      (unsigned long long)f.bytes, f.name.c_str(), i, f.to_rank,
+                      (f.end_s - t0) * 1e6);
+        out << line;
     }
     out << "\n]}\n";
     if (!out) throw std::runtime_error(path.string() + ": write failed");

@@ -23,6 +23,8 @@ inline constexpr const char* kTraceStages[] = {"intersection", "propagation", "r
 enum class Stage : std::uint8_t { intersection, propagation, render, comm, idle, compose, setup };
 
 double thread_cpu_seconds();
+// Wall clock, seconds since the Unix epoch: the time base of spans (aligned across ranks).
+double wall_now_s();
 
 class TraceRecorder {
   public:
@@ -48,9 +50,19 @@ struct RankTrace {
     std::vector<TraceSpan> spans;
 };
 
+// An arrow between two ranks' tracks (a screen-region job migrated from its owner to a helper, or
+// its result going back), drawn from (from_rank, at start_s) to (to_rank, at end_s).
+struct TraceFlow {
+    int from_rank = 0, to_rank = 0;
+    double start_s = 0, end_s = 0;  // wall clock, the spans' time base
+    std::string name;
+    std::uint64_t bytes = 0;
+};
+
 // Chrome trace-event JSON (opens in Perfetto / chrome://tracing): one process per rank, one
-// complete event per span, with its CPU milliseconds in args.
-void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks);
+// complete event per span, with its CPU milliseconds in args, and one flow event pair per flow.
+void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks,
+                        const std::vector<TraceFlow>& flows = {});
 // rank,label,stage,start_s,wall_s,cpu_s
 void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks);
 

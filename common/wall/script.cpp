@@ -58,6 +58,10 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
         if (f <= 0) throw InputError(where, c, "expected a positive factor, got " + w[1]);
         return ZoomCmd{float(f)};
     }
+    if (c == "pan") {
+        expect_args(w, 2, where, "pan DX DY");
+        return PanCmd{float(num(1)), float(num(2))};
+    }
     if (c == "iso") {
         expect_args(w, 1, where, "iso V");
         return IsoCmd{num(1)};
@@ -84,7 +88,7 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     }
     throw InputError(where, "command",
                      "unknown command \"" + c +
-                         "\" (expected orbit, look-at, zoom, iso, wait, snapshot or quit)");
+                         "\" (expected orbit, look-at, zoom, pan, iso, wait, snapshot or quit)");
 }
 
 std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file) {

@@ -3,6 +3,7 @@
 //   orbit YAW PITCH            turn the camera about the volume centre (degrees)
 //   look-at EX EY EZ TX TY TZ  eye and target in object space
 //   zoom F                     F > 1 moves closer
+//   pan DX DY                  move the view by DX screen widths right and DY heights up
 //   iso V                      new isovalue
 //   wait rays N | wait time S | wait done
 //   snapshot NAME              write the mosaic as NAME.png
@@ -27,6 +28,9 @@ struct LookAtCmd {
 struct ZoomCmd {
     float factor = 1;
 };
+struct PanCmd {
+    float dx = 0, dy = 0;
+};
 struct IsoCmd {
     double iso = 0;
 };
@@ -40,7 +44,7 @@ struct SnapshotCmd {
 struct QuitCmd {};
 
 using ScriptCommand =
-    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
+    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages

@@ -1,0 +1,138 @@
+#include "master/job_board.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "common/core/ray.h"
+
+namespace isowall {
+
+std::vector<PixelRect> cut_into_regions(int width, int height, int region_w, int region_h) {
+    if (region_w <= 0 || region_w > width) region_w = width;
+    if (region_h <= 0 || region_h > height) region_h = height;
+    std::vector<PixelRect> out;
+    for (int y = 0; y < height; y += region_h)
+        for (int x = 0; x < width; x += region_w)
+            out.push_back({x, y, std::min(region_w, width - x), std::min(region_h, height - y)});
+    return out;
+}
+
+std::vector<double> estimated_rays(const FrameView& view, const std::vector<PixelRect>& regions,
+                                   const Box3& bounds, bool screen_box) {
+    const PixelRect box = screen_box ? isowall::screen_box(bounds, view.camera.view(),
+                                                           view.frustum, view.width, view.height)
+                                     : view.screen();
+    std::vector<double> out;
+    for (const PixelRect& r : regions) {
+        const int w = std::min(r.x + r.width, box.x + box.width) - std::max(r.x, box.x);
+        const int h = std::min(r.y + r.height, box.y + box.height) - std::max(r.y, box.y);
+        out.push_back(w > 0 && h > 0 ? double(w) * double(h) : 0.0);
+    }
+    return out;
+}
+
+namespace {
+constexpr double kCoarseShare = 1.0 / 16.0;  // the coarse band ends after ~1/16 of the rays
+}
+
+JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
+                   const std::vector<std::vector<double>>& rays, bool balance, int depth)
+    : balance_(balance),
+      depth_(depth),
+      in_hand_(regions.size(), 0),
+      cpu_(regions.size(), 0.0),
+      rays_(regions.size(), 0.0) {
+    for (std::size_t owner = 0; owner < regions.size(); ++owner) {
+        for (std::size_t i = 0; i < regions[owner].size(); ++i) {
+            const double r = rays.at(owner).at(i);
+            if (r <= 0) continue;
+            BoardJob coarse;
+            coarse.owner = static_cast<int>(owner);
+            coarse.rect = regions[owner][i];
+            coarse.holder = coarse.owner;
+            coarse.rays = r * kCoarseShare;
+            BoardJob fine = coarse;
+            fine.band = Band::fine;
+            fine.rays = r - coarse.rays;
+            fine.coarse = static_cast<std::uint32_t>(jobs_.size());
+            jobs_.push_back(coarse);
+            jobs_.push_back(fine);  // always right after its coarse job
+        }
+    }
+}
+
+double JobBoard::cost(const BoardJob& j) const {
+    const auto o = static_cast<std::size_t>(j.owner);
+    if (rays_[o] > 0) return j.rays * cpu_[o] / rays_[o];
+    double cpu = 0, rays = 0;
+    for (std::size_t i = 0; i < cpu_.size(); ++i) cpu += cpu_[i], rays += rays_[i];
+    return j.rays * (rays > 0 ? cpu / rays : 1e-6);
+}
+
+std::optional<std::uint32_t> JobBoard::steal(Band band) const {
+    std::vector<double> work(in_hand_.size(), 0.0);
+    std::vector<std::optional<std::uint32_t>> last(in_hand_.size());
+    for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
+        const BoardJob& j = jobs_[id];
+        if (j.state != BoardJob::State::queued || j.band != band) continue;
+        const auto k = static_cast<std::size_t>(key(j));
+        work[k] += cost(j);
+        last[k] = id;
+    }
+    const auto most = std::max_element(work.begin(), work.end()) - work.begin();
+    return last[static_cast<std::size_t>(most)];
+}
+
+std::optional<std::uint32_t> JobBoard::pick(int rank) const {
+    auto first = [&](Band band) -> std::optional<std::uint32_t> {
+        for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
+            const BoardJob& j = jobs_[id];
+            if (j.state == BoardJob::State::queued && j.band == band && key(j) == rank) return id;
+        }
+        return std::nullopt;
+    };
+    if (auto id = first(Band::coarse)) return id;
+    if (balance_)
+        if (auto id = steal(Band::coarse)) return id;
+    if (auto id = first(Band::fine)) return id;
+    if (balance_) return steal(Band::fine);
+    return std::nullopt;
+}
+
+std::optional<std::uint32_t> JobBoard::next_for(int rank) {
+    if (rank < 0 || static_cast<std::size_t>(rank) >= in_hand_.size())
+        throw std::out_of_range("job board: no rank " + std::to_string(rank));
+    if (in_hand_[static_cast<std::size_t>(rank)] >= depth_) return std::nullopt;
+    const auto id = pick(rank);
+    if (!id) return std::nullopt;
+    BoardJob& j = jobs_[*id];
+    j.state = BoardJob::State::running;
+    j.worker = rank;
+    if (rank != j.owner) ++migrated_;
+    if (j.band == Band::coarse) jobs_[*id + 1].holder = rank;  // its fine band follows it
+    ++in_hand_[static_cast<std::size_t>(rank)];
+    return id;
+}
+
+void JobBoard::done(std::uint32_t id, std::uint64_t rays, double cpu_s) {
+    BoardJob& j = jobs_.at(id);
+    if (j.state != BoardJob::State::running)
+        throw std::runtime_error("job " + std::to_string(id) + " reported done but not running");
+    j.state = BoardJob::State::done;
+    --in_hand_[static_cast<std::size_t>(j.worker)];
+    cpu_[static_cast<std::size_t>(j.owner)] += cpu_s;
+    rays_[static_cast<std::size_t>(j.owner)] += static_cast<double>(rays);
+    if (has_landed(j)) ++landed_;
+}
+
+void JobBoard::landed(std::uint32_t id) {
+    BoardJob& j = jobs_.at(id);
+    if (j.state == BoardJob::State::queued || j.worker == j.owner || j.arrived)
+        throw std::runtime_error("job " + std::to_string(id) +
+                                 " reported landed but no helper's result was due");
+    j.arrived = true;
+    if (has_landed(j)) ++landed_;
+}
+
+}  // namespace isowall

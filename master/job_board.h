@@ -1,0 +1,87 @@
+#pragma once
+// The screen-region scheduler's state (dissertation, section 5.2.2): which job each rank runs,
+// pure and without messages, so the policy is tested alone. Every tile's screen is cut into
+// regions; each region is two jobs, its coarse band then its fine band (see Band). A rank asks for
+// work whenever it has fewer than `depth` jobs in hand and gets, in this order:
+//   1. a coarse job of its own tile;
+//   2. (balancing) a coarse job of the tile with the most estimated work left: coarse levels over
+//      every tile come before fine levels anywhere;
+//   3. a fine job whose coarse band it cast itself (it holds that region's ray order and its
+//      groups, so nothing is cast twice);
+//   4. (balancing) a fine job of the rank with the most estimated work left: the region is cast
+//      again from its first level by the helper, whose image must show all of it.
+// Stolen jobs are taken from the end of a queue, the owner works from its front. Estimated work is
+// a job's rays (its region inside the volume's screen box, 1/16 of them coarse) times the recent
+// CPU cost per ray of its tile.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "comm/protocol.h"
+#include "common/core/box.h"
+#include "common/core/camera.h"
+#include "common/core/view.h"
+
+namespace isowall {
+
+// The regions of a tile of `width` x `height` pixels, `region_w` x `region_h` each (the last row
+// and column smaller), in row-major order. Sizes <= 0 or larger than the tile mean the whole tile.
+std::vector<PixelRect> cut_into_regions(int width, int height, int region_w, int region_h);
+
+// The rays each region of `view`'s screen will cast: its pixels inside the volume's screen box
+// (all its pixels when `screen_box` is off, as the engine does).
+std::vector<double> estimated_rays(const FrameView& view, const std::vector<PixelRect>& regions,
+                                   const Box3& bounds, bool screen_box);
+
+struct BoardJob {
+    int owner = 0;
+    PixelRect rect;
+    Band band = Band::coarse;
+    double rays = 0;  // estimated rays
+    enum class State : std::uint8_t { queued, running, done } state = State::queued;
+    bool arrived = false;  // the owner has composited the helper's result (helpers only)
+    int worker = -1;  // the rank it was handed to
+    int holder = -1;  // the rank whose turn it is (the owner, or who cast the coarse band)
+    std::uint32_t coarse = 0;  // fine jobs: the id of the region's coarse job
+};
+
+class JobBoard {
+  public:
+    // regions[rank] and rays[rank]: the rank's regions and the estimated rays of each (rank 0,
+    // the master, has none). Regions with no estimated ray get no job.
+    JobBoard(const std::vector<std::vector<PixelRect>>& regions,
+             const std::vector<std::vector<double>>& rays, bool balance, int depth = 2);
+
+    // The next job for `rank`, now marked running, or nullopt when it has `depth` jobs in hand
+    // or none is left for it.
+    std::optional<std::uint32_t> next_for(int rank);
+    // The worker finished: frees its slot and learns the cost per ray. A job has landed once it
+    // is done and, when a helper ran it, the owner has its result (the two messages come from
+    // different ranks, so in either order).
+    void done(std::uint32_t id, std::uint64_t rays, double cpu_s);
+    void landed(std::uint32_t id);
+
+    const BoardJob& job(std::uint32_t id) const { return jobs_.at(id); }
+    std::size_t size() const { return jobs_.size(); }
+    bool complete() const { return landed_ == jobs_.size(); }
+    bool has_landed(const BoardJob& j) const {
+        return j.state == BoardJob::State::done && (j.worker == j.owner || j.arrived);
+    }
+    int in_hand(int rank) const { return in_hand_.at(static_cast<std::size_t>(rank)); }
+    std::size_t migrated() const { return migrated_; }  // jobs run by a rank other than the owner
+
+  private:
+    std::optional<std::uint32_t> pick(int rank) const;
+    std::optional<std::uint32_t> steal(Band band) const;
+    double cost(const BoardJob& j) const;
+    int key(const BoardJob& j) const { return j.band == Band::coarse ? j.owner : j.holder; }
+
+    std::vector<BoardJob> jobs_;
+    bool balance_;
+    int depth_;
+    std::vector<int> in_hand_;
+    std::vector<double> cpu_, rays_;  // by owner: CPU seconds and rays of the jobs done
+    std::size_t landed_ = 0, migrated_ = 0;
+};
+
+}  // namespace isowall

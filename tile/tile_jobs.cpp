@@ -1,0 +1,197 @@
+#include "tile/tile_jobs.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/core/image_ops.h"
+#include "common/core/ray.h"
+#include "common/core/wire.h"
+#include "common/progressive/correctness.h"
+#include "common/progressive/trace.h"
+
+namespace isowall {
+
+FrameView region_view(const FrameView& owner, const PixelRect& rect) {
+    FrameView v = owner;
+    v.frustum = sub_frustum(owner.frustum, owner.width, owner.height, rect);
+    v.width = rect.width;
+    v.height = rect.height;
+    return v;
+}
+
+// Where a job's groups go: every group is kept with its bounds (to draw it again into later
+// region images), drawn into the help image when the job is for another tile, and drawn into the
+// rank's own tile when it may show there. A group whose bounds project outside the tile cannot be
+// what a later ray of the tile hits, so leaving it out of the tile loses nothing.
+class TileJobs::JobSink final : public GroupSink {
+  public:
+    JobSink(TileJobs& jobs, GroupSink* help) : jobs_(jobs), help_(help) {}
+    void add(const Group& group) override {
+        Box3 b;
+        for (const glm::vec3& p : group.mesh.positions) b.merge(p);
+        if (help_) help_->add(group);
+        if (jobs_.shows(b, jobs_.own_)) jobs_.tile_sink_.add(group);
+        jobs_.groups_.push_back({group, b});
+    }
+    double present() override {
+        return (help_ ? help_->present() : 0.0) + jobs_.tile_sink_.present();
+    }
+    bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
+        return help_ ? help_->coverage(covered, rect) : jobs_.tile_sink_.coverage(covered, rect);
+    }
+
+  private:
+    TileJobs& jobs_;
+    GroupSink* help_;
+};
+
+bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
+    if (bounds.empty()) return false;
+    const PixelRect on = screen_box(bounds, view.camera.view(), view.frustum, view.width,
+                                    view.height);
+    return on.width > 0 && on.height > 0;
+}
+
+TileJobs::TileJobs(ProgressiveEngine& engine, Renderer& tile, Renderer& help, bool measure)
+    : engine_(engine), tile_sink_(tile), help_sink_(help), measure_(measure) {
+    warm_up(help);
+}
+
+void TileJobs::prepare(int width, int height) {
+    tile_sink_.begin(FrameView{Camera{}, Frustum{}, width, height, 0.0});
+    tile_sink_.present();
+    landed_.resize(width, height);
+}
+
+void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
+                     const ProgressiveEngine::Progress& progress) {
+    const double c0 = thread_cpu_seconds();
+    cpu0_ = c0;
+    frame_.reset();
+    generation_ = v.generation;
+    own_ = v.view;
+    groups_.clear();
+    cursors_.clear();
+    shots_.clear();
+    last_draw_s_ = 0;
+    if (landed_any_ || landed_.width != own_.width || landed_.height != own_.height)
+        landed_.resize(own_.width, own_.height);
+    landed_any_ = false;
+    frame_ = std::make_unique<EngineFrame>(engine_, own_, stop, progress);
+    tile_sink_.begin(own_);
+    busy_cpu_s_ = thread_cpu_seconds() - c0;
+}
+
+void TileJobs::draw_earlier_groups(const FrameView& view) {
+    for (const Recorded& r : groups_)
+        if (shows(r.bounds, view)) help_sink_.add(r.group);
+}
+
+TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
+    const double c0 = thread_cpu_seconds();
+    Outcome out;
+    out.done.generation = job.generation;
+    out.done.job = job.job;
+    out.done.start_s = wall_now_s();
+    const bool own = job.owner == rank;
+    const FrameView view = own ? own_ : region_view(job.view, job.rect);
+    const PixelRect region = own ? job.rect : view.screen();
+    const auto key = std::make_tuple(job.owner, job.rect.x, job.rect.y);
+    auto it = cursors_.find(key);
+    if (it == cursors_.end()) it = cursors_.emplace(key, frame_->cursor(view, region)).first;
+    RegionCursor& cursor = it->second;
+
+    if (!own) {
+        help_sink_.begin(view);
+        draw_earlier_groups(view);
+    }
+    JobSink sink(*this, own ? nullptr : &help_sink_);
+    const std::size_t area = static_cast<std::size_t>(std::max(0, cursor.rect.width)) *
+                             static_cast<std::size_t>(std::max(0, cursor.rect.height));
+    const std::size_t limit =
+        job.band == Band::coarse ? std::max<std::size_t>(1, area / 16) : SIZE_MAX;
+    const TimelineSample before = frame_->now();
+    out.completed = frame_->cast(view, cursor, sink, limit);
+    const TimelineSample& after = frame_->now();
+    out.done.rays = after.rays - before.rays;
+    out.done.groups = after.groups - before.groups;
+    out.done.triangles = after.triangles - before.triangles;
+    const double c1 = thread_cpu_seconds();
+    out.done.cpu_s = c1 - c0;
+    out.done.cpu_end_s = c1 - cpu0_;
+    out.done.end_s = wall_now_s();
+    last_draw_s_ = out.done.cpu_end_s;
+    if (out.completed && !own) {
+        Image img;
+        help_sink_.read_back(img);
+        RegionMsg r;
+        r.generation = job.generation;
+        r.job = job.job;
+        r.rect = job.rect;
+        r.cpu_end_s = out.done.cpu_end_s;
+        r.rgba = std::move(img.rgba);
+        r.depth = std::move(img.depth);
+        out.result = std::move(r);
+    } else if (out.completed && measure_) {
+        Image img;
+        tile_sink_.read_back(img, job.rect);
+        shots_.push_back({out.done.cpu_end_s, job.rect, std::move(img), true});
+    }
+    busy_cpu_s_ += thread_cpu_seconds() - c0;
+    return out;
+}
+
+void TileJobs::land(const RegionMsg& m) {
+    const double c0 = thread_cpu_seconds();
+    if (m.rect.x < 0 || m.rect.y < 0 || m.rect.x + m.rect.width > own_.width ||
+        m.rect.y + m.rect.height > own_.height)
+        throw WireError("region message: rect: outside this tile's " + std::to_string(own_.width) +
+                        "x" + std::to_string(own_.height) + " screen");
+    Image img;
+    img.width = m.rect.width;
+    img.height = m.rect.height;
+    img.rgba = m.rgba;
+    img.depth = m.depth;
+    composite_by_depth(landed_, img, m.rect);
+    landed_any_ = true;
+    if (measure_) shots_.push_back({m.cpu_end_s, m.rect, std::move(img), false});
+    busy_cpu_s_ += thread_cpu_seconds() - c0;
+}
+
+Image TileJobs::image() {
+    Image img;
+    tile_sink_.read_back(img);
+    if (landed_any_) composite_by_depth(img, landed_, own_.screen());
+    return img;
+}
+
+std::vector<CurvePoint> TileJobs::curve(std::uint64_t& significant) {
+    const Image final_image = image();
+    std::stable_sort(shots_.begin(), shots_.end(),
+                     [](const Shot& a, const Shot& b) { return a.emulated_s < b.emulated_s; });
+    Image own, shown;
+    own.resize(own_.width, own_.height);
+    Image helped = own;
+    std::vector<CurvePoint> out;
+    significant = measure_correctness(own, final_image).significant;
+    for (const Shot& s : shots_) {
+        if (s.own)
+            place(own, s.image, s.rect);
+        else
+            composite_by_depth(helped, s.image, s.rect);
+        shown = own;
+        composite_by_depth(shown, helped, own_.screen());
+        const Correctness c = measure_correctness(shown, final_image);
+        const double n = static_cast<double>(c.significant);
+        out.push_back({s.emulated_s, static_cast<std::uint64_t>(std::llround(c.final_pixels * n)),
+                       (1.0 - c.c) * (1.0 - c.c) * n});
+    }
+    // The crops above miss what later jobs drew outside their own regions; once this rank's last
+    // job and the last helper's result are in, the tile shows its final image.
+    double end_s = last_draw_s_;
+    for (const Shot& s : shots_) end_s = std::max(end_s, s.emulated_s);
+    out.push_back({end_s, significant, 0.0});
+    return out;
+}
+
+}  // namespace isowall
