@@ -7,7 +7,6 @@
 namespace isowall::wire_pieces {
 namespace {
 
-
 glm::vec3 get_finite_vec3(MessageReader& r, const char* field) {
     const glm::vec3 v = r.get_vec3();
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))

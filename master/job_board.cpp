@@ -20,8 +20,8 @@ std::vector<PixelRect> cut_into_regions(int width, int height, int region_w, int
 
 std::vector<double> estimated_rays(const FrameView& view, const std::vector<PixelRect>& regions,
                                    const Box3& bounds, bool screen_box) {
-    const PixelRect box = screen_box ? isowall::screen_box(bounds, view.camera.view(),
-                                                           view.frustum, view.width, view.height)
+    const PixelRect box = screen_box ? isowall::screen_box(bounds, view.camera.view(), view.frustum,
+                                                           view.width, view.height)
                                      : view.screen();
     std::vector<double> out;
     for (const PixelRect& r : regions) {

@@ -39,9 +39,9 @@ struct BoardJob {
     Band band = Band::coarse;
     double rays = 0;  // estimated rays
     enum class State : std::uint8_t { queued, running, done } state = State::queued;
-    bool arrived = false;  // the owner has composited the helper's result (helpers only)
-    int worker = -1;  // the rank it was handed to
-    int holder = -1;  // the rank whose turn it is (the owner, or who cast the coarse band)
+    bool arrived = false;      // the owner has composited the helper's result (helpers only)
+    int worker = -1;           // the rank it was handed to
+    int holder = -1;           // the rank whose turn it is (the owner, or who cast the coarse band)
     std::uint32_t coarse = 0;  // fine jobs: the id of the region's coarse job
 };
 

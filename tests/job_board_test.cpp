@@ -34,7 +34,7 @@ TEST(JobBoard, RegionsCoverTheTileOnce) {
     EXPECT_EQ(regions[3].width, 36);
     EXPECT_EQ(regions[3].height, 2);
     EXPECT_EQ(cut_into_regions(1024, 768, 256, 192).size(), 16u);
-    ASSERT_EQ(cut_into_regions(1024, 768, 0, 0).size(), 1u);         // "tile"
+    ASSERT_EQ(cut_into_regions(1024, 768, 0, 0).size(), 1u);            // "tile"
     EXPECT_EQ(cut_into_regions(1024, 768, 4096, 4096)[0].width, 1024);  // larger than the tile
 }
 

@@ -31,11 +31,23 @@ TEST(ProtocolJobs, JobFaultsThrowNamingTheField) {
         {"rect", [](JobMsg& m) { m.rect.y = -1; }},
         {"rect", [](JobMsg& m) { m.rect.width = 0; }},  // an empty job has nothing to cast
         {"rect", [](JobMsg& m) { m.rect.height = -1; }},
-        {"rect", [](JobMsg& m) { m.rect = {1601, 0, 320, 240}; }},  // one past the right
-        {"rect", [](JobMsg& m) { m.rect = {0, 841, 320, 240}; }},   // one past the bottom
+        {"rect",
+         [](JobMsg& m) {
+             m.rect = {1601, 0, 320, 240};
+         }},  // one past the right
+        {"rect",
+         [](JobMsg& m) {
+             m.rect = {0, 841, 320, 240};
+         }},  // one past the bottom
         // x + width wraps around in 32 bits and would pass a naive check
-        {"rect", [](JobMsg& m) { m.rect = {10, 0, kIntMax, 240}; }},
-        {"rect", [](JobMsg& m) { m.rect = {0, 10, 320, kIntMax}; }},
+        {"rect",
+         [](JobMsg& m) {
+             m.rect = {10, 0, kIntMax, 240};
+         }},
+        {"rect",
+         [](JobMsg& m) {
+             m.rect = {0, 10, 320, kIntMax};
+         }},
     };
     for (const JobFault& f : faults) {
         JobMsg m = sample_job();
@@ -70,7 +82,10 @@ TEST(ProtocolJobs, RegionFaultsThrowNamingTheField) {
     const RegionFault faults[] = {
         {"rect", [](RegionMsg& m) { m.rect.width = 0; }},
         {"rect", [](RegionMsg& m) { m.rect.x = -1; }},
-        {"rect", [](RegionMsg& m) { m.rect = {kMaxImageSide, 0, 3, 2}; }},
+        {"rect",
+         [](RegionMsg& m) {
+             m.rect = {kMaxImageSide, 0, 3, 2};
+         }},
         {"cpu_end_s", [](RegionMsg& m) { m.cpu_end_s = -1; }},
         {"cpu_end_s", [](RegionMsg& m) { m.cpu_end_s = kInf; }},
         {"rgba", [](RegionMsg& m) { m.rgba.pop_back(); }},

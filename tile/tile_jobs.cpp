@@ -47,8 +47,8 @@ class TileJobs::JobSink final : public GroupSink {
 
 bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
     if (bounds.empty()) return false;
-    const PixelRect on = screen_box(bounds, view.camera.view(), view.frustum, view.width,
-                                    view.height);
+    const PixelRect on =
+        screen_box(bounds, view.camera.view(), view.frustum, view.width, view.height);
     return on.width > 0 && on.height > 0;
 }
 

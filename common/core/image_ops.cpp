@@ -15,7 +15,8 @@ void composite_by_depth(Image& dst, const Image& src, const PixelRect& where) {
 }
 
 void place(Image& dst, const Image& src, const PixelRect& where) {
-    const bool depth = dst.depth.size() == dst.pixel_count() && src.depth.size() == src.pixel_count();
+    const bool depth =
+        dst.depth.size() == dst.pixel_count() && src.depth.size() == src.pixel_count();
     for_each_placed_pixel(dst, src, where, [&](std::size_t d, std::size_t s) {
         if (depth) dst.depth[d] = src.depth[s];
         for (int k = 0; k < 4; ++k) dst.rgba[4 * d + k] = src.rgba[4 * s + k];
