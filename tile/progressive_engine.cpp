@@ -58,6 +58,7 @@ class FrameRun {
         sink_ = &sink;
         view_inv_ = glm::inverse(view.camera.view());
         rect_ = c.rect;
+        cursor_ = &c;
         params_ = opt_.propagation;
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
         const std::size_t limit = c.rays + ray_limit;
@@ -80,7 +81,9 @@ class FrameRun {
             else
                 c.done = true;
         }
-        record(true);
+        // A sample at every job's end, but no present: groups show at the next refresh (a
+        // present flushes the renderer, which llvmpipe pays per call, not per triangle).
+        record(true, false);
         return true;
     }
 
@@ -153,6 +156,7 @@ class FrameRun {
         if (second_pass) ++frame_.rays_second_pass;
         // A meta-cell whose triangles miss this pixel's surface gets its full-resolution triangles
         // drawn over (adaptive resolution only); any other unvisited hit seeds a pass.
+        if (hit.found) ++cursor_->hits;
         if (!hit.found || (!hit.refine && ex_.visited(hit.cell))) return true;
         return seed(hit, ray);
     }
@@ -182,6 +186,10 @@ class FrameRun {
     }
 
     void give_coverage(RayOrder& order) {
+        // Before any ray of the region has met the surface, what shows there is at most the edge
+        // of a group found elsewhere: the order is left searching, which saves a read-back (a
+        // renderer flush) and a screen-sized copy per level in every region of background.
+        if (cursor_->hits == 0) return;
         stage(Stage::render);
         const auto t0 = Clock::now();
         if (!sink_->coverage(covered_, rect_))
@@ -194,7 +202,7 @@ class FrameRun {
     }
 
     // A timeline sample, after ray counts growing by a factor and at least every interval.
-    void record(bool force) {
+    void record(bool force, bool present_now = true) {
         now_.time_s = since(start_);
         while (next_extra_ < extra_.size() && extra_[next_extra_] < now_.rays) ++next_extra_;
         if (next_extra_ < extra_.size() && extra_[next_extra_] == now_.rays) force = true;
@@ -204,13 +212,17 @@ class FrameRun {
         // The sample shows what is on screen: present queued groups as a display would at its
         // next refresh. Presenting after every group would cost a full-screen flush each time
         // (about 7 ms at 1600x1200 in llvmpipe), so between refreshes a sample may count groups
-        // still in flight: sample times are exact to one refresh (1/60 s).
-        if (dirty_ && sink_ && (force || now_.time_s - last_present_s_ >= kRefreshS)) {
+        // still in flight: sample times are exact to one refresh (1/60 s). The refresh is paced
+        // by this thread's CPU clock, which is the wall clock of a rank with a core of its own;
+        // with many ranks per core (an emulated wall) the wall clock would present far more
+        // often than a real display node does.
+        const double cpu = thread_cpu_seconds();
+        if (dirty_ && sink_ && ((force && present_now) || cpu - last_present_cpu_s_ >= kRefreshS)) {
             stage(Stage::render);
             now_.t_render_s += sink_->present();
             stage(Stage::intersection);
             now_.time_s = since(start_);
-            last_present_s_ = now_.time_s;
+            last_present_cpu_s_ = thread_cpu_seconds();
             dirty_ = false;
         }
         now_.cells_visited = ex_.visited_count();
@@ -240,12 +252,14 @@ class FrameRun {
     TimelineSample now_;
     Clock::time_point start_;
     glm::mat4 view_inv_{1.0f};
-    PixelRect rect_;            // the region being cast
-    PropagationParams params_;  // the options, with the clip of the region being cast
+    PixelRect rect_;                  // the region being cast
+    RegionCursor* cursor_ = nullptr;  // its cursor
+    PropagationParams params_;        // the options, with the clip of the region being cast
     std::vector<std::size_t> extra_;
     std::size_t next_extra_ = 0, next_sample_rays_ = 1;
     // The first progress report comes at the first ray: a wall master then knows the frame began.
-    double last_sample_s_ = 0, last_progress_s_ = -1e9, last_present_s_ = 0;
+    double last_sample_s_ = 0, last_progress_s_ = -1e9;
+    double last_present_cpu_s_ = thread_cpu_seconds();
     bool dirty_ = false;  // groups added since the last present()
     std::vector<glm::ivec2> pixels_;
     std::vector<std::uint8_t> covered_;

@@ -80,6 +80,7 @@ struct RegionCursor {
     std::unique_ptr<RayOrder> order;  // null before the first level and between passes
     int pass = 0;                     // 1: the exact second pass of approximate mode
     std::size_t rays = 0;             // cast so far
+    std::size_t hits = 0;             // of them, rays that met the surface
     bool done = false;                // every pixel of rect has had its ray
 };
 

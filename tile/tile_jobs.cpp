@@ -66,7 +66,8 @@ void TileJobs::prepare(int width, int height) {
 void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
                      const ProgressiveEngine::Progress& progress) {
     const double c0 = thread_cpu_seconds();
-    cpu0_ = c0;
+    wall0_ = wall_now_s();
+    wall_end_ = wall0_;
     frame_.reset();
     generation_ = v.generation;
     own_ = v.view;
@@ -116,11 +117,6 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     out.done.rays = after.rays - before.rays;
     out.done.groups = after.groups - before.groups;
     out.done.triangles = after.triangles - before.triangles;
-    const double c1 = thread_cpu_seconds();
-    out.done.cpu_s = c1 - c0;
-    out.done.cpu_end_s = c1 - cpu0_;
-    out.done.end_s = wall_now_s();
-    last_draw_s_ = out.done.cpu_end_s;
     if (out.completed && !own) {
         Image img;
         help_sink_.read_back(img);
@@ -128,16 +124,24 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
         r.generation = job.generation;
         r.job = job.job;
         r.rect = job.rect;
-        r.cpu_end_s = out.done.cpu_end_s;
         r.rgba = std::move(img.rgba);
         r.depth = std::move(img.depth);
         out.result = std::move(r);
-    } else if (out.completed && measure_) {
+    }
+    // The emulated clock of a rank is its busy CPU: what it would have spent on a core of its own.
+    out.done.cpu_s = thread_cpu_seconds() - c0;
+    busy_cpu_s_ += out.done.cpu_s;
+    out.done.cpu_end_s = busy_cpu_s_;
+    if (out.result) out.result->cpu_end_s = busy_cpu_s_;
+    out.done.end_s = wall_now_s();
+    wall_end_ = out.done.end_s;
+    last_draw_s_ = busy_cpu_s_;
+    // The measurement's read-back is not part of the job (nor of the emulated clock).
+    if (out.completed && own && measure_) {
         Image img;
         tile_sink_.read_back(img, job.rect);
-        shots_.push_back({out.done.cpu_end_s, job.rect, std::move(img), true});
+        shots_.push_back({busy_cpu_s_, job.rect, std::move(img), true});
     }
-    busy_cpu_s_ += thread_cpu_seconds() - c0;
     return out;
 }
 
@@ -154,8 +158,8 @@ void TileJobs::land(const RegionMsg& m) {
     img.depth = m.depth;
     composite_by_depth(landed_, img, m.rect);
     landed_any_ = true;
-    if (measure_) shots_.push_back({m.cpu_end_s, m.rect, std::move(img), false});
     busy_cpu_s_ += thread_cpu_seconds() - c0;
+    if (measure_) shots_.push_back({m.cpu_end_s, m.rect, std::move(img), false});
 }
 
 Image TileJobs::image() {

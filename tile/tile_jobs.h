@@ -50,8 +50,12 @@ class TileJobs {
 
     // What the tile shows now: its own drawing with every landed result over it.
     Image image();
-    // CPU seconds the frame thread spent in this frame's jobs and landings.
+    // CPU seconds the frame thread spent in this frame's jobs and landings (and what the caller
+    // adds: sending results): a rank's emulated clock, as if it had a core of its own.
     double busy_cpu_s() const { return busy_cpu_s_; }
+    void add_busy(double cpu_s) { busy_cpu_s_ += cpu_s; }
+    // Wall seconds from the frame's start to its last job's end.
+    double frame_wall_s() const { return wall_end_ - wall0_; }
     const TimelineSample& now() const { return frame_->now(); }
 
     // The correctness of what the tile showed against its final image (image()) at each job end,
@@ -78,7 +82,7 @@ class TileJobs {
     std::map<std::tuple<int, int, int>, RegionCursor> cursors_;  // (owner, x, y)
     Image landed_;  // helpers' results, composited by depth; depth 1 where none
     bool landed_any_ = false;
-    double cpu0_ = 0;  // thread CPU at the frame's start
+    double wall0_ = 0, wall_end_ = 0;
     double busy_cpu_s_ = 0;
     double last_draw_s_ = 0;  // emulated time of this rank's last job: its own image is final
     struct Shot {

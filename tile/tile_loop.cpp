@@ -125,6 +125,7 @@ class TileRank {
     void close_frame() {
         if (!jobs_.started()) return;
         result_.cpu_s += jobs_.busy_cpu_s();
+        result_.frame_s += jobs_.frame_wall_s();
         result_.rays += jobs_.now().rays;
         result_.groups += jobs_.now().groups;
         result_.triangles = jobs_.now().triangles;
@@ -142,11 +143,13 @@ class TileRank {
             return;
         }
         if (out.result) {
+            const double c0 = thread_cpu_seconds();
             const auto bytes = encode(*out.result);
             out.done.bytes = bytes.size();
             result_.bytes_sent += bytes.size();
             comm_.send(j.owner, Tag::region, bytes);
             ++result_.jobs_helped;
+            jobs_.add_busy(thread_cpu_seconds() - c0);  // sending is part of the job
         } else {
             ++result_.jobs_own;
         }

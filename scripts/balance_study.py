@@ -1,0 +1,227 @@
+#!/usr/bin/python3
+"""The load-balance study of the screen-region scheduler: a 6x4 wall (25 ranks: a master and 24
+tiles) with the surface inside 1 tile, across 2, across 4 and over all tiles, with balancing off
+(every tile casts its own screen: the static wall) and on at several region sizes.
+
+Usage: scripts/balance_study.py [--build build] [--data ../shared/data] [--out out/study]
+                                [--volumes head,phantom] [--regions 256x192,128x96,64x48]
+                                [--repeat 1]
+
+Every figure is derived from thread CPU time, not wall time: with 25 ranks on this machine's 2
+cores the wall clock says nothing about a cluster. A rank's busy CPU is what its frame thread
+spent on jobs, landing helpers' results and sending its own (llvmpipe rasterises in that thread:
+LP_NUM_THREADS=0). The makespan is the largest busy CPU of any rank; efficiency is mean busy /
+makespan (the master's "balance"); emulated times to wall-wide C are from each rank's own CPU
+clock, as if every rank had a core of its own (isowall wall --measure). Writes study.csv,
+study.md (the table the README quotes), per-rank busy bars and a summary plot, and each run's
+mosaic, into --out; prints which of the issue's targets hold.
+"""
+import argparse
+import csv
+import os
+import re
+import statistics
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WALL = os.path.join(ROOT, "walls", "6x4.toml")
+
+# (name, zoom, pan dx, pan dy): the volume's screen box inside one tile (column 2, row 1), on
+# the edge between two tiles of row 1, on the corner of four, and the front full view.
+CASES = [
+    ("1 tile", 0.2, 0.0833, -0.125),
+    ("2 tiles", 0.2, 0.0, -0.125),
+    ("4 tiles", 0.3, 0.0, 0.0),
+    ("all tiles", 1.0, 0.0, 0.0),
+]
+
+RANK_ROW = re.compile(
+    r"^\s+(\d+)\s+(\S+)\s+(\d+)\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)"
+    r"\s+([\d.]+)\s+(\d+)\s+(\d+)\s+([\d.]+)$")
+SUMMARY = re.compile(r"^makespan ([\d.]+) s \(CPU\), total ([\d.]+) s, balance ([\d.]+)")
+SCHED = re.compile(r"^scheduler: .*: (\d+) jobs, (\d+) migrated, ([\d.]+) MB")
+EMULATED = re.compile(r"C = 90/99/100%: (\S+) / (\S+) / (\S+) s; final pixels 90/99/100%: "
+                      r"(\S+) / (\S+) / (\S+) s")
+
+
+def volume_args(name, data):
+    if name == "phantom":
+        return []
+    return ["-v", os.path.join(data, "vhp_ct_head.nhdr"), "--iso", "40"]
+
+
+def run_wall(isowall, vol, case, balance, region, out_png):
+    _, zoom, dx, dy = case
+    cmd = ["mpirun", "--oversubscribe", "-np", "25", "-x", "LP_NUM_THREADS=0", isowall, "wall",
+           "--wall", WALL, *vol, "--zoom", str(zoom), "--pan", str(dx), str(dy), "--measure",
+           "--balance", "on" if balance else "off", "--out", out_png]
+    if region:
+        cmd += ["--region", region]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if proc.returncode != 0:
+        sys.exit(f"balance_study: {' '.join(cmd)} failed:\n{proc.stderr[-2000:]}")
+    return parse(proc.stdout, " ".join(cmd))
+
+
+def parse(text, cmd):
+    r = {"busy": [], "rays": [], "helped": [], "jobs": []}
+    for line in text.splitlines():
+        if m := RANK_ROW.match(line):
+            r["busy"].append(float(m.group(4)))
+            r["rays"].append(int(m.group(8)))
+            r["jobs"].append(int(m.group(12)))
+            r["helped"].append(int(m.group(13)))
+        elif m := SUMMARY.match(line):
+            r["makespan"], r["total"], r["balance"] = map(float, m.groups())
+        elif m := SCHED.match(line):
+            r["job_count"], r["migrated"] = int(m.group(1)), int(m.group(2))
+            r["mb_moved"] = float(m.group(3))
+        elif m := EMULATED.search(line):
+            vals = [float("nan") if v == "never" else float(v) for v in m.groups()]
+            r["c90"], r["c99"], r["c100"], r["px90"], r["px99"], r["px100"] = vals
+    for key in ("makespan", "job_count", "c99"):
+        if key not in r:
+            sys.exit(f"balance_study: no '{key}' in the output of {cmd}:\n{text[-2000:]}")
+    r["tiles_with_rays"] = sum(1 for n in r["rays"] if n > 0)
+    return r
+
+
+def median_run(runs):
+    out = dict(runs[0])
+    for key, value in runs[0].items():
+        if isinstance(value, float):
+            out[key] = statistics.median(r[key] for r in runs)
+    return out
+
+
+def plot(rows, out_dir, volume):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mine = [r for r in rows if r["volume"] == volume]
+    regions = sorted({r["region"] for r in mine if r["region"] != "static"},
+                     key=lambda s: -int(s.split("x")[0]))
+    fig, axes = plt.subplots(len(CASES), 1, figsize=(11, 2.6 * len(CASES)), sharex=True)
+    for ax, case in zip(axes, CASES):
+        runs = [r for r in mine if r["case"] == case[0]]
+        width = 0.8 / len(runs)
+        for i, r in enumerate(runs):
+            xs = [k + 1 + (i - (len(runs) - 1) / 2) * width for k in range(len(r["busy"]))]
+            label = "static" if r["region"] == "static" else f"balanced {r['region']}"
+            ax.bar(xs, r["busy"], width=width, label=label)
+        ax.set_title(f"{volume}, surface in {case[0]}: busy CPU per rank")
+        ax.set_ylabel("busy CPU s")
+        ax.legend(fontsize=7, ncol=len(runs))
+    axes[-1].set_xlabel("tile rank")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, f"busy_{volume}.png"), dpi=90)
+    plt.close(fig)
+
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(14, 4))
+    labels = ["static"] + regions
+    for case in CASES:
+        by = {r["region"]: r for r in mine if r["case"] == case[0]}
+        a1.plot(labels, [by[l]["makespan"] for l in labels], marker="o", label=case[0])
+        a2.plot(labels, [by[l]["balance"] for l in labels], marker="o", label=case[0])
+        a3.plot(labels, [by[l]["c99"] for l in labels], marker="o", label=case[0])
+    a1.set_title("makespan (CPU s)")
+    a2.set_title("efficiency (mean busy / makespan)")
+    a3.set_title("emulated time to wall-wide C = 99% (s)")
+    for a in (a1, a2, a3):
+        a.set_xlabel("region size (static: one job per tile)")
+        a.legend(fontsize=7)
+    a1.set_yscale("log")
+    a3.set_yscale("log")
+    fig.suptitle(f"6x4 wall, {volume}: balancing off vs on")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, f"summary_{volume}.png"), dpi=90)
+    plt.close(fig)
+
+
+def check_targets(rows, volume):
+    mine = {(r["case"], r["region"]): r for r in rows if r["volume"] == volume}
+    balanced = [r for r in rows if r["volume"] == volume and r["region"] != "static"]
+    print(f"\ntargets ({volume}; best region size of each case, same run):")
+    for case, checks in (("1 tile", "one"), ("all tiles", "all")):
+        static = mine[(case, "static")]
+        best = min((r for r in balanced if r["case"] == case), key=lambda r: r["makespan"])
+        ms_ratio = static["makespan"] / best["makespan"]
+        if checks == "one":
+            c99_ratio = static["c99"] / best["c99"]
+            print(f"  surface inside 1 tile, region {best['region']}: makespan static/balanced "
+                  f"{ms_ratio:.1f}x (target >= 8: {'holds' if ms_ratio >= 8 else 'missed'}); "
+                  f"efficiency {best['balance']:.2f} (target >= 0.75: "
+                  f"{'holds' if best['balance'] >= 0.75 else 'missed'}); emulated C=99% "
+                  f"static/balanced {c99_ratio:.1f}x (target >= 5: "
+                  f"{'holds' if c99_ratio >= 5 else 'missed'})")
+        else:
+            rel = best["makespan"] / static["makespan"]
+            print(f"  surface over all tiles, region {best['region']}: balance "
+                  f"{best['balance']:.2f} (target >= 0.85: "
+                  f"{'holds' if best['balance'] >= 0.85 else 'missed'}); makespan "
+                  f"balanced/static {rel:.2f} (target <= 1.05: "
+                  f"{'holds' if rel <= 1.05 else 'missed'})")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "study"))
+    ap.add_argument("--volumes", default="head,phantom")
+    ap.add_argument("--regions", default="256x192,128x96,64x48")
+    ap.add_argument("--repeat", type=int, default=1, help="runs per configuration (median)")
+    a = ap.parse_args()
+    isowall = os.path.join(a.build, "master", "isowall")
+    if not os.access(isowall, os.X_OK):
+        sys.exit(f"balance_study: {isowall} not found; build first (scripts/setup.sh)")
+    volumes = a.volumes.split(",")
+    if "head" in volumes and not os.path.exists(os.path.join(a.data, "vhp_ct_head.nhdr")):
+        print(f"balance_study: {a.data}/vhp_ct_head.nhdr not found; the head is skipped")
+        volumes.remove("head")
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for volume in volumes:
+        vol = volume_args(volume, a.data)
+        for case in CASES:
+            for region in ["static"] + a.regions.split(","):
+                tag = f"{volume}_{case[0].replace(' ', '')}_{region}"
+                png = os.path.join(a.out, f"mosaic_{tag}.png")
+                runs = [run_wall(isowall, vol, case, region != "static",
+                                 None if region == "static" else region, png)
+                        for _ in range(a.repeat)]
+                r = median_run(runs)
+                r.update(volume=volume, case=case[0], region=region)
+                rows.append(r)
+                print(f"{volume:8s} {case[0]:10s} {region:8s} makespan {r['makespan']:.3f} s, "
+                      f"total {r['total']:.3f} s, efficiency {r['balance']:.2f}, "
+                      f"C=90/99/100% at {r['c90']:.3f}/{r['c99']:.3f}/{r['c100']:.3f} s, "
+                      f"{r['migrated']} of {r['job_count']} jobs migrated, "
+                      f"{r['mb_moved']:.1f} MB moved, tiles with rays of their own "
+                      f"{r['tiles_with_rays']}", flush=True)
+        plot(rows, a.out, volume)
+    fields = ["volume", "case", "region", "makespan", "total", "balance", "c90", "c99", "c100",
+              "px90", "px99", "px100", "job_count", "migrated", "mb_moved", "tiles_with_rays"]
+    with open(os.path.join(a.out, "study.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    with open(os.path.join(a.out, "study.md"), "w") as f:
+        f.write("| volume | surface in | regions | makespan s | total s | efficiency | "
+                "C=90% s | C=99% s | C=100% s | migrated / jobs | MB moved |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write(f"| {r['volume']} | {r['case']} | {r['region']} | {r['makespan']:.3f} | "
+                    f"{r['total']:.3f} | {r['balance']:.2f} | {r['c90']:.3f} | {r['c99']:.3f} | "
+                    f"{r['c100']:.3f} | {r['migrated']} / {r['job_count']} | "
+                    f"{r['mb_moved']:.1f} |\n")
+    for volume in volumes:
+        check_targets(rows, volume)
+    print(f"\nwrote {a.out}/study.csv, study.md, busy_*.png, summary_*.png, mosaic_*.png")
+
+
+if __name__ == "__main__":
+    main()
