@@ -41,8 +41,8 @@ JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
     : balance_(balance),
       depth_(depth),
       in_hand_(regions.size(), 0),
-      cpu_(regions.size(), 0.0),
-      rays_(regions.size(), 0.0) {
+      cpu_(2 * regions.size(), 0.0),
+      rays_(2 * regions.size(), 0.0) {
     for (std::size_t owner = 0; owner < regions.size(); ++owner) {
         for (std::size_t i = 0; i < regions[owner].size(); ++i) {
             const double r = rays.at(owner).at(i);
@@ -62,26 +62,45 @@ JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
     }
 }
 
+// The recent cost per ray of the job's tile in its band (coarse rays find the seeds and pay for
+// most extraction, fine rays mostly meet visited cells); else of the band wall-wide; else of any.
 double JobBoard::cost(const BoardJob& j) const {
-    const auto o = static_cast<std::size_t>(j.owner);
-    if (rays_[o] > 0) return j.rays * cpu_[o] / rays_[o];
-    double cpu = 0, rays = 0;
-    for (std::size_t i = 0; i < cpu_.size(); ++i) cpu += cpu_[i], rays += rays_[i];
-    return j.rays * (rays > 0 ? cpu / rays : 1e-6);
+    const std::size_t b = j.band == Band::coarse ? 0 : 1;
+    const std::size_t k = 2 * static_cast<std::size_t>(j.owner) + b;
+    if (rays_[k] > 0) return j.rays * cpu_[k] / rays_[k];
+    double cpu = 0, rays = 0, cpu_any = 0, rays_any = 0;
+    for (std::size_t i = 0; i < cpu_.size(); ++i) {
+        if (i % 2 == b) cpu += cpu_[i], rays += rays_[i];
+        cpu_any += cpu_[i], rays_any += rays_[i];
+    }
+    if (rays > 0) return j.rays * cpu / rays;
+    return j.rays * (rays_any > 0 ? cpu_any / rays_any : 1e-6);
 }
 
-std::optional<std::uint32_t> JobBoard::steal(Band band) const {
-    std::vector<double> work(in_hand_.size(), 0.0);
-    std::vector<std::optional<std::uint32_t>> last(in_hand_.size());
+JobBoard::Queues JobBoard::queued(Band band) const {
+    Queues q{std::vector<double>(in_hand_.size(), 0.0),
+             std::vector<std::optional<std::uint32_t>>(in_hand_.size())};
     for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
         const BoardJob& j = jobs_[id];
         if (j.state != BoardJob::State::queued || j.band != band) continue;
         const auto k = static_cast<std::size_t>(key(j));
-        work[k] += cost(j);
-        last[k] = id;
+        q.work[k] += cost(j);
+        q.last[k] = id;
     }
-    const auto most = std::max_element(work.begin(), work.end()) - work.begin();
-    return last[static_cast<std::size_t>(most)];
+    return q;
+}
+
+std::optional<std::uint32_t> JobBoard::steal(const Queues& q, Band band) const {
+    const auto most =
+        static_cast<std::size_t>(std::max_element(q.work.begin(), q.work.end()) - q.work.begin());
+    if (!q.last[most] || band == Band::coarse) return q.last[most];
+    // A stolen fine band is cast again from the region's first level, so the helper pays for its
+    // coarse band too: worth it only while the holder keeps at least that much work of its own.
+    const BoardJob& j = jobs_[*q.last[most]];
+    const BoardJob& coarse = jobs_[j.coarse];
+    const double again = (coarse.state == BoardJob::State::done ? coarse.cpu : cost(coarse));
+    if (q.work[most] - cost(j) < again + cost(j)) return std::nullopt;
+    return q.last[most];
 }
 
 std::optional<std::uint32_t> JobBoard::pick(int rank) const {
@@ -92,11 +111,21 @@ std::optional<std::uint32_t> JobBoard::pick(int rank) const {
         }
         return std::nullopt;
     };
-    if (auto id = first(Band::coarse)) return id;
-    if (balance_)
-        if (auto id = steal(Band::coarse)) return id;
-    if (auto id = first(Band::fine)) return id;
-    if (balance_) return steal(Band::fine);
+    const auto r = static_cast<std::size_t>(rank);
+    for (const Band band : {Band::coarse, Band::fine}) {
+        if (!balance_) {
+            if (auto id = first(band)) return id;
+            continue;
+        }
+        // A rank keeps to its own queue while it holds at least half the work of the busiest
+        // one; else it helps there first (its own cheap jobs wait, and anyone may take them).
+        const Queues q = queued(band);
+        const double most = *std::max_element(q.work.begin(), q.work.end());
+        if (q.last[r] && q.work[r] >= 0.5 * most)
+            if (auto id = first(band)) return id;
+        if (auto id = steal(q, band)) return id;
+        if (auto id = first(band)) return id;
+    }
     return std::nullopt;
 }
 
@@ -121,8 +150,15 @@ void JobBoard::done(std::uint32_t id, std::uint64_t rays, double cpu_s) {
         throw std::runtime_error("job " + std::to_string(id) + " reported done but not running");
     j.state = BoardJob::State::done;
     --in_hand_[static_cast<std::size_t>(j.worker)];
-    cpu_[static_cast<std::size_t>(j.owner)] += cpu_s;
-    rays_[static_cast<std::size_t>(j.owner)] += static_cast<double>(rays);
+    j.cpu = cpu_s;
+    // A fine band cast by a rank other than its holder cast the coarse band again: its cost is not
+    // what a fine band costs, and counting it would make fine bands look worth stealing.
+    if (j.band == Band::coarse || j.worker == j.holder) {
+        const std::size_t k =
+            2 * static_cast<std::size_t>(j.owner) + (j.band == Band::coarse ? 0 : 1);
+        cpu_[k] += cpu_s;
+        rays_[k] += static_cast<double>(rays);
+    }
     if (has_landed(j)) ++landed_;
 }
 

@@ -2,17 +2,17 @@
 // The screen-region scheduler's state (dissertation, section 5.2.2): which job each rank runs,
 // pure and without messages, so the policy is tested alone. Every tile's screen is cut into
 // regions; each region is two jobs, its coarse band then its fine band (see Band). A rank asks for
-// work whenever it has fewer than `depth` jobs in hand and gets, in this order:
-//   1. a coarse job of its own tile;
-//   2. (balancing) a coarse job of the tile with the most estimated work left: coarse levels over
-//      every tile come before fine levels anywhere;
-//   3. a fine job whose coarse band it cast itself (it holds that region's ray order and its
-//      groups, so nothing is cast twice);
-//   4. (balancing) a fine job of the rank with the most estimated work left: the region is cast
-//      again from its first level by the helper, whose image must show all of it.
+// work whenever it has fewer than `depth` jobs in hand and gets a coarse job if any is left
+// anywhere (coarse levels over every tile come before fine levels anywhere), else a fine job:
+//   - coarse: of its own tile while that holds at least half the estimated work of the busiest
+//     tile, else (balancing) of the busiest tile;
+//   - fine: one whose coarse band it cast itself (it holds that region's ray order and groups, so
+//     nothing is cast twice) under the same rule, else (balancing) one of the busiest holder:
+//     the region is cast again from its first level by the helper, whose image must show all of
+//     it, so only while that holder keeps more work than the helper's whole region costs.
 // Stolen jobs are taken from the end of a queue, the owner works from its front. Estimated work is
 // a job's rays (its region inside the volume's screen box, 1/16 of them coarse) times the recent
-// CPU cost per ray of its tile.
+// CPU cost per ray of its tile in its band.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -43,6 +43,7 @@ struct BoardJob {
     int worker = -1;           // the rank it was handed to
     int holder = -1;           // the rank whose turn it is (the owner, or who cast the coarse band)
     std::uint32_t coarse = 0;  // fine jobs: the id of the region's coarse job
+    double cpu = 0;            // CPU seconds it took (once done)
 };
 
 class JobBoard {
@@ -50,7 +51,7 @@ class JobBoard {
     // regions[rank] and rays[rank]: the rank's regions and the estimated rays of each (rank 0,
     // the master, has none). Regions with no estimated ray get no job.
     JobBoard(const std::vector<std::vector<PixelRect>>& regions,
-             const std::vector<std::vector<double>>& rays, bool balance, int depth = 2);
+             const std::vector<std::vector<double>>& rays, bool balance, int depth = 1);
 
     // The next job for `rank`, now marked running, or nullopt when it has `depth` jobs in hand
     // or none is left for it.
@@ -71,8 +72,14 @@ class JobBoard {
     std::size_t migrated() const { return migrated_; }  // jobs run by a rank other than the owner
 
   private:
+    // Estimated work queued and the last queued job, per key (owner or holder), in one band.
+    struct Queues {
+        std::vector<double> work;
+        std::vector<std::optional<std::uint32_t>> last;
+    };
+    Queues queued(Band band) const;
     std::optional<std::uint32_t> pick(int rank) const;
-    std::optional<std::uint32_t> steal(Band band) const;
+    std::optional<std::uint32_t> steal(const Queues& q, Band band) const;
     double cost(const BoardJob& j) const;
     int key(const BoardJob& j) const { return j.band == Band::coarse ? j.owner : j.holder; }
 
@@ -80,7 +87,7 @@ class JobBoard {
     bool balance_;
     int depth_;
     std::vector<int> in_hand_;
-    std::vector<double> cpu_, rays_;  // by owner: CPU seconds and rays of the jobs done
+    std::vector<double> cpu_, rays_;  // by owner and band (2 * owner + band): of the jobs done
     std::size_t landed_ = 0, migrated_ = 0;
 };
 

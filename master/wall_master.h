@@ -33,7 +33,7 @@ struct MasterOptions {
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
     bool balance = true;
-    int region_w = 256, region_h = 192;
+    int region_w = 128, region_h = 96;
     bool screen_box = true;  // the engine casts no ray outside the volume's screen box
     bool measure = false;    // tiles report emulated correctness curves
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here

@@ -27,10 +27,10 @@ struct WallOptions {
     std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
     std::vector<float> orbit, pan;   // the first view: yaw pitch; dx dy (empty: none)
     float zoom = 1;
-    bool balance = true;             // the screen-region scheduler migrates jobs
-    std::string region = "256x192";  // region size WxH, or "tile"
-    bool measure = false;            // emulated wall-wide correctness curves
-    bool region_clip = true;         // propagation stays within each job's region
+    bool balance = true;            // the screen-region scheduler migrates jobs
+    std::string region = "128x96";  // region size WxH, or "tile" (the study's best)
+    bool measure = false;           // emulated wall-wide correctness curves
+    bool region_clip = true;        // propagation stays within each job's region
     // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
     // so this is the rank's budget, not the machine's core count.
     int threads = 1;

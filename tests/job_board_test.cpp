@@ -100,14 +100,35 @@ TEST(JobBoard, IdleRanksTakeCoarseJobsOfTheBusyTileFirst) {
 TEST(JobBoard, AJobLandsWhenDoneAndDeliveredInEitherOrder) {
     JobBoard b = board_of({0, 1, 0}, true, 1);
     const auto a = b.next_for(2);  // the helper takes the coarse job
-    const auto c = b.next_for(1);  // the owner is left the fine one, which it may cast from scratch
-    ASSERT_TRUE(a && c);
+    ASSERT_TRUE(a);
     EXPECT_EQ(b.job(*a).worker, 2);
+    // The fine band is the helper's: the owner would have to cast the whole region again, which
+    // is worth it only if the helper had more work queued than that.
+    EXPECT_FALSE(b.next_for(1));
     b.landed(*a);  // the owner's word can come before the helper's
     EXPECT_FALSE(b.complete());
     b.done(*a, 10, 0.001);
-    b.done(*c, 90, 0.002);  // the owner's own job lands at once
+    const auto c = b.next_for(2);
+    ASSERT_TRUE(c);
+    EXPECT_EQ(b.job(*c).band, Band::fine);
+    b.done(*c, 90, 0.002);
+    EXPECT_FALSE(b.complete()) << "the helper's fine band has not landed";
+    b.landed(*c);
     EXPECT_TRUE(b.complete());
+}
+
+TEST(JobBoard, ARankHelpsTheBusiestTileBeforeItsOwnCheapJobs) {
+    JobBoard b = board_of({0, 4, 4}, true, 1);
+    // Tile 1 turns out expensive, tile 2 cheap: rank 2 helps tile 1 before its own queue.
+    const auto one = b.next_for(1);
+    const auto two = b.next_for(2);
+    ASSERT_TRUE(one && two);
+    b.done(*one, 6, 0.5);
+    b.done(*two, 6, 0.001);
+    const auto next = b.next_for(2);
+    ASSERT_TRUE(next);
+    EXPECT_EQ(b.job(*next).owner, 1);
+    EXPECT_EQ(b.job(*next).band, Band::coarse);
 }
 
 TEST(JobBoard, ReportsOutOfTurnThrow) {

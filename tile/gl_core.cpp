@@ -200,10 +200,19 @@ void GlCore::resize(int width, int height) {
         fail("resize(" + std::to_string(width) + ", " + std::to_string(height) + ")",
              "each side must be in [1, " + std::to_string(max_size) + "]");
     }
+    width_ = width;
+    height_ = height;
+    // The frame is the bottom-left width x height of its buffers (the viewport), so a smaller
+    // frame reuses them: a wall rank resizes its help frame for every region it fills, and
+    // reallocating costs llvmpipe fresh pages each time.
+    if (width <= storage_width_ && height <= storage_height_) return;
+    storage_width_ = std::max(width, storage_width_);
+    storage_height_ = std::max(height, storage_height_);
     gl_->BindRenderbuffer(GL_RENDERBUFFER, colour_buffer_);
-    gl_->RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    gl_->RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, storage_width_, storage_height_);
     gl_->BindRenderbuffer(GL_RENDERBUFFER, depth_buffer_);
-    gl_->RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    gl_->RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, storage_width_,
+                             storage_height_);
     gl_->BindRenderbuffer(GL_RENDERBUFFER, 0);
     check("glRenderbufferStorage");
 
@@ -215,8 +224,6 @@ void GlCore::resize(int width, int height) {
     const GLenum status = gl_->CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE)
         fail("glCheckFramebufferStatus", "status " + std::to_string(status));
-    width_ = width;
-    height_ = height;
 }
 
 void GlCore::bind_frame() {

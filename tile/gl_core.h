@@ -47,6 +47,7 @@ class GlCore {
 
     std::string backend_;
     std::unique_ptr<GlFunctions> gl_;
+    int storage_width_ = 0, storage_height_ = 0;  // of the renderbuffers, >= the frame
     int width_ = 0;
     int height_ = 0;
     unsigned framebuffer_ = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "common/core/image_ops.h"
 #include "common/core/ray.h"
@@ -19,19 +20,29 @@ FrameView region_view(const FrameView& owner, const PixelRect& rect) {
     return v;
 }
 
-// Where a job's groups go: every group is kept with its bounds (to draw it again into later
-// region images), drawn into the help image when the job is for another tile, and drawn into the
-// rank's own tile when it may show there. A group whose bounds project outside the tile cannot be
-// what a later ray of the tile hits, so leaving it out of the tile loses nothing.
+// Where a job's groups go: every group is kept (a later job may need it), drawn into the help
+// image when the job is for another tile, and drawn into the rank's own tile when it may show
+// there (a group whose bounds project outside the tile cannot be what a later ray of the tile
+// hits, so leaving it out loses nothing). A help image also gets each earlier group of the frame
+// that a ray of its region meets (a visited cell: the engine casts no new pass there), once:
+// every pixel's ray then shows its cell's group, as in a frame of its own.
 class TileJobs::JobSink final : public GroupSink {
   public:
     JobSink(TileJobs& jobs, GroupSink* help) : jobs_(jobs), help_(help) {}
     void add(const Group& group) override {
         Box3 b;
         for (const glm::vec3& p : group.mesh.positions) b.merge(p);
-        if (help_) help_->add(group);
+        if (help_) {
+            help_->add(group);
+            drawn_.insert(group.id);
+        }
         if (jobs_.shows(b, jobs_.own_)) jobs_.tile_sink_.add(group);
         jobs_.groups_.push_back({group, b});
+    }
+    bool wants_seen() const override { return help_ != nullptr; }
+    void seen(std::uint32_t group_id) override {
+        if (group_id < jobs_.groups_.size() && drawn_.insert(group_id).second)
+            help_->add(jobs_.groups_[group_id].group);
     }
     double present() override {
         return (help_ ? help_->present() : 0.0) + jobs_.tile_sink_.present();
@@ -43,6 +54,7 @@ class TileJobs::JobSink final : public GroupSink {
   private:
     TileJobs& jobs_;
     GroupSink* help_;
+    std::unordered_set<std::uint32_t> drawn_;  // groups in the help image
 };
 
 bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
@@ -83,11 +95,6 @@ void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
     busy_cpu_s_ = thread_cpu_seconds() - c0;
 }
 
-void TileJobs::draw_earlier_groups(const FrameView& view) {
-    for (const Recorded& r : groups_)
-        if (shows(r.bounds, view)) help_sink_.add(r.group);
-}
-
 TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const double c0 = thread_cpu_seconds();
     Outcome out;
@@ -102,10 +109,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     if (it == cursors_.end()) it = cursors_.emplace(key, frame_->cursor(view, region)).first;
     RegionCursor& cursor = it->second;
 
-    if (!own) {
-        help_sink_.begin(view);
-        draw_earlier_groups(view);
-    }
+    if (!own) help_sink_.begin(view);
     JobSink sink(*this, own ? nullptr : &help_sink_);
     const std::size_t area = static_cast<std::size_t>(std::max(0, cursor.rect.width)) *
                              static_cast<std::size_t>(std::max(0, cursor.rect.height));
