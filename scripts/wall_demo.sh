@@ -11,4 +11,7 @@ shift || true
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 NP=$(./build/master/isowall wall --wall "$WALL" --ranks-needed)
 mkdir -p out
-mpirun --oversubscribe -np "$NP" ./build/master/isowall wall --wall "$WALL" --out out/mosaic.png "$@"
+# llvmpipe rasterises in the calling thread, so each rank's thread CPU counts its drawing too: the
+# per-rank table then says what each rank would cost on a node of its own.
+mpirun --oversubscribe -np "$NP" -x LP_NUM_THREADS=0 \
+    ./build/master/isowall wall --wall "$WALL" --out out/mosaic.png "$@"

@@ -188,6 +188,17 @@ WallOptions balance_wall(const std::filesystem::path& dir, bool balance, bool on
     return o;
 }
 
+// The acceptance rule for two mosaics of one view: mask IoU >= 0.999 and >= 99.9% of pixels
+// within 1/255.
+test::ImageComparison expect_same_view(const std::string& a, const std::string& b) {
+    test::CompareOptions within_one;
+    within_one.channel_tolerance = 1;
+    const test::ImageComparison m = test::compare_images(read_image(a), read_image(b), within_one);
+    EXPECT_GE(m.mask_iou, 0.999) << m;
+    EXPECT_GE(m.equal_share, 0.999) << m;
+    return m;
+}
+
 std::uint64_t jobs_helped(const WallRun& r) {
     std::uint64_t n = 0;
     for (const TileResultMsg& t : r.results) n += t.jobs_helped;
@@ -217,12 +228,7 @@ TEST(WallBalance, BalancedAndStaticMosaicsAreEqual) {
             EXPECT_EQ(rs.results[static_cast<std::size_t>(rank)].rays, 0u)
                 << "rank " << rank << " has surface of its own";
         }
-        test::CompareOptions within_one;
-        within_one.channel_tolerance = 1;
-        const test::ImageComparison m =
-            test::compare_images(read_image(b.out), read_image(s.out), within_one);
-        EXPECT_GE(m.mask_iou, 0.999) << m;
-        EXPECT_GE(m.equal_share, 0.999) << m;
+        const test::ImageComparison m = expect_same_view(b.out, s.out);
         EXPECT_GT(m.covered_both, 1000u) << m;
         std::printf("%s: %llu jobs migrated; %s\n", name.c_str(),
                     (unsigned long long)jobs_helped(rb), testing::PrintToString(m).c_str());
@@ -244,12 +250,7 @@ TEST(WallBalance, AnInterruptWhileJobsMigrateLeavesNothingOfTheOldView) {
     direct.script = write_script(dir, "orbit 70 -30\nwait done\n").string();
     const WallRun d = run_wall_in_process(direct);
     for (int code : d.codes) ASSERT_EQ(code, 0) << d.err;
-    test::CompareOptions within_one;
-    within_one.channel_tolerance = 1;
-    const test::ImageComparison m =
-        test::compare_images(read_image(o.out), read_image(direct.out), within_one);
-    EXPECT_GE(m.mask_iou, 0.999) << m;
-    EXPECT_GE(m.equal_share, 0.999) << m;
+    const test::ImageComparison m = expect_same_view(o.out, direct.out);
     std::printf("%llu jobs interrupted, %llu migrated; %s\n", (unsigned long long)interrupted,
                 (unsigned long long)jobs_helped(r), testing::PrintToString(m).c_str());
 }

@@ -7,8 +7,6 @@ namespace isowall {
 void RendererSink::begin(const FrameView& view) {
     view_m_ = view.camera.view();
     proj_m_ = view.frustum.matrix();
-    width_ = view.width;
-    height_ = view.height;
     renderer_.resize(view.width, view.height);
     renderer_.clear();
 }
@@ -25,11 +23,8 @@ double RendererSink::present() {
 
 bool RendererSink::coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {
     renderer_.read_back(scratch_, rect);
-    covered.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
-    for (int y = 0; y < rect.height; ++y)
-        for (int x = 0; x < rect.width; ++x)
-            covered[static_cast<std::size_t>(rect.y + y) * width_ + (rect.x + x)] =
-                scratch_.depth[static_cast<std::size_t>(y) * rect.width + x] < 1.0f;
+    covered.resize(scratch_.depth.size());
+    for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = scratch_.depth[i] < 1.0f;
     return true;
 }
 

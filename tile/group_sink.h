@@ -28,9 +28,9 @@ class GroupSink {
     // Makes every group added so far visible, as a display does at its next refresh. Called at
     // most once per refresh and at the end of each ray-order level; returns the seconds it took.
     virtual double present() { return 0; }
-    // Sizes `covered` to the whole screen and writes covered[y * width + x] != 0 for every pixel
-    // of `rect` that shows the surface now (0 outside rect); false when this sink cannot tell
-    // (the readback ray orders then see nothing covered).
+    // Sizes `covered` to `rect` and writes covered[y * rect.width + x] != 0 when pixel
+    // (rect.x + x, rect.y + y) shows the surface now; false when this sink cannot tell (the
+    // readback ray orders then see nothing covered).
     virtual bool coverage(std::vector<std::uint8_t>& /*covered*/, const PixelRect& /*rect*/) {
         return false;
     }
@@ -50,7 +50,6 @@ class RendererSink final : public GroupSink {
 
   private:
     Renderer& renderer_;
-    int width_ = 0, height_ = 0;
     glm::mat4 view_m_{1.0f}, proj_m_{1.0f};
     Image scratch_;
 };

@@ -64,7 +64,11 @@ class FrameRun {
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
         const std::size_t limit = c.rays + ray_limit;
         while (!c.done && c.rays < limit) {
-            if (!c.order) c.order = make_ray_order(opt_.order, view.width, view.height, c.rect);
+            // The order sees the region as a screen of its own (pixels and coverage local to it):
+            // a region's coverage is then its own pixels, not a copy of the whole screen.
+            if (!c.order)
+                c.order = make_ray_order(opt_.order, c.rect.width, c.rect.height,
+                                         PixelRect{0, 0, c.rect.width, c.rect.height});
             const std::size_t before = now_.rays;
             const bool level = c.order->next_level(pixels_);
             if (level && !cast_level(*c.order, c.pass == 1)) {
@@ -139,7 +143,7 @@ class FrameRun {
         now_.level = order.level();
         for (const glm::ivec2 px : pixels_) {
             if (stopped()) return false;
-            if (!cast_ray(px, mode, second_pass)) return false;
+            if (!cast_ray(px + glm::ivec2(rect_.x, rect_.y), mode, second_pass)) return false;
             record(false);
         }
         if (order.wants_coverage()) give_coverage(order);
@@ -199,8 +203,7 @@ class FrameRun {
         const auto t0 = Clock::now();
         if (!sink_->coverage(covered_, rect_))
             covered_.assign(
-                static_cast<std::size_t>(view_->width) * static_cast<std::size_t>(view_->height),
-                0);
+                static_cast<std::size_t>(rect_.width) * static_cast<std::size_t>(rect_.height), 0);
         order.set_coverage(covered_);
         now_.t_render_s += since(t0);
         stage(Stage::intersection);

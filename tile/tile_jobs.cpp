@@ -87,6 +87,7 @@ void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
     cursors_.clear();
     shots_.clear();
     last_draw_s_ = 0;
+    last_shot_s_ = -1;
     if (landed_any_ || landed_.width != own_.width || landed_.height != own_.height)
         landed_.resize(own_.width, own_.height);
     landed_any_ = false;
@@ -95,8 +96,26 @@ void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
     busy_cpu_s_ = thread_cpu_seconds() - c0;
 }
 
+void TileJobs::measure_point() {
+    if (!measure_ || !in_own_job_) return;
+    // What the tile shows now: queued groups drawn first, as busy time (a display shows them at
+    // its next refresh anyway); only the copy of the region is the measurement's own cost.
+    tile_sink_.present();
+    const double now = thread_cpu_seconds();
+    const double busy_now = busy_cpu_s_ + (now - job_c0_ - job_measure_cpu_);
+    if (busy_now - last_shot_s_ < kShotIntervalS) return;
+    Image img;
+    tile_sink_.read_back(img, job_rect_);
+    shots_.push_back({busy_now, job_rect_, std::move(img), true});
+    last_shot_s_ = busy_now;
+    job_measure_cpu_ += thread_cpu_seconds() - now;
+}
+
 TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const double c0 = thread_cpu_seconds();
+    job_c0_ = c0;
+    job_measure_cpu_ = 0;
+    job_rect_ = job.rect;
     Outcome out;
     out.done.generation = job.generation;
     out.done.job = job.job;
@@ -111,12 +130,14 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
 
     if (!own) help_sink_.begin(view);
     JobSink sink(*this, own ? nullptr : &help_sink_);
+    in_own_job_ = own;
     const std::size_t area = static_cast<std::size_t>(std::max(0, cursor.rect.width)) *
                              static_cast<std::size_t>(std::max(0, cursor.rect.height));
     const std::size_t limit =
         job.band == Band::coarse ? std::max<std::size_t>(1, area / 16) : SIZE_MAX;
     const TimelineSample before = frame_->now();
     out.completed = frame_->cast(view, cursor, sink, limit);
+    in_own_job_ = false;
     const TimelineSample& after = frame_->now();
     out.done.rays = after.rays - before.rays;
     out.done.groups = after.groups - before.groups;
@@ -133,7 +154,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
         out.result = std::move(r);
     }
     // The emulated clock of a rank is its busy CPU: what it would have spent on a core of its own.
-    out.done.cpu_s = thread_cpu_seconds() - c0;
+    out.done.cpu_s = thread_cpu_seconds() - c0 - job_measure_cpu_;
     busy_cpu_s_ += out.done.cpu_s;
     out.done.cpu_end_s = busy_cpu_s_;
     if (out.result) out.result->cpu_end_s = busy_cpu_s_;

@@ -44,6 +44,12 @@ class TileJobs {
     };
     Outcome run(const JobMsg& job, int rank);
 
+    // With `measure`, during a job for the rank's own tile (the engine's progress points): keeps
+    // what the tile shows of the job's region, at most every kShotIntervalS of busy CPU. The
+    // copy is not counted as busy.
+    void measure_point();
+    static constexpr double kShotIntervalS = 0.002;
+
     // A helper's result for this rank's tile, composited by depth into what the tile shows.
     // Throws WireError when the rect is not inside the tile.
     void land(const RegionMsg& m);
@@ -84,6 +90,9 @@ class TileJobs {
     double wall0_ = 0, wall_end_ = 0;
     double busy_cpu_s_ = 0;
     double last_draw_s_ = 0;  // emulated time of this rank's last job: its own image is final
+    bool in_own_job_ = false;
+    PixelRect job_rect_;
+    double job_c0_ = 0, job_measure_cpu_ = 0, last_shot_s_ = -1;
     struct Shot {
         double emulated_s;
         PixelRect rect;

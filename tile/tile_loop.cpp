@@ -14,6 +14,8 @@ namespace {
 
 // How long the communication thread waits for a message before it looks at its stop request.
 constexpr double kReceivePollS = 0.05;
+// How often the frame thread tells the master how far it is.
+constexpr double kProgressIntervalS = 0.05;
 
 // The communication thread: every message for this rank into the inbox, until release (the last
 // message a master sends a tile) or until told to end. A transport error, a malformed message or
@@ -100,7 +102,9 @@ class TileRank {
   private:
     EngineOptions options() {
         EngineOptions opt = setup_.engine;
-        opt.progress_interval_s = 0.05;
+        // Every sample point: the measurement's shots want them; progress messages go out
+        // every kProgressIntervalS.
+        opt.progress_interval_s = setup_.measure ? 0.0 : kProgressIntervalS;
         opt.trace = &trace_;
         return opt;
     }
@@ -111,12 +115,16 @@ class TileRank {
         if (setup_.fault.kind == "throw") throw std::runtime_error("test fault: a tile throws");
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
+            jobs_.measure_point();
+            if (s.time_s - last_progress_s_ < kProgressIntervalS) return;
+            last_progress_s_ = s.time_s;
             const Stage left = trace_.switch_to(Stage::comm);
             send_message(comm_, kMasterRank,
                          ProgressMsg{jobs_.generation(), s.rays, thread_cpu_seconds() - cpu0_});
             answer_snapshots();
             trace_.switch_to(left);
         });
+        last_progress_s_ = -1;
         cpu0_ = thread_cpu_seconds();
         ++result_.frames;
     }
@@ -193,7 +201,7 @@ class TileRank {
     TileJobs jobs_;
     TileInbox inbox_;
     TileResultMsg result_;
-    double cpu0_ = 0;
+    double cpu0_ = 0, last_progress_s_ = -1;
     bool interrupted_ = false;
 };
 
