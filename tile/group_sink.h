@@ -20,11 +20,6 @@ class GroupSink {
     // A new frame of `view` (the whole screen); nothing of an earlier frame shows any more.
     virtual void begin(const FrameView& /*view*/) {}
     virtual void add(const Group& group) = 0;
-    // A ray of the frame met a cell that group `group_id` (an id add() was given earlier in the
-    // frame) took: its pixel shows that group. Only sinks that draw a frame's groups into more
-    // than one image need this; see wants_seen().
-    virtual void seen(std::uint32_t /*group_id*/) {}
-    virtual bool wants_seen() const { return false; }
     // Makes every group added so far visible, as a display does at its next refresh. Called at
     // most once per refresh and at the end of each ray-order level; returns the seconds it took.
     virtual double present() { return 0; }

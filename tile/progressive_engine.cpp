@@ -59,7 +59,6 @@ class FrameRun {
         view_inv_ = glm::inverse(view.camera.view());
         rect_ = c.rect;
         cursor_ = &c;
-        wants_seen_ = sink.wants_seen();
         params_ = opt_.propagation;
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
         const std::size_t limit = c.rays + ray_limit;
@@ -162,11 +161,7 @@ class FrameRun {
         // A meta-cell whose triangles miss this pixel's surface gets its full-resolution triangles
         // drawn over (adaptive resolution only); any other unvisited hit seeds a pass.
         if (hit.found) ++cursor_->hits;
-        if (!hit.found) return true;
-        if (!hit.refine && ex_.visited(hit.cell)) {
-            if (wants_seen_) sink_->seen(ex_.group_of(hit.cell));
-            return true;
-        }
+        if (!hit.found || (!hit.refine && ex_.visited(hit.cell))) return true;
         return seed(hit, ray);
     }
 
@@ -262,7 +257,6 @@ class FrameRun {
     glm::mat4 view_inv_{1.0f};
     PixelRect rect_;                  // the region being cast
     RegionCursor* cursor_ = nullptr;  // its cursor
-    bool wants_seen_ = false;         // the sink draws seen groups into its image
     PropagationParams params_;        // the options, with the clip of the region being cast
     std::vector<std::size_t> extra_;
     std::size_t next_extra_ = 0, next_sample_rays_ = 1;

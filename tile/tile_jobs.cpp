@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_set>
 
 #include "common/core/image_ops.h"
 #include "common/core/ray.h"
@@ -23,26 +22,16 @@ FrameView region_view(const FrameView& owner, const PixelRect& rect) {
 // Where a job's groups go: every group is kept (a later job may need it), drawn into the help
 // image when the job is for another tile, and drawn into the rank's own tile when it may show
 // there (a group whose bounds project outside the tile cannot be what a later ray of the tile
-// hits, so leaving it out loses nothing). A help image also gets each earlier group of the frame
-// that a ray of its region meets (a visited cell: the engine casts no new pass there), once:
-// every pixel's ray then shows its cell's group, as in a frame of its own.
+// hits, so leaving it out loses nothing).
 class TileJobs::JobSink final : public GroupSink {
   public:
     JobSink(TileJobs& jobs, GroupSink* help) : jobs_(jobs), help_(help) {}
     void add(const Group& group) override {
         Box3 b;
         for (const glm::vec3& p : group.mesh.positions) b.merge(p);
-        if (help_) {
-            help_->add(group);
-            drawn_.insert(group.id);
-        }
+        if (help_) help_->add(group);
         if (jobs_.shows(b, jobs_.own_)) jobs_.tile_sink_.add(group);
         jobs_.groups_.push_back({group, b});
-    }
-    bool wants_seen() const override { return help_ != nullptr; }
-    void seen(std::uint32_t group_id) override {
-        if (group_id < jobs_.groups_.size() && drawn_.insert(group_id).second)
-            help_->add(jobs_.groups_[group_id].group);
     }
     double present() override {
         return (help_ ? help_->present() : 0.0) + jobs_.tile_sink_.present();
@@ -54,7 +43,6 @@ class TileJobs::JobSink final : public GroupSink {
   private:
     TileJobs& jobs_;
     GroupSink* help_;
-    std::unordered_set<std::uint32_t> drawn_;  // groups in the help image
 };
 
 bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
@@ -111,6 +99,14 @@ void TileJobs::measure_point() {
     job_measure_cpu_ += thread_cpu_seconds() - now;
 }
 
+// Every group found earlier in the frame that may show in `view`: the engine casts no new pass
+// where a ray meets one of its cells, and its triangles may cover pixels of the region whose own
+// rays meet other cells (a whole frame on one rank would show them too).
+void TileJobs::draw_earlier_groups(const FrameView& view) {
+    for (const Recorded& r : groups_)
+        if (shows(r.bounds, view)) help_sink_.add(r.group);
+}
+
 TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const double c0 = thread_cpu_seconds();
     job_c0_ = c0;
@@ -128,7 +124,10 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     if (it == cursors_.end()) it = cursors_.emplace(key, frame_->cursor(view, region)).first;
     RegionCursor& cursor = it->second;
 
-    if (!own) help_sink_.begin(view);
+    if (!own) {
+        help_sink_.begin(view);
+        draw_earlier_groups(view);
+    }
     JobSink sink(*this, own ? nullptr : &help_sink_);
     in_own_job_ = own;
     const std::size_t area = static_cast<std::size_t>(std::max(0, cursor.rect.width)) *

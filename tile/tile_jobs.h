@@ -3,9 +3,9 @@
 // side is master/job_board.h). A rank draws every group it extracts into its own tile's image,
 // whatever job found it: all jobs of a frame share one set of visited cells (EngineFrame), so a
 // group found for another tile may be the one a later ray of its own tile hits. A job for another
-// tile (the owner) is drawn into a region image of the owner's view, with each group found earlier
-// in the frame that one of its rays meets, and is sent to the owner, which composites it by depth
-// into what its tile shows.
+// tile (the owner) is drawn into a region image of the owner's view, first with the groups found
+// earlier in the frame that may show in it, and is sent to the owner, which composites it by
+// depth into what its tile shows.
 #include <atomic>
 #include <map>
 #include <optional>
@@ -74,6 +74,7 @@ class TileJobs {
         Box3 bounds;
     };
     class JobSink;
+    void draw_earlier_groups(const FrameView& view);
     // Whether a group with these bounds may show in `view` (its projected box touches it).
     static bool shows(const Box3& bounds, const FrameView& view);
 
