@@ -7,10 +7,12 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 
 #include "comm/inproc_comm.h"
 #include "common/core/wire.h"
 #include "common/io/image_io.h"
+#include "master/wall_report.h"
 #include "master/wall_run.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
@@ -217,7 +219,9 @@ TEST(WallBalance, BalancedAndStaticMosaicsAreEqual) {
         const std::string name = one_tile ? "one" : "all";
         const WallOptions s =
             balance_wall(test::scratch_dir("balance_static_" + name), false, one_tile);
-        const WallOptions b = balance_wall(test::scratch_dir("balance_on_" + name), true, one_tile);
+        WallOptions b = balance_wall(test::scratch_dir("balance_on_" + name), true, one_tile);
+        b.measure = true;
+        b.trace = (std::filesystem::path(b.out).parent_path() / "trace").string();
         const WallRun rs = run_wall_in_process(s);
         const WallRun rb = run_wall_in_process(b);
         for (int code : rs.codes) ASSERT_EQ(code, 0) << rs.err;
@@ -230,6 +234,20 @@ TEST(WallBalance, BalancedAndStaticMosaicsAreEqual) {
         }
         const test::ImageComparison m = expect_same_view(b.out, s.out);
         EXPECT_GT(m.covered_both, 1000u) << m;
+        // Wall-wide correctness against emulated time rises to 1 once every job has landed.
+        const std::vector<WallCurvePoint> curve = wall_curve(rb.results);
+        ASSERT_FALSE(curve.empty());
+        EXPECT_LT(curve.front().c, 1.0);
+        EXPECT_DOUBLE_EQ(curve.back().final_pixels, 1.0);
+        EXPECT_NEAR(curve.back().c, 1.0, 1e-9);
+        EXPECT_GT(time_to(curve, 0.99, false), 0.0);
+        // Each migrated job is a flow from its owner to the helper and back in the trace.
+        std::ifstream json(b.trace + ".json");
+        const std::string text((std::istreambuf_iterator<char>(json)), {});
+        EXPECT_EQ(test::count_of(text, "\"ph\": \"s\""), 2 * jobs_helped(rb));
+        EXPECT_EQ(
+            test::count_of(text, "\"name\": \"region result\", \"cat\": \"job\", \"ph\": \"f\""),
+            jobs_helped(rb));
         std::printf("%s: %llu jobs migrated; %s\n", name.c_str(),
                     (unsigned long long)jobs_helped(rb), testing::PrintToString(m).c_str());
     }
