@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <thread>
+#include <vector>
 
 #include "common/core/util.h"
 #include "common/progressive/trace.h"
@@ -81,7 +82,7 @@ class TileRank {
             } else if (auto* j = std::get_if<JobMsg>(&*m)) {
                 if (!quit) job(*j);
             } else if (auto* r = std::get_if<RegionMsg>(&*m)) {
-                if (!quit) land(*r);
+                if (!quit) land(std::move(*r));
             } else if (std::holds_alternative<QuitMsg>(*m)) {
                 quit = true;
                 send_result();
@@ -127,6 +128,7 @@ class TileRank {
         last_progress_s_ = -1;
         cpu0_ = thread_cpu_seconds();
         ++result_.frames;
+        land_early();
     }
 
     // The figures of the frame that ends (a new view or quit).
@@ -164,10 +166,23 @@ class TileRank {
         send_message(comm_, kMasterRank, out.done);
     }
 
-    void land(const RegionMsg& r) {
-        if (!jobs_.started() || r.generation != jobs_.generation()) return;  // an older frame's
+    // A helper's result can overtake the master's view of its frame (they come from different
+    // ranks): one of a newer frame waits for that view; one of an older frame is dropped.
+    void land(RegionMsg r) {
+        if (!jobs_.started() || r.generation > jobs_.generation()) {
+            early_.push_back(std::move(r));
+            return;
+        }
+        if (r.generation != jobs_.generation()) return;
         jobs_.land(r);
         send_message(comm_, kMasterRank, LandedMsg{r.generation, r.job});
+    }
+
+    void land_early() {
+        std::vector<RegionMsg> waiting;
+        waiting.swap(early_);
+        for (RegionMsg& r : waiting)
+            if (r.generation >= jobs_.generation()) land(std::move(r));
     }
 
     void answer_snapshots() {
@@ -201,6 +216,7 @@ class TileRank {
     TileJobs jobs_;
     TileInbox inbox_;
     TileResultMsg result_;
+    std::vector<RegionMsg> early_;  // helpers' results that came before their frame's view
     double cpu0_ = 0, last_progress_s_ = -1;
     bool interrupted_ = false;
 };
