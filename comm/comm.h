@@ -60,9 +60,16 @@ void send_message(Comm& comm, int dest, const T& message) {
     comm.send(dest, T::kTag, encode(message));
 }
 
+// How long MPI_Init and MPI_Finalize may take: they wait for every rank, so a stopped rank would
+// hold the others there for ever. Past the limit the process prints one line and exits (2).
+struct MpiLimits {
+    double startup_s = 600;
+    double end_s = 120;
+};
+
 // MPI_Init (once, asking for MPI_THREAD_SERIALIZED: calls are serialised by a lock) and a
 // duplicate of MPI_COMM_WORLD, so our traffic never matches anyone else's. Finalizes MPI when
 // destroyed.
-std::unique_ptr<Comm> make_mpi_comm(int& argc, char**& argv);
+std::unique_ptr<Comm> make_mpi_comm(int& argc, char**& argv, const MpiLimits& limits = {});
 
 }  // namespace isowall

@@ -2,8 +2,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <iterator>
 #include <list>
 #include <mutex>
@@ -30,9 +33,70 @@ constexpr auto kPollSleep = std::chrono::microseconds(200);
 // How long a rank that ends waits for its last sends to be taken.
 constexpr auto kFinalSendWait = std::chrono::seconds(10);
 
+// MPI_Init and MPI_Finalize wait for every rank of the job, and a rank that is stopped or cut off
+// would keep the others there for ever, where no message of ours can reach them. A watchdog
+// thread ends this process with one line if the call has not returned in time; mpirun then ends
+// the job. The master's limit is the shortest, so when it is alive its line is the one printed.
+class Watchdog {
+  public:
+    Watchdog(double limit_s, std::string line) : line_(std::move(line)) {
+        thread_ = std::thread([this, limit_s] {
+            std::unique_lock lock(mutex_);
+            const auto limit = std::chrono::duration<double>(limit_s);
+            if (!cv_.wait_for(lock, limit, [this] { return disarmed_; })) {
+                std::fflush(stdout);
+                std::fputs(line_.c_str(), stderr);
+                std::fflush(stderr);
+                _exit(2);
+            }
+        });
+    }
+    ~Watchdog() {
+        {
+            std::lock_guard lock(mutex_);
+            disarmed_ = true;
+        }
+        cv_.notify_all();
+        thread_.join();
+    }
+
+  private:
+    std::string line_;
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    bool disarmed_ = false;
+    std::thread thread_;
+};
+
+// This process's rank and host before MPI can say (from the launcher's environment).
+std::string who_before_init() {
+    const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+    if (!rank) rank = std::getenv("PMIX_RANK");
+    char host[256] = "?";
+    ::gethostname(host, sizeof(host) - 1);
+    return std::string("rank ") + (rank ? rank : "?") + " (host " + host + ")";
+}
+
+// Tiles wait a little longer than the master, and each a little longer than the one before (up
+// to 4 s), so that one rank names the stall, the master when it can, before mpirun ends the rest.
+double watchdog_limit(double limit_s, int rank) {
+    return rank == 0 ? limit_s : limit_s + 2 + 0.5 * std::min(rank - 1, 8);
+}
+
+int rank_before_init() {
+    const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+    if (!rank) rank = std::getenv("PMIX_RANK");
+    return rank ? std::atoi(rank) : 1;
+}
+
 class MpiComm final : public Comm {
   public:
-    MpiComm(int& argc, char**& argv) {
+    MpiComm(int& argc, char**& argv, const MpiLimits& limits) : limits_(limits) {
+        Watchdog watchdog(watchdog_limit(limits.startup_s, rank_before_init()),
+                          "isowall: error: " + who_before_init() +
+                              ": MPI start-up did not finish within " + seconds(limits.startup_s) +
+                              " (--startup-timeout): a rank of this job has stopped or cannot be "
+                              "reached\n");
         int initialized = 0;
         MPI_Initialized(&initialized);
         if (!initialized) {
@@ -49,6 +113,11 @@ class MpiComm final : public Comm {
         ISOWALL_MPI_CALL(MPI_Comm_size(comm_, &size_));
     }
     ~MpiComm() override {
+        Watchdog watchdog(watchdog_limit(limits_.end_s, rank_),
+                          "isowall: error: rank " + std::to_string(rank_) + " (host " + host() +
+                              "): MPI did not end within " + seconds(limits_.end_s) +
+                              " (--timeout): a rank of this job has stopped or cannot be "
+                              "reached\n");
         // Sends still in flight complete before MPI ends; a peer that is gone cannot take them,
         // so the wait is bounded (the master releases tiles only once every result is in).
         const auto start = std::chrono::steady_clock::now();
@@ -131,6 +200,12 @@ class MpiComm final : public Comm {
     }
 
   private:
+    static std::string seconds(double s) {
+        char text[32];
+        std::snprintf(text, sizeof(text), "%g s", s);
+        return text;
+    }
+
     struct PendingSend {
         MPI_Request request = MPI_REQUEST_NULL;
         std::vector<std::byte> bytes;
@@ -158,6 +233,7 @@ class MpiComm final : public Comm {
         return e;
     }
 
+    MpiLimits limits_;
     mutable std::mutex mutex_;
     std::list<PendingSend> pending_;
     MPI_Comm comm_ = MPI_COMM_NULL;
@@ -167,8 +243,8 @@ class MpiComm final : public Comm {
 
 }  // namespace
 
-std::unique_ptr<Comm> make_mpi_comm(int& argc, char**& argv) {
-    return std::make_unique<MpiComm>(argc, argv);
+std::unique_ptr<Comm> make_mpi_comm(int& argc, char**& argv, const MpiLimits& limits) {
+    return std::make_unique<MpiComm>(argc, argv, limits);
 }
 
 }  // namespace isowall

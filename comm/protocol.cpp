@@ -50,6 +50,7 @@ TraceSpan get_trace_span(MessageReader& r) {
 std::vector<std::byte> encode(const HelloMsg& m) {
     MessageWriter w(HelloMsg::kVersion);
     w.put_string(m.host);
+    w.put(static_cast<std::uint8_t>(m.loaded));
     return w.take();
 }
 
@@ -57,6 +58,7 @@ static HelloMsg decode_hello(std::span<const std::byte> bytes) {
     MessageReader r(bytes, HelloMsg::kVersion, "hello message");
     HelloMsg m;
     m.host = r.get_string();
+    m.loaded = r.get_bool();
     r.finish();
     return m;
 }
@@ -224,6 +226,10 @@ const char* to_string(Tag tag) {
             return "tile_result";
         case Tag::release:
             return "release";
+        case Tag::start:
+            return "start";
+        case Tag::alive:
+            return "alive";
         case Tag::job:
             return "job";
         case Tag::job_done:
@@ -255,6 +261,10 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return decode_tile_result(bytes);
         case Tag::release:
             return job_wire::decode_release(bytes);
+        case Tag::start:
+            return job_wire::decode_start(bytes);
+        case Tag::alive:
+            return job_wire::decode_alive(bytes);
         case Tag::job:
             return job_wire::decode_job(bytes);
         case Tag::job_done:
@@ -265,7 +275,7 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_landed(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
-                    ": unknown tag, expected 1..8 or 16..19");
+                    ": unknown tag, expected 1..10 or 16..19");
 }
 
 }  // namespace isowall

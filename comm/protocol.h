@@ -17,7 +17,7 @@ namespace isowall {
 
 // The MPI tag of each message. 16..31 are the screen-region scheduler's job messages.
 enum class Tag : std::int32_t {
-    hello = 1,        // tile -> master, first thing: its host name
+    hello = 1,        // tile -> master: its host name, once joined and again once loaded
     view = 2,         // master -> tile: a new frame (interrupts the current one); jobs follow
     progress = 3,     // tile -> master: rays cast so far in a frame
     snapshot = 4,     // master -> tile: send the image being built
@@ -25,6 +25,8 @@ enum class Tag : std::int32_t {
     quit = 6,         // master -> tile: send the result and the final image, then stop
     tile_result = 7,  // tile -> master: a tile's figures and trace, its last message but the image
     release = 8,      // master -> tile: every rank has sent its result; exit now
+    start = 9,        // master -> tile: the volume and its octree cache are ready; load them
+    alive = 10,       // both ways, every kAliveIntervalS: the sender's message loop is running
     job = 16,         // master -> worker: fill a screen region of a tile (its own or another's)
     job_done = 17,    // worker -> master: the job's figures; the worker is free for the next
     region = 18,      // worker -> owner: colour and depth of a region it filled for the owner
@@ -36,10 +38,14 @@ const char* to_string(Tag tag);
 // a tile is far smaller (a 4K display is 32 MiB of RGBA).
 inline constexpr int kMaxImageSide = 32768;
 
+// A tile says hello twice: as soon as it has joined the job (loaded = false), and once it has
+// loaded the volume and can take views (loaded = true). The master names the tiles it has not
+// heard from when a stage of the start-up runs past --startup-timeout.
 struct HelloMsg {
     static constexpr Tag kTag = Tag::hello;
-    static constexpr std::uint8_t kVersion = 1;
+    static constexpr std::uint8_t kVersion = 2;
     std::string host;
+    bool loaded = false;
 };
 
 struct ViewMsg {
@@ -105,6 +111,19 @@ struct ReleaseMsg {
     static constexpr std::uint8_t kVersion = 1;
 };
 
+struct StartMsg {
+    static constexpr Tag kTag = Tag::start;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+// Liveness: a rank whose peer has sent nothing, not even this, for --timeout seconds ends the job
+// naming that peer (stopped, killed without a word, or on a host that cannot be reached).
+inline constexpr double kAliveIntervalS = 0.5;
+struct AliveMsg {
+    static constexpr Tag kTag = Tag::alive;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
 // Which ray-order levels of a region a job casts: the coarse levels (until about 1/16 of the
 // region's rays) or the rest. Coarse jobs of every tile go before fine jobs anywhere.
 enum class Band : std::uint8_t { coarse = 0, fine = 1 };
@@ -150,8 +169,9 @@ struct LandedMsg {
     std::uint32_t job = 0;
 };
 
-using Message = std::variant<HelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
-                             TileResultMsg, ReleaseMsg, JobMsg, JobDoneMsg, RegionMsg, LandedMsg>;
+using Message =
+    std::variant<HelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg, TileResultMsg,
+                 ReleaseMsg, StartMsg, AliveMsg, JobMsg, JobDoneMsg, RegionMsg, LandedMsg>;
 
 std::vector<std::byte> encode(const HelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -161,6 +181,8 @@ std::vector<std::byte> encode(const ImageMsg& m);
 std::vector<std::byte> encode(const QuitMsg& m);
 std::vector<std::byte> encode(const TileResultMsg& m);
 std::vector<std::byte> encode(const ReleaseMsg& m);
+std::vector<std::byte> encode(const StartMsg& m);
+std::vector<std::byte> encode(const AliveMsg& m);
 std::vector<std::byte> encode(const JobMsg& m);
 std::vector<std::byte> encode(const JobDoneMsg& m);
 std::vector<std::byte> encode(const RegionMsg& m);

@@ -1,5 +1,6 @@
-// The screen-region scheduler's messages (tags 16..19) and release, each encoder right above its
-// decoder, with the same value checks as the frame messages in protocol.cpp.
+// The screen-region scheduler's messages (tags 16..19), and release, start and alive (8..10), each
+// encoder right above its decoder, with the same value checks as the frame messages in
+// protocol.cpp.
 #include "comm/protocol_jobs.h"
 
 #include <string>
@@ -16,6 +17,26 @@ std::vector<std::byte> encode(const ReleaseMsg&) {
 
 ReleaseMsg job_wire::decode_release(std::span<const std::byte> bytes) {
     MessageReader r(bytes, ReleaseMsg::kVersion, "release message");
+    r.finish();
+    return {};
+}
+
+std::vector<std::byte> encode(const StartMsg&) {
+    return MessageWriter(StartMsg::kVersion).take();
+}
+
+StartMsg job_wire::decode_start(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, StartMsg::kVersion, "start message");
+    r.finish();
+    return {};
+}
+
+std::vector<std::byte> encode(const AliveMsg&) {
+    return MessageWriter(AliveMsg::kVersion).take();
+}
+
+AliveMsg job_wire::decode_alive(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, AliveMsg::kVersion, "alive message");
     r.finish();
     return {};
 }

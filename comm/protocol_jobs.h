@@ -9,6 +9,8 @@
 namespace isowall::job_wire {
 
 ReleaseMsg decode_release(std::span<const std::byte> bytes);
+StartMsg decode_start(std::span<const std::byte> bytes);
+AliveMsg decode_alive(std::span<const std::byte> bytes);
 JobMsg decode_job(std::span<const std::byte> bytes);
 JobDoneMsg decode_job_done(std::span<const std::byte> bytes);
 RegionMsg decode_region(std::span<const std::byte> bytes);

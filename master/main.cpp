@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/core/util.h"
 #include "master/commands.h"
 #include "master/wall_run.h"
 
@@ -221,7 +222,10 @@ int main(int argc, char** argv) {
         if (wall_cmd->parsed()) {
             std::tie(wall.fault_kind, wall.fault_rank) =
                 parse_test_fault(std::getenv("ISOWALL_TEST_FAULT"));
-            auto comm = make_mpi_comm(argc, argv);
+            const char* env_rank = std::getenv("OMPI_COMM_WORLD_RANK");
+            if (env_rank && std::atoi(env_rank) == wall.fault_rank)
+                raise_test_signal(wall.fault_kind, "init");
+            auto comm = make_mpi_comm(argc, argv, {wall.startup_timeout_s, wall.timeout_s});
             return run_wall(wall, *comm);
         }
     } catch (const std::exception& e) {

@@ -45,9 +45,12 @@ void WallMaster::handle(const Envelope& e) {
     } catch (const WireError& err) {
         throw WireError(rank_label(spec_, e.from) + ": " + err.what());
     }
+    t.heard.restart();
     if (auto* h = std::get_if<HelloMsg>(&m)) {
         t.host = h->host;
-        t.hello = true;
+        (h->loaded ? t.hello : t.joined) = true;
+    } else if (std::holds_alternative<AliveMsg>(m)) {
+        // its message loop runs: heard is all it tells
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
         if (p->generation == generation_)  // older generations: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);
@@ -62,6 +65,7 @@ void WallMaster::handle(const Envelope& e) {
                 std::to_string(r.width) + "x" + std::to_string(r.height) + ")");
         t.image = std::move(*img);
     } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
+        raise_test_signal(o_.fault, "gather");
         t.result = std::move(*res);
     } else {
         throw WireError(rank_label(spec_, e.from) + " sent a " + to_string(e.tag) +
@@ -72,11 +76,13 @@ void WallMaster::handle(const Envelope& e) {
 
 void WallMaster::wait_until(const std::function<bool()>& done, double timeout_s) {
     const Stage left = trace_.switch_to(Stage::idle);
-    Stopwatch silent;
+    Stopwatch silent;  // since the last message other than alive
     while (!done()) {
+        keep_alive();
         if (auto e = comm_.receive(-1, kReceiveSliceS)) {
+            const bool alive = e->tag == Tag::alive;
             handle(*e);
-            silent.restart();
+            if (!alive) silent.restart();
         } else if (silent.seconds() > timeout_s) {
             char msg[96];
             std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", timeout_s);
@@ -85,6 +91,42 @@ void WallMaster::wait_until(const std::function<bool()>& done, double timeout_s)
         }
     }
     trace_.switch_to(left);
+}
+
+void WallMaster::wait_for_tiles(const std::function<bool(const TileState&)>& pred,
+                                double timeout_s) {
+    awaited_ = pred;
+    wait_until([&] { return all_tiles(pred); }, timeout_s);
+    awaited_ = nullptr;
+}
+
+void WallMaster::keep_alive() {
+    // Called every few tens of milliseconds while the master waits; a far longer gap means the
+    // master itself was stopped (SIGSTOP, a debugger) and has just been let go, and the tiles'
+    // silence meanwhile is not theirs: their clocks start again.
+    if (alive_checked_.seconds() > o_.timeout_s / 2)
+        for (TileState& t : tiles_) t.heard.restart();
+    alive_checked_.restart();
+    if (alive_sent_.seconds() < kAliveIntervalS) return;
+    alive_sent_.restart();
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        if (!t.joined) continue;  // it is not yet listening
+        send_message(comm_, rank, AliveMsg{});
+        if (t.hello && t.heard.seconds() > o_.timeout_s) {
+            char msg[160];
+            std::snprintf(msg, sizeof(msg),
+                          " on %s has sent nothing for %g s (--timeout): it has stopped, or its "
+                          "host cannot be reached; ending the job",
+                          t.host.c_str(), o_.timeout_s);
+            throw std::runtime_error(rank_label(spec_, rank) + msg);
+        }
+    }
+}
+
+void WallMaster::idle() {
+    keep_alive();
+    while (auto e = comm_.receive(-1, 0)) handle(*e);
 }
 
 bool WallMaster::all_tiles(const std::function<bool(const TileState&)>& pred) const {
@@ -98,7 +140,8 @@ std::string WallMaster::waiting_on() const {
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
         const bool busy = board_ && !board_->complete() && board_->in_hand(rank) > 0;
-        if (!t.hello || busy) list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
+        if (awaited_ ? !awaited_(t) : busy)
+            list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
     }
     return list.empty() ? "all tiles" : list;
 }
@@ -112,11 +155,13 @@ std::uint64_t WallMaster::total_rays() const {
 void WallMaster::start() {
     // Tiles load the volume and build their renderer before their hello: a start-up of its own
     // length, so a short --timeout for a running wall does not cut a slow load short.
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.hello; }); },
-               o_.startup_timeout_s);
+    wait_for_tiles([](const TileState& t) { return t.joined; }, o_.startup_timeout_s);
+    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, StartMsg{});
+    wait_for_tiles([](const TileState& t) { return t.hello; }, o_.startup_timeout_s);
     print_map();
     send_views();
-    if (o_.throw_fault) throw std::runtime_error("test fault: the master throws");
+    raise_test_signal(o_.fault, "frame");
+    if (o_.fault == "throw") throw std::runtime_error("test fault: the master throws");
 }
 
 void WallMaster::print_map() const {
@@ -178,6 +223,7 @@ void WallMaster::fill(int rank) {
         m.view = tiles_[static_cast<std::size_t>(j.owner)].view;
         m.rect = j.rect;
         send_message(comm_, rank, m);
+        if (j.owner != rank) raise_test_signal(o_.fault, "migration");
     }
 }
 
@@ -261,8 +307,7 @@ void WallMaster::wait(const WaitCmd& w) {
 Image WallMaster::gather_snapshot() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, SnapshotMsg{});
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.image.has_value(); }); },
-               o_.timeout_s);
+    wait_for_tiles([](const TileState& t) { return t.image.has_value(); }, o_.timeout_s);
     return compose().image;
 }
 
@@ -290,8 +335,7 @@ Mosaic WallMaster::compose() {
 int WallMaster::finish() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
-    wait_until([&] { return all_tiles([](const TileState& t) { return t.result && t.image; }); },
-               o_.timeout_s);
+    wait_for_tiles([](const TileState& t) { return t.result && t.image; }, o_.timeout_s);
     // Every rank has stopped working, so no helper's result is on its way any more.
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
     const Mosaic mosaic = compose();

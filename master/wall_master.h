@@ -26,7 +26,7 @@ struct MasterOptions {
     std::string trace;               // PREFIX for PREFIX.json and PREFIX.csv, or empty
     double timeout_s = 120;          // the wall silent this long ends the job
     double startup_timeout_s = 600;  // the same, while the tiles start (load, say hello)
-    bool throw_fault = false;        // test hook: fail after the first views are out
+    std::string fault;  // test hook (ISOWALL_TEST_FAULT of the master): "throw", "stop@frame"...
     // The screen-region scheduler: off, every tile casts its own screen (one job per band);
     // on, tiles are cut into regions of region_w x region_h and idle ranks take others' regions.
     // The first view: the front full view turned, zoomed and panned by these.
@@ -44,8 +44,13 @@ class WallMaster {
     WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
                double iso, double value_min, double value_max);
 
-    // Waits for every tile's hello, prints the rank -> host -> tile map, sends the first views.
+    // Waits for every tile to join, lets them load (start), waits until each has loaded, prints
+    // the rank -> host -> tile map and sends the first views. Each stage may take the start-up
+    // limit; past it the job ends naming the tiles not heard from.
     void start();
+    // Between commands at the console: takes the messages that came (so a frame goes on while
+    // the operator types), tells the tiles the master is alive, and checks that they are.
+    void idle();
     // Runs one command; false for quit. Throws InputError for a command that cannot apply
     // (isovalue out of range), naming `where`.
     bool execute(const ScriptCommand& cmd, const std::string& where);
@@ -58,9 +63,11 @@ class WallMaster {
   private:
     struct TileState {
         std::string host;
-        bool hello = false;
-        std::uint64_t rays = 0;         // of the current generation
-        FrameView view;                 // of the current generation
+        bool joined = false;     // said hello before loading
+        bool hello = false;      // said hello after loading: takes views, sends alive messages
+        Stopwatch heard;         // since its last message of any kind
+        std::uint64_t rays = 0;  // of the current generation
+        FrameView view;          // of the current generation
         std::optional<ImageMsg> image;  // the answer to the pending image request
         std::optional<TileResultMsg> result;
     };
@@ -73,8 +80,13 @@ class WallMaster {
     // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
     // naming the tiles still awaited.
     void wait_until(const std::function<bool()>& done, double timeout_s);
+    // wait_until every tile holds `pred`; on a timeout the tiles that do not are named.
+    void wait_for_tiles(const std::function<bool(const TileState&)>& pred, double timeout_s);
     bool all_tiles(const std::function<bool(const TileState&)>& pred) const;
     std::string waiting_on() const;
+    // Every kAliveIntervalS: an alive message to each tile; throws naming a loaded tile that has
+    // sent nothing for the timeout.
+    void keep_alive();
 
     void send_views();
     void wait(const WaitCmd& w);
@@ -97,6 +109,8 @@ class WallMaster {
     TraceRecorder trace_;
     std::optional<JobBoard> board_;      // the current generation's jobs
     std::vector<Migration> migrations_;  // of the current generation
+    Stopwatch alive_sent_, alive_checked_;
+    std::function<bool(const TileState&)> awaited_;  // set by wait_for_tiles, for waiting_on
 };
 
 }  // namespace isowall

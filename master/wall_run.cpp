@@ -1,5 +1,8 @@
 #include "master/wall_run.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +12,7 @@
 #include <tuple>
 
 #include "common/core/error.h"
+#include "common/core/util.h"
 #include "common/extract/surface_extractor.h"
 #include "common/volume/phantom.h"
 #include "common/wall/script.h"
@@ -74,7 +78,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.trace = o.trace;
     mo.timeout_s = o.timeout_s;
     mo.startup_timeout_s = o.startup_timeout_s;
-    mo.throw_fault = o.fault_kind == "throw" && o.fault_rank == kMasterRank;
+    if (o.fault_rank == kMasterRank) mo.fault = o.fault_kind;
     mo.results_out = o.results_out;
     mo.balance = o.balance;
     if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
@@ -88,9 +92,10 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     master.start();
     const std::string where = o.script.empty() ? std::string("--script") : o.script;
     if (o.script == "-") {
-        run_console(std::cin, [&](const ScriptCommand& c, const std::string& w) {
-            return master.execute(c, w);
-        });
+        run_console(
+            STDIN_FILENO,
+            [&](const ScriptCommand& c, const std::string& w) { return master.execute(c, w); },
+            [&] { master.idle(); });
     } else {
         for (const ScriptLine& l : in.script)
             if (!master.execute(l.command, where + ":" + std::to_string(l.line))) break;
@@ -109,9 +114,33 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
     setup.engine.region_clip = o.region_clip;
     if (o.fault_rank == comm.rank()) setup.fault.kind = o.fault_kind;
     const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
+    setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
     return run_tile(comm, setup);
+}
+
+// A tile waits for the master's start (the volume is loaded and its octree cached, so the tile
+// maps the same files rather than building its own), for at most the start-up limit.
+void await_start(Comm& comm, double timeout_s) {
+    // Tiles after the first wait a little longer, so that one names a lost master, not all.
+    const double limit_s = timeout_s + 0.5 * std::min(comm.rank() - 1, 8);
+    Stopwatch waited;
+    while (waited.seconds() < limit_s) {
+        auto e = comm.receive(kMasterRank, 0.05);
+        if (!e) continue;
+        const Message m = decode_message(e->tag, e->bytes);
+        if (std::holds_alternative<StartMsg>(m)) return;
+        if (!std::holds_alternative<AliveMsg>(m))
+            throw WireError(std::string("expected start from the master, got ") +
+                            to_string(e->tag));
+    }
+    char msg[200];
+    std::snprintf(msg, sizeof(msg),
+                  "the master (rank 0) has not started the wall within %g s (--startup-timeout): "
+                  "it is still loading the volume, has stopped, or cannot be reached",
+                  timeout_s);
+    throw std::runtime_error(msg);
 }
 
 std::string role(const WallSpec& spec, int rank) {
@@ -174,16 +203,20 @@ int run_wall(const WallOptions& o, Comm& comm) {
     try {
         // The master loads first and writes the octree cache; the tile ranks then map the same
         // files, so the machine holds one copy of the volume and the octree.
-        std::optional<MasterInput> input;
-        if (comm.is_master()) {
-            try {
-                input.emplace(check_master_input(o));
-            } catch (const InputError& e) {
-                fail(comm, spec, e, true);
-            }
+        if (!comm.is_master()) {
+            send_message(comm, kMasterRank, HelloMsg{comm.host(), false});
+            await_start(comm, o.startup_timeout_s);
+            if (o.fault_rank == comm.rank()) raise_test_signal(o.fault_kind, "load");
+            return run_tile_rank(o, comm, spec);
         }
-        comm.barrier();
-        return comm.is_master() ? run_master(o, comm, spec, *input) : run_tile_rank(o, comm, spec);
+        if (o.fault_rank == kMasterRank) raise_test_signal(o.fault_kind, "load");
+        std::optional<MasterInput> input;
+        try {
+            input.emplace(check_master_input(o));
+        } catch (const InputError& e) {
+            fail(comm, spec, e, true);
+        }
+        return run_master(o, comm, spec, *input);
     } catch (const CommAborted&) {
         throw;  // another rank failed and has said why
     } catch (const InputError& e) {

@@ -75,7 +75,7 @@ TEST(ProtocolMalformed, TrailingByteThrows) {
 
 TEST(ProtocolMalformed, UnknownTagThrows) {
     const Bytes bytes = encode(QuitMsg{});
-    for (std::int32_t tag : {0, 9, 15, 20, 31, -1, std::numeric_limits<std::int32_t>::max()})
+    for (std::int32_t tag : {0, 11, 15, 20, 31, -1, std::numeric_limits<std::int32_t>::max()})
         EXPECT_THROW(decode_message(static_cast<Tag>(tag), bytes), WireError) << "tag " << tag;
 }
 
@@ -114,6 +114,12 @@ TEST(ProtocolMalformed, HelloWithAHugeLengthThrowsWithoutAllocating) {
             largest_allocation_in([&] { expect_wire_error(Tag::hello, bytes, "length"); });
         EXPECT_LT(largest, 4096u) << "length " << length;
     }
+}
+
+TEST(ProtocolMalformed, HelloWithABadBoolThrows) {
+    Bytes bytes = encode(sample_hello());
+    bytes.back() = std::byte{2};  // `loaded` is the last byte
+    expect_wire_error(Tag::hello, bytes, "bool byte 2");
 }
 
 // ---- view ---------------------------------------------------------------------------------------
@@ -304,8 +310,8 @@ std::string mutate(Bytes& b, Tag& tag, std::mt19937_64& rng) {
             return "word at " + std::to_string(at);
         }
         default: {
-            // 1..8: every tag and one unknown one
-            tag = static_cast<Tag>(1 + rng() % 8);
+            // 1..11: every frame tag and one unknown one
+            tag = static_cast<Tag>(1 + rng() % 11);
             return "tag " + std::to_string(static_cast<int>(tag));
         }
     }

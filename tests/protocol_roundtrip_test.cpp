@@ -31,6 +31,8 @@ TEST(Protocol, DegenerateMessagesRoundTrip) {
     one_pixel.view.height = 1;
     expect_round_trip(one_pixel);
     expect_round_trip(ReleaseMsg{});
+    expect_round_trip(StartMsg{});
+    expect_round_trip(AliveMsg{});
     expect_round_trip(JobDoneMsg{});
     expect_round_trip(LandedMsg{});
 }
@@ -122,12 +124,14 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::quit), "quit");
     EXPECT_STREQ(to_string(Tag::tile_result), "tile_result");
     EXPECT_STREQ(to_string(Tag::release), "release");
+    EXPECT_STREQ(to_string(Tag::start), "start");
+    EXPECT_STREQ(to_string(Tag::alive), "alive");
     EXPECT_STREQ(to_string(Tag::job), "job");
     EXPECT_STREQ(to_string(Tag::job_done), "job_done");
     EXPECT_STREQ(to_string(Tag::region), "region");
     EXPECT_STREQ(to_string(Tag::landed), "landed");
     EXPECT_STREQ(to_string(static_cast<Tag>(0)), "unknown");
-    EXPECT_STREQ(to_string(static_cast<Tag>(9)), "unknown");
+    EXPECT_STREQ(to_string(static_cast<Tag>(11)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(20)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }

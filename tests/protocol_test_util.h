@@ -48,7 +48,7 @@ inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
            a.cpu_s == b.cpu_s;
 }
 inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
-    return a.host == b.host;
+    return a.host == b.host && a.loaded == b.loaded;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
     return a.generation == b.generation && a.view == b.view;
@@ -77,6 +77,12 @@ inline bool operator==(const TileResultMsg& a, const TileResultMsg& b) {
 inline bool operator==(const ReleaseMsg&, const ReleaseMsg&) {
     return true;
 }
+inline bool operator==(const StartMsg&, const StartMsg&) {
+    return true;
+}
+inline bool operator==(const AliveMsg&, const AliveMsg&) {
+    return true;
+}
 inline bool operator==(const JobMsg& a, const JobMsg& b) {
     return a.generation == b.generation && a.job == b.job && a.owner == b.owner &&
            a.band == b.band && a.view == b.view && a.rect == b.rect;
@@ -103,7 +109,7 @@ inline std::ostream& operator<<(std::ostream& os, const TraceSpan& s) {
               << s.wall_s << ", cpu " << s.cpu_s << "}";
 }
 inline void PrintTo(const HelloMsg& m, std::ostream* os) {
-    *os << "HelloMsg{" << m.host << "}";
+    *os << "HelloMsg{" << m.host << (m.loaded ? ", loaded}" : "}");
 }
 inline void PrintTo(const ViewMsg& m, std::ostream* os) {
     *os << "ViewMsg{generation " << m.generation << ", " << m.view << "}";
@@ -133,6 +139,12 @@ inline void PrintTo(const TileResultMsg& m, std::ostream* os) {
 }
 inline void PrintTo(const ReleaseMsg&, std::ostream* os) {
     *os << "ReleaseMsg{}";
+}
+inline void PrintTo(const StartMsg&, std::ostream* os) {
+    *os << "StartMsg{}";
+}
+inline void PrintTo(const AliveMsg&, std::ostream* os) {
+    *os << "AliveMsg{}";
 }
 inline void PrintTo(const JobMsg& m, std::ostream* os) {
     *os << "JobMsg{generation " << m.generation << ", job " << m.job << ", owner " << m.owner
@@ -168,7 +180,7 @@ inline std::string hex(std::span<const std::byte> bytes) {
 
 inline HelloMsg sample_hello() {
     using namespace std::string_literals;
-    return {"rank\0host-\xc3\xa9"s};  // an inner NUL and UTF-8: the length is on the wire
+    return {"rank\0host-\xc3\xa9"s, true};  // an inner NUL and UTF-8: the length is on the wire
 }
 
 inline ViewMsg sample_view() {
@@ -266,6 +278,8 @@ inline std::vector<Sample> samples() {
             {"quit", Tag::quit, encode(QuitMsg{})},
             {"tile_result", Tag::tile_result, encode(sample_tile_result())},
             {"release", Tag::release, encode(ReleaseMsg{})},
+            {"start", Tag::start, encode(StartMsg{})},
+            {"alive", Tag::alive, encode(AliveMsg{})},
             {"job", Tag::job, encode(sample_job())},
             {"job_done", Tag::job_done, encode(sample_job_done())},
             {"region", Tag::region, encode(sample_region())},

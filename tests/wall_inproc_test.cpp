@@ -280,8 +280,7 @@ TEST(WallInProcess, AMalformedMessageToTheMasterEndsTheJobNamingTheRank) {
     testing::internal::CaptureStderr();
     const std::vector<int> codes = run_in_process(5, [&](Comm& comm) {
         if (comm.rank() != 4) return run_wall(o, comm);
-        comm.barrier();
-        const std::byte junk[] = {std::byte{1}, std::byte{9}};  // a hello that is cut short
+        const std::byte junk[] = {std::byte{HelloMsg::kVersion}, std::byte{9}};  // cut short
         comm.send(kMasterRank, Tag::hello, junk);
         for (;;) comm.receive(-1, kForever);  // until the job ends
     });

@@ -1,7 +1,10 @@
 #include "tile/tile_loop.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -19,13 +22,14 @@ constexpr double kReceivePollS = 0.05;
 constexpr double kProgressIntervalS = 0.05;
 
 // The communication thread: every message for this rank into the inbox, until release (the last
-// message a master sends a tile) or until told to end. A transport error, a malformed message or
-// one from a rank that may not send it closes the inbox with that error, so the frame thread
-// reports it.
+// message a master sends a tile) or until told to end. It tells the master it is alive every
+// kAliveIntervalS, whatever the frame thread is doing. A transport error, a malformed message,
+// one from a rank that may not send it, or a master silent for the timeout closes the inbox with
+// that error, so the frame thread reports it.
 class Receiver {
   public:
-    Receiver(Comm& comm, TileInbox& inbox)
-        : comm_(comm), inbox_(inbox), thread_([this] { loop(); }) {}
+    Receiver(Comm& comm, TileInbox& inbox, double timeout_s)
+        : comm_(comm), inbox_(inbox), timeout_s_(timeout_s), thread_([this] { loop(); }) {}
     ~Receiver() {
         ending_ = true;
         thread_.join();
@@ -34,10 +38,25 @@ class Receiver {
   private:
     void loop() {
         try {
+            Stopwatch alive_sent, master_heard, turn;
             while (!ending_) {
+                // A turn of this loop takes kReceivePollS; one far longer means this process was
+                // stopped (SIGSTOP, a debugger) and has just been let go: the master is not the
+                // one that went silent, so its clock starts again.
+                if (turn.seconds() > timeout_s_ / 2) master_heard.restart();
+                turn.restart();
+                if (alive_sent.seconds() >= kAliveIntervalS) {
+                    send_message(comm_, kMasterRank, AliveMsg{});
+                    alive_sent.restart();
+                }
                 auto e = comm_.receive(-1, kReceivePollS);
-                if (!e) continue;
+                if (!e) {
+                    if (master_heard.seconds() > limit_s()) throw silent_master();
+                    continue;
+                }
+                if (e->from == kMasterRank) master_heard.restart();
                 Message m = decode_message(e->tag, e->bytes);
+                if (std::holds_alternative<AliveMsg>(m) && e->from == kMasterRank) continue;
                 // Region results come from helpers (tile ranks); everything else from the master.
                 const bool from_helper = std::holds_alternative<RegionMsg>(m);
                 if (from_helper == (e->from == kMasterRank))
@@ -52,8 +71,22 @@ class Receiver {
         }
     }
 
+    // Tiles other than the first wait a little longer, so that when the master is gone one tile
+    // names it before mpirun ends the others.
+    double limit_s() const { return timeout_s_ + 0.5 * std::min(comm_.rank() - 1, 8); }
+
+    std::runtime_error silent_master() const {
+        char msg[200];
+        std::snprintf(msg, sizeof(msg),
+                      "the master (rank 0) has sent nothing for %g s (--timeout): it has stopped, "
+                      "or its host cannot be reached",
+                      timeout_s_);
+        return std::runtime_error(msg);
+    }
+
     Comm& comm_;
     TileInbox& inbox_;
+    double timeout_s_;
     std::atomic<bool> ending_{false};
     std::thread thread_;
 };
@@ -68,8 +101,8 @@ class TileRank {
 
     int run() {
         if (setup_.tile_width > 0) jobs_.prepare(setup_.tile_width, setup_.tile_height);
-        send_message(comm_, kMasterRank, HelloMsg{comm_.host()});
-        Receiver receiver(comm_, inbox_);
+        send_message(comm_, kMasterRank, HelloMsg{comm_.host(), true});
+        Receiver receiver(comm_, inbox_, setup_.timeout_s);
         bool quit = false;
         for (;;) {
             trace_.switch_to(Stage::idle);
@@ -84,6 +117,7 @@ class TileRank {
             } else if (auto* r = std::get_if<RegionMsg>(&*m)) {
                 if (!quit) land(std::move(*r));
             } else if (std::holds_alternative<QuitMsg>(*m)) {
+                raise_test_signal(setup_.fault.kind, "gather");
                 quit = true;
                 send_result();
                 send_image();
@@ -114,6 +148,7 @@ class TileRank {
         if (setup_.fault.kind == "hang") inbox_.wait_closed();
         if (setup_.fault.kind == "exit") std::_Exit(3);
         if (setup_.fault.kind == "throw") throw std::runtime_error("test fault: a tile throws");
+        raise_test_signal(setup_.fault.kind, "frame");
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             jobs_.measure_point();
@@ -146,6 +181,7 @@ class TileRank {
     void job(const JobMsg& j) {
         // Jobs of an older frame are dropped: the master no longer counts on them.
         if (!jobs_.started() || j.generation != jobs_.generation()) return;
+        if (j.owner != comm_.rank()) raise_test_signal(setup_.fault.kind, "migration");
         TileJobs::Outcome out = jobs_.run(j, comm_.rank());
         trace_.switch_to(Stage::comm);
         if (!out.completed) {

@@ -17,7 +17,8 @@ namespace isowall {
 
 // Test hooks for fault handling (ISOWALL_TEST_FAULT=KIND:RANK): after its first view a tile
 // "hang"s (stops answering until the job ends), "exit"s at once (process only; never in process),
-// or "throw"s an error.
+// or "throw"s an error; "stop@MOMENT" and "kill@MOMENT" send the process SIGSTOP or SIGKILL at
+// a moment (init, load, frame, migration, gather; see raise_test_signal).
 struct TileFault {
     std::string kind;  // empty: none
 };
@@ -28,7 +29,8 @@ struct TileSetup {
     Renderer& help_renderer;  // the regions it fills for other tiles
     EngineOptions engine;
     TileFault fault;
-    bool measure = false;  // keep each job's result for the emulated correctness curve
+    bool measure = false;    // keep each job's result for the emulated correctness curve
+    double timeout_s = 120;  // the master silent this long (not even alive messages) ends the job
     int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up
 };
 

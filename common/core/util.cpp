@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 #include <unistd.h>
+#include <csignal>
 
 #include <charconv>
 #include <fstream>
@@ -32,6 +33,14 @@ std::optional<glm::ivec2> parse_size(std::string_view s) {
     if (b.ec != std::errc() || b.ptr != s.data() + s.size()) return std::nullopt;
     if (w <= 0 || h <= 0 || w > 32768 || h > 32768) return std::nullopt;
     return glm::ivec2(w, h);
+}
+
+void raise_test_signal(std::string_view kind, std::string_view moment) {
+    const auto at = kind.find('@');
+    if (at == std::string_view::npos || kind.substr(at + 1) != moment) return;
+    const std::string_view what = kind.substr(0, at);
+    if (what == "stop") ::raise(SIGSTOP);
+    if (what == "kill") ::raise(SIGKILL);
 }
 
 }  // namespace isowall
