@@ -2,46 +2,22 @@
 // of the whole virtual screen, and bad input ends every rank with a non-zero exit, never a hang.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include "common/io/image_io.h"
 #include "tests/image_compare.h"
+#include "tests/run_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
 namespace {
 
-// Runs a command under `timeout` (the test guards against hangs itself) and returns its exit code.
-int run(const std::string& cmd, const std::filesystem::path& log, int guard_s = 120) {
-    const std::string full = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout " +
-                             std::to_string(guard_s) + " " + cmd + " > '" + log.string() + "' 2>&1";
-    const int status = std::system(full.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-// The binary, quoted. Built step by step: GCC 12 warns falsely (-Wrestrict) on "literal" + string.
-std::string isowall_cmd() {
-    std::string s = "'";
-    s += ISOWALL_BINARY;
-    s += "' ";
-    return s;
-}
-
-std::string mpirun(int np) {
-    std::string s = "mpirun --oversubscribe -np ";
-    s += std::to_string(np);
-    s += ' ';
-    return s + isowall_cmd();
-}
-
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using test::isowall_cmd;
+using test::mpirun;
+using test::run;
+using test::slurp;
 
 // PNG files carry no depth: a pixel is covered where its colour is not the black background.
 const test::CompareOptions kFromFiles{.coverage = test::Coverage::colour};

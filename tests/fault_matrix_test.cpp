@@ -1,0 +1,152 @@
+// The fault matrix (issue "Nothing hangs, nothing lies"): under mpirun, a 2x2 wall whose tile
+// (rank 2) or master (rank 0) is killed (SIGKILL) or stopped (SIGSTOP) at each moment of a run:
+// in MPI start-up, while loading, mid-frame, while it migrates a job, during the gather. Every
+// case must end every rank within the limits plus a few seconds, name the rank that went (or, in
+// MPI start-up, that a rank went), and leave no process and no output behind.
+//
+// The signal comes from the rank itself at the named moment (ISOWALL_TEST_FAULT=stop@frame:2),
+// which is exact where an outside `kill` would race the run; the last test sends a real one from
+// outside to a running wall.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <ostream>
+#include <string>
+
+#include "common/core/util.h"
+#include "tests/run_util.h"
+#include "tests/test_util.h"
+
+namespace isowall {
+namespace {
+
+using test::mpirun;
+using test::run;
+using test::slurp;
+
+constexpr int kTimeoutS = 4;   // --timeout: silence of a running wall
+constexpr int kStartupS = 10;  // --startup-timeout: MPI start-up, loading
+constexpr int kGuardS = 90;    // the test's own limit on one run
+
+struct Fault {
+    const char* signal;  // "stop" or "kill"
+    const char* moment;  // init, load, frame, migration, gather
+    int rank;            // 2 (tile 1) or 0 (master)
+};
+
+std::string name_of(const Fault& f) {
+    std::string s = f.signal;
+    s += std::string("_") + f.moment + (f.rank == 0 ? "_master" : "_tile");
+    return s;
+}
+
+void PrintTo(const Fault& f, std::ostream* os) {
+    *os << f.signal << "@" << f.moment << ":" << f.rank;
+}
+
+// What the one line must say: who went silent (or, inside MPI start-up, where no rank can know
+// which, that one did); for SIGKILL, mpirun names the process it lost.
+std::string expected_line(const Fault& f) {
+    const std::string moment = f.moment;
+    if (std::string(f.signal) == "kill")
+        return "process rank " + std::to_string(f.rank) + " with PID";
+    if (moment == "init") return "MPI start-up did not finish within";
+    if (f.rank != 0) return "rank 2 (tile 1)";
+    if (moment == "load") return "the master (rank 0) has not started the wall";
+    return "the master (rank 0) has sent nothing for";
+}
+
+// The processes of a run: its folder is in every rank's command line.
+bool any_process_of(const std::filesystem::path& dir) {
+    const std::string cmd = "pgrep -f '[w]all --wall " + (dir / "2x2.toml").string() + "' >/dev/null";
+    return std::system(cmd.c_str()) == 0;
+}
+
+// Files left in the run's folder other than its wall file and logs.
+std::string outputs_in(const std::filesystem::path& dir) {
+    std::string left;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        if (name != "2x2.toml" && name != "frames.txt" && name != "stop.sh" &&
+            e.path().extension() != ".log")
+            left += name + " ";
+    }
+    return left;
+}
+
+std::string wall_args(const std::filesystem::path& dir) {
+    // The surface fills the top-right tile, so the other tiles help it (jobs migrate).
+    return "wall --wall '" + (dir / "2x2.toml").string() + "' --out '" + (dir / "m.png").string() +
+           "' --timeout " + std::to_string(kTimeoutS) + " --startup-timeout " +
+           std::to_string(kStartupS) + " --zoom 0.5 --pan 0.25 -0.25";
+}
+
+class FaultMatrix : public testing::TestWithParam<Fault> {};
+
+TEST_P(FaultMatrix, EveryRankEndsNamingTheRankAndNothingIsLeft) {
+    const Fault f = GetParam();
+    const auto dir = test::scratch_dir("fault_" + name_of(f));
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
+    const std::string fault = std::string(f.signal) + "@" + f.moment + ":" + std::to_string(f.rank);
+    Stopwatch took;
+    const int rc = run("env ISOWALL_TEST_FAULT=" + fault + " " + mpirun(5) + wall_args(dir),
+                       dir / "run.log", kGuardS);
+    const double seconds = took.seconds();
+    const std::string log = slurp(dir / "run.log");
+    std::printf("%s: exit %d after %.1f s\n", fault.c_str(), rc, seconds);
+    EXPECT_NE(rc, 0) << log;
+    EXPECT_NE(rc, 124) << "still running after " << kGuardS << " s: " << log;
+    // Bounded: start-up and silence limits (the watchdog of a tile adds up to 4 s) plus the
+    // start of five processes on two cores and mpirun's clean-up.
+    EXPECT_LT(seconds, kStartupS + kTimeoutS + 30) << log;
+    EXPECT_NE(log.find(expected_line(f)), std::string::npos) << log;
+    if (std::string(f.signal) == "stop") {
+        EXPECT_EQ(test::count_of(log, "isowall: error:"), 1u) << log;
+    }
+    EXPECT_FALSE(any_process_of(dir)) << "a rank outlived mpirun\n" << log;
+    EXPECT_EQ(outputs_in(dir), "") << log;
+}
+
+std::vector<Fault> all_faults() {
+    std::vector<Fault> faults;
+    for (const char* signal : {"stop", "kill"})
+        for (const char* moment : {"init", "load", "frame", "migration", "gather"})
+            for (int rank : {2, 0}) faults.push_back({signal, moment, rank});
+    return faults;
+}
+
+INSTANTIATE_TEST_SUITE_P(Wall, FaultMatrix, testing::ValuesIn(all_faults()),
+                         [](const testing::TestParamInfo<Fault>& i) { return name_of(i.param); });
+
+// An operator's `kill -STOP` from outside, at no moment the program chose: the wall is running a
+// script of frames; once the master has printed its rank map, rank 2 is stopped by its pid.
+TEST(FaultMatrix, AnOutsideStopOfARunningTileIsNamed) {
+    const auto dir = test::scratch_dir("fault_outside_stop");
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
+    std::ofstream script(dir / "frames.txt");
+    for (int i = 0; i < 200; ++i) script << "orbit 3 0\nwait done\n";
+    script.close();
+    const std::string log = (dir / "run.log").string();
+    // The rank's pid: the process of this run whose environment says OMPI_COMM_WORLD_RANK=2.
+    std::ofstream(dir / "stop.sh")
+        << mpirun(5) << wall_args(dir) << " --script '" << (dir / "frames.txt").string() << "' > '"
+        << log << "' 2>&1 &\nm=$!\n"
+        << "for i in $(seq 600); do grep -q '^wall:' '" << log << "' && break; sleep 0.1; done\n"
+        << "for p in $(pgrep -f '[w]all --wall " << (dir / "2x2.toml").string() << "'); do\n"
+        << "  tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=2 &&"
+        << " kill -STOP $p\ndone\nwait $m\n";
+    Stopwatch took;
+    const int rc = run("bash '" + (dir / "stop.sh").string() + "'", dir / "shell.log", kGuardS);
+    const std::string text = slurp(log);
+    std::printf("outside stop: exit %d after %.1f s\n", rc, took.seconds());
+    EXPECT_NE(rc, 0) << text;
+    EXPECT_NE(rc, 124) << text;
+    EXPECT_NE(text.find("rank 2 (tile 1) on "), std::string::npos) << text;
+    EXPECT_EQ(test::count_of(text, "isowall: error:"), 1u) << text;
+    EXPECT_FALSE(any_process_of(dir)) << text;
+    EXPECT_EQ(outputs_in(dir), "") << text;
+}
+
+}  // namespace
+}  // namespace isowall
