@@ -68,8 +68,8 @@ std::unique_ptr<Loaded> load(const CacheScene& s) {
 struct CacheCase {
     const char* name;
     void (*change)(const CacheScene& s, const fs::path& cache_file);
-    const char* note;   // part of the cache note; "" for a hit
-    float value_max;    // the range the next load must report
+    const char* note;  // part of the cache note; "" for a hit
+    float value_max;   // the range the next load must report
 };
 
 void replace_data_by_rename(const CacheScene& s, const fs::path&) {
@@ -127,8 +127,8 @@ TEST(OctreeCache, NeverServesNodesThatDoNotMatchTheirFilesOrChecksum) {
         // Whatever happened, the nodes equal a fresh build, and the rebuilt file is a hit again.
         const auto fresh = MinMaxOctree<float>::build(next->volume.view<float>());
         ASSERT_EQ(fresh.nodes().size(), next->octree.nodes().size());
-        EXPECT_TRUE(std::equal(fresh.nodes().begin(), fresh.nodes().end(),
-                               next->octree.nodes().begin()));
+        EXPECT_TRUE(
+            std::equal(fresh.nodes().begin(), fresh.nodes().end(), next->octree.nodes().begin()));
         EXPECT_TRUE(load(s)->stats.from_cache);
     }
 }
@@ -198,7 +198,8 @@ TEST(OctreeNonFinite, NanIsBelowEveryIsovalueAndTheRangeIsFinite) {
         for (int z = 0; z < leaf.dims.z; ++z)
             for (int y = 0; y < leaf.dims.y; ++y)
                 for (int x = 0; x < leaf.dims.x; ++x) {
-                    const glm::ivec3 n(x, y, z), b = shape.cell_begin(0, n), e = shape.cell_end(0, n);
+                    const glm::ivec3 n(x, y, z), b = shape.cell_begin(0, n),
+                                                 e = shape.cell_end(0, n);
                     float lo = INFINITY, hi = -INFINITY;
                     bool only_nan = true;
                     for (int k = b.z; k <= e.z; ++k)

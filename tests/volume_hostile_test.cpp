@@ -66,27 +66,43 @@ Scene make_scene(const std::string& name) {
 }
 
 struct BadCase {
-    const char* name;  // the file written (or already in the scene) and loaded
+    const char* name;     // the file written (or already in the scene) and loaded
     std::string content;  // empty: the scene's file as it is
     const char* field;
     const char* says;  // a part of the message
 };
 
-std::vector<BadCase> bad_cases(const Scene& s) {
+// Sizes that wrap or overflow.
+std::vector<BadCase> size_cases([[maybe_unused]] const Scene& s) {
     const std::string raw = "encoding: raw\n";
     const std::string s222 = "sizes: 2 2 2\n";
     return {
-        // Sizes that wrap or overflow.
-        {"wrap32.nhdr", kU8 + "sizes: 4294967298 2 2\n" + raw + "data file: v.raw\n", "sizes", "2147483647"},
-        {"wrap64.nhdr", kU8 + "sizes: 18446744073709551618 2 2\n" + raw + "data file: v.raw\n", "sizes", "64 bits"},
-        {"int31.nhdr", kU8 + "sizes: 2147483648 2 2\n" + raw + "data file: v.raw\n", "sizes", "2147483647"},
-        {"product.nhdr", kU8 + "sizes: 2000000000 2000000000 2000000000\n" + raw + "data file: v.raw\n", "sizes", "overflow"},
-        {"negative.nhdr", kU8 + "sizes: -5 2 2\n" + raw + "data file: v.raw\n", "sizes", "whole numbers"},
-        {"huge.nhdr", kU8 + "sizes: 65536 65536 65536\n" + raw + "data file: v.raw\n", "size", "shorter"},
-        {"huge_gzip.nrrd", kU8 + "sizes: 65536 65536 16384\nencoding: gzip\n\n" + s.gzip8, "sizes", "memory"},
-        // Data files that are not regular files, or not there.
+        {"wrap32.nhdr", kU8 + "sizes: 4294967298 2 2\n" + raw + "data file: v.raw\n", "sizes",
+         "2147483647"},
+        {"wrap64.nhdr", kU8 + "sizes: 18446744073709551618 2 2\n" + raw + "data file: v.raw\n",
+         "sizes", "64 bits"},
+        {"int31.nhdr", kU8 + "sizes: 2147483648 2 2\n" + raw + "data file: v.raw\n", "sizes",
+         "2147483647"},
+        {"product.nhdr",
+         kU8 + "sizes: 2000000000 2000000000 2000000000\n" + raw + "data file: v.raw\n", "sizes",
+         "overflow"},
+        {"negative.nhdr", kU8 + "sizes: -5 2 2\n" + raw + "data file: v.raw\n", "sizes",
+         "whole numbers"},
+        {"huge.nhdr", kU8 + "sizes: 65536 65536 65536\n" + raw + "data file: v.raw\n", "size",
+         "shorter"},
+        {"huge_gzip.nrrd", kU8 + "sizes: 65536 65536 16384\nencoding: gzip\n\n" + s.gzip8, "sizes",
+         "memory"},
+    };
+}
+
+// Data files that are not regular files, or not there.
+std::vector<BadCase> file_cases([[maybe_unused]] const Scene& s) {
+    const std::string raw = "encoding: raw\n";
+    const std::string s222 = "sizes: 2 2 2\n";
+    return {
         {"zero.nhdr", kU8 + s222 + raw + "data file: /dev/zero\n", "data file", "character device"},
-        {"zero_skip.nhdr", kU8 + s222 + raw + "line skip: 1\ndata file: zero.raw\n", "data file", "character device"},
+        {"zero_skip.nhdr", kU8 + s222 + raw + "line skip: 1\ndata file: zero.raw\n", "data file",
+         "character device"},
         {"fifo.nhdr", kU8 + s222 + raw + "data file: fifo.raw\n", "data file", "FIFO"},
         {"folder.nhdr", kU8 + s222 + raw + "data file: folder\n", "data file", "folder"},
         {"missing.nhdr", kU8 + s222 + raw + "data file: nope.raw\n", "data file", "no such file"},
@@ -95,46 +111,118 @@ std::vector<BadCase> bad_cases(const Scene& s) {
         {"pattern.nhdr", kU8 + s222 + raw + "data file: v%d.raw 0 1 1\n", "data file", "several"},
         {"zero.nrrd", "", "file", "character device"},
         {"folder.nrrd", "", "file", "folder"},
-        // Skips that point past the data, or are not numbers.
-        {"lineskip_eof.nhdr", kU8 + s222 + raw + "line skip: 5\ndata file: lines.raw\n", "line skip", "ends after 1"},
-        {"lineskip_neg.nhdr", kU8 + s222 + raw + "line skip: -1\ndata file: v.raw\n", "line skip", ">= 0"},
-        {"byteskip_neg.nhdr", kU8 + s222 + raw + "byte skip: -2\ndata file: v.raw\n", "byte skip", ">= -1"},
-        {"byteskip_big.nhdr", kU8 + s222 + raw + "byte skip: 99999999999\ndata file: v.raw\n", "byte skip", "only 8"},
-        {"byteskip_gzip.nhdr", kU8 + s222 + "encoding: gzip\nbyte skip: -1\ndata file: g.raw.gz\n", "byte skip", "raw"},
-        {"byteskip_twice.nhdr", kU8 + s222 + raw + "byte skip: 1\nbyteskip: 1\ndata file: v.raw\n", "byte skip", "twice"},
-        // Compressed data of the wrong length.
+    };
+}
+
+// Skips that point past the data, or are not numbers.
+std::vector<BadCase> skip_cases([[maybe_unused]] const Scene& s) {
+    const std::string raw = "encoding: raw\n";
+    const std::string s222 = "sizes: 2 2 2\n";
+    return {
+        {"lineskip_eof.nhdr", kU8 + s222 + raw + "line skip: 5\ndata file: lines.raw\n",
+         "line skip", "ends after 1"},
+        {"lineskip_neg.nhdr", kU8 + s222 + raw + "line skip: -1\ndata file: v.raw\n", "line skip",
+         ">= 0"},
+        {"byteskip_neg.nhdr", kU8 + s222 + raw + "byte skip: -2\ndata file: v.raw\n", "byte skip",
+         ">= -1"},
+        {"byteskip_big.nhdr", kU8 + s222 + raw + "byte skip: 99999999999\ndata file: v.raw\n",
+         "byte skip", "only 8"},
+        {"byteskip_gzip.nhdr", kU8 + s222 + "encoding: gzip\nbyte skip: -1\ndata file: g.raw.gz\n",
+         "byte skip", "raw"},
+        {"byteskip_twice.nhdr", kU8 + s222 + raw + "byte skip: 1\nbyteskip: 1\ndata file: v.raw\n",
+         "byte skip", "twice"},
+    };
+}
+
+// Compressed data of the wrong length.
+std::vector<BadCase> compressed_cases([[maybe_unused]] const Scene& s) {
+    const std::string raw = "encoding: raw\n";
+    const std::string s222 = "sizes: 2 2 2\n";
+    return {
         {"gzip_long.nrrd", kU8 + s222 + "encoding: gzip\n\n" + s.gzip8 + s.gzip8, "data", "longer"},
         {"gzip_short.nrrd", kU8 + "sizes: 2 2 3\nencoding: gzip\n\n" + s.gzip8, "data", "shorter"},
-        {"gzip_cut.nrrd", kU8 + s222 + "encoding: gzip\n\n" + s.gzip8.substr(0, 12), "data", "ends early"},
+        {"gzip_cut.nrrd", kU8 + s222 + "encoding: gzip\n\n" + s.gzip8.substr(0, 12), "data",
+         "ends early"},
         {"gzip_junk.nrrd", kU8 + s222 + "encoding: gzip\n\n" + s.gzip8 + "junk", "data", "follow"},
-        {"gzip_garbage.nrrd", kU8 + s222 + "encoding: gzip\n\n" + std::string(40, 'x'), "data", "corrupt"},
+        {"gzip_garbage.nrrd", kU8 + s222 + "encoding: gzip\n\n" + std::string(40, 'x'), "data",
+         "corrupt"},
         {"bzip2_long.nrrd", kU8 + s222 + "encoding: bzip2\n\n" + kBzip2Of100, "data", "longer"},
-        {"bzip2_cut.nrrd", kU8 + s222 + "encoding: bzip2\n\n" + kBzip2Of8.substr(0, 30), "data", "ends early"},
-        // Text encodings: long, binary, too many, too few, out of range.
-        {"ascii_long.nrrd", kU8 + s222 + "encoding: ascii\n\n" + std::string(100000, '1'), "data", "longer than 64"},
-        {"ascii_nul.nrrd", kU8 + s222 + "encoding: ascii\n\n" + std::string(100000, '\0'), "data", "\\x00"},
-        {"ascii_more.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 8 9\n", "data", "longer"},
+        {"bzip2_cut.nrrd", kU8 + s222 + "encoding: bzip2\n\n" + kBzip2Of8.substr(0, 30), "data",
+         "ends early"},
+    };
+}
+
+// Text encodings: long, binary, too many, too few, out of range.
+std::vector<BadCase> text_cases([[maybe_unused]] const Scene& s) {
+    const std::string raw = "encoding: raw\n";
+    const std::string s222 = "sizes: 2 2 2\n";
+    return {
+        {"ascii_long.nrrd", kU8 + s222 + "encoding: ascii\n\n" + std::string(100000, '1'), "data",
+         "longer than 64"},
+        {"ascii_nul.nrrd", kU8 + s222 + "encoding: ascii\n\n" + std::string(100000, '\0'), "data",
+         "\\x00"},
+        {"ascii_more.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 8 9\n", "data",
+         "longer"},
         {"ascii_fewer.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3\n", "data", "shorter"},
-        {"ascii_range.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 300\n", "data", "value 8"},
-        {"ascii_frac.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 1.5\n", "data", "\"1.5\""},
-        {"ascii_big_float.nrrd", kF32 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 1e300\n", "data", "value 8"},
-        {"hex_long.nrrd", kU8 + s222 + "encoding: hex\n\n" + std::string(200000, '0'), "data", "longer"},
+        {"ascii_range.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 300\n", "data",
+         "value 8"},
+        {"ascii_frac.nrrd", kU8 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 1.5\n", "data",
+         "\"1.5\""},
+        {"ascii_big_float.nrrd", kF32 + s222 + "encoding: ascii\n\n1 2 3 4 5 6 7 1e300\n", "data",
+         "value 8"},
+        {"hex_long.nrrd", kU8 + s222 + "encoding: hex\n\n" + std::string(200000, '0'), "data",
+         "longer"},
         {"hex_bad.nrrd", kU8 + s222 + "encoding: hex\n\n0001020304050607zz", "data", "hex digit"},
         {"hex_half.nrrd", kU8 + s222 + "encoding: hex\n\n000102030405060", "data", "half"},
-        // Fields Teem accepts but a volume cannot use.
-        {"dim4.nhdr", "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 2 1\n" + raw + "data file: v.raw\n", "dimension", "expected 3"},
-        {"int64.nhdr", "NRRD0004\ntype: int64\ndimension: 3\nsizes: 2 2 2\nendian: little\n" + raw + "data file: v.raw\n", "type", "unsupported"},
-        {"zrl.nrrd", kU8 + s222 + "encoding: zrl\n\n" + std::string(8, '\0'), "encoding", "not supported"},
-        {"spacing_inf.nhdr", kU8 + s222 + "spacings: 1e300 1 1\n" + raw + "data file: v.raw\n", "spacings", "unusable"},
-        {"spacing_tiny.nhdr", kU8 + s222 + "spacings: 1e-300 1 1\n" + raw + "data file: v.raw\n", "spacings", "unusable"},
-        {"direction_inf.nhdr", kU8 + s222 + "space dimension: 3\nspace directions: (1e300,0,0) (0,1,0) (0,0,1)\n" + raw + "data file: v.raw\n", "space directions", "unusable"},
-        {"kinds.nhdr", kU8 + s222 + "kinds: 2-vector domain domain\n" + raw + "data file: v.raw\n", "kinds", "not a space axis"},
-        {"sizes_u32max.nhdr", kU8 + "sizes: 4294967295 4294967295 4294967295\n" + raw + "data file: v.raw\n", "sizes", "2147483647"},
-        {"not_nrrd.nrrd", std::string(1000, '\0'), "header", "not a NRRD file"},
-        {"nul_header.nrrd", kU8 + std::string("sizes: 2 2\0 2\n", 14) + raw + "\n" + std::string(8, '\0'), "header", "NUL"},
-        {"no_blank.nrrd", kU8 + s222 + raw, "header", "no blank line"},
-        {"endian_missing.nhdr", "NRRD0004\ntype: ushort\ndimension: 3\nsizes: 2 2 2\n" + raw + "data file: v.raw\n", "header", "endian"},
     };
+}
+
+// Fields Teem accepts but a volume cannot use.
+std::vector<BadCase> field_cases([[maybe_unused]] const Scene& s) {
+    const std::string raw = "encoding: raw\n";
+    const std::string s222 = "sizes: 2 2 2\n";
+    return {
+        {"dim4.nhdr",
+         "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 2 1\n" + raw + "data file: v.raw\n",
+         "dimension", "expected 3"},
+        {"int64.nhdr",
+         "NRRD0004\ntype: int64\ndimension: 3\nsizes: 2 2 2\nendian: little\n" + raw +
+             "data file: v.raw\n",
+         "type", "unsupported"},
+        {"zrl.nrrd", kU8 + s222 + "encoding: zrl\n\n" + std::string(8, '\0'), "encoding",
+         "not supported"},
+        {"spacing_inf.nhdr", kU8 + s222 + "spacings: 1e300 1 1\n" + raw + "data file: v.raw\n",
+         "spacings", "unusable"},
+        {"spacing_tiny.nhdr", kU8 + s222 + "spacings: 1e-300 1 1\n" + raw + "data file: v.raw\n",
+         "spacings", "unusable"},
+        {"direction_inf.nhdr",
+         kU8 + s222 + "space dimension: 3\nspace directions: (1e300,0,0) (0,1,0) (0,0,1)\n" + raw +
+             "data file: v.raw\n",
+         "space directions", "unusable"},
+        {"kinds.nhdr", kU8 + s222 + "kinds: 2-vector domain domain\n" + raw + "data file: v.raw\n",
+         "kinds", "not a space axis"},
+        {"sizes_u32max.nhdr",
+         kU8 + "sizes: 4294967295 4294967295 4294967295\n" + raw + "data file: v.raw\n", "sizes",
+         "2147483647"},
+        {"not_nrrd.nrrd", std::string(1000, '\0'), "header", "not a NRRD file"},
+        {"nul_header.nrrd",
+         kU8 + std::string("sizes: 2 2\0 2\n", 14) + raw + "\n" + std::string(8, '\0'), "header",
+         "NUL"},
+        {"no_blank.nrrd", kU8 + s222 + raw, "header", "no blank line"},
+        {"endian_missing.nhdr",
+         "NRRD0004\ntype: ushort\ndimension: 3\nsizes: 2 2 2\n" + raw + "data file: v.raw\n",
+         "header", "endian"},
+    };
+}
+
+std::vector<BadCase> bad_cases(const Scene& s) {
+    std::vector<BadCase> all;
+    for (auto* part :
+         {size_cases, file_cases, skip_cases, compressed_cases, text_cases, field_cases}) {
+        auto cases = part(s);
+        all.insert(all.end(), cases.begin(), cases.end());
+    }
+    return all;
 }
 
 TEST(VolumeHostile, EveryBadNrrdIsOneLineNamingTheFileAndField) {
@@ -177,17 +265,22 @@ std::vector<GoodCase> good_cases(const Scene& s) {
     return {
         {"ascii.nrrd", kU8 + s222 + "encoding: ascii\n\n0 1 2 3\n4 5 6 7\n", ramp},
         {"ascii_commas.nrrd", kU8 + s222 + "encoding: ascii\n\n0, 1, 2, 3,\n+4,5,6,7", ramp},
-        {"ascii_float.nrrd", kF32 + s222 + "encoding: ascii\n\n1 2.5 -3 nan 5 inf -inf 8e1\n",
+        {"ascii_float.nrrd",
+         kF32 + s222 + "encoding: ascii\n\n1 2.5 -3 nan 5 inf -inf 8e1\n",
          {1, 2.5f, -3, nan, 5, inf, -inf, 80}},
         {"hex.nrrd", kU8 + s222 + "encoding: hex\n\n00 01 02 03\n04050607\n", ramp},
-        {"gzip_two_members.nrrd", kU8 + "sizes: 2 2 4\nencoding: gzip\n\n" + s.gzip8 + s.gzip8,
+        {"gzip_two_members.nrrd",
+         kU8 + "sizes: 2 2 4\nencoding: gzip\n\n" + s.gzip8 + s.gzip8,
          {0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7}},
         {"bzip2.nrrd", kU8 + s222 + "encoding: bzip2\n\n" + kBzip2Of8, ramp},
         {"lineskip.nhdr", kU8 + s222 + "encoding: raw\nline skip: 1\ndata file: lines.raw\n", ramp},
-        {"byteskip_end.nhdr", kU8 + s222 + "encoding: raw\nbyte skip: -1\ndata file: lines.raw\n", ramp},
+        {"byteskip_end.nhdr", kU8 + s222 + "encoding: raw\nbyte skip: -1\ndata file: lines.raw\n",
+         ramp},
         {"byteskip.nhdr", kU8 + s222 + "encoding: raw\nbyteskip: 12\ndatafile: lines.raw\n", ramp},
         {"spacing_neg_nan.nhdr",
-         kU8 + s222 + "spacings: -2 nan 0.5\nencoding: raw\ndata file: v.raw\n", ramp, {2, 1, 0.5f}},
+         kU8 + s222 + "spacings: -2 nan 0.5\nencoding: raw\ndata file: v.raw\n",
+         ramp,
+         {2, 1, 0.5f}},
         {"gzip.nhdr", "", ramp},
     };
 }

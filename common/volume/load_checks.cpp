@@ -72,8 +72,8 @@ void check_fits_memory(std::uint64_t bytes, const std::string& where, const std:
     const long pages = ::sysconf(_SC_PHYS_PAGES);
     const long page = ::sysconf(_SC_PAGESIZE);
     if (pages <= 0 || page <= 0) return;
-    const auto memory = checked_product(
-        {static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page)});
+    const auto memory =
+        checked_product({static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page)});
     if (memory && bytes > *memory)
         throw InputError(where, field,
                          "the voxels need " + std::to_string(bytes) +

@@ -44,7 +44,8 @@ class GrowingOutput {
         size_ += n;
         if (size_ > need_)
             throw InputError(where_, "data",
-                             std::string(what_) + " data is longer than the header says: more than " +
+                             std::string(what_) +
+                                 " data is longer than the header says: more than " +
                                  count_words(need_, "bytes"));
     }
     std::vector<std::byte> finish() {
@@ -130,8 +131,8 @@ std::size_t skip_lines(std::span<const std::byte> bytes, std::size_t offset, std
         const auto* nl = std::find(begin, end, std::byte{'\n'});
         if (nl == end)
             throw InputError(where, "line skip",
-                             "the file ends after " + count_words(i, "lines") +
-                                 " of the " + std::to_string(lines) + " to skip");
+                             "the file ends after " + count_words(i, "lines") + " of the " +
+                                 std::to_string(lines) + " to skip");
         offset = static_cast<std::size_t>(nl - bytes.data()) + 1;
     }
     return offset;
@@ -169,8 +170,9 @@ std::vector<std::byte> decode_gzip(std::span<const std::byte> in, std::uint64_t 
         if (rc == Z_BUF_ERROR)
             throw InputError(where, "data",
                              "gzip data ends early: the file is shorter than the header says");
-        throw InputError(where, "data",
-                         std::string("gzip data is corrupt: ") + (z.msg ? z.msg : "inflate failed"));
+        throw InputError(
+            where, "data",
+            std::string("gzip data is corrupt: ") + (z.msg ? z.msg : "inflate failed"));
     }
     return out.finish();
 }
@@ -206,7 +208,8 @@ std::vector<std::byte> decode_bzip2(std::span<const std::byte> in, std::uint64_t
             continue;
         }
         if (rc != BZ_OK)
-            throw InputError(where, "data", "bzip2 data is corrupt (error " + std::to_string(rc) + ")");
+            throw InputError(where, "data",
+                             "bzip2 data is corrupt (error " + std::to_string(rc) + ")");
         if (s.avail_in == in_n && s.avail_out == out_n)
             throw InputError(where, "data",
                              "bzip2 data ends early: the file is shorter than the header says");

@@ -62,8 +62,8 @@ void set_data_file(NrrdHeaderText& h, std::string_view value, const std::string&
     const auto w = words(value);
     if (w.empty()) throw InputError(where, "data file", "no file name");
     const bool list = w[0] == "LIST" || w[0] == "SKIPLIST";
-    const bool pattern = w.size() >= 4 && parse_int<long long>(w[1]) && parse_int<long long>(w[2]) &&
-                         parse_int<long long>(w[3]);
+    const bool pattern = w.size() >= 4 && parse_int<long long>(w[1]) &&
+                         parse_int<long long>(w[2]) && parse_int<long long>(w[3]);
     if (list || pattern)
         throw InputError(where, "data file",
                          "several data files (" + quote_bounded(trim(value)) +
@@ -89,8 +89,9 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
     const bool ours = key == "datafile" || key == "lineskip" || key == "byteskip";
     if (key == "sizes") set_sizes(h, value, where);
     if (!ours) return false;
-    const std::string name = key == "datafile" ? "data file" : key == "lineskip" ? "line skip"
-                                                                                 : "byte skip";
+    const std::string name = key == "datafile"   ? "data file"
+                             : key == "lineskip" ? "line skip"
+                                                 : "byte skip";
     if (std::find(seen.begin(), seen.end(), key) != seen.end())
         throw InputError(where, name, "given twice");
     seen.push_back(key);
@@ -98,12 +99,15 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
         set_data_file(h, value, where);
     } else if (key == "lineskip") {
         const auto v = parse_int<std::uint64_t>(value);
-        if (!v) throw InputError(where, name, "expected a whole number >= 0, got " + quote_bounded(value));
+        if (!v)
+            throw InputError(where, name,
+                             "expected a whole number >= 0, got " + quote_bounded(value));
         h.line_skip = *v;
     } else {
         const auto v = parse_int<std::int64_t>(value);
         if (!v || *v < -1)
-            throw InputError(where, name, "expected a whole number >= -1, got " + quote_bounded(value));
+            throw InputError(where, name,
+                             "expected a whole number >= -1, got " + quote_bounded(value));
         h.byte_skip = *v;
     }
     return true;
@@ -114,9 +118,10 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
 NrrdHeaderText split_nrrd_header(std::span<const std::byte> file, const std::string& where) {
     const std::string_view all(reinterpret_cast<const char*>(file.data()), file.size());
     if (all.substr(0, 7) != "NRRD000")
-        throw InputError(where, "header",
-                         "not a NRRD file: expected \"NRRD000N\" first, got " +
-                             quote_bounded(all.substr(0, std::min(all.find('\n'), all.size())), 20));
+        throw InputError(
+            where, "header",
+            "not a NRRD file: expected \"NRRD000N\" first, got " +
+                quote_bounded(all.substr(0, std::min(all.find('\n'), all.size())), 20));
     NrrdHeaderText h;
     h.data_offset = blank_line_end(file.first(std::min(file.size(), kMaxNrrdHeaderBytes)));
     if (!h.data_offset && file.size() > kMaxNrrdHeaderBytes)

@@ -14,8 +14,8 @@
 namespace isowall {
 
 struct NrrdHeaderText {
-    std::string teem_text;                   // the header without the data-location fields
-    std::optional<std::string> data_file;    // as written; nullopt: the data is attached
+    std::string teem_text;                 // the header without the data-location fields
+    std::optional<std::string> data_file;  // as written; nullopt: the data is attached
     std::uint64_t line_skip = 0;
     std::int64_t byte_skip = 0;              // -1: the data is the last bytes of the file
     std::vector<std::uint64_t> sizes;        // the "sizes" field, each checked against 64 bits

@@ -137,7 +137,8 @@ std::size_t data_start(std::span<const std::byte> bytes, std::size_t offset,
     offset = skip_lines(bytes, offset, h.line_skip, data_where);
     if (h.byte_skip == -1) {
         if (info.encoding != Encoding::raw)
-            throw InputError(where, "byte skip", "-1 (data at the end of the file) needs raw encoding");
+            throw InputError(where, "byte skip",
+                             "-1 (data at the end of the file) needs raw encoding");
         if (bytes.size() - offset < need) check_size(data_where, bytes.size(), offset, need);
         return bytes.size() - static_cast<std::size_t>(need);
     }
@@ -187,7 +188,8 @@ Volume load_nrrd(const fs::path& path) {
         data_file = MappedFile(data_path);
     } else {
         if (!text.data_offset)
-            throw InputError(where, "header", "no blank line ends the header and no data file is named");
+            throw InputError(where, "header",
+                             "no blank line ends the header and no data file is named");
         data_file = std::move(header_file);
         offset = *text.data_offset;
     }
