@@ -59,21 +59,29 @@ TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
     const auto dir = test::scratch_dir("cli_volume");
     const std::string u8 = "NRRD0004\ntype: uchar\ndimension: 3\n";
     write_bytes(dir / "ok.raw", std::string(64, '\x01'));
-    write_bytes(dir / "wrap.nhdr", u8 + "sizes: 4294967300 4 4\nencoding: raw\ndata file: ok.raw\n");
-    write_bytes(dir / "ascii.nrrd", u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '1'));
-    write_bytes(dir / "nul.nrrd", u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '\0'));
-    write_bytes(dir / "zero.nhdr", u8 + "sizes: 4 4 4\nencoding: raw\nline skip: 1\ndata file: /dev/zero\n");
+    write_bytes(dir / "wrap.nhdr",
+                u8 + "sizes: 4294967300 4 4\nencoding: raw\ndata file: ok.raw\n");
+    write_bytes(dir / "ascii.nrrd",
+                u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '1'));
+    write_bytes(dir / "nul.nrrd",
+                u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '\0'));
+    write_bytes(dir / "zero.nhdr",
+                u8 + "sizes: 4 4 4\nencoding: raw\nline skip: 1\ndata file: /dev/zero\n");
     write_bytes(dir / "nan.raw", floats({NAN, INFINITY, -INFINITY}, 64));
     const CliCase cases[] = {
-        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes -8", {"--header-bytes", "\"-8\""}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes -8",
+         {"--header-bytes", "\"-8\""}},
         {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 1.5", {"--header-bytes", "1.5"}},
-        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 99999999999999999999", {"--header-bytes"}},
-        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 18446744073709551615", {"ok.raw", "size", "shorter"}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 99999999999999999999",
+         {"--header-bytes"}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 18446744073709551615",
+         {"ok.raw", "size", "shorter"}},
         {"info -v wrap.nhdr", {"wrap.nhdr", "sizes", "4294967300"}},
         {"info -v ascii.nrrd", {"ascii.nrrd", "data", "64 characters"}},
         {"info -v nul.nrrd", {"nul.nrrd", "data", "\\x00"}},
         {"info -v zero.nhdr", {"zero.nhdr", "data file", "/dev/zero", "character device"}},
-        {"extract -v nan.raw --dims 4 4 4 --type float32 --iso 0 --out s.ply", {"nan.raw", "data", "no finite voxel"}},
+        {"extract -v nan.raw --dims 4 4 4 --type float32 --iso 0 --out s.ply",
+         {"nan.raw", "data", "no finite voxel"}},
     };
     for (const CliCase& c : cases) {
         SCOPED_TRACE(c.args);
