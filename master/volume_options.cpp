@@ -1,5 +1,7 @@
 #include "master/volume_options.h"
 
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 
 #include "common/core/error.h"
@@ -8,6 +10,23 @@
 #include "common/volume/phantom.h"
 
 namespace isowall {
+
+namespace {
+
+// CLI11 reads "-8" into an unsigned option as a huge number; a byte count must be written as
+// digits only and fit 64 bits.
+const CLI::Validator kByteCount(
+    [](std::string& text) {
+        std::uint64_t v = 0;
+        const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (!text.empty() && r.ec == std::errc() && r.ptr == text.data() + text.size())
+            return std::string();
+        const std::string shown = text.size() > 60 ? text.substr(0, 60) + "..." : text;
+        return "expected a whole number of bytes >= 0, got \"" + shown + "\"";
+    },
+    "BYTES >= 0");
+
+}  // namespace
 
 void add_volume_options(CLI::App& app, VolumeOptions& o) {
     app.add_option("--volume,-v", o.path,
@@ -21,7 +40,8 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
         ->expected(3);
     app.add_option("--endian", o.endian, "Raw byte order: little or big")
         ->check(CLI::IsMember({"little", "big"}));
-    app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file");
+    app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file")
+        ->check(kByteCount);
     app.add_option("--cache-dir", o.cache_dir,
                    "Octree cache folder (default $ISOWALL_CACHE_DIR, else ~/.cache/isowall)");
     app.add_flag("--no-cache", o.no_cache,

@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
     build-essential cmake pkg-config clang-format
-    libglm-dev libteem-dev zlib1g-dev libtomlplusplus-dev libcli11-dev
+    libglm-dev libteem-dev zlib1g-dev libbz2-dev libtomlplusplus-dev libcli11-dev
     libopenimageio-dev openimageio-tools
     libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev
     libopenmpi-dev openmpi-bin

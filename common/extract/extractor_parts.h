@@ -20,6 +20,7 @@
 #include <functional>
 #include <limits>
 
+#include "common/core/error.h"
 #include "common/core/ray.h"
 #include "common/core/thread_budget.h"
 #include "common/extract/adaptive.h"
@@ -36,11 +37,17 @@ namespace isowall {
 template <class T>
 struct ExtractionData {
     // Builds the octree over `build` threads, or maps it from the cache.
+    // The cache key covers every file the volume was read from, and a volume without one
+    // finite voxel has no isovalue to offer: an error naming the file.
     ExtractionData(const Volume& v, const OctreeSource& source, OctreeStats* stats,
                    ThreadBudget build)
         : volume(v),
           view(v.view<T>()),
-          octree(MinMaxOctree<T>::load_or_build(view, source, stats, build)) {}
+          octree(MinMaxOctree<T>::load_or_build(view, with_files(source, v), stats, build)) {
+        if (!octree.finite_range().any)
+            throw InputError(v.source(), "data",
+                             "no finite voxel (every voxel is NaN or infinite)");
+    }
     // Workers hold references to the view and the octree, so the data never moves.
     ExtractionData(const ExtractionData&) = delete;
     ExtractionData& operator=(const ExtractionData&) = delete;
@@ -48,6 +55,13 @@ struct ExtractionData {
     const Volume& volume;
     const VolumeView<T> view;
     const MinMaxOctree<T> octree;
+
+  private:
+    static OctreeSource with_files(OctreeSource s, const Volume& v) {
+        for (const auto& f : v.files())
+            if (f != s.volume_path) s.data_files.push_back(f);
+        return s;
+    }
 };
 
 struct FrameState {

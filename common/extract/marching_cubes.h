@@ -2,7 +2,9 @@
 // Marching cubes on one cell or meta-cell (chapter 2.1; Lorensen and Cline): case index from the
 // eight corner signs, vertices by interpolation on crossed edges, normals from interpolated
 // central-difference gradients. Voxels equal to the isovalue count as inside (value >= iso): the
-// epsilon perturbation of the dissertation, which keeps every case non-degenerate.
+// epsilon perturbation of the dissertation, which keeps every case non-degenerate. NaN voxels are
+// outside for every isovalue (NaN >= iso is false), and no vertex is placed by interpolating
+// towards a NaN or infinite voxel (crossing_fraction).
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -133,11 +135,14 @@ inline glm::vec3 gradient(const VolumeView<T>& v, glm::ivec3 p) {
 
 // Appends a vertex at `pos` (voxel space) whose normal mixes the gradients at the edge's two ends
 // at t, and returns its index. The surface faces the low side: the normal is the negated gradient.
+// A gradient through a NaN or infinite voxel is not finite: such a vertex gets +z, like a flat
+// spot, so no NaN reaches a mesh.
 inline std::uint32_t append_vertex(Mesh& mesh, glm::vec3 pos, glm::vec3 g0, glm::vec3 g1, float t,
                                    glm::vec3 spacing) {
     const glm::vec3 g = glm::mix(g0, g1, t);
     const float len2 = glm::dot(g, g);
-    const glm::vec3 n = len2 > 0 ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
+    const bool usable = len2 > 0 && std::isfinite(len2);
+    const glm::vec3 n = usable ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
     mesh.positions.push_back(pos * spacing);
     mesh.normals.push_back(n);
     return static_cast<std::uint32_t>(mesh.positions.size() - 1);
@@ -154,11 +159,22 @@ struct EdgeCrossing {
     float t() const { return static_cast<float>(segment) + frac; }  // voxels from pa
 };
 
+// How far from va to vb, in [0, 1], the surface crosses an edge whose ends straddle iso. NaN is
+// below every isovalue and +-infinity is ordered, but neither can be interpolated: the crossing
+// then lies at the finite end, the limit of linear interpolation as the other end goes to
+// infinity (and at the middle when neither end is finite), so every vertex is finite.
+inline double crossing_fraction(double iso, double va, double vb) {
+    const bool fa = std::isfinite(va), fb = std::isfinite(vb);
+    if (!fa || !fb) return fa ? 0.0 : fb ? 1.0 : 0.5;
+    const double f = (iso - va) / (vb - va);
+    return f >= 0 && f <= 1 ? f : f > 1 ? 1.0 : 0.0;  // NaN (an overflowed difference) to 0
+}
+
 template <class T>
 inline EdgeCrossing edge_crossing(const VolumeView<T>& v, glm::ivec3 pa, int axis, int level,
                                   double iso, double va, double vb) {
     EdgeCrossing best;
-    best.frac = static_cast<float>((iso - va) / (vb - va));
+    best.frac = static_cast<float>(crossing_fraction(iso, va, vb));
     if (level == 0) return best;
     const int s = 1 << level;
     const float linear = static_cast<float>(s) * best.frac;
@@ -169,7 +185,7 @@ inline EdgeCrossing edge_crossing(const VolumeView<T>& v, glm::ivec3 pa, int axi
         ++p[axis];
         const double f1 = k + 1 == s ? vb : static_cast<double>(v.at(p.x, p.y, p.z));
         if ((f0 >= iso) != (f1 >= iso)) {
-            const auto frac = static_cast<float>((iso - f0) / (f1 - f0));
+            const auto frac = static_cast<float>(crossing_fraction(iso, f0, f1));
             const float miss = std::abs(static_cast<float>(k) + frac - linear);
             if (miss < best_miss) {
                 best_miss = miss;

@@ -21,8 +21,8 @@ class TypedExtractor final : public SurfaceExtractor {
     }
 
     const Volume& volume() const override { return data_.volume; }
-    double value_min() const override { return static_cast<double>(data_.octree.value_min()); }
-    double value_max() const override { return static_cast<double>(data_.octree.value_max()); }
+    double value_min() const override { return data_.octree.finite_range().min; }
+    double value_max() const override { return data_.octree.finite_range().max; }
     const OctreeShape& octree_shape() const override { return data_.octree.shape(); }
     std::size_t octree_bytes() const override { return data_.octree.bytes(); }
     int threads() const override { return static_cast<int>(workers_.size()); }

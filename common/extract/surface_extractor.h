@@ -24,6 +24,7 @@ class SurfaceExtractor {
     virtual ~SurfaceExtractor() = default;
 
     virtual const Volume& volume() const = 0;
+    // The range of the finite voxels (NaN and infinity left out): the isovalues worth asking for.
     virtual double value_min() const = 0;
     virtual double value_max() const = 0;
     virtual const OctreeShape& octree_shape() const = 0;

@@ -10,7 +10,8 @@ namespace isowall {
 class MappedFile {
   public:
     MappedFile() = default;
-    // Throws std::runtime_error naming the file when it cannot be opened or mapped.
+    // Throws std::runtime_error naming the file when it cannot be opened or mapped, or is not a
+    // regular file (a device or FIFO has no size to map, and may never end).
     explicit MappedFile(const std::filesystem::path& path);
     MappedFile(MappedFile&& other) noexcept;
     MappedFile& operator=(MappedFile&& other) noexcept;

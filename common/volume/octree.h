@@ -11,13 +11,17 @@
 // volume bytes for every type.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -59,6 +63,9 @@ struct OctreeShape {
 struct OctreeSource {
     std::filesystem::path volume_path;  // empty: not cacheable (generated volume)
     std::filesystem::path cache_dir;    // empty: no cache
+    // Every other file the voxels come from (a detached header's data file): the key covers each,
+    // so data replaced behind an unchanged header is never served a stale octree.
+    std::vector<std::filesystem::path> data_files{};
 };
 
 struct OctreeStats {
@@ -68,6 +75,34 @@ struct OctreeStats {
     std::string cache_note;  // why the cache was not used or written, if it was not
 };
 
+// The range of a volume's finite voxels (NaN and +-infinity left out); `any` is false when there
+// is none. Isovalues are checked against it.
+struct FiniteRange {
+    bool any = false;
+    double min = 0, max = 0;
+    void merge(double v) {
+        if (!std::isfinite(v)) return;
+        min = any ? std::min(min, v) : v;
+        max = any ? std::max(max, v) : v;
+        any = true;
+    }
+    void merge(const FiniteRange& r) {
+        if (r.any) merge(r.min), merge(r.max);
+    }
+};
+
+// NaN voxels are outside the surface for every isovalue: marching cubes classifies them below
+// (value >= iso is false), so the octree orders them as -infinity too. A node of only NaN then
+// has min = max = -inf and is never active, and a node where NaN meets a value >= iso is, as the
+// cells it holds are crossed. Infinite voxels are ordinary ordered values.
+template <class T>
+constexpr T octree_key(T v) {
+    if constexpr (std::is_floating_point_v<T>)
+        return v != v ? -std::numeric_limits<T>::infinity() : v;
+    else
+        return v;
+}
+
 template <class T>
 class MinMaxOctree {
   public:
@@ -76,7 +111,7 @@ class MinMaxOctree {
     // Splits the leaf level over `budget` threads (the rank's budget; by default every core).
     static MinMaxOctree build(const VolumeView<T>& volume,
                               ThreadBudget budget = ThreadBudget::hardware());
-    // Map a cache file when its key matches the volume, else build and write it.
+    // Map a cache file when its key and checksum match the volume, else build and write it.
     static MinMaxOctree load_or_build(const VolumeView<T>& volume, const OctreeSource& source,
                                       OctreeStats* stats,
                                       ThreadBudget budget = ThreadBudget::hardware());
@@ -87,6 +122,8 @@ class MinMaxOctree {
     T max(int level, glm::ivec3 n) const { return nodes_[2 * shape_.node_index(level, n) + 1]; }
     T value_min() const { return min(level_count() - 1, glm::ivec3(0)); }
     T value_max() const { return max(level_count() - 1, glm::ivec3(0)); }
+    // The finite voxels' range: value_min()/value_max() without NaN and infinity.
+    const FiniteRange& finite_range() const { return finite_; }
     // A node holds part of the surface when some corner is >= iso and some is < iso.
     bool active(int level, glm::ivec3 n, double iso) const {
         const std::size_t i = 2 * shape_.node_index(level, n);
@@ -96,10 +133,14 @@ class MinMaxOctree {
     std::size_t bytes() const { return nodes_.size_bytes(); }
 
   private:
+    FiniteRange build_leaves(const VolumeView<T>& v, ThreadBudget budget);
+    void build_upper_levels();
+
     OctreeShape shape_;
     std::span<const T> nodes_;  // (min, max) per node, in node_index order
     std::vector<T> owned_;
     std::shared_ptr<MappedFile> mapped_;
+    FiniteRange finite_;
 };
 
 // Cache file plumbing shared by every voxel type (octree_cache.cpp).
@@ -107,34 +148,39 @@ namespace octree_cache {
 struct Key {
     std::uint32_t type = 0;
     glm::ivec3 dims{0};
-    std::uint64_t volume_file_size = 0;
-    std::int64_t volume_mtime_ns = 0;
+    std::uint64_t sources = 0;  // digest of each source file's path, size, mtime, ctime, inode
 };
-std::optional<Key> key_for(const std::filesystem::path& volume_path, VoxelType type,
+// nullopt when a file cannot be stat'ed.
+std::optional<Key> key_for(const std::vector<std::filesystem::path>& files, VoxelType type,
                            glm::ivec3 dims);
 std::filesystem::path file_for(const std::filesystem::path& cache_dir,
                                const std::filesystem::path& volume_path);
-// The node bytes of a cache file whose header matches `key`; nullopt (and `why`) otherwise.
-std::optional<std::span<const std::byte>> match(const MappedFile& file, const Key& key,
-                                                std::size_t node_bytes, std::string* why);
+// 64-bit FNV-1a over 8-byte words (the tail bytes zero-padded): a changed word always changes it.
+std::uint64_t checksum(std::span<const std::byte> bytes);
+struct Hit {
+    std::span<const std::byte> nodes;
+    FiniteRange range;
+};
+// The node bytes of a cache file whose header matches `key` and whose nodes match their checksum;
+// nullopt (and `why`: stale, truncated or damaged) otherwise.
+std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
+                         std::string* why);
 // Writes header + nodes to a temporary file and renames it into place (atomic for readers).
 bool write(const std::filesystem::path& file, const Key& key, std::span<const std::byte> nodes,
-           std::string* why);
+           const FiniteRange& range, std::string* why);
 // The default folder: $ISOWALL_CACHE_DIR, else $XDG_CACHE_HOME/isowall, else ~/.cache/isowall.
 std::filesystem::path default_dir();
 }  // namespace octree_cache
 
+// Leaves: a brick of B cells spans B+1 voxels per axis (cells share their faces). Leaf slabs are
+// independent; they are split over the budget (the build runs once per volume), each slab
+// keeping its own finite range, merged at the end.
 template <class T>
-MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v, ThreadBudget budget) {
-    MinMaxOctree o;
-    o.shape_ = OctreeShape::for_cells(v.cell_dims());
-    o.owned_.resize(2 * o.shape_.node_count);
-    T* nodes = o.owned_.data();
-    const auto& leaf = o.shape_.levels[0];
+FiniteRange MinMaxOctree<T>::build_leaves(const VolumeView<T>& v, ThreadBudget budget) {
+    T* nodes = owned_.data();
+    const auto& leaf = shape_.levels[0];
     constexpr int B = OctreeShape::kLeafCells;
-
-    // Leaves: a brick of B cells spans B+1 voxels per axis (cells share their faces).
-    auto leaf_rows = [&](int bz0, int bz1) {
+    auto leaf_rows = [&](int bz0, int bz1, FiniteRange* range) {
         for (int bz = bz0; bz < bz1; ++bz)
             for (int by = 0; by < leaf.dims.y; ++by)
                 for (int bx = 0; bx < leaf.dims.x; ++bx) {
@@ -142,52 +188,75 @@ MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v, ThreadBudget budg
                     const int x1 = std::min(x0 + B, v.dims.x - 1);
                     const int y1 = std::min(y0 + B, v.dims.y - 1);
                     const int z1 = std::min(z0 + B, v.dims.z - 1);
-                    T lo = v.at(x0, y0, z0), hi = lo;
+                    T lo = octree_key(v.at(x0, y0, z0)), hi = lo;
                     for (int z = z0; z <= z1; ++z)
                         for (int y = y0; y <= y1; ++y) {
                             const T* row = v.data + v.index(0, y, z);
                             for (int x = x0; x <= x1; ++x) {
-                                lo = std::min(lo, row[x]);
-                                hi = std::max(hi, row[x]);
+                                lo = std::min(lo, octree_key(row[x]));
+                                hi = std::max(hi, octree_key(row[x]));
+                                if constexpr (std::is_floating_point_v<T>)
+                                    range->merge(static_cast<double>(row[x]));
                             }
                         }
-                    const std::size_t i = 2 * o.shape_.node_index(0, {bx, by, bz});
+                    const std::size_t i = 2 * shape_.node_index(0, {bx, by, bz});
                     nodes[i] = lo;
                     nodes[i + 1] = hi;
                 }
     };
-    // Leaf slabs are independent; split them over the budget (the build runs once per volume).
     const int threads = std::max(1, std::min(budget.usable(), leaf.dims.z));
+    std::vector<FiniteRange> ranges(static_cast<std::size_t>(threads));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t)
-        pool.emplace_back(leaf_rows, leaf.dims.z * t / threads, leaf.dims.z * (t + 1) / threads);
-    leaf_rows(0, leaf.dims.z / threads);
+        pool.emplace_back(leaf_rows, leaf.dims.z * t / threads, leaf.dims.z * (t + 1) / threads,
+                          &ranges[static_cast<std::size_t>(t)]);
+    leaf_rows(0, leaf.dims.z / threads, &ranges[0]);
     for (auto& th : pool) th.join();
+    FiniteRange all;
+    for (const FiniteRange& r : ranges) all.merge(r);
+    return all;
+}
 
-    // Upper levels: reduce the (up to) eight children of each node.
-    for (int l = 1; l < o.level_count(); ++l) {
-        const auto& L = o.shape_.levels[static_cast<std::size_t>(l)];
-        const auto& C = o.shape_.levels[static_cast<std::size_t>(l - 1)];
+// Upper levels: reduce the (up to) eight children of each node.
+template <class T>
+void MinMaxOctree<T>::build_upper_levels() {
+    T* nodes = owned_.data();
+    for (int l = 1; l < level_count(); ++l) {
+        const auto& L = shape_.levels[static_cast<std::size_t>(l)];
+        const auto& C = shape_.levels[static_cast<std::size_t>(l - 1)];
         for (int z = 0; z < L.dims.z; ++z)
             for (int y = 0; y < L.dims.y; ++y)
                 for (int x = 0; x < L.dims.x; ++x) {
                     const glm::ivec3 c0(2 * x, 2 * y, 2 * z);
                     const glm::ivec3 c1 = glm::min(c0 + 2, C.dims);
-                    const std::size_t first = 2 * o.shape_.node_index(l - 1, c0);
+                    const std::size_t first = 2 * shape_.node_index(l - 1, c0);
                     T lo = nodes[first], hi = nodes[first + 1];
                     for (int cz = c0.z; cz < c1.z; ++cz)
                         for (int cy = c0.y; cy < c1.y; ++cy)
                             for (int cx = c0.x; cx < c1.x; ++cx) {
-                                const std::size_t i = 2 * o.shape_.node_index(l - 1, {cx, cy, cz});
+                                const std::size_t i = 2 * shape_.node_index(l - 1, {cx, cy, cz});
                                 lo = std::min(lo, nodes[i]);
                                 hi = std::max(hi, nodes[i + 1]);
                             }
-                    const std::size_t i = 2 * o.shape_.node_index(l, {x, y, z});
+                    const std::size_t i = 2 * shape_.node_index(l, {x, y, z});
                     nodes[i] = lo;
                     nodes[i + 1] = hi;
                 }
     }
+}
+
+template <class T>
+MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v, ThreadBudget budget) {
+    MinMaxOctree o;
+    o.shape_ = OctreeShape::for_cells(v.cell_dims());
+    o.owned_.resize(2 * o.shape_.node_count);
+    o.finite_ = o.build_leaves(v, budget);
+    o.build_upper_levels();
     o.nodes_ = o.owned_;
+    if constexpr (!std::is_floating_point_v<T>) {
+        o.finite_.merge(static_cast<double>(o.value_min()));
+        o.finite_.merge(static_cast<double>(o.value_max()));
+    }
     return o;
 }
 
@@ -198,9 +267,11 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     OctreeStats& st = stats ? *stats : local;
     std::optional<octree_cache::Key> key;
     std::filesystem::path file;
+    std::vector<std::filesystem::path> sources{src.volume_path};
+    sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
     if (src.volume_path.empty() || src.cache_dir.empty()) {
         st.cache_note = src.volume_path.empty() ? "generated volume, not cached" : "cache disabled";
-    } else if ((key = octree_cache::key_for(src.volume_path, voxel_type_of<T>(), v.dims))) {
+    } else if ((key = octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
         file = octree_cache::file_for(src.cache_dir, src.volume_path);
         st.cache_file = file;
         std::error_code ec;
@@ -209,12 +280,13 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
                 auto mapped = std::make_shared<MappedFile>(file);
                 const OctreeShape shape = OctreeShape::for_cells(v.cell_dims());
                 const std::size_t count = 2 * shape.node_count;
-                if (auto bytes =
+                if (auto hit =
                         octree_cache::match(*mapped, *key, count * sizeof(T), &st.cache_note)) {
                     MinMaxOctree o;
                     o.shape_ = shape;
                     o.mapped_ = std::move(mapped);
-                    o.nodes_ = {reinterpret_cast<const T*>(bytes->data()), count};
+                    o.nodes_ = {reinterpret_cast<const T*>(hit->nodes.data()), count};
+                    o.finite_ = hit->range;
                     st.from_cache = true;
                     return o;
                 }
@@ -223,12 +295,14 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
             }
         }
     } else {
-        st.cache_note = "cannot stat the volume file";
+        st.cache_note = "cannot stat the volume's files";
     }
     const auto t0 = std::chrono::steady_clock::now();
     MinMaxOctree o = build(v, budget);
     st.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (key) octree_cache::write(file, *key, std::as_bytes(o.nodes_), &st.cache_note);
+    std::string write_note;
+    if (key && !octree_cache::write(file, *key, std::as_bytes(o.nodes_), o.finite_, &write_note))
+        st.cache_note += (st.cache_note.empty() ? "" : "; ") + write_note;
     return o;
 }
 

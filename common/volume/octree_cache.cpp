@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -27,7 +28,7 @@ namespace octree_cache {
 namespace {
 
 // Bumped whenever the layout of the nodes or of the header changes.
-constexpr char kMagic[8] = {'I', 'S', 'O', 'W', 'O', 'C', 'T', '1'};
+constexpr char kMagic[8] = {'I', 'S', 'O', 'W', 'O', 'C', 'T', '2'};
 
 struct Header {
     char magic[8];
@@ -35,13 +36,19 @@ struct Header {
     std::int32_t dims[3];
     std::int32_t leaf_log2;
     std::uint32_t pad;
-    std::uint64_t volume_file_size;
-    std::int64_t volume_mtime_ns;
+    std::uint64_t sources;  // Key::sources
     std::uint64_t node_bytes;
-    std::uint64_t reserved[2];
+    // What the nodes decide, after the key:
+    std::uint64_t node_checksum;    // checksum() of the node bytes
+    double finite_min, finite_max;  // FiniteRange, when has_finite is 1
+    std::uint64_t has_finite;
 };
-static_assert(sizeof(Header) == 72);
+static_assert(sizeof(Header) == 80);
 constexpr std::size_t kNodeOffset = 128;  // keeps the nodes 16-byte aligned for every type
+
+// The header without what only the nodes decide (their checksum and value range): two headers
+// for one key compare equal on these bytes.
+constexpr std::size_t kKeyBytes = offsetof(Header, node_checksum);
 
 Header header_for(const Key& key, std::size_t node_bytes) {
     Header h{};
@@ -51,24 +58,56 @@ Header header_for(const Key& key, std::size_t node_bytes) {
     h.dims[1] = key.dims.y;
     h.dims[2] = key.dims.z;
     h.leaf_log2 = OctreeShape::kLeafLog2;
-    h.volume_file_size = key.volume_file_size;
-    h.volume_mtime_ns = key.volume_mtime_ns;
+    h.sources = key.sources;
     h.node_bytes = node_bytes;
     return h;
 }
 
+constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
+constexpr std::uint64_t kFnvPrime = 1099511628211ull;
+
+std::uint64_t fnv_mix(std::uint64_t h, std::uint64_t word) {
+    return (h ^ word) * kFnvPrime;
+}
+
+std::uint64_t fnv_string(std::uint64_t h, const std::string& s) {
+    for (unsigned char c : s) h = fnv_mix(h, c);
+    return fnv_mix(h, s.size());
+}
+
 }  // namespace
 
-std::optional<Key> key_for(const std::filesystem::path& volume_path, VoxelType type,
+std::uint64_t checksum(std::span<const std::byte> bytes) {
+    std::uint64_t h = kFnvOffset;
+    std::size_t i = 0;
+    for (; i + 8 <= bytes.size(); i += 8) {
+        std::uint64_t w;
+        std::memcpy(&w, bytes.data() + i, 8);
+        h = fnv_mix(h, w);
+    }
+    std::uint64_t tail = 0;
+    if (i < bytes.size()) std::memcpy(&tail, bytes.data() + i, bytes.size() - i);
+    return fnv_mix(fnv_mix(h, tail), bytes.size());
+}
+
+std::optional<Key> key_for(const std::vector<std::filesystem::path>& files, VoxelType type,
                            glm::ivec3 dims) {
-    struct stat st {};
-    if (::stat(volume_path.c_str(), &st) != 0) return std::nullopt;
     Key k;
     k.type = static_cast<std::uint32_t>(type);
     k.dims = dims;
-    k.volume_file_size = static_cast<std::uint64_t>(st.st_size);
-    k.volume_mtime_ns =
-        static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
+    std::uint64_t h = kFnvOffset;
+    for (const auto& f : files) {
+        struct stat st {};
+        if (::stat(f.c_str(), &st) != 0) return std::nullopt;
+        std::error_code ec;
+        auto canonical = std::filesystem::weakly_canonical(f, ec);
+        h = fnv_string(h, (ec ? std::filesystem::absolute(f) : canonical).string());
+        for (std::int64_t v : {std::int64_t(st.st_size), std::int64_t(st.st_ino),
+                               std::int64_t(st.st_mtim.tv_sec), std::int64_t(st.st_mtim.tv_nsec),
+                               std::int64_t(st.st_ctim.tv_sec), std::int64_t(st.st_ctim.tv_nsec)})
+            h = fnv_mix(h, static_cast<std::uint64_t>(v));
+    }
+    k.sources = h;
     return k;
 }
 
@@ -83,19 +122,32 @@ std::filesystem::path file_for(const std::filesystem::path& cache_dir,
     return cache_dir / name.str();
 }
 
-std::optional<std::span<const std::byte>> match(const MappedFile& file, const Key& key,
-                                                std::size_t node_bytes, std::string* why) {
+std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
+                         std::string* why) {
     const Header want = header_for(key, node_bytes);
-    if (file.size() != kNodeOffset + node_bytes ||
-        std::memcmp(file.bytes().data(), &want, sizeof(Header)) != 0) {
+    Header have{};
+    if (file.size() >= sizeof(Header)) std::memcpy(&have, file.bytes().data(), sizeof(Header));
+    if (file.size() < sizeof(Header) || std::memcmp(&have, &want, kKeyBytes) != 0) {
         if (why) *why = "cache file is stale (volume changed), rebuilt";
         return std::nullopt;
     }
-    return file.bytes().subspan(kNodeOffset, node_bytes);
+    if (file.size() != kNodeOffset + node_bytes) {
+        if (why) *why = "cache file is truncated or padded, rebuilt";
+        return std::nullopt;
+    }
+    const auto nodes = file.bytes().subspan(kNodeOffset, node_bytes);
+    FiniteRange range;
+    if (have.has_finite) range.merge(have.finite_min), range.merge(have.finite_max);
+    const bool range_ok = (have.has_finite != 0) == range.any && have.has_finite <= 1;
+    if (checksum(nodes) != have.node_checksum || !range_ok) {
+        if (why) *why = "cache file is damaged (checksum mismatch), rebuilt";
+        return std::nullopt;
+    }
+    return Hit{nodes, range};
 }
 
 bool write(const std::filesystem::path& file, const Key& key, std::span<const std::byte> nodes,
-           std::string* why) {
+           const FiniteRange& range, std::string* why) {
     std::error_code ec;
     std::filesystem::create_directories(file.parent_path(), ec);
     // A per-process temporary name, renamed at the end: ranks that build at once never read a
@@ -104,7 +156,11 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
     tmp += ".tmp" + std::to_string(::getpid());
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        const Header h = header_for(key, nodes.size());
+        Header h = header_for(key, nodes.size());
+        h.node_checksum = checksum(nodes);
+        h.has_finite = range.any ? 1 : 0;
+        h.finite_min = range.min;
+        h.finite_max = range.max;
         char pad[kNodeOffset] = {};
         std::memcpy(pad, &h, sizeof(h));
         out.write(pad, kNodeOffset);

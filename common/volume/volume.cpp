@@ -1,7 +1,5 @@
 #include "common/volume/volume.h"
 
-#include <teem/nrrd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -11,6 +9,8 @@
 #include <sstream>
 
 #include "common/core/error.h"
+#include "common/volume/load_checks.h"
+#include "common/volume/teem_util.h"
 
 namespace isowall {
 namespace fs = std::filesystem;
@@ -97,91 +97,17 @@ Box3 Volume::bounds() const {
 
 namespace {
 
-std::size_t expected_bytes(glm::ivec3 dims, VoxelType type) {
-    return static_cast<std::size_t>(dims.x) * dims.y * dims.z * voxel_size(type);
-}
-
-void check_dims(const std::string& where, const std::string& field, glm::ivec3 dims) {
+void check_dims(const std::string& where, const std::string& field, glm::ivec3 dims,
+                VoxelType type) {
+    const std::uint64_t sizes[3] = {static_cast<std::uint64_t>(std::max(dims.x, 0)),
+                                    static_cast<std::uint64_t>(std::max(dims.y, 0)),
+                                    static_cast<std::uint64_t>(std::max(dims.z, 0))};
     if (dims.x < 2 || dims.y < 2 || dims.z < 2) {
         std::ostringstream os;
         os << "expected three sizes >= 2, got " << dims.x << " " << dims.y << " " << dims.z;
         throw InputError(where, field, os.str());
     }
-}
-
-// The exact-size rule: a data file shorter or longer than the header says is an error, since a
-// wrong size almost always means wrong dims or type, and a silent crop would hide it.
-void check_size(const std::string& file, std::size_t have, std::size_t offset, std::size_t need) {
-    if (have < offset + need) {
-        throw InputError(file, "size",
-                         "file is shorter than the header says: expected " +
-                             std::to_string(offset + need) + " bytes, found " +
-                             std::to_string(have));
-    }
-    if (have > offset + need) {
-        throw InputError(file, "size",
-                         "file is longer than the header says: expected " +
-                             std::to_string(offset + need) + " bytes, found " +
-                             std::to_string(have));
-    }
-}
-
-Volume read_swapped(const fs::path& path, glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
-                    std::size_t offset, std::string source) {
-    const std::size_t need = expected_bytes(dims, type);
-    std::vector<std::byte> bytes(need);
-    std::ifstream in(path, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(need));
-    if (!in)
-        throw InputError(path.string(), "data", "cannot read " + std::to_string(need) + " bytes");
-    swap_bytes(bytes, voxel_size(type));
-    return Volume(dims, type, spacing, std::move(bytes), std::move(source));
-}
-
-// Teem reports a stack of messages, outermost first; the innermost one says what was wrong.
-std::string teem_error() {
-    char* raw = biffGetDone(NRRD);
-    std::string all = raw ? raw : "unknown error";
-    std::free(raw);
-    std::string last;
-    std::istringstream lines(all);
-    for (std::string line; std::getline(lines, line);)
-        if (!line.empty()) last = line;
-    // Drop the "[nrrd] function: " prefix.
-    if (auto p = last.find("] "); p != std::string::npos) last = last.substr(p + 2);
-    if (auto p = last.find(": "); p != std::string::npos && p < 40) last = last.substr(p + 2);
-    return last;
-}
-
-struct NrrdDeleter {
-    void operator()(Nrrd* n) const { nrrdNuke(n); }
-};
-struct NioDeleter {
-    void operator()(NrrdIoState* n) const { nrrdIoStateNix(n); }
-};
-
-std::optional<VoxelType> from_teem_type(int t) {
-    switch (t) {
-        case nrrdTypeUChar:
-            return VoxelType::u8;
-        case nrrdTypeChar:
-            return VoxelType::i8;
-        case nrrdTypeUShort:
-            return VoxelType::u16;
-        case nrrdTypeShort:
-            return VoxelType::i16;
-        case nrrdTypeUInt:
-            return VoxelType::u32;
-        case nrrdTypeInt:
-            return VoxelType::i32;
-        case nrrdTypeFloat:
-            return VoxelType::f32;
-        case nrrdTypeDouble:
-            return VoxelType::f64;
-        default:
-            return std::nullopt;
-    }
+    checked_dims(where, field, sizes, type);
 }
 
 int to_teem_type(VoxelType t) {
@@ -206,112 +132,31 @@ int to_teem_type(VoxelType t) {
     return nrrdTypeUnknown;
 }
 
-glm::vec3 nrrd_spacing(const Nrrd* n) {
-    glm::vec3 s(1.0f);
-    for (int i = 0; i < 3; ++i) {
-        const NrrdAxisInfo& ax = n->axis[i];
-        if (std::isfinite(ax.spacing) && ax.spacing > 0) {
-            s[i] = static_cast<float>(ax.spacing);
-        } else if (n->spaceDim > 0) {
-            double len2 = 0;
-            for (unsigned d = 0; d < n->spaceDim; ++d)
-                if (std::isfinite(ax.spaceDirection[d]))
-                    len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
-            if (len2 > 0) s[i] = static_cast<float>(std::sqrt(len2));
-        }
-    }
-    return s;
-}
-
-// Offset of the first byte after an attached header's blank line.
-std::optional<std::size_t> attached_data_offset(std::span<const std::byte> bytes) {
-    for (std::size_t i = 0; i + 1 < bytes.size(); ++i) {
-        if (bytes[i] != std::byte{'\n'}) continue;
-        if (bytes[i + 1] == std::byte{'\n'}) return i + 2;
-        if (bytes[i + 1] == std::byte{'\r'} && i + 2 < bytes.size() &&
-            bytes[i + 2] == std::byte{'\n'})
-            return i + 3;
-    }
-    return std::nullopt;
-}
-
 }  // namespace
 
 Volume load_raw(const fs::path& path, const RawSpec& spec) {
     const std::string where = path.string();
-    check_dims(where, "--dims", spec.dims);
-    if (!fs::exists(path)) throw InputError(where, "file", "no such file");
+    check_dims(where, "--dims", spec.dims, spec.type);
+    check_regular_file(path, where, "file");
     for (int i = 0; i < 3; ++i)
         if (!(spec.spacing[i] > 0) || !std::isfinite(spec.spacing[i]))
             throw InputError(where, "--spacing", "expected three positive numbers");
-    const std::size_t need = expected_bytes(spec.dims, spec.type);
+    const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
     MappedFile file(path);
     check_size(where, file.size(), spec.header_bytes, need);
-    if (spec.endian != host_endian() && voxel_size(spec.type) > 1)
-        return read_swapped(path, spec.dims, spec.type, spec.spacing, spec.header_bytes, where);
-    return Volume(spec.dims, spec.type, spec.spacing, std::move(file), spec.header_bytes, where);
-}
-
-Volume load_nrrd(const fs::path& path) {
-    const std::string where = path.string();
-    if (!fs::exists(path)) throw InputError(where, "file", "no such file");
-    std::unique_ptr<Nrrd, NrrdDeleter> nrrd(nrrdNew());
-    std::unique_ptr<NrrdIoState, NioDeleter> nio(nrrdIoStateNew());
-    // First pass: the header only, so raw data can be mapped instead of read.
-    nio->skipData = AIR_TRUE;
-    if (nrrdLoad(nrrd.get(), path.c_str(), nio.get()))
-        throw InputError(where, "header", teem_error());
-    if (nrrd->dim != 3)
-        throw InputError(where, "dimension", "expected 3, got " + std::to_string(nrrd->dim));
-    const auto type = from_teem_type(nrrd->type);
-    if (!type)
-        throw InputError(where, "type",
-                         std::string("unsupported voxel type \"") +
-                             airEnumStr(nrrdType, nrrd->type) +
-                             "\" (expected one of uint8 int8 uint16 int16 uint32 "
-                             "int32 float32 float64)");
-    const glm::ivec3 dims(static_cast<int>(nrrd->axis[0].size),
-                          static_cast<int>(nrrd->axis[1].size),
-                          static_cast<int>(nrrd->axis[2].size));
-    check_dims(where, "sizes", dims);
-    const glm::vec3 spacing = nrrd_spacing(nrrd.get());
-    const std::size_t need = expected_bytes(dims, *type);
-    const bool raw = nio->encoding == nrrdEncodingRaw;
-    const bool host_order = voxel_size(*type) == 1 ||
-                            (nio->endian == airEndianLittle) == (host_endian() == Endian::little);
-    const unsigned data_files = nio->dataFNArr ? nio->dataFNArr->len : 0;
-
-    if (raw && data_files <= 1 && nio->lineSkip == 0) {
-        fs::path data_path = path;
-        if (data_files == 1) {
-            data_path = nio->dataFN[0];
-            if (data_path.is_relative()) data_path = path.parent_path() / data_path;
-        }
-        const std::string data_where = data_path.string();
-        MappedFile file(data_path);
-        std::size_t offset = 0;
-        if (data_files == 0) {
-            auto off = attached_data_offset(file.bytes());
-            if (!off) throw InputError(where, "header", "no blank line ends the header");
-            offset = *off;
-        } else if (nio->byteSkip == -1) {
-            // "byte skip: -1" means the data is the last bytes of the file.
-            if (file.size() < need) check_size(data_where, file.size(), 0, need);
-            offset = file.size() - need;
-        } else {
-            offset = static_cast<std::size_t>(nio->byteSkip);
-        }
-        check_size(data_where, file.size(), offset, need);
-        if (host_order) return Volume(dims, *type, spacing, std::move(file), offset, where);
-        return read_swapped(data_path, dims, *type, spacing, offset, where);
+    Volume volume;
+    if (spec.endian == host_endian() || voxel_size(spec.type) == 1) {
+        volume =
+            Volume(spec.dims, spec.type, spec.spacing, std::move(file), spec.header_bytes, where);
+    } else {
+        std::vector<std::byte> bytes = allocate_voxels(need, where, "--dims");
+        const auto data = file.bytes().subspan(spec.header_bytes, bytes.size());
+        std::copy(data.begin(), data.end(), bytes.begin());
+        swap_bytes(bytes, voxel_size(spec.type));
+        volume = Volume(spec.dims, spec.type, spec.spacing, std::move(bytes), where);
     }
-
-    // Anything else (gzip, bzip2, ascii, hex, multiple files): let Teem decode it.
-    std::unique_ptr<Nrrd, NrrdDeleter> full(nrrdNew());
-    if (nrrdLoad(full.get(), path.c_str(), nullptr)) throw InputError(where, "data", teem_error());
-    const auto* p = static_cast<const std::byte*>(full->data);
-    std::vector<std::byte> bytes(p, p + need);
-    return Volume(dims, *type, spacing, std::move(bytes), where);
+    volume.set_files({path});
+    return volume;
 }
 
 Volume load_volume(const fs::path& path, const std::optional<RawSpec>& raw) {
@@ -327,14 +172,14 @@ void save_nrrd(const fs::path& path, const Volume& volume, std::string_view enco
     if (endian != host_endian() && voxel_size(volume.type()) > 1)
         throw std::runtime_error("save_nrrd: only host byte order is written");
     std::vector<std::byte> copy(volume.bytes().begin(), volume.bytes().end());
-    std::unique_ptr<Nrrd, NrrdDeleter> nrrd(nrrdNew());
+    std::unique_ptr<Nrrd, teem::NrrdDeleter> nrrd(nrrdNew());
     const glm::ivec3 d = volume.dims();
     if (nrrdWrap_va(nrrd.get(), copy.data(), to_teem_type(volume.type()), 3,
                     static_cast<size_t>(d.x), static_cast<size_t>(d.y), static_cast<size_t>(d.z)))
-        throw std::runtime_error(path.string() + ": " + teem_error());
+        throw std::runtime_error(path.string() + ": " + teem::error());
     const glm::vec3 s = volume.spacing();
     nrrdAxisInfoSet_va(nrrd.get(), nrrdAxisInfoSpacing, double(s.x), double(s.y), double(s.z));
-    std::unique_ptr<NrrdIoState, NioDeleter> nio(nrrdIoStateNew());
+    std::unique_ptr<NrrdIoState, teem::NioDeleter> nio(nrrdIoStateNew());
     if (encoding == "gzip") {
         nio->encoding = nrrdEncodingGzip;
     } else if (encoding == "raw") {
@@ -345,7 +190,7 @@ void save_nrrd(const fs::path& path, const Volume& volume, std::string_view enco
     nio->detachedHeader = path.extension() == ".nhdr" ? AIR_TRUE : AIR_FALSE;
     const int rc = nrrdSave(path.c_str(), nrrd.get(), nio.get());
     nrrd->data = nullptr;  // owned by `copy`, not by Teem
-    if (rc) throw std::runtime_error(path.string() + ": " + teem_error());
+    if (rc) throw std::runtime_error(path.string() + ": " + teem::error());
 }
 
 }  // namespace isowall

@@ -65,6 +65,10 @@ class Volume {
     glm::vec3 spacing() const { return spacing_; }
     VoxelType type() const { return type_; }
     const std::string& source() const { return source_; }  // file name or "phantom"
+    // Every file the voxels were read from (a detached header and its data file); empty for a
+    // generated volume. The octree cache key covers each.
+    const std::vector<std::filesystem::path>& files() const { return files_; }
+    void set_files(std::vector<std::filesystem::path> files) { files_ = std::move(files); }
     std::span<const std::byte> bytes() const { return bytes_; }
     bool mapped() const { return file_.size() > 0; }
     std::size_t voxel_count() const {
@@ -82,6 +86,7 @@ class Volume {
     glm::vec3 spacing_{1.0f};
     VoxelType type_ = VoxelType::u8;
     std::string source_;
+    std::vector<std::filesystem::path> files_;
     MappedFile file_;
     std::vector<std::byte> owned_;
     std::span<const std::byte> bytes_;
@@ -139,10 +144,13 @@ struct RawSpec {
     std::size_t header_bytes = 0;  // bytes to skip at the start of the file
 };
 
-// Headerless voxels, x fastest. The file must hold exactly header_bytes + voxels * size bytes.
+// Headerless voxels, x fastest. The file must be a regular file holding exactly
+// header_bytes + voxels * size bytes.
 Volume load_raw(const std::filesystem::path& path, const RawSpec& spec);
-// NRRD through Teem: attached or detached header, raw or gzip (any encoding Teem reads).
-// Raw data in host byte order is memory-mapped, everything else decoded into memory.
+// NRRD: Teem parses the header text; we locate the data (one regular data file, line and byte
+// skips checked against its size) and decode it: raw, gzip, bzip2, ascii, hex, each with the
+// exact count the header gives. Raw data in host byte order is memory-mapped, everything else
+// decoded into memory. Every failure is an InputError naming the file and the field.
 Volume load_nrrd(const std::filesystem::path& path);
 // Picks the loader by extension (.nrrd/.nhdr -> NRRD, anything else needs a RawSpec).
 Volume load_volume(const std::filesystem::path& path, const std::optional<RawSpec>& raw);

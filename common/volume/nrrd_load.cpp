@@ -1,0 +1,214 @@
+// load_nrrd: Teem parses the header text (nrrd_header.h keeps the data-location fields from it),
+// and we locate and decode the data (nrrd_decode.h), so every size and skip is checked by us.
+#include <cfloat>
+#include <cmath>
+#include <memory>
+
+#include "common/core/error.h"
+#include "common/volume/load_checks.h"
+#include "common/volume/nrrd_decode.h"
+#include "common/volume/nrrd_header.h"
+#include "common/volume/teem_util.h"
+#include "common/volume/volume.h"
+
+namespace isowall {
+namespace fs = std::filesystem;
+namespace {
+
+std::optional<VoxelType> from_teem_type(int t) {
+    switch (t) {
+        case nrrdTypeUChar:
+            return VoxelType::u8;
+        case nrrdTypeChar:
+            return VoxelType::i8;
+        case nrrdTypeUShort:
+            return VoxelType::u16;
+        case nrrdTypeShort:
+            return VoxelType::i16;
+        case nrrdTypeUInt:
+            return VoxelType::u32;
+        case nrrdTypeInt:
+            return VoxelType::i32;
+        case nrrdTypeFloat:
+            return VoxelType::f32;
+        case nrrdTypeDouble:
+            return VoxelType::f64;
+        default:
+            return std::nullopt;
+    }
+}
+
+enum class Encoding { raw, gzip, bzip2, ascii, hex };
+
+// What the loader needs from a header, every number checked.
+struct NrrdInfo {
+    glm::ivec3 dims{0};
+    VoxelType type = VoxelType::u8;
+    glm::vec3 spacing{1.0f};
+    Encoding encoding = Encoding::raw;
+    bool host_order = true;  // the file's byte order is ours (or it does not matter)
+};
+
+Encoding encoding_of(const NrrdIoState& nio, const std::string& where) {
+    const std::string name = nio.encoding ? nio.encoding->name : "?";
+    if (nio.encoding == nrrdEncodingRaw) return Encoding::raw;
+    if (nio.encoding == nrrdEncodingGzip) return Encoding::gzip;
+    if (nio.encoding == nrrdEncodingBzip2) return Encoding::bzip2;
+    if (nio.encoding == nrrdEncodingAscii) return Encoding::ascii;
+    if (nio.encoding == nrrdEncodingHex) return Encoding::hex;
+    throw InputError(where, "encoding",
+                     "\"" + name + "\" is not supported (expected raw, gzip, bzip2, ascii or hex)");
+}
+
+// An axis's spacing: `spacings` (its magnitude: negative means the axis runs backwards), else the
+// length of its space direction, else 1. It must survive as a positive float32 and keep the
+// volume's extent finite: geometry is float, and an infinite or zero spacing turns it into NaN.
+float axis_spacing(const Nrrd& n, int axis, int size, const std::string& where) {
+    const NrrdAxisInfo& ax = n.axis[axis];
+    double s = 1;
+    const char* field = "spacings";
+    if (std::isfinite(ax.spacing) && ax.spacing != 0) {
+        s = std::abs(ax.spacing);
+    } else if (n.spaceDim > 0) {
+        double len2 = 0;
+        for (unsigned d = 0; d < n.spaceDim; ++d)
+            if (std::isfinite(ax.spaceDirection[d]))
+                len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
+        if (len2 > 0) s = std::sqrt(len2);
+        field = "space directions";
+    }
+    const double extent = s * (size - 1);
+    if (!(s >= FLT_MIN && extent <= FLT_MAX && std::isfinite(extent))) {
+        char msg[160];
+        std::snprintf(msg, sizeof(msg),
+                      "axis %d: spacing %g is unusable (expected a number from %g to about %g)",
+                      axis, s, double(FLT_MIN), double(FLT_MAX) / (size - 1));
+        throw InputError(where, field, msg);
+    }
+    return static_cast<float>(s);
+}
+
+NrrdInfo parse_info(const NrrdHeaderText& text, const std::string& where) {
+    std::unique_ptr<Nrrd, teem::NrrdDeleter> nrrd(nrrdNew());
+    std::unique_ptr<NrrdIoState, teem::NioDeleter> nio(nrrdIoStateNew());
+    nio->skipData = AIR_TRUE;  // the text names no data file, so Teem opens nothing
+    // Sizes whose bytes overflow are ours to name (Teem's words for it are vaguer).
+    if (text.sizes.size() == 3) checked_dims(where, "sizes", text.sizes, VoxelType::u8);
+    if (nrrdStringRead(nrrd.get(), text.teem_text.c_str(), nio.get()))
+        throw InputError(where, "header", teem::error());
+    if (nrrd->dim != 3)
+        throw InputError(where, "dimension", "expected 3, got " + std::to_string(nrrd->dim));
+    NrrdInfo info;
+    const auto type = from_teem_type(nrrd->type);
+    if (!type)
+        throw InputError(where, "type",
+                         std::string("unsupported voxel type \"") +
+                             airEnumStr(nrrdType, nrrd->type) +
+                             "\" (expected one of uint8 int8 uint16 int16 uint32 "
+                             "int32 float32 float64)");
+    info.type = *type;
+    for (unsigned a = 0; a < 3; ++a) {
+        const int kind = nrrd->axis[a].kind;
+        if (kind != nrrdKindUnknown && !nrrdKindIsDomain(kind))
+            throw InputError(where, "kinds",
+                             "axis " + std::to_string(a) + " is \"" + airEnumStr(nrrdKind, kind) +
+                                 "\", not a space axis (a scalar volume has three)");
+    }
+    // Our own reading of the sizes: Teem wraps numbers past 64 bits.
+    info.dims = checked_dims(where, "sizes", text.sizes, info.type);
+    for (int a = 0; a < 3; ++a) info.spacing[a] = axis_spacing(*nrrd, a, info.dims[a], where);
+    info.encoding = encoding_of(*nio, where);
+    info.host_order = voxel_size(info.type) == 1 || info.encoding == Encoding::ascii ||
+                      (nio->endian == airEndianLittle) == (host_endian() == Endian::little);
+    return info;
+}
+
+// The data file a detached header names, relative to the header's folder unless absolute.
+fs::path data_path_of(const fs::path& header, const std::string& name) {
+    fs::path p = name;
+    return p.is_relative() ? header.parent_path() / p : p;
+}
+
+// The first byte of the data: after the line skip, then the byte skip (-1: the last `need` bytes,
+// for raw data only, since only raw data has a known length).
+std::size_t data_start(std::span<const std::byte> bytes, std::size_t offset,
+                       const NrrdHeaderText& h, const NrrdInfo& info, std::uint64_t need,
+                       const std::string& where, const std::string& data_where) {
+    offset = skip_lines(bytes, offset, h.line_skip, data_where);
+    if (h.byte_skip == -1) {
+        if (info.encoding != Encoding::raw)
+            throw InputError(where, "byte skip",
+                             "-1 (data at the end of the file) needs raw encoding");
+        if (bytes.size() - offset < need) check_size(data_where, bytes.size(), offset, need);
+        return bytes.size() - static_cast<std::size_t>(need);
+    }
+    const auto skip = static_cast<std::uint64_t>(h.byte_skip);
+    if (skip > bytes.size() - offset)
+        throw InputError(data_where, "byte skip",
+                         "skips " + std::to_string(skip) + " bytes, but only " +
+                             std::to_string(bytes.size() - offset) + " are left in the file");
+    return offset + static_cast<std::size_t>(skip);
+}
+
+std::vector<std::byte> decode(Encoding e, std::span<const std::byte> data, const NrrdInfo& info,
+                              std::uint64_t need, const std::string& data_where) {
+    switch (e) {
+        case Encoding::gzip:
+            return decode_gzip(data, need, data_where);
+        case Encoding::bzip2:
+            return decode_bzip2(data, need, data_where);
+        case Encoding::hex:
+            return decode_hex(data, need, data_where);
+        case Encoding::ascii:
+            return decode_ascii(data, info.type, need / voxel_size(info.type), data_where);
+        case Encoding::raw:
+            break;
+    }
+    std::vector<std::byte> bytes = allocate_voxels(need, data_where, "sizes");
+    std::copy(data.begin(), data.end(), bytes.begin());
+    return bytes;
+}
+
+}  // namespace
+
+Volume load_nrrd(const fs::path& path) {
+    const std::string where = path.string();
+    check_regular_file(path, where, "file");
+    MappedFile header_file(path);
+    const NrrdHeaderText text = split_nrrd_header(header_file.bytes(), where);
+    const NrrdInfo info = parse_info(text, where);
+    const std::uint64_t need = voxel_bytes(info.dims, info.type);
+
+    fs::path data_path = path;
+    MappedFile data_file;
+    std::size_t offset = 0;
+    if (text.data_file) {
+        data_path = data_path_of(path, *text.data_file);
+        check_regular_file(data_path, where, "data file");
+        data_file = MappedFile(data_path);
+    } else {
+        if (!text.data_offset)
+            throw InputError(where, "header",
+                             "no blank line ends the header and no data file is named");
+        data_file = std::move(header_file);
+        offset = *text.data_offset;
+    }
+    const std::string data_where = data_path.string();
+    offset = data_start(data_file.bytes(), offset, text, info, need, where, data_where);
+    const auto data = data_file.bytes().subspan(offset);
+    Volume volume;
+    if (info.encoding == Encoding::raw) check_size(data_where, data_file.size(), offset, need);
+    if (info.encoding == Encoding::raw && info.host_order) {
+        volume = Volume(info.dims, info.type, info.spacing, std::move(data_file), offset, where);
+    } else {
+        std::vector<std::byte> bytes = decode(info.encoding, data, info, need, data_where);
+        if (!info.host_order) swap_bytes(bytes, voxel_size(info.type));
+        volume = Volume(info.dims, info.type, info.spacing, std::move(bytes), where);
+    }
+    std::vector<fs::path> files{path};
+    if (data_path != path) files.push_back(data_path);
+    volume.set_files(std::move(files));
+    return volume;
+}
+
+}  // namespace isowall

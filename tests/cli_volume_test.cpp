@@ -1,0 +1,101 @@
+// The isowall program on hostile volumes and volume options, by class: each is one error line
+// naming the file or option and the field, a non-zero exit within the time limit, nothing written.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "tests/test_util.h"
+
+namespace isowall {
+namespace {
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct RunOutcome {
+    int exit_code = -1;
+    std::string err;
+};
+
+// The real binary under `timeout`: a hang fails the case (exit 124) instead of the suite.
+RunOutcome run_isowall(const std::filesystem::path& dir, const std::string& args) {
+    const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+    const std::string cmd = "cd '" + dir.string() + "' && timeout 60 '" +
+                            std::string(ISOWALL_BINARY) + "' " + args + " > '" + out.string() +
+                            "' 2> '" + err.string() + "'";
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+}
+
+void write_bytes(const std::filesystem::path& p, const std::string& bytes) {
+    std::ofstream(p, std::ios::binary) << bytes;
+}
+
+std::string floats(std::initializer_list<float> values, std::size_t count) {
+    std::string out;
+    for (std::size_t i = 0; i < count; ++i) {
+        const float v = *(values.begin() + i % values.size());
+        out.append(reinterpret_cast<const char*>(&v), sizeof v);
+    }
+    return out;
+}
+
+struct CliCase {
+    const char* args;
+    std::vector<std::string> mentions;
+};
+
+TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
+    const auto dir = test::scratch_dir("cli_volume");
+    const std::string u8 = "NRRD0004\ntype: uchar\ndimension: 3\n";
+    write_bytes(dir / "ok.raw", std::string(64, '\x01'));
+    write_bytes(dir / "wrap.nhdr",
+                u8 + "sizes: 4294967300 4 4\nencoding: raw\ndata file: ok.raw\n");
+    write_bytes(dir / "ascii.nrrd",
+                u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '1'));
+    write_bytes(dir / "nul.nrrd",
+                u8 + "sizes: 4 4 4\nencoding: ascii\n\n" + std::string(100000, '\0'));
+    write_bytes(dir / "zero.nhdr",
+                u8 + "sizes: 4 4 4\nencoding: raw\nline skip: 1\ndata file: /dev/zero\n");
+    write_bytes(dir / "nan.raw", floats({NAN, INFINITY, -INFINITY}, 64));
+    const CliCase cases[] = {
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes -8",
+         {"--header-bytes", "\"-8\""}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 1.5", {"--header-bytes", "1.5"}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 99999999999999999999",
+         {"--header-bytes"}},
+        {"info -v ok.raw --dims 4 4 4 --type uint8 --header-bytes 18446744073709551615",
+         {"ok.raw", "size", "shorter"}},
+        {"info -v wrap.nhdr", {"wrap.nhdr", "sizes", "4294967300"}},
+        {"info -v ascii.nrrd", {"ascii.nrrd", "data", "64 characters"}},
+        {"info -v nul.nrrd", {"nul.nrrd", "data", "\\x00"}},
+        {"info -v zero.nhdr", {"zero.nhdr", "data file", "/dev/zero", "character device"}},
+        {"extract -v nan.raw --dims 4 4 4 --type float32 --iso 0 --out s.ply",
+         {"nan.raw", "data", "no finite voxel"}},
+    };
+    for (const CliCase& c : cases) {
+        SCOPED_TRACE(c.args);
+        const RunOutcome r = run_isowall(dir, c.args);
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_NE(r.exit_code, 124) << "timed out";
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_EQ(r.err.rfind("isowall: error: ", 0), 0u) << r.err;
+        EXPECT_LT(r.err.size(), 400u) << r.err;
+        for (const auto& m : c.mentions)
+            EXPECT_NE(r.err.find(m), std::string::npos) << "missing \"" << m << "\" in: " << r.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "s.ply"));
+}
+
+}  // namespace
+}  // namespace isowall
