@@ -34,12 +34,14 @@ for h in "${HARNESSES[@]}"; do
     mkdir -p "$work" "$findings"
     seeds=(fuzz/corpus/"$h")
     [ -d fuzz/regressions/"$h" ] && seeds+=(fuzz/regressions/"$h")
+    dict=()
+    [ -f fuzz/"$h".dict ] && dict=(-dict=fuzz/"$h".dict)
     echo "fuzz: $h for ${SECONDS_EACH}s"
     # The NRRD loader's known crash classes are fixed on another branch (fuzz/fuzz_nrrd.cpp).
     if ! ISOWALL_FUZZ_NRRD_SKIP_KNOWN=1 ASAN_OPTIONS=detect_leaks=1 \
         UBSAN_OPTIONS=print_stacktrace=1 "$BUILD/fuzz/fuzz_$h" "$work" "${seeds[@]}" \
         -max_total_time="$SECONDS_EACH" -timeout=5 -rss_limit_mb=2048 \
-        -malloc_limit_mb="$(malloc_limit_mb "$h")" -dict=fuzz/"$h".dict \
+        -malloc_limit_mb="$(malloc_limit_mb "$h")" "${dict[@]}" \
         -artifact_prefix="$findings/" -print_final_stats=1 > "$findings/log.txt" 2>&1; then
         failed+=("$h")
         tail -n 40 "$findings/log.txt"
