@@ -4,6 +4,7 @@
 // is caught as a broken property even without UBSan), at least one tile is enabled, and for a
 // wall small enough to walk, ranks and tiles map one to one.
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -49,6 +50,20 @@ void check_sizes(const isowall::WallSpec& s) {
     check(screen.width == width && screen.height == height, "virtual_screen_size");
 }
 
+// Bezels given in mm are the nearest pixels at the tile's pitch.
+void check_bezel_mm(const isowall::WallSpec& s) {
+    if (!s.physical) return;
+    const isowall::BezelsMm& mm = s.physical->bezel_mm;
+    if (mm.left == 0 && mm.right == 0 && mm.top == 0 && mm.bottom == 0) return;  // bezel_px
+    const double pitch_x = s.physical->tile_width_mm / s.tile_width_px;
+    const double pitch_y = s.physical->tile_height_mm / s.tile_height_px;
+    auto near = [](int px, double v) { return std::isfinite(v) && std::abs(px - v) <= 0.5001; };
+    const isowall::Bezels& b = s.bezel_px;
+    check(near(b.left, mm.left / pitch_x) && near(b.right, mm.right / pitch_x) &&
+              near(b.top, mm.top / pitch_y) && near(b.bottom, mm.bottom / pitch_y),
+          "bezel_px are bezel_mm at the tile's pixel pitch");
+}
+
 void check_ranks(const isowall::WallSpec& s) {
     const int ranks = isowall::rank_count(s);
     check(ranks >= 2 && ranks <= isowall::tile_count(s) + 1, "one master and 1..T tile ranks");
@@ -68,6 +83,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const isowall::WallSpec spec =
             isowall::parse_wall(isowall::fuzz::as_text(data, size), "fuzz.toml");
         check_sizes(spec);
+        check_bezel_mm(spec);
         check_ranks(spec);
     } catch (const isowall::InputError&) {
     }
