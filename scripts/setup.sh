@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(
-    build-essential cmake pkg-config clang-format
+    build-essential cmake pkg-config clang-format clang
     libglm-dev libteem-dev zlib1g-dev libbz2-dev libtomlplusplus-dev libcli11-dev
     libopenimageio-dev openimageio-tools
     libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev

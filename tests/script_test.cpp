@@ -55,6 +55,12 @@ TEST(Script, MistakesNameTheFileLineAndCommand) {
         {"fly 1 2", "s.txt:1: command: unknown command \"fly\""},
         {"quit now", "s.txt:1: quit: expected \"quit\""},
         {"orbit 1 nan", "s.txt:1: orbit: expected a number"},
+        // Found by fuzz/fuzz_script.cpp: numbers that are finite as doubles but not as floats,
+        // and names that are not file names.
+        {"look-at 0 0 0 1e300 0 0", "s.txt:1: look-at: expected a number within float range"},
+        {"pan 0 -1e39", "s.txt:1: pan: expected a number within float range"},
+        {"zoom 1e-50", "s.txt:1: zoom: expected a positive factor, got 1e-50"},
+        {"snapshot a\x01", "s.txt:1: snapshot: expected a plain name"},
     };
     for (const Case& c : cases) {
         try {

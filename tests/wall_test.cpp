@@ -340,6 +340,23 @@ TEST(Wall, MalformedInputNamesFileAndField) {
          "every tile is disabled"},
         {"syntax error", "tiles = [2, 2]\ntile_size_px = [1024, 768\n", "line 2, column",
          "TOML syntax"},
+        // Found by fuzz/fuzz_wall.cpp, or written beside it: walls whose numbers parse but whose
+        // geometry would not fit an image message or an int.
+        {"tile past a message", "tiles = [4, 4]\ntile_size_px = [1399, 101050]\n", "tile_size_px",
+         "in [1, 32768], got [1399, 101050]"},
+        {"screen past an int", "tiles = [100000, 1]\ntile_size_px = [32768, 1]\n", "tiles",
+         "got 3276800000x1"},
+        {"bezels past an int", "tiles = [2000, 1]\n" + size + "bezel_px = 1000000\n", "tiles",
+         "virtual screen of at most 1073741824"},
+        {"bezel_mm past an int",
+         "tiles = [2, 2]\n" + size + "[physical]\ntile_size_mm = [400, 300]\nbezel_mm = 1e300\n",
+         "physical.bezel_mm", "at most a million pixels"},
+        {"tiny pitch",
+         "tiles = [2, 2]\n" + size + "[physical]\ntile_size_mm = [1e-320, 300]\nbezel_mm = 1\n",
+         "physical.bezel_mm", "at most a million pixels"},
+        {"offset past a million",
+         "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\noffset_px = [2147483647, 0]\n",
+         "tile[0].offset_px", "got [2147483647, 0]"},
     };
     for (const BadWall& c : cases) {
         try {

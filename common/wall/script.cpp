@@ -1,6 +1,7 @@
 #include "common/wall/script.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "common/core/error.h"
@@ -28,6 +29,23 @@ double number(const std::string& word, const std::string& where, const std::stri
     return v;
 }
 
+// Camera commands hold floats: a double beyond float range would become an infinite float (found
+// by fuzz/fuzz_script.cpp), so the range is checked before the cast.
+float float_number(const std::string& word, const std::string& where, const std::string& command) {
+    const double v = number(word, where, command);
+    if (std::abs(v) > std::numeric_limits<float>::max())
+        throw InputError(where, command, "expected a number within float range, got " + word);
+    return static_cast<float>(v);
+}
+
+// A snapshot name becomes a file name: no folders, and no control characters (a NUL would cut
+// the name short, so the snapshot would land in another file).
+bool plain_name(const std::string& name) {
+    for (const char ch : name)
+        if (ch == '/' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) return false;
+    return true;
+}
+
 void expect_args(const std::vector<std::string>& w, std::size_t n, const std::string& where,
                  const std::string& usage) {
     if (w.size() != n + 1)
@@ -43,24 +61,25 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     if (w.empty()) throw InputError(where, "command", "empty command");
     const std::string& c = w[0];
     auto num = [&](std::size_t i) { return number(w[i], where, c); };
+    auto fnum = [&](std::size_t i) { return float_number(w[i], where, c); };
     if (c == "orbit") {
         expect_args(w, 2, where, "orbit YAW PITCH");
-        return OrbitCmd{float(num(1)), float(num(2))};
+        return OrbitCmd{fnum(1), fnum(2)};
     }
     if (c == "look-at") {
         expect_args(w, 6, where, "look-at EX EY EZ TX TY TZ");
-        return LookAtCmd{{float(num(1)), float(num(2)), float(num(3))},
-                         {float(num(4)), float(num(5)), float(num(6))}};
+        return LookAtCmd{{fnum(1), fnum(2), fnum(3)}, {fnum(4), fnum(5), fnum(6)}};
     }
     if (c == "zoom") {
         expect_args(w, 1, where, "zoom F");
-        const double f = num(1);
-        if (f <= 0) throw InputError(where, c, "expected a positive factor, got " + w[1]);
-        return ZoomCmd{float(f)};
+        // A factor below float's smallest would be zero as a float.
+        const float f = fnum(1);
+        if (!(f > 0)) throw InputError(where, c, "expected a positive factor, got " + w[1]);
+        return ZoomCmd{f};
     }
     if (c == "pan") {
         expect_args(w, 2, where, "pan DX DY");
-        return PanCmd{float(num(1)), float(num(2))};
+        return PanCmd{fnum(1), fnum(2)};
     }
     if (c == "iso") {
         expect_args(w, 1, where, "iso V");
@@ -78,7 +97,7 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     }
     if (c == "snapshot") {
         expect_args(w, 1, where, "snapshot NAME");
-        if (w[1].find('/') != std::string::npos)
+        if (!plain_name(w[1]))
             throw InputError(where, c, "expected a plain name, got \"" + w[1] + "\"");
         return SnapshotCmd{w[1]};
     }

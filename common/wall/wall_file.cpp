@@ -17,6 +17,16 @@
 namespace isowall {
 namespace {
 
+// A tile's image travels to the master in one message, whose sides are at most 32768 pixels
+// (kMaxImageSide in comm/protocol.h, which common/ does not see): a larger tile would fail only
+// at its first frame, with a wire error.
+constexpr long long kMaxTileSide = 32768;
+// Bezels, overlaps and tile offsets, in pixels either way.
+constexpr long long kMaxBezelPx = 1'000'000;
+// Each side of the virtual screen is computed in int (wall_geometry.cpp), offsets added: 2^30
+// leaves room for them.
+constexpr long long kMaxScreenSide = 1LL << 30;
+
 // A TOML value as the user wrote it, for "got ..." in error messages (toml++'s own printer
 // pads arrays as "[ 6, 0 ]" and can span lines).
 std::string describe(const toml::node& node) {
@@ -72,8 +82,8 @@ class Reader {
         return *n;
     }
 
-    // `count` integers, each at least `min`.
-    std::vector<int> ints(std::string_view key, size_t count, long long min,
+    // `count` integers, each in [min, max].
+    std::vector<int> ints(std::string_view key, size_t count, long long min, long long max,
                           const std::string& expected) const {
         const toml::node& n = require(key, expected);
         const auto* a = n.as_array();
@@ -81,7 +91,7 @@ class Reader {
         if (a && a->size() == count)
             for (const toml::node& e : *a) {
                 const auto* i = e.as_integer();
-                if (!i || i->get() < min || i->get() > std::numeric_limits<int>::max()) break;
+                if (!i || i->get() < min || i->get() > max) break;
                 out.push_back(static_cast<int>(i->get()));
             }
         if (out.size() != count) fail(key, "expected " + expected + ", got " + describe(n));
@@ -131,7 +141,7 @@ void read_bezels(const Reader& r, std::string_view key, T& left, T& right, T& to
     auto value = [&](const toml::node& v) -> std::optional<T> {
         if (integer) {
             const auto* i = v.as_integer();
-            if (!i || std::abs(i->get()) > 1'000'000) return std::nullopt;
+            if (!i || std::abs(i->get()) > kMaxBezelPx) return std::nullopt;
             return static_cast<T>(i->get());
         }
         const auto d = Reader::number(v);
@@ -188,10 +198,17 @@ PhysicalSize read_physical(const Reader& top, WallSpec& spec) {
         // the wall's true proportions and lines stay straight across the mullions.
         const double pitch_x = p.tile_width_mm / spec.tile_width_px;
         const double pitch_y = p.tile_height_mm / spec.tile_height_px;
-        spec.bezel_px = {static_cast<int>(std::lround(b.left / pitch_x)),
-                         static_cast<int>(std::lround(b.right / pitch_x)),
-                         static_cast<int>(std::lround(b.top / pitch_y)),
-                         static_cast<int>(std::lround(b.bottom / pitch_y))};
+        // Checked before the rounding: a bezel of 1e300 mm (or a pitch of almost 0) is no int.
+        auto px = [&](double mm, double pitch) {
+            const double v = mm / pitch;
+            if (!(std::abs(v) <= kMaxBezelPx))
+                r.fail("bezel_mm", "expected bezels of at most a million pixels either way, got " +
+                                       describe(*r.find("bezel_mm")) + " mm at " +
+                                       std::to_string(pitch) + " mm per pixel");
+            return static_cast<int>(std::lround(v));
+        };
+        spec.bezel_px = {px(b.left, pitch_x), px(b.right, pitch_x), px(b.top, pitch_y),
+                         px(b.bottom, pitch_y)};
     }
     if (r.find("viewer_mm")) {
         const auto v = r.numbers("viewer_mm", 3, false, "three numbers (x, y, z) with z > 0");
@@ -228,7 +245,8 @@ void read_overrides(const Reader& top, WallSpec& spec) {
             o.disabled = b->get();
         }
         if (r.find("offset_px")) {
-            const auto off = r.ints("offset_px", 2, -1'000'000, "two integers (x right, y down)");
+            const auto off = r.ints("offset_px", 2, -kMaxBezelPx, kMaxBezelPx,
+                                    "two integers (x right, y down) of at most a million");
             o.offset_x_px = off[0];
             o.offset_y_px = off[1];
         }
@@ -239,6 +257,20 @@ void read_overrides(const Reader& top, WallSpec& spec) {
         spec.overrides.push_back(o);
     }
     if (rank_count(spec) == 1) top.fail("tile", "every tile is disabled; expected at least one");
+}
+
+// The virtual screen's sides, computed here in 64 bits, must fit the int geometry of
+// wall_geometry.cpp: a million tiles of 32768 pixels would overflow it.
+void check_screen_size(const Reader& r, const WallSpec& spec) {
+    const Bezels& b = spec.bezel_px;
+    const long long width = static_cast<long long>(spec.columns) * spec.tile_width_px +
+                            (spec.columns - 1LL) * (static_cast<long long>(b.left) + b.right);
+    const long long height = static_cast<long long>(spec.rows) * spec.tile_height_px +
+                             (spec.rows - 1LL) * (static_cast<long long>(b.top) + b.bottom);
+    if (width > kMaxScreenSide || height > kMaxScreenSide)
+        r.fail("tiles", "expected a virtual screen of at most " + std::to_string(kMaxScreenSide) +
+                            " pixels a side, got " + std::to_string(width) + "x" +
+                            std::to_string(height));
 }
 
 }  // namespace
@@ -271,12 +303,14 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
     r.check_keys({"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile"});
 
     WallSpec spec;
-    const auto tiles = r.ints("tiles", 2, 1, "two positive integers (columns, rows)");
+    const auto tiles = r.ints("tiles", 2, 1, std::numeric_limits<int>::max(),
+                              "two positive integers (columns, rows)");
     spec.columns = tiles[0];
     spec.rows = tiles[1];
     if (static_cast<long long>(spec.columns) * spec.rows > 1'000'000)
         r.fail("tiles", "expected at most a million tiles, got " + describe(*r.find("tiles")));
-    const auto size = r.ints("tile_size_px", 2, 1, "two positive integers (width, height)");
+    const auto size =
+        r.ints("tile_size_px", 2, 1, kMaxTileSide, "two integers (width, height) in [1, 32768]");
     spec.tile_width_px = size[0];
     spec.tile_height_px = size[1];
     Bezels& b = spec.bezel_px;
@@ -297,6 +331,7 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
             "expected vertical overlap (-(top + bottom) = " + std::to_string(-(b.top + b.bottom)) +
                 " px) less than the tile height " + std::to_string(spec.tile_height_px));
 
+    check_screen_size(r, spec);
     if (r.find("tile")) read_overrides(r, spec);
     return spec;
 }
