@@ -59,7 +59,8 @@ std::string expected_line(const Fault& f) {
 
 // The processes of a run: its folder is in every rank's command line.
 bool any_process_of(const std::filesystem::path& dir) {
-    const std::string cmd = "pgrep -f '[w]all --wall " + (dir / "2x2.toml").string() + "' >/dev/null";
+    const std::string cmd =
+        "pgrep -f '[w]all --wall " + (dir / "2x2.toml").string() + "' >/dev/null";
     return std::system(cmd.c_str()) == 0;
 }
 
