@@ -42,9 +42,9 @@ void check_outputs(const std::vector<OutputPath>& outputs) {
         check_output(outputs[i].path, outputs[i].option);
         for (std::size_t k = 0; k < i; ++k)
             if (same_file_name(outputs[k].path, outputs[i].path))
-                throw InputError(outputs[i].path.string(), outputs[i].option,
-                                 "is also the file of " + outputs[k].option +
-                                     "; expected a file of its own");
+                throw InputError(
+                    outputs[i].path.string(), outputs[i].option,
+                    "is also the file of " + outputs[k].option + "; expected a file of its own");
     }
 }
 

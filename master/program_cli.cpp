@@ -148,12 +148,10 @@ ProgramCli::ProgramCli() {
     app.require_subcommand(1);
     app.set_version_flag("--version", "isowall 0.1.0");
 
-    info_cmd =
-        app.add_subcommand("info", "Print a volume's size, type, value range and octree");
+    info_cmd = app.add_subcommand("info", "Print a volume's size, type, value range and octree");
     add_volume_options(*info_cmd, info.volume);
 
-    ex_cmd =
-        app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
+    ex_cmd = app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
     add_volume_options(*ex_cmd, ex.volume);
     ex_cmd->add_option("--iso", ex.iso, "Isovalue (default for the phantom: skin, 50)")
         ->transform(number_in(limits::kAnyFinite));
@@ -163,7 +161,6 @@ ProgramCli::ProgramCli() {
     wall_cmd = add_wall_command(app, wall);
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");
-
 }
 
 }  // namespace isowall

@@ -31,7 +31,7 @@ TEST(CameraDegenerate, AnUpAlongTheViewIsReplacedAndEveryOperationStaysFinite) {
         looking(t - glm::vec3(0, 0, 50), t, {0, 0, 1}),   // straight up it
         looking(t + glm::vec3(0, 0, 50), t, {0, 0, -7}),  // any length
         looking(t + glm::vec3(50, 0, 0), t, {1, 0, 0}),
-        looking(t + glm::vec3(0, 50, 0), t, {0, 0, 0}),  // no up at all
+        looking(t + glm::vec3(0, 50, 0), t, {0, 0, 0}),      // no up at all
         looking(t + glm::vec3(0, 0, 50), t, {1e-6f, 0, 1}),  // within rounding of parallel
     };
     for (const Camera& c : cases) {

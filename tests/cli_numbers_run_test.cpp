@@ -23,9 +23,9 @@ TEST(CliNumbers, TheCameraRefusesADegenerateZoom) {
                           {"--zoom", "apart"});
     EXPECT_TRUE(files_in(dir).empty());
     // An orbit far past one turn is the same view as its remainder.
-    ASSERT_EQ(run_isowall(dir, "render --size 64x48 -q --no-measure --orbit 720.5 0 -o a.png")
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        run_isowall(dir, "render --size 64x48 -q --no-measure --orbit 720.5 0 -o a.png").exit_code,
+        0);
     ASSERT_EQ(
         run_isowall(dir, "render --size 64x48 -q --no-measure --orbit 0.5 0 -o b.png").exit_code,
         0);
@@ -37,7 +37,7 @@ TEST(CliNumbers, ErrorsAreOneBoundedLine) {
     const std::string huge(100000, '9');  // under the kernel's 128 KiB per argument
     for (const std::string& args : std::vector<std::string>{
              "render --size " + huge, "render --order " + huge, "render --zoom " + huge,
-          "render --" + huge, "render --size \"$(printf '64x48\\n\\033[2J')\""}) {
+             "render --" + huge, "render --size \"$(printf '64x48\\n\\033[2J')\""}) {
         const auto e = run_isowall(dir, args);
         expect_one_line_error(e, {});
         EXPECT_LT(e.err.size(), 1000u) << args.substr(0, 40);

@@ -80,10 +80,11 @@ TEST(CliNumbers, EveryNumberOptionRefusesNonFiniteAndOutOfRangeValues) {
     }
     EXPECT_GT(tried, 200);
     // The good values of the same slots parse.
-    for (const char* ok : {"render --zoom 1e-6", "render --zoom 1e6", "render --orbit -1e6 1e6",
-                           "render --snapshots 0.001,100", "render --snapshot-rays 0,1e15",
-                           "wall --wall w.toml --pan -1000 1000", "wall --wall w.toml --threads 1024",
-                           "render --cutoff-angle 180 --foldback-tolerance 0"})
+    for (const char* ok :
+         {"render --zoom 1e-6", "render --zoom 1e6", "render --orbit -1e6 1e6",
+          "render --snapshots 0.001,100", "render --snapshot-rays 0,1e15",
+          "wall --wall w.toml --pan -1000 1000", "wall --wall w.toml --threads 1024",
+          "render --cutoff-angle 180 --foldback-tolerance 0"})
         EXPECT_EQ(parse_error(ok), "") << ok;
 }
 

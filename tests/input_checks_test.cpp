@@ -67,12 +67,12 @@ TEST(Quote, InputErrorBoundsEveryPartWhoeverBuiltIt) {
 }
 
 TEST(Numbers, ParseRefusesEverythingButOneFiniteNumber) {
-    for (const char* bad : {"", "+", "-", "nan", "NaN", "-nan", "inf", "-inf", "+inf", "infinity",
-                            "1e999", "-1e999", "0x10", "5abc", " 5", "5 ", "+-5", "--5", "1,5",
-                            "1e", ".", "1..2", "five", "\t1"})
+    for (const char* bad : {"",     "+",        "-",     "nan",    "NaN",  "-nan", "inf",  "-inf",
+                            "+inf", "infinity", "1e999", "-1e999", "0x10", "5abc", " 5",   "5 ",
+                            "+-5",  "--5",      "1,5",   "1e",     ".",    "1..2", "five", "\t1"})
         EXPECT_FALSE(parse_number(bad).has_value()) << '"' << bad << '"';
     const std::vector<std::pair<const char*, double>> good = {
-        {"0", 0},   {"-0", 0},       {"+5", 5},     {"1e3", 1000},   {"2.5", 2.5},
+        {"0", 0},    {"-0", 0},        {"+5", 5},   {"1e3", 1000},    {"2.5", 2.5},
         {".5", 0.5}, {"-1e-3", -1e-3}, {"010", 10}, {"1e300", 1e300}, {"007.50", 7.5}};
     for (const auto& [text, value] : good) {
         ASSERT_TRUE(parse_number(text).has_value()) << text;
@@ -85,12 +85,18 @@ TEST(Numbers, EveryRangeRefusesNonFiniteAndOutOfRange) {
         const char* name;
         NumberRange range;
     };
-    const Named ranges[] = {{"any", limits::kAnyFinite},   {"angle", limits::kAngleDeg},
-                            {"zoom", limits::kZoom},       {"pan", limits::kPan},
-                            {"coord", limits::kCoordinate}, {"percent", limits::kPercent},
-                            {"seconds", limits::kSeconds}, {"wait", limits::kWaitSeconds},
-                            {"rays", limits::kRayCount},   {"cutoff", limits::kCutoffDeg},
-                            {"foldback", limits::kFoldbackDeg}, {"cells", limits::kCellCount}};
+    const Named ranges[] = {{"any", limits::kAnyFinite},
+                            {"angle", limits::kAngleDeg},
+                            {"zoom", limits::kZoom},
+                            {"pan", limits::kPan},
+                            {"coord", limits::kCoordinate},
+                            {"percent", limits::kPercent},
+                            {"seconds", limits::kSeconds},
+                            {"wait", limits::kWaitSeconds},
+                            {"rays", limits::kRayCount},
+                            {"cutoff", limits::kCutoffDeg},
+                            {"foldback", limits::kFoldbackDeg},
+                            {"cells", limits::kCellCount}};
     int tried = 0;
     for (const Named& n : ranges) {
         for (const char* bad : {"nan", "inf", "-inf", "1e999", "", "x"}) {
@@ -125,8 +131,9 @@ TEST(Numbers, CheckedNumberNamesSourceAndField) {
         checked_number("1e-300", limits::kZoom, "demo.txt:3", "zoom");
         ADD_FAILURE() << "accepted";
     } catch (const InputError& e) {
-        EXPECT_STREQ(e.what(), "demo.txt:3: zoom: expected a number in [1e-06, 1e+06], got "
-                               "\"1e-300\"");
+        EXPECT_STREQ(e.what(),
+                     "demo.txt:3: zoom: expected a number in [1e-06, 1e+06], got "
+                     "\"1e-300\"");
     }
 }
 

@@ -56,8 +56,9 @@ TEST(OutputFiles, EveryUnwritableTargetIsNamedBeforeAnyWork) {
         check_output(dir / "folder", "--timeline");
         ADD_FAILURE() << "accepted a folder";
     } catch (const InputError& e) {
-        EXPECT_EQ(std::string(e.what()), (dir / "folder").string() + ": --timeline: is a folder; "
-                                                                     "expected a file name");
+        EXPECT_EQ(std::string(e.what()), (dir / "folder").string() +
+                                             ": --timeline: is a folder; "
+                                             "expected a file name");
     }
 }
 

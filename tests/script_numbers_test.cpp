@@ -12,11 +12,20 @@ namespace isowall {
 namespace {
 
 // Each numeric slot of each command, as a line with {} where the value goes.
-const std::vector<std::string> kSlots = {
-    "orbit {} 0",         "orbit 0 {}",         "look-at {} 0 0 1 1 1", "look-at 0 {} 0 1 1 1",
-    "look-at 0 0 {} 1 1 1", "look-at 0 0 0 {} 1 1", "look-at 0 0 0 1 {} 1", "look-at 0 0 0 1 1 {}",
-    "zoom {}",            "pan {} 0",           "pan 0 {}",             "iso {}",
-    "wait rays {}",       "wait time {}"};
+const std::vector<std::string> kSlots = {"orbit {} 0",
+                                         "orbit 0 {}",
+                                         "look-at {} 0 0 1 1 1",
+                                         "look-at 0 {} 0 1 1 1",
+                                         "look-at 0 0 {} 1 1 1",
+                                         "look-at 0 0 0 {} 1 1",
+                                         "look-at 0 0 0 1 {} 1",
+                                         "look-at 0 0 0 1 1 {}",
+                                         "zoom {}",
+                                         "pan {} 0",
+                                         "pan 0 {}",
+                                         "iso {}",
+                                         "wait rays {}",
+                                         "wait time {}"};
 
 std::string fill(const std::string& slot, const std::string& value) {
     std::string line = slot;
@@ -36,8 +45,8 @@ std::string error_of(const std::string& line) {
 TEST(ScriptNumbers, NoSlotTakesANonNumber) {
     int tried = 0;
     for (const std::string& slot : kSlots)
-        for (const char* bad : {"nan", "-nan", "NaN", "inf", "-inf", "infinity", "1e999",
-                                "-1e999", "0x10", "5abc", "1e", "--1", "+-1", "1,5"}) {
+        for (const char* bad : {"nan", "-nan", "NaN", "inf", "-inf", "infinity", "1e999", "-1e999",
+                                "0x10", "5abc", "1e", "--1", "+-1", "1,5"}) {
             const std::string line = fill(slot, bad);
             const std::string command = line.substr(0, line.find(' '));
             const std::string e = error_of(line);
@@ -54,17 +63,36 @@ TEST(ScriptNumbers, EverySlotHasARange) {
         bool ok;
     };
     const std::vector<Case> cases = {
-        {"orbit 1e300 0", false},      {"orbit 0 -1e300", false},     {"orbit 1000001 0", false},
-        {"orbit 1e6 -1e6", true},      {"look-at 1e300 0 0 1 1 1", false},
-        {"look-at 0 0 0 1 1 2e6", false}, {"look-at 0 0 0 0 0 0", false},
-        {"look-at 5 5 5 5 5 5", false}, {"look-at 1000 0 0 1000.01 0 0", false},
-        {"look-at 0 0 0 0 0 1", true}, {"zoom 0", false},             {"zoom -2", false},
-        {"zoom 1e-300", false},        {"zoom 1e300", false},         {"zoom 1e-7", false},
-        {"zoom 1e7", false},           {"zoom 1e-6", true},           {"zoom 1e6", true},
-        {"pan 1001 0", false},         {"pan 0 -1e300", false},       {"pan -1000 1000", true},
-        {"iso 1e300", true},           {"iso -1e300", true},          {"wait rays -5", false},
-        {"wait rays 2.5", false},      {"wait rays 1e300", false},    {"wait rays 1e15", true},
-        {"wait time -1", false},       {"wait time 1e300", false},    {"wait time 0", true},
+        {"orbit 1e300 0", false},
+        {"orbit 0 -1e300", false},
+        {"orbit 1000001 0", false},
+        {"orbit 1e6 -1e6", true},
+        {"look-at 1e300 0 0 1 1 1", false},
+        {"look-at 0 0 0 1 1 2e6", false},
+        {"look-at 0 0 0 0 0 0", false},
+        {"look-at 5 5 5 5 5 5", false},
+        {"look-at 1000 0 0 1000.01 0 0", false},
+        {"look-at 0 0 0 0 0 1", true},
+        {"zoom 0", false},
+        {"zoom -2", false},
+        {"zoom 1e-300", false},
+        {"zoom 1e300", false},
+        {"zoom 1e-7", false},
+        {"zoom 1e7", false},
+        {"zoom 1e-6", true},
+        {"zoom 1e6", true},
+        {"pan 1001 0", false},
+        {"pan 0 -1e300", false},
+        {"pan -1000 1000", true},
+        {"iso 1e300", true},
+        {"iso -1e300", true},
+        {"wait rays -5", false},
+        {"wait rays 2.5", false},
+        {"wait rays 1e300", false},
+        {"wait rays 1e15", true},
+        {"wait time -1", false},
+        {"wait time 1e300", false},
+        {"wait time 0", true},
     };
     for (const Case& c : cases) {
         const std::string e = error_of(c.line);

@@ -42,8 +42,8 @@ TEST(WallNumbers, NoFieldTakesNonFiniteOrHugeValues) {
     int tried = 0;
     for (const Slot& s : kSlots)
         for (const char* bad : {"nan", "+nan", "-nan", "inf", "+inf", "-inf", "1e300", "-1e300",
-                                "9223372036854775807", "-9223372036854775808", "2147483648",
-                                "1e8", "\"5\"", "true"}) {
+                                "9223372036854775807", "-9223372036854775808", "2147483648", "1e8",
+                                "\"5\"", "true"}) {
             const std::string text = fill(s.text, bad);
             try {
                 const WallSpec w = parse_wall(text, "bad.toml");
@@ -113,9 +113,9 @@ TEST(WallNumbers, AWallFileMustBeARegularFile) {
         std::filesystem::path path;
         const char* mentions;
     };
-    for (const Case& c : {Case{dir / "folder.toml", "is a folder"},
-                          Case{"/dev/zero", "not a regular file"},
-                          Case{dir / "huge.toml", "expected at most"}}) {
+    for (const Case& c :
+         {Case{dir / "folder.toml", "is a folder"}, Case{"/dev/zero", "not a regular file"},
+          Case{dir / "huge.toml", "expected at most"}}) {
         try {
             load_wall(c.path);
             ADD_FAILURE() << "accepted " << c.path;

@@ -20,9 +20,9 @@ std::string read_input_file(const std::filesystem::path& path, const std::string
         throw InputError(where, field, "is not a regular file (a device, pipe or socket)");
     const auto size = fs::file_size(path, ec);
     if (!ec && size > max_bytes)
-        throw InputError(where, field,
-                         "is " + std::to_string(size) + " bytes; expected at most " +
-                             std::to_string(max_bytes));
+        throw InputError(
+            where, field,
+            "is " + std::to_string(size) + " bytes; expected at most " + std::to_string(max_bytes));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(where, field, "cannot be opened");
     std::string text;

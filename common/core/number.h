@@ -26,11 +26,11 @@ inline constexpr NumberRange kAnyFinite{-kMaxFinite, kMaxFinite};
 // Orbit angles are reduced modulo 360; past a million degrees a float has lost the fraction.
 inline constexpr NumberRange kAngleDeg{-1e6, 1e6};
 inline constexpr NumberRange kZoom{1e-6, 1e6};
-inline constexpr NumberRange kPan{-1e3, 1e3};          // screen widths / heights
-inline constexpr NumberRange kCoordinate{-1e6, 1e6};   // look-at eye and target, object units
-inline constexpr NumberRange kPercent{0, 100, true};   // --snapshots
-inline constexpr NumberRange kSeconds{0, 1e6, true};   // timeouts, `wait time`
-inline constexpr NumberRange kWaitSeconds{0, 1e6};     // `wait time`
+inline constexpr NumberRange kPan{-1e3, 1e3};         // screen widths / heights
+inline constexpr NumberRange kCoordinate{-1e6, 1e6};  // look-at eye and target, object units
+inline constexpr NumberRange kPercent{0, 100, true};  // --snapshots
+inline constexpr NumberRange kSeconds{0, 1e6, true};  // --timeout, --startup-timeout
+inline constexpr NumberRange kWaitSeconds{0, 1e6};    // `wait time`
 inline constexpr NumberRange kRayCount{0, 9007199254740992.0, false, true};  // 2^53
 inline constexpr NumberRange kCutoffDeg{0, 180, true};
 inline constexpr NumberRange kFoldbackDeg{0, 180};
