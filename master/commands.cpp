@@ -123,6 +123,10 @@ void check_render_outputs(const RenderOptions& o) {
     for (std::size_t rays : o.snapshot_rays)
         outputs.push_back({"--snapshot-rays", rays_snapshot(o, rays)});
     check_outputs(outputs);
+    for (const OutputPath& p : outputs)
+        if (p.option != "--timeline")
+            if (std::string problem = image_format_problem(p.path); !problem.empty())
+                throw InputError(p.path.string(), p.option, problem);
 }
 
 // The view of `render`: the front full view, turned and zoomed; InputError naming the option

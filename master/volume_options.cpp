@@ -21,7 +21,7 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "Raw voxel type: uint8 int8 uint16 int16 uint32 int32 float32 float64");
     app.add_option("--spacing", o.spacing, "Raw voxel spacing: SX SY SZ (default 1 1 1)")
         ->expected(3)
-        ->transform(number_in({0, 1e6, true}));
+        ->transform(number_in({1e-6, 1e6}));
     app.add_option("--endian", o.endian, "Raw byte order: little or big")
         ->check(CLI::IsMember({"little", "big"}));
     app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file")

@@ -28,7 +28,7 @@ const std::vector<Slot> kSlots = {
     {"render --adaptive-max-level {}", "--adaptive-max-level", {"0", "4", "-5", "2.5"}},
     {"render --snapshots 90,{}", "--snapshots", {"0", "-5", "100.5", "1e300"}},
     {"render --snapshot-rays 100,{}", "--snapshot-rays", {"-5", "2.5", "1e16", "1e300"}},
-    {"render --spacing 1 {} 1", "--spacing", {"0", "-5", "1e300"}},
+    {"render --spacing 1 {} 1", "--spacing", {"0", "-5", "1e300", "1e-300"}},
     {"render --dims 4 {} 4", "--dims", {"0", "-5", "2.5", "2147483648"}},
     {"render --header-bytes {}", "--header-bytes", {"-5", "2.5", "1e300"}},
     {"extract --iso {} --out s.ply", "--iso", {}},

@@ -92,8 +92,15 @@ TEST(CliOutputs, EveryUnwritableOutputIsNamedBeforeAnyWorkAndLeavesNothing) {
     EXPECT_EQ(tried, 4 * 4 + 2 * 2);
 }
 
-TEST(CliOutputs, TwoOptionsNamingOneFileAreRefused) {
+TEST(CliOutputs, CollidingOrFormatlessOutputsAreRefused) {
     const auto dir = test::scratch_dir("cli_outputs_twice");
+    // The image format is checked with the paths: this failed only after the whole render.
+    for (const char* args : {"render --size 64x48 --out a.nosuchext",
+                             "render --size 64x48 --out a.png --depth-out d.nosuchext"}) {
+        const auto r = run_isowall(dir, args);
+        expect_one_line_error(r, {"nosuchext", "no image format"});
+        EXPECT_EQ(r.out, "") << "work started before the check";
+    }
     expect_one_line_error(run_isowall(dir, "render --size 64x48 --out a.png --depth-out ./a.png"),
                           {"--depth-out", "--out"});
     expect_one_line_error(run_isowall(dir, "render --size 64x48 --out a.png --timeline a.png"),

@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "common/core/error.h"
 #include "common/core/output_files.h"
 
 namespace isowall {
@@ -71,6 +72,13 @@ void encode_depth(const std::filesystem::path& path, const std::filesystem::path
 }
 
 }  // namespace
+
+std::string image_format_problem(const std::filesystem::path& path) {
+    if (OIIO::ImageOutput::create(path.string())) return {};
+    OIIO::geterror();  // clear OIIO's pending message
+    return "no image format for the extension " + quote(path.extension().string()) +
+           " (e.g. .png, .tif, .exr)";
+}
 
 void write_image(const std::filesystem::path& path, const Image& image) {
     write_output(path, [&](const std::filesystem::path& t) { encode_image(path, t, image); });
