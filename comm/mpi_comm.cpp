@@ -77,10 +77,10 @@ std::string who_before_init() {
     return std::string("rank ") + (rank ? rank : "?") + " (host " + host + ")";
 }
 
-// Tiles wait a little longer than the master, and each a little longer than the one before (up
-// to 4 s), so that one rank names the stall, the master when it can, before mpirun ends the rest.
+// Tiles wait a little longer than the master, and each a second longer than the one before (up
+// to 8 s), so that one rank names the stall, the master when it can, before mpirun ends the rest.
 double watchdog_limit(double limit_s, int rank) {
-    return rank == 0 ? limit_s : limit_s + 2 + 0.5 * std::min(rank - 1, 8);
+    return rank == 0 ? limit_s : limit_s + 2 + 1.0 * std::min(rank - 1, 8);
 }
 
 int rank_before_init() {

@@ -11,6 +11,7 @@
 #include "common/io/image_io.h"
 #include "common/io/ply.h"
 #include "common/volume/phantom.h"
+#include "master/cli_checks.h"
 #include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 
@@ -92,15 +93,6 @@ Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
     return mesh;
 }
 
-// Output goes through a temporary name, so nothing half-written is left; check the folder first
-// so a typo fails before the expensive work.
-void check_output_path(const std::string& path, const char* option) {
-    if (path.empty()) throw InputError(option, "path", "an output file is required");
-    auto dir = std::filesystem::path(path).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw InputError(path, option, "folder " + dir.string() + " does not exist");
-}
-
 // "out/img.png" + "_c99" -> "out/img_c99.png"
 std::filesystem::path with_suffix(const std::string& path, const std::string& suffix) {
     std::filesystem::path p(path);
@@ -111,6 +103,43 @@ std::string percent_label(double pct) {
     char buf[32];
     std::snprintf(buf, sizeof(buf), "%g", pct);
     return buf;
+}
+
+std::filesystem::path percent_snapshot(const RenderOptions& o, double pct) {
+    return with_suffix(o.out, (o.snapshot_measure == "c" ? "_c" : "_final") + percent_label(pct));
+}
+
+std::filesystem::path rays_snapshot(const RenderOptions& o, std::size_t rays) {
+    return with_suffix(o.out, "_r" + std::to_string(rays));
+}
+
+// Every file `render` may write, checked before any work: a typo fails at once, and nothing is
+// written at all when one of them cannot be.
+void check_render_outputs(const RenderOptions& o) {
+    std::vector<OutputPath> outputs{{"--out", o.out}};
+    if (!o.depth_out.empty()) outputs.push_back({"--depth-out", o.depth_out});
+    if (!o.timeline.empty()) outputs.push_back({"--timeline", o.timeline});
+    for (double pct : o.snapshots) outputs.push_back({"--snapshots", percent_snapshot(o, pct)});
+    for (std::size_t rays : o.snapshot_rays)
+        outputs.push_back({"--snapshot-rays", rays_snapshot(o, rays)});
+    check_outputs(outputs);
+    for (const OutputPath& p : outputs)
+        if (p.option != "--timeline")
+            if (std::string problem = image_format_problem(p.path); !problem.empty())
+                throw InputError(p.path.string(), p.option, problem);
+}
+
+// The view of `render`: the front full view, turned and zoomed; InputError naming the option
+// when the result is degenerate (common/core/camera.h: camera_problem).
+Camera render_camera(const RenderOptions& o, const Box3& bounds, float aspect) {
+    const Projection proj =
+        o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
+    Camera cam = front_full_view(bounds, aspect, proj);
+    if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
+    cam = zoom(cam, float(o.zoom));
+    if (std::string p = camera_problem(cam); !p.empty())
+        throw InputError("--zoom", "value", "zoom " + percent_label(o.zoom) + ": " + p);
+    return fit_depth_range(cam, bounds);
 }
 
 EngineOptions engine_options(const RenderOptions& o) {
@@ -167,8 +196,29 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
     }
 }
 
+// The snapshots due at replayed sample `s`, staged in `batch`.
+void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Image& img,
+                     std::vector<bool>& c_done, std::vector<bool>& r_done, OutputFiles& batch) {
+    for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
+        const double m = o.snapshot_measure == "c" ? s.correctness.c : s.correctness.final_pixels;
+        if (c_done[k] || m < o.snapshots[k] / 100.0) continue;
+        c_done[k] = true;
+        const auto path = percent_snapshot(o, o.snapshots[k]);
+        write_image(batch, path, img);
+        std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n", path.c_str(),
+                    s.correctness.c, s.correctness.final_pixels, s.time_s, s.rays);
+    }
+    for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
+        if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
+        r_done[k] = true;
+        const auto path = rays_snapshot(o, o.snapshot_rays[k]);
+        write_image(batch, path, img);
+        std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
+    }
+}
+
 std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
-                               const FrameView& fv, Timings& t) {
+                               const FrameView& fv, Timings& t, OutputFiles& batch) {
     ProgressiveEngine engine(ex, renderer, engine_options(o));
     auto progress = [&](const TimelineSample& s) {
         if (o.quiet) return;
@@ -195,11 +245,9 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
 
     Stopwatch sw;
-    write_image(o.out, fr.final_image);
-    if (!o.depth_out.empty()) write_depth(o.depth_out, fr.final_image);
+    write_image(batch, o.out, fr.final_image);
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
     t.write = sw.seconds();
-    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
-                o.depth_out.c_str());
 
     const bool want_measure =
         !o.no_measure || !o.timeline.empty() || !o.snapshots.empty() || !o.snapshot_rays.empty();
@@ -207,31 +255,13 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     sw.restart();
     std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
     engine.measure(fr, fv, [&](const TimelineSample& s, const Image& img) {
-        for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
-            const double m =
-                o.snapshot_measure == "c" ? s.correctness.c : s.correctness.final_pixels;
-            if (c_done[k] || m < o.snapshots[k] / 100.0) continue;
-            c_done[k] = true;
-            const auto path = with_suffix(o.out, (o.snapshot_measure == "c" ? "_c" : "_final") +
-                                                     percent_label(o.snapshots[k]));
-            write_image(path, img);
-            std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n",
-                        path.c_str(), s.correctness.c, s.correctness.final_pixels, s.time_s,
-                        s.rays);
-        }
-        for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
-            if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
-            r_done[k] = true;
-            const auto path = with_suffix(o.out, "_r" + std::to_string(o.snapshot_rays[k]));
-            write_image(path, img);
-            std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
-        }
+        stage_snapshots(o, s, img, c_done, r_done, batch);
     });
     print_thresholds(fr);
     print_draw_only(fr, fv, renderer);
     if (!o.timeline.empty()) {
-        write_timeline_csv(o.timeline, fr.timeline, fr.rays_screen);
-        std::printf("wrote %s (%zu samples; plot with scripts/plot_timeline.py)\n",
+        write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
+        std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
                     o.timeline.c_str(), fr.timeline.size());
     }
     std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
@@ -256,7 +286,7 @@ int run_info(const InfoOptions& o) {
 }
 
 int run_extract(const ExtractOptions& o) {
-    check_output_path(o.out, "--out");
+    check_outputs({{"--out", o.out}});
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
@@ -274,14 +304,10 @@ int run_extract(const ExtractOptions& o) {
 int run_render(const RenderOptions& o) {
     const auto size = parse_size(o.size);
     if (!size)
-        throw InputError("--size", "value",
-                         "expected WIDTHxHEIGHT with positive integers, got \"" + o.size + "\"");
-    check_output_path(o.out, "--out");
-    if (!o.depth_out.empty()) check_output_path(o.depth_out, "--depth-out");
-    if (!o.timeline.empty()) check_output_path(o.timeline, "--timeline");
-    for (double c : o.snapshots)
-        if (!(c > 0 && c <= 100))
-            throw InputError("--snapshots", "value", "expected percentages in (0, 100]");
+        throw InputError(
+            "--size", "value",
+            "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
+    check_render_outputs(o);
     const EngineOptions checked = engine_options(o);  // fails early on a bad --order
     (void)checked;
     Timings t;
@@ -293,15 +319,18 @@ int run_render(const RenderOptions& o) {
     const double iso = checked_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);
-    const Projection proj =
-        o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
-    Camera cam = front_full_view(ov.volume.bounds(), aspect, proj);
-    if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
-    cam = fit_depth_range(zoom(cam, o.zoom), ov.volume.bounds());
+    const Camera cam = render_camera(o, ov.volume.bounds(), aspect);
     FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso};
 
+    // Every output is staged here and appears at the end, all together (no partial output).
+    OutputFiles batch;
     if (!o.full) {
-        t.print(render_progressive(o, *ex, *renderer, fv, t));
+        const std::size_t triangles = render_progressive(o, *ex, *renderer, fv, t, batch);
+        const std::size_t files = batch.size();
+        batch.commit();
+        std::printf("wrote %s%s%s (%zu file(s) in all)\n", o.out.c_str(),
+                    o.depth_out.empty() ? "" : " and ", o.depth_out.c_str(), files);
+        t.print(triangles);
         return 0;
     }
     Mesh mesh = extract_timed(*ex, iso, t);
@@ -318,8 +347,9 @@ int run_render(const RenderOptions& o) {
                 std::string(renderer->name()).c_str(), size->x, size->y,
                 100.0 * double(covered) / double(image.pixel_count()), t.render);
     sw.restart();
-    write_image(o.out, image);
-    if (!o.depth_out.empty()) write_depth(o.depth_out, image);
+    write_image(batch, o.out, image);
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);
+    batch.commit();
     t.write = sw.seconds();
     std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
                 o.depth_out.c_str());

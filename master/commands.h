@@ -26,8 +26,8 @@ struct RenderOptions {
     std::string depth_out;
     std::string gl = "osmesa";
     std::string projection = "perspective";
-    std::vector<float> orbit;  // yaw pitch in degrees
-    float zoom = 1.0f;
+    std::vector<double> orbit;  // yaw pitch in degrees
+    double zoom = 1.0;
 
     // Progressive engine (the default) or the full surface.
     bool full = false;

@@ -3,6 +3,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "common/core/error.h"
+#include "master/cli_checks.h"
 
 namespace isowall {
 
@@ -23,13 +24,14 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
         ->check(CLI::IsMember({"count", "angle"}))
         ->capture_default_str();
     app.add_option("--max-count", e.max_count, "Cells per propagation pass (count mode)")
+        ->transform(number_in(limits::kCellCount))
         ->capture_default_str();
     app.add_option("--cutoff-angle", e.cutoff_deg, "Cut-off angle in degrees (angle mode)")
-        ->check(CLI::PositiveNumber)
+        ->transform(number_in(limits::kCutoffDeg))
         ->capture_default_str();
     app.add_option("--foldback-tolerance", e.foldback_deg,
                    "Fold-back tolerance in degrees (angle mode)")
-        ->check(CLI::NonNegativeNumber)
+        ->transform(number_in(limits::kFoldbackDeg))
         ->capture_default_str();
     app.add_flag("--no-interpolant-cache", e.no_interpolant_cache,
                  "Do not share vertices between cells of a group");
@@ -40,6 +42,7 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
                  "meta-cells of 2^i cells per side");
     app.add_option("--adaptive-max-level", e.adaptive_max_level,
                    "Largest meta-cell level i with --adaptive")
+        ->transform(number_in({1, double(kMaxMetaLevel), false, true}))
         ->capture_default_str();
 }
 
@@ -55,7 +58,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     const auto order = parse_ray_order(c.order);
     if (!order)
         throw InputError("--order", "value",
-                         "expected grid, readback or dynamic, got \"" + c.order + "\"");
+                         "expected grid, readback or dynamic, got " + quote(c.order));
     e.order = *order;
     e.intersect = c.intersect == "approximate" ? IntersectMode::approximate : IntersectMode::exact;
     e.propagation.mode =

@@ -1,47 +1,31 @@
 #include "master/volume_options.h"
 
-#include <charconv>
-#include <cstdint>
 #include <cstdio>
 
 #include "common/core/error.h"
 #include "common/core/util.h"
 #include "common/volume/octree.h"
 #include "common/volume/phantom.h"
+#include "master/cli_checks.h"
 
 namespace isowall {
-
-namespace {
-
-// CLI11 reads "-8" into an unsigned option as a huge number; a byte count must be written as
-// digits only and fit 64 bits.
-const CLI::Validator kByteCount(
-    [](std::string& text) {
-        std::uint64_t v = 0;
-        const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-        if (!text.empty() && r.ec == std::errc() && r.ptr == text.data() + text.size())
-            return std::string();
-        const std::string shown = text.size() > 60 ? text.substr(0, 60) + "..." : text;
-        return "expected a whole number of bytes >= 0, got \"" + shown + "\"";
-    },
-    "BYTES >= 0");
-
-}  // namespace
 
 void add_volume_options(CLI::App& app, VolumeOptions& o) {
     app.add_option("--volume,-v", o.path,
                    "Volume file: .nrrd/.nhdr (NRRD), or headerless raw with --dims and --type. "
                    "Default: the built-in phantom");
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
-        ->expected(3);
+        ->expected(3)
+        ->transform(number_in({1, 2147483647.0, false, true}));
     app.add_option("--type", o.type,
                    "Raw voxel type: uint8 int8 uint16 int16 uint32 int32 float32 float64");
     app.add_option("--spacing", o.spacing, "Raw voxel spacing: SX SY SZ (default 1 1 1)")
-        ->expected(3);
+        ->expected(3)
+        ->transform(number_in({1e-6, 1e6}));
     app.add_option("--endian", o.endian, "Raw byte order: little or big")
         ->check(CLI::IsMember({"little", "big"}));
     app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file")
-        ->check(kByteCount);
+        ->transform(number_in({0, 9007199254740992.0, false, true}));
     app.add_option("--cache-dir", o.cache_dir,
                    "Octree cache folder (default $ISOWALL_CACHE_DIR, else ~/.cache/isowall)");
     app.add_flag("--no-cache", o.no_cache,
@@ -63,8 +47,8 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
     if (!type)
         throw InputError(
             o.path, "--type",
-            "expected one of uint8 int8 uint16 int16 uint32 int32 float32 float64, got \"" +
-                o.type + "\"");
+            "expected one of uint8 int8 uint16 int16 uint32 int32 float32 float64, got " +
+                quote(o.type));
     spec.type = *type;
     if (!o.spacing.empty()) spec.spacing = {o.spacing[0], o.spacing[1], o.spacing[2]};
     spec.endian = o.endian == "big" ? Endian::big : Endian::little;

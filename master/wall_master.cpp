@@ -31,6 +31,8 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     camera_ = orbit(camera_, o.orbit.first, o.orbit.second);
     camera_ = zoom(camera_, o.zoom);
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
+    if (std::string p = camera_problem(camera_); !p.empty())
+        throw InputError("--orbit/--zoom/--pan", "value", p);
     tiles_.resize(static_cast<std::size_t>(comm.size()));
 }
 
@@ -257,6 +259,19 @@ void WallMaster::handle_job(int from, const Message& m) {
 }
 
 bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
+    // A command that would leave the view degenerate (a run of zooms or pans past float
+    // precision) is refused naming its line, and the view stays as it was.
+    const Camera before = camera_;
+    const bool moved = change_view(cmd, where);
+    if (std::string p = camera_problem(camera_); !p.empty()) {
+        camera_ = before;
+        throw InputError(where, "view", p);
+    }
+    if (moved) send_views();
+    return !std::holds_alternative<QuitCmd>(cmd);
+}
+
+bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where) {
     if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
         camera_ = orbit(camera_, c->yaw_deg, c->pitch_deg);
     } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
@@ -277,18 +292,17 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
         iso_ = c->iso;
     } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
         wait(*c);
-        return true;
+        return false;
     } else if (const auto* c = std::get_if<SnapshotCmd>(&cmd)) {
         const auto path = std::filesystem::path(o_.out).parent_path() / (c->name + ".png");
         write_image(path, gather_snapshot());
         std::printf("snapshot: %s (frame %llu, %.3f s into it, %llu rays)\n", path.c_str(),
                     (unsigned long long)generation_, frame_start_.seconds(),
                     (unsigned long long)total_rays());
-        return true;
+        return false;
     } else if (std::holds_alternative<QuitCmd>(cmd)) {
         return false;
     }
-    send_views();
     return true;
 }
 

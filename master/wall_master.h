@@ -52,7 +52,8 @@ class WallMaster {
     // the operator types), tells the tiles the master is alive, and checks that they are.
     void idle();
     // Runs one command; false for quit. Throws InputError for a command that cannot apply
-    // (isovalue out of range), naming `where`.
+    // (isovalue out of range, a view left degenerate: camera_problem), naming `where`; the view
+    // is then as it was.
     bool execute(const ScriptCommand& cmd, const std::string& where);
     // Quit: every tile's figures and final image; writes the mosaic, prints the tables.
     int finish();
@@ -90,6 +91,8 @@ class WallMaster {
 
     void send_views();
     void wait(const WaitCmd& w);
+    // Applies `cmd` (waits, snapshots); true when it changed the view or isovalue.
+    bool change_view(const ScriptCommand& cmd, const std::string& where);
     // Asks every tile for its image (snapshot) and composes the mosaic.
     Image gather_snapshot();
     Mosaic compose();

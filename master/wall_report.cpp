@@ -131,8 +131,11 @@ void write_wall_traces(const std::string& prefix, const WallSpec& spec,
         flows.push_back({m.owner, m.helper, m.start_s, m.start_s, "job", 0});
         flows.push_back({m.helper, m.owner, m.end_s, m.end_s, "region result", m.bytes});
     }
-    write_chrome_trace(prefix + ".json", ranks, flows);
-    write_trace_csv(prefix + ".csv", ranks);
+    // The pair appears together or not at all.
+    OutputFiles batch;
+    write_chrome_trace(batch, prefix + ".json", ranks, flows);
+    write_trace_csv(batch, prefix + ".csv", ranks);
+    batch.commit();
 }
 
 }  // namespace isowall

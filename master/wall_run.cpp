@@ -19,6 +19,7 @@
 #include "common/wall/wall.h"
 #include "master/console.h"
 #include "master/wall_master.h"
+#include "master/wall_outputs.h"
 #include "tile/renderer.h"
 #include "tile/tile_loop.h"
 
@@ -54,19 +55,10 @@ MasterInput check_master_input(const WallOptions& o) {
         throw InputError(
             ov.file ? ov.file->string() : "phantom", "--iso",
             "isovalue " + std::to_string(in.iso) + " is outside the volume's value range");
-    const auto dir = std::filesystem::path(o.out).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw InputError(o.out, "--out", "folder " + dir.string() + " does not exist");
-    if (!o.tiles_out.empty() && !std::filesystem::is_directory(o.tiles_out))
-        throw InputError(o.tiles_out, "--tiles-out", "folder does not exist");
     to_engine_options(o.engine);
-    if (!o.script.empty() && o.script != "-") {
-        std::ifstream file(o.script);
-        if (!file) throw InputError(o.script, "--script", "cannot open the file");
-        std::stringstream text;
-        text << file.rdbuf();
-        in.script = parse_script(text.str(), o.script);
-    }
+    // A folder, a device or a missing file is an error naming --script (a folder read as empty).
+    if (!o.script.empty() && o.script != "-") in.script = load_script(o.script);
+    check_wall_outputs(o, load_wall(o.wall), in.script);
     return in;
 }
 

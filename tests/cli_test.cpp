@@ -2,57 +2,21 @@
 // non-zero exit, and no output file; good input writes what it says.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include "common/io/ply.h"
+#include "tests/cli_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
 namespace {
 
-struct RunResult {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-// Runs the real binary under `timeout`, so a hang fails the test instead of the suite.
-RunResult run_isowall(const std::filesystem::path& dir, const std::string& args) {
-    const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = "cd '" + dir.string() + "' && timeout 120 '" +
-                            std::string(ISOWALL_BINARY) + "' " + args + " > '" + out.string() +
-                            "' 2> '" + err.string() + "'";
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
-
-void write_text(const std::filesystem::path& p, const std::string& text) {
-    std::ofstream(p) << text;
-}
-
-void expect_one_line_error(const RunResult& r, std::initializer_list<std::string> mentions) {
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_NE(r.exit_code, 124) << "timed out";
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
-    EXPECT_EQ(r.err.rfind("isowall: error: ", 0), 0u) << "stderr: " << r.err;
-    for (const auto& m : mentions)
-        EXPECT_NE(r.err.find(m), std::string::npos) << "missing \"" << m << "\" in: " << r.err;
-}
+using test::expect_one_line_error;
+using test::run_isowall;
+using test::write_text;
 
 class Cli : public ::testing::Test {
   protected:

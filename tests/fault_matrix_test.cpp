@@ -103,7 +103,11 @@ TEST_P(FaultMatrix, EveryRankEndsNamingTheRankAndNothingIsLeft) {
     EXPECT_LT(seconds, kStartupS + kTimeoutS + 30) << log;
     EXPECT_NE(log.find(expected_line(f)), std::string::npos) << log;
     if (std::string(f.signal) == "stop") {
-        EXPECT_EQ(test::count_of(log, "isowall: error:"), 1u) << log;
+        // Inside MPI_Init no rank knows the others: the watchdogs are staggered by a second, and
+        // a second rank may still speak before mpirun ends it.
+        const std::size_t lines = test::count_of(log, "isowall: error:");
+        EXPECT_GE(lines, 1u) << log;
+        EXPECT_LE(lines, std::string(f.moment) == "init" ? 2u : 1u) << log;
     }
     EXPECT_FALSE(any_process_of(dir)) << "a rank outlived mpirun\n" << log;
     EXPECT_EQ(outputs_in(dir), "") << log;

@@ -2,6 +2,7 @@
 // the file.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <iterator>
 #include <random>
 #include <stdexcept>
@@ -11,6 +12,7 @@
 
 #include "common/core/image.h"
 #include "common/io/image_io.h"
+#include "common/io/ply.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -54,7 +56,8 @@ TEST(ImageIo, DepthExrIsReadable) {
 TEST(ImageIo, MissingFolderThrowsNamingThePath) {
     const auto path = test::scratch_dir("image_io_missing") / "no" / "such" / "frame.png";
     const Image image = test_pattern(4, 4);
-    for (const auto& write : {write_image, write_depth}) {
+    using Writer = void (*)(const std::filesystem::path&, const Image&);
+    for (const Writer write : {Writer(write_image), Writer(write_depth)}) {
         try {
             write(path, image);
             FAIL() << "writing " << path << " did not throw";
@@ -69,6 +72,42 @@ TEST(ImageIo, RejectsAnEmptyImage) {
     const auto path = test::scratch_dir("image_io_empty") / "empty.png";
     EXPECT_THROW(write_image(path, Image{}), std::runtime_error);
     EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// Every writer goes through OutputFiles: whatever fails, the folder is left as it was (no target,
+// no temporary), and a staged write appears only at commit.
+TEST(ImageIo, AFailedWriteLeavesNothingInTheFolder) {
+    const Image image = test_pattern(4, 4);
+    Mesh mesh;
+    using Write = std::function<void(const std::filesystem::path&)>;
+    const std::vector<std::pair<const char*, Write>> writers = {
+        {"write_image", [&](const std::filesystem::path& p) { write_image(p, image); }},
+        {"write_depth", [&](const std::filesystem::path& p) { write_depth(p, image); }},
+        {"write_ply", [&](const std::filesystem::path& p) { write_ply(p, mesh); }},
+    };
+    for (const auto& [name, write] : writers)
+        for (const char* target : {"x.nosuchformat", "busy"}) {
+            if (std::string(name) == "write_ply" && *target == 'x') continue;  // any name is PLY
+            const auto dir = test::scratch_dir(std::string("image_io_fail_") + name);
+            // A folder that is not empty: the final rename onto it fails.
+            std::filesystem::create_directories(dir / "busy" / "inside");
+            EXPECT_THROW(write(dir / target), std::runtime_error) << name << " " << target;
+            std::vector<std::string> left;
+            for (const auto& e : std::filesystem::directory_iterator(dir))
+                left.push_back(e.path().filename());
+            EXPECT_EQ(left, std::vector<std::string>{"busy"}) << name << " " << target;
+        }
+}
+
+TEST(ImageIo, AStagedWriteAppearsAtCommit) {
+    const auto dir = test::scratch_dir("image_io_staged");
+    OutputFiles batch;
+    write_image(batch, dir / "a.png", test_pattern(4, 4));
+    write_ply(batch, dir / "a.ply", Mesh{});
+    EXPECT_FALSE(std::filesystem::exists(dir / "a.png"));
+    batch.commit();
+    EXPECT_EQ(read_image(dir / "a.png").width, 4);
+    EXPECT_EQ(read_ply(dir / "a.ply").triangle_count(), 0u);
 }
 
 }  // namespace

@@ -247,12 +247,12 @@ TEST(WallRun, BadInputEndsEveryRank) {
          mpirun(5) + wall + " --script '" + (dir / "iso.txt").string() + "'",
          "iso.txt:1: iso: isovalue 999"},
         {"a timeout that is not a number", mpirun(5) + wall + " --timeout nan",
-         "--timeout: expected a finite number of seconds > 0, got nan"},
+         "--timeout: expected a number in (0, 1e+06], got \"nan\""},
         {"an empty region", mpirun(5) + wall + " --region 0x48", "--region: expected WxH"},
         {"a balance that is neither on nor off", mpirun(5) + wall + " --balance maybe",
          "--balance"},
         {"a pan that is not a number", mpirun(5) + wall + " --pan nan 0",
-         "--pan: expected a finite number"},
+         "--pan: expected a number in [-1000, 1000], got \"nan\""},
     };
     for (const Case& c : cases) {
         const int rc = run(c.cmd, dir / "log.txt");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/rotate_vector.hpp>
@@ -27,7 +28,60 @@ Frustum sub_frustum(const Frustum& full, int screen_w, int screen_h, const Pixel
 }
 
 glm::mat4 Camera::view() const {
-    return glm::lookAt(eye, target, up);
+    return glm::lookAt(eye, target, valid_up(target - eye, up));
+}
+
+glm::vec3 valid_up(const glm::vec3& forward, const glm::vec3& up) {
+    const float f = glm::length(forward), u = glm::length(up);
+    // sin(0.06 degrees) ~ 1e-3: closer to parallel, the right vector is mostly rounding error.
+    if (f > 0 && u > 0 && glm::length(glm::cross(forward / f, up / u)) >= 1e-3f) return up;
+    if (!(f > 0) || std::abs(forward.z / f) < 0.9f) return {0, 0, 1};
+    return {0, 1, 0};
+}
+
+namespace {
+
+bool finite(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+std::string format(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%g", v);
+    return buf;
+}
+
+constexpr double kMaxReach = 1e9;        // object units from the origin
+constexpr double kMinSeparation = 1e-4;  // of the scale (the distance from the origin, >= 1)
+
+}  // namespace
+
+std::string eye_target_problem(const glm::vec3& eye, const glm::vec3& target) {
+    if (!finite(eye) || !finite(target)) return "the eye or the target is not a finite point";
+    const double scale = std::max({1.0, double(glm::length(eye)), double(glm::length(target))});
+    const double apart = glm::length(glm::dvec3(eye) - glm::dvec3(target));
+    if (apart < kMinSeparation * scale)
+        return apart == 0
+                   ? "the eye and the target are the same point"
+                   : "the eye and the target are " + format(apart) + " apart; expected at least " +
+                         format(kMinSeparation * scale) + " at this distance from the origin";
+    return {};
+}
+
+std::string camera_problem(const Camera& c) {
+    if (!finite(c.up) || !std::isfinite(c.fovy_deg) || !std::isfinite(c.ortho_height))
+        return "the view is not finite";
+    if (std::string p = eye_target_problem(c.eye, c.target); !p.empty()) return p;
+    const double reach = std::max(glm::length(c.eye), glm::length(c.target));
+    if (reach > kMaxReach)
+        return "the view would be " + format(reach) + " from the origin; expected at most " +
+               format(kMaxReach);
+    const double scale = std::max(1.0, double(glm::length(c.target)));
+    if (c.projection == Projection::orthographic &&
+        (c.ortho_height < kMinSeparation * scale || c.ortho_height > kMaxReach))
+        return "the view would be " + format(c.ortho_height) + " high; expected " +
+               format(kMinSeparation * scale) + " to " + format(kMaxReach);
+    return {};
 }
 
 float Camera::distance() const {
@@ -82,13 +136,16 @@ Camera front_full_view(const Box3& bounds, float aspect, Projection projection) 
     return fit_depth_range(c, bounds);
 }
 
-Camera orbit(const Camera& c, float yaw_deg, float pitch_deg) {
+Camera orbit(const Camera& c, double yaw_deg, double pitch_deg) {
     Camera out = c;
     glm::vec3 offset = c.eye - c.target;
-    const glm::vec3 up = glm::normalize(c.up);
-    offset = glm::rotate(offset, glm::radians(yaw_deg), up);
+    const glm::vec3 up = glm::normalize(valid_up(-offset, c.up));
+    const auto radians = [](double deg) {
+        return static_cast<float>(glm::radians(std::fmod(deg, 360.0)));
+    };
+    offset = glm::rotate(offset, radians(yaw_deg), up);
     const glm::vec3 right = glm::normalize(glm::cross(-offset, up));
-    offset = glm::rotate(offset, glm::radians(pitch_deg), right);
+    offset = glm::rotate(offset, radians(pitch_deg), right);
     out.eye = c.target + offset;
     // Keep up orthogonal to the view direction so that lookAt never degenerates.
     out.up = glm::normalize(glm::cross(right, -offset));
@@ -97,7 +154,7 @@ Camera orbit(const Camera& c, float yaw_deg, float pitch_deg) {
 
 Camera pan(const Camera& c, float dx, float dy, float aspect) {
     const glm::vec3 forward = glm::normalize(c.target - c.eye);
-    const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+    const glm::vec3 right = glm::normalize(glm::cross(forward, valid_up(forward, c.up)));
     const glm::vec3 up = glm::cross(right, forward);
     const float height = c.projection == Projection::perspective
                              ? 2.0f * c.distance() * std::tan(glm::radians(c.fovy_deg) * 0.5f)

@@ -2,6 +2,7 @@
 // Camera and frustum value types. A Frustum is the general off-axis form (the extents of the
 // near plane in view space), so a wall tile is just a sub-rectangle of the wall's frustum.
 #include <ostream>
+#include <string>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
@@ -52,14 +53,29 @@ struct Camera {
 Camera front_full_view(const Box3& bounds, float aspect,
                        Projection projection = Projection::perspective);
 
-// Rotate the eye around the target: yaw about the up vector, pitch about the right vector.
-Camera orbit(const Camera& c, float yaw_deg, float pitch_deg);
+// Rotate the eye around the target: yaw about the up vector, pitch about the right vector. The
+// angles are reduced modulo 360 in double precision first, so 720.5 turns exactly as 0.5 does.
+Camera orbit(const Camera& c, double yaw_deg, double pitch_deg);
 // Moves eye and target together in the view plane by dx screen widths (positive: the view moves
 // right, so the scene moves left) and dy screen heights (positive: the view moves up), measured
 // at the target's distance on a screen of the given aspect (width / height).
 Camera pan(const Camera& c, float dx, float dy, float aspect);
 // factor > 1 moves closer (perspective) or narrows the view (orthographic).
 Camera zoom(const Camera& c, float factor);
+
+// The up vector a view uses: `up` when it is at least about 0.06 degrees off the view direction
+// `forward`; otherwise (a look-at straight along `up`, or an up of zero length) the object's +z,
+// or +y when the view itself runs along z. Never parallel to a non-zero `forward`.
+glm::vec3 valid_up(const glm::vec3& forward, const glm::vec3& up);
+
+// Why the eye and target cannot make a view, or empty: they must be finite and apart by at
+// least 1e-4 of their distance from the origin (at least 1e-4), or float precision leaves the view
+// direction undefined (eye == target is the extreme case).
+std::string eye_target_problem(const glm::vec3& eye, const glm::vec3& target);
+// Why `c` cannot be drawn, or empty: eye_target_problem, and everything within 1e9 object units
+// of the origin, an orthographic height within [1e-4 * scale, 1e9], where scale is the target's
+// distance from the origin (at least 1): what a run of zooms and pans must keep.
+std::string camera_problem(const Camera& c);
 
 // Set near/far so that `bounds` lies between them, with a small margin.
 Camera fit_depth_range(const Camera& c, const Box3& bounds);

@@ -1,15 +1,14 @@
 #include "common/io/image_io.h"
 
-#include <unistd.h>
-
-#include <atomic>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
+
+#include "common/core/error.h"
+#include "common/core/output_files.h"
 
 namespace isowall {
 namespace {
@@ -30,19 +29,6 @@ void require_pixels(std::string_view function, const std::filesystem::path& path
     }
 }
 
-// Beside the target, so the final rename stays on one file system and is atomic; hidden, and
-// unique per process and call, so concurrent writers never share one. The extension is kept
-// because OIIO picks the format by it.
-std::filesystem::path temporary_path(const std::filesystem::path& path) {
-    static std::atomic<unsigned> counter{0};
-    // Appended piece by piece: GCC 12 misreports "." + std::string as an overlapping memcpy.
-    std::string name(".");
-    name += path.stem().string();
-    name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    name += path.extension().string();
-    return path.parent_path() / name;
-}
-
 // The writer for `path`'s format.
 std::unique_ptr<OIIO::ImageOutput> create_output(std::string_view function,
                                                  const std::filesystem::path& path) {
@@ -51,31 +37,21 @@ std::unique_ptr<OIIO::ImageOutput> create_output(std::string_view function,
     return out;
 }
 
-// Writes `spec`-shaped pixels from `data` (with `xstride` bytes between pixels) to a temporary
-// file, then renames it to `path`.
-void write_atomically(std::string_view function, const std::filesystem::path& path,
-                      OIIO::ImageOutput& out, const OIIO::ImageSpec& spec, const void* data,
-                      OIIO::stride_t xstride) {
-    const std::filesystem::path temporary = temporary_path(path);
-    const auto discard = [&](const std::string& message) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        fail(function, path, message);
-    };
-    if (!out.open(temporary.string(), spec)) discard(out.geterror());
-    if (!out.write_image(spec.format, data, xstride)) discard(out.geterror());
-    if (!out.close()) discard(out.geterror());
-    std::error_code error;
-    std::filesystem::rename(temporary, path, error);
-    if (error) discard("rename from " + temporary.string() + ": " + error.message());
+// Writes `spec`-shaped pixels from `data` (with `xstride` bytes between pixels) to `temporary`,
+// the staged file of `path` (its owner removes it on an error).
+void write_pixels(std::string_view function, const std::filesystem::path& path,
+                  const std::filesystem::path& temporary, const OIIO::ImageSpec& spec,
+                  const void* data, OIIO::stride_t xstride) {
+    auto out = create_output(function, path);
+    if (!out->open(temporary.string(), spec)) fail(function, path, out->geterror());
+    if (!out->write_image(spec.format, data, xstride)) fail(function, path, out->geterror());
+    if (!out->close()) fail(function, path, out->geterror());
 }
 
-}  // namespace
-
-void write_image(const std::filesystem::path& path, const Image& image) {
+void encode_image(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                  const Image& image) {
     require_pixels("write_image", path, image, image.rgba.size(), 4);
-    auto out = create_output("write_image", path);
-    const int channels = out->supports("alpha") ? 4 : 3;
+    const int channels = create_output("write_image", path)->supports("alpha") ? 4 : 3;
     OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
     if (channels == 4) {
         spec.alpha_channel = 3;
@@ -83,16 +59,41 @@ void write_image(const std::filesystem::path& path, const Image& image) {
         spec.attribute("oiio:UnassociatedAlpha", 1);
     }
     // With a 4-byte pixel stride, an RGB file simply skips each pixel's alpha.
-    write_atomically("write_image", path, *out, spec, image.rgba.data(), 4);
+    write_pixels("write_image", path, temporary, spec, image.rgba.data(), 4);
 }
 
-void write_depth(const std::filesystem::path& path, const Image& image) {
+void encode_depth(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                  const Image& image) {
     require_pixels("write_depth", path, image, image.depth.size(), 1);
     OIIO::ImageSpec spec(image.width, image.height, 1, OIIO::TypeDesc::FLOAT);
     spec.channelnames = {"Z"};
     spec.z_channel = 0;
-    auto out = create_output("write_depth", path);
-    write_atomically("write_depth", path, *out, spec, image.depth.data(), sizeof(float));
+    write_pixels("write_depth", path, temporary, spec, image.depth.data(), sizeof(float));
+}
+
+}  // namespace
+
+std::string image_format_problem(const std::filesystem::path& path) {
+    if (OIIO::ImageOutput::create(path.string())) return {};
+    OIIO::geterror();  // clear OIIO's pending message
+    return "no image format for the extension " + quote(path.extension().string()) +
+           " (e.g. .png, .tif, .exr)";
+}
+
+void write_image(const std::filesystem::path& path, const Image& image) {
+    write_output(path, [&](const std::filesystem::path& t) { encode_image(path, t, image); });
+}
+
+void write_image(OutputFiles& batch, const std::filesystem::path& path, const Image& image) {
+    encode_image(path, batch.stage(path), image);
+}
+
+void write_depth(const std::filesystem::path& path, const Image& image) {
+    write_output(path, [&](const std::filesystem::path& t) { encode_depth(path, t, image); });
+}
+
+void write_depth(OutputFiles& batch, const std::filesystem::path& path, const Image& image) {
+    encode_depth(path, batch.stage(path), image);
 }
 
 Image read_image(const std::filesystem::path& path) {

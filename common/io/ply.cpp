@@ -6,51 +6,56 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-
-#include <unistd.h>
+#include <vector>
 
 namespace isowall {
 
-void write_ply(const std::filesystem::path& path, const Mesh& mesh) {
-    auto tmp = path;
-    tmp += ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
-        out << "ply\nformat binary_little_endian 1.0\ncomment isowall isosurface\n"
-            << "element vertex " << mesh.positions.size() << "\n"
-            << "property float x\nproperty float y\nproperty float z\n"
-            << "property float nx\nproperty float ny\nproperty float nz\n"
-            << "element face " << mesh.triangle_count() << "\n"
-            << "property list uchar int vertex_indices\nend_header\n";
-        std::vector<float> verts(mesh.positions.size() * 6);
-        for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-            for (int a = 0; a < 3; ++a) {
-                verts[6 * i + a] = mesh.positions[i][a];
-                verts[6 * i + 3 + a] = mesh.normals[i][a];
-            }
-        }
-        out.write(reinterpret_cast<const char*>(verts.data()),
-                  static_cast<std::streamsize>(verts.size() * sizeof(float)));
-        // 13 bytes per face: the count byte and three int32 indices, packed.
-        std::vector<char> faces(mesh.triangle_count() * 13);
-        for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-            char* f = faces.data() + 13 * t;
-            f[0] = 3;
-            for (int k = 0; k < 3; ++k) {
-                const auto idx =
-                    static_cast<std::int32_t>(mesh.indices[3 * t + static_cast<std::size_t>(k)]);
-                std::memcpy(f + 1 + 4 * k, &idx, 4);
-            }
-        }
-        out.write(faces.data(), static_cast<std::streamsize>(faces.size()));
-        if (!out) {
-            out.close();
-            std::filesystem::remove(tmp);
-            throw std::runtime_error(path.string() + ": write failed");
+namespace {
+
+// The file at `temporary` (staged for `path`, which errors name).
+void encode_ply(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                const Mesh& mesh) {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+    out << "ply\nformat binary_little_endian 1.0\ncomment isowall isosurface\n"
+        << "element vertex " << mesh.positions.size() << "\n"
+        << "property float x\nproperty float y\nproperty float z\n"
+        << "property float nx\nproperty float ny\nproperty float nz\n"
+        << "element face " << mesh.triangle_count() << "\n"
+        << "property list uchar int vertex_indices\nend_header\n";
+    std::vector<float> verts(mesh.positions.size() * 6);
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+        for (int a = 0; a < 3; ++a) {
+            verts[6 * i + a] = mesh.positions[i][a];
+            verts[6 * i + 3 + a] = mesh.normals[i][a];
         }
     }
-    std::filesystem::rename(tmp, path);
+    out.write(reinterpret_cast<const char*>(verts.data()),
+              static_cast<std::streamsize>(verts.size() * sizeof(float)));
+    // 13 bytes per face: the count byte and three int32 indices, packed.
+    std::vector<char> faces(mesh.triangle_count() * 13);
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        char* f = faces.data() + 13 * t;
+        f[0] = 3;
+        for (int k = 0; k < 3; ++k) {
+            const auto idx =
+                static_cast<std::int32_t>(mesh.indices[3 * t + static_cast<std::size_t>(k)]);
+            std::memcpy(f + 1 + 4 * k, &idx, 4);
+        }
+    }
+    out.write(faces.data(), static_cast<std::streamsize>(faces.size()));
+    out.close();
+    if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+}  // namespace
+
+void write_ply(const std::filesystem::path& path, const Mesh& mesh) {
+    write_output(path, [&](const std::filesystem::path& t) { encode_ply(path, t, mesh); });
+}
+
+void write_ply(OutputFiles& batch, const std::filesystem::path& path, const Mesh& mesh) {
+    encode_ply(path, batch.stage(path), mesh);
 }
 
 Mesh read_ply(const std::filesystem::path& path) {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/core/output_files.h"
 #include "common/progressive/correctness.h"
 
 namespace isowall {
@@ -26,6 +27,9 @@ struct TimelineSample {
 // Columns: time_s, rays, rays_share (of `rays_screen`), cells_visited, triangles, groups,
 // final_pixels, c, t_intersect_s, t_propagate_s, t_extract_s, t_render_s, level.
 void write_timeline_csv(const std::filesystem::path& path,
+                        const std::vector<TimelineSample>& samples, std::size_t rays_screen);
+// The same, staged in a command's batch: the file appears at batch.commit().
+void write_timeline_csv(OutputFiles& batch, const std::filesystem::path& path,
                         const std::vector<TimelineSample>& samples, std::size_t rays_screen);
 
 enum class Measure { c, final_pixels };

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 
 namespace isowall {
@@ -56,10 +57,20 @@ std::vector<double> TraceRecorder::cpu_by_stage() const {
     return sum;
 }
 
-void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks,
-                        const std::vector<TraceFlow>& flows) {
-    std::ofstream out(path);
+namespace {
+
+// Opens `temporary` (staged for `path`, which errors name), lets `body` write, checks the stream.
+void write_text(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                const std::function<void(std::ostream&)>& body) {
+    std::ofstream out(temporary);
     if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+    body(out);
+    out.close();
+    if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+void chrome_trace(std::ostream& out, const std::vector<RankTrace>& ranks,
+                  const std::vector<TraceFlow>& flows) {
     double t0 = 0;
     bool first_span = true;
     for (const RankTrace& r : ranks)
@@ -102,12 +113,9 @@ void write_chrome_trace(const std::filesystem::path& path, const std::vector<Ran
         out << line;
     }
     out << "\n]}\n";
-    if (!out) throw std::runtime_error(path.string() + ": write failed");
 }
 
-void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks) {
-    std::ofstream out(path);
-    if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+void trace_csv(std::ostream& out, const std::vector<RankTrace>& ranks) {
     out << "rank,label,stage,start_s,wall_s,cpu_s\n";
     char line[256];
     for (const RankTrace& r : ranks)
@@ -116,7 +124,31 @@ void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTr
                           kTraceStages[s.stage], s.start_s, s.wall_s, s.cpu_s);
             out << line;
         }
-    if (!out) throw std::runtime_error(path.string() + ": write failed");
+}
+
+}  // namespace
+
+void write_chrome_trace(OutputFiles& batch, const std::filesystem::path& path,
+                        const std::vector<RankTrace>& ranks, const std::vector<TraceFlow>& flows) {
+    write_text(path, batch.stage(path), [&](std::ostream& o) { chrome_trace(o, ranks, flows); });
+}
+
+void write_chrome_trace(const std::filesystem::path& path, const std::vector<RankTrace>& ranks,
+                        const std::vector<TraceFlow>& flows) {
+    OutputFiles batch;
+    write_chrome_trace(batch, path, ranks, flows);
+    batch.commit();
+}
+
+void write_trace_csv(OutputFiles& batch, const std::filesystem::path& path,
+                     const std::vector<RankTrace>& ranks) {
+    write_text(path, batch.stage(path), [&](std::ostream& o) { trace_csv(o, ranks); });
+}
+
+void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks) {
+    OutputFiles batch;
+    write_trace_csv(batch, path, ranks);
+    batch.commit();
 }
 
 }  // namespace isowall

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "common/core/output_files.h"
+
 namespace isowall {
 
 struct TraceSpan {
@@ -65,5 +67,11 @@ void write_chrome_trace(const std::filesystem::path& path, const std::vector<Ran
                         const std::vector<TraceFlow>& flows = {});
 // rank,label,stage,start_s,wall_s,cpu_s
 void write_trace_csv(const std::filesystem::path& path, const std::vector<RankTrace>& ranks);
+// The same two, staged in a command's batch: the files appear at batch.commit().
+void write_chrome_trace(OutputFiles& batch, const std::filesystem::path& path,
+                        const std::vector<RankTrace>& ranks,
+                        const std::vector<TraceFlow>& flows = {});
+void write_trace_csv(OutputFiles& batch, const std::filesystem::path& path,
+                     const std::vector<RankTrace>& ranks);
 
 }  // namespace isowall

@@ -1,10 +1,11 @@
 #include "common/wall/script.h"
 
-#include <cmath>
-#include <limits>
 #include <sstream>
 
+#include "common/core/camera.h"
 #include "common/core/error.h"
+#include "common/core/input_file.h"
+#include "common/core/number.h"
 
 namespace isowall {
 namespace {
@@ -16,33 +17,14 @@ std::vector<std::string> words_of(std::string_view text) {
     return words;
 }
 
-double number(const std::string& word, const std::string& where, const std::string& command) {
-    std::size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(word, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != word.size() || !std::isfinite(v))
-        throw InputError(where, command, "expected a number, got \"" + word + "\"");
-    return v;
-}
+// A snapshot's name becomes NAME.png beside the mosaic: one file name, short enough for any file
+// system with the extension.
+constexpr std::size_t kMaxSnapshotName = 200;
 
-// Camera commands hold floats: a double beyond float range would become an infinite float (found
-// by fuzz/fuzz_script.cpp), so the range is checked before the cast.
-float float_number(const std::string& word, const std::string& where, const std::string& command) {
-    const double v = number(word, where, command);
-    if (std::abs(v) > std::numeric_limits<float>::max())
-        throw InputError(where, command, "expected a number within float range, got " + word);
-    return static_cast<float>(v);
-}
-
-// A snapshot name becomes a file name: no folders, and no control characters (a NUL would cut
-// the name short, so the snapshot would land in another file).
 bool plain_name(const std::string& name) {
+    if (name.size() > kMaxSnapshotName) return false;
     for (const char ch : name)
-        if (ch == '/' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) return false;
+        if (ch == '/' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F) return false;
     return true;
 }
 
@@ -60,37 +42,42 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     const auto w = words_of(text);
     if (w.empty()) throw InputError(where, "command", "empty command");
     const std::string& c = w[0];
-    auto num = [&](std::size_t i) { return number(w[i], where, c); };
-    auto fnum = [&](std::size_t i) { return float_number(w[i], where, c); };
+    auto num = [&](std::size_t i, const NumberRange& range) {
+        return checked_number(w[i], range, where, c);
+    };
     if (c == "orbit") {
         expect_args(w, 2, where, "orbit YAW PITCH");
-        return OrbitCmd{fnum(1), fnum(2)};
+        return OrbitCmd{num(1, limits::kAngleDeg), num(2, limits::kAngleDeg)};
     }
     if (c == "look-at") {
         expect_args(w, 6, where, "look-at EX EY EZ TX TY TZ");
-        return LookAtCmd{{fnum(1), fnum(2), fnum(3)}, {fnum(4), fnum(5), fnum(6)}};
+        auto point = [&](std::size_t i) {
+            const auto v = [&](std::size_t k) { return float(num(k, limits::kCoordinate)); };
+            return glm::vec3(v(i), v(i + 1), v(i + 2));
+        };
+        const LookAtCmd cmd{point(1), point(4)};
+        if (std::string p = eye_target_problem(cmd.eye, cmd.target); !p.empty())
+            throw InputError(where, c, p);
+        return cmd;
     }
     if (c == "zoom") {
         expect_args(w, 1, where, "zoom F");
-        // A factor below float's smallest would be zero as a float.
-        const float f = fnum(1);
-        if (!(f > 0)) throw InputError(where, c, "expected a positive factor, got " + w[1]);
-        return ZoomCmd{f};
+        return ZoomCmd{float(num(1, limits::kZoom))};
     }
     if (c == "pan") {
         expect_args(w, 2, where, "pan DX DY");
-        return PanCmd{fnum(1), fnum(2)};
+        return PanCmd{float(num(1, limits::kPan)), float(num(2, limits::kPan))};
     }
     if (c == "iso") {
         expect_args(w, 1, where, "iso V");
-        return IsoCmd{num(1)};
+        return IsoCmd{num(1, limits::kAnyFinite)};
     }
     if (c == "wait") {
         if (w.size() == 2 && w[1] == "done") return WaitCmd{WaitCmd::Until::done, 0};
         if (w.size() == 3 && (w[1] == "rays" || w[1] == "time")) {
-            const double a = num(2);
-            if (a < 0) throw InputError(where, c, "expected a non-negative amount, got " + w[2]);
-            return WaitCmd{w[1] == "rays" ? WaitCmd::Until::rays : WaitCmd::Until::time, a};
+            const bool rays = w[1] == "rays";
+            return WaitCmd{rays ? WaitCmd::Until::rays : WaitCmd::Until::time,
+                           num(2, rays ? limits::kRayCount : limits::kWaitSeconds)};
         }
         throw InputError(where, c,
                          "expected \"wait rays N\", \"wait time SECONDS\" or \"wait done\"");
@@ -98,7 +85,9 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     if (c == "snapshot") {
         expect_args(w, 1, where, "snapshot NAME");
         if (!plain_name(w[1]))
-            throw InputError(where, c, "expected a plain name, got \"" + w[1] + "\"");
+            throw InputError(where, c,
+                             "expected a plain name (no '/', no control characters, at most " +
+                                 std::to_string(kMaxSnapshotName) + " bytes), got " + quote(w[1]));
         return SnapshotCmd{w[1]};
     }
     if (c == "quit") {
@@ -106,8 +95,8 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
         return QuitCmd{};
     }
     throw InputError(where, "command",
-                     "unknown command \"" + c +
-                         "\" (expected orbit, look-at, zoom, pan, iso, wait, snapshot or quit)");
+                     "unknown command " + quote(c) +
+                         " (expected orbit, look-at, zoom, pan, iso, wait, snapshot or quit)");
 }
 
 std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file) {
@@ -126,6 +115,10 @@ std::vector<ScriptLine> parse_script(std::string_view text, const std::string& f
         pos = end + 1;
     }
     return lines;
+}
+
+std::vector<ScriptLine> load_script(const std::filesystem::path& path) {
+    return parse_script(read_input_file(path, "--script", kMaxScriptBytes), path.string());
 }
 
 }  // namespace isowall

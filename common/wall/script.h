@@ -10,6 +10,8 @@
 //   quit
 // '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
 // frame on every tile (and interrupts the current one).
+#include <cstddef>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -20,7 +22,7 @@
 namespace isowall {
 
 struct OrbitCmd {
-    float yaw_deg = 0, pitch_deg = 0;
+    double yaw_deg = 0, pitch_deg = 0;  // the camera reduces them modulo 360
 };
 struct LookAtCmd {
     glm::vec3 eye{0}, target{0};
@@ -55,5 +57,9 @@ struct ScriptLine {
 ScriptCommand parse_command(std::string_view text, const std::string& where);
 // A whole script; blank and comment lines are skipped.
 std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file);
+// The script in `path` (a regular file of at most kMaxScriptBytes); errors name the file and
+// --script, or the file, line and command.
+std::vector<ScriptLine> load_script(const std::filesystem::path& path);
+inline constexpr std::size_t kMaxScriptBytes = 16u << 20;
 
 }  // namespace isowall

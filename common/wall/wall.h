@@ -72,7 +72,9 @@ struct PixelSize {
 // Throws InputError naming `where`, the field, what was expected and what was found; unknown keys
 // are errors, so a typo never passes silently.
 WallSpec parse_wall(std::string_view toml_text, const std::string& where);
+// A regular file of at most kMaxWallFileBytes (a folder or a device is an error naming "file").
 WallSpec load_wall(const std::filesystem::path& path);
+inline constexpr std::size_t kMaxWallFileBytes = 1u << 20;
 
 std::string to_string(RankOrder order);  // "row-major", "column-major", "serpentine"
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <sstream>
@@ -13,32 +12,36 @@
 #include <toml++/toml.h>
 
 #include "common/core/error.h"
+#include "common/core/input_file.h"
+#include "common/core/number.h"
 
 namespace isowall {
 namespace {
 
-// A tile's image travels to the master in one message, whose sides are at most 32768 pixels
-// (kMaxImageSide in comm/protocol.h, which common/ does not see): a larger tile would fail only
-// at its first frame, with a wire error.
-constexpr long long kMaxTileSide = 32768;
-// Bezels, overlaps and tile offsets, in pixels either way.
+// The ranges of a wall file's numbers (README, "Numbers"). Sides in pixels stay well inside int
+// arithmetic whatever the tile count, and a virtual screen of 131072 px a side is past any wall
+// built so far.
+constexpr long long kMaxTilePx = 32768;
+constexpr long long kMaxScreenPx = 131072;
 constexpr long long kMaxBezelPx = 1'000'000;
-// Each side of the virtual screen is computed in int (wall_geometry.cpp), offsets added: 2^30
-// leaves room for them.
-constexpr long long kMaxScreenSide = 1LL << 30;
+constexpr NumberRange kTileMm{1e-3, 1e6};
+constexpr NumberRange kBezelMm{-1e6, 1e6};
+constexpr NumberRange kViewerMm{-1e7, 1e7};
 
 // A TOML value as the user wrote it, for "got ..." in error messages (toml++'s own printer
 // pads arrays as "[ 6, 0 ]" and can span lines).
+// Bounded like every quoted input (common/core/error.h): a long array or string shows its start.
 std::string describe(const toml::node& node) {
     std::ostringstream os;
     if (const auto* a = node.as_array()) {
         os << '[';
-        for (size_t i = 0; i < a->size(); ++i) os << (i ? ", " : "") << describe(*a->get(i));
+        for (size_t i = 0; i < a->size() && os.tellp() <= std::streamoff(kQuoteChars); ++i)
+            os << (i ? ", " : "") << describe(*a->get(i));
         os << ']';
     } else if (node.is_table()) {
         os << "a table";
     } else if (const auto* s = node.as_string()) {
-        os << '"' << s->get() << '"';
+        os << quote(s->get());
     } else if (const auto* b = node.as_boolean()) {
         os << (b->get() ? "true" : "false");
     } else if (const auto* i = node.as_integer()) {
@@ -49,7 +52,7 @@ std::string describe(const toml::node& node) {
     } else {
         os << "a date or time";
     }
-    return os.str();
+    return clip(os.str());
 }
 
 // Reads one table, naming fields with their dotted path, so every error says where it is.
@@ -98,22 +101,24 @@ class Reader {
         return out;
     }
 
-    static std::optional<double> number(const toml::node& n) {
-        if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
-        if (const auto* f = n.as_floating_point())
-            if (std::isfinite(f->get())) return f->get();
+    // A TOML integer or float in `range` (the shared rule for numbers: finite and in range).
+    static std::optional<double> number(const toml::node& n, const NumberRange& range) {
+        std::optional<double> v;
+        if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
+        if (const auto* f = n.as_floating_point()) v = f->get();
+        if (v && range.contains(*v)) return v;
         return std::nullopt;
     }
 
-    std::vector<double> numbers(std::string_view key, size_t count, bool positive,
+    std::vector<double> numbers(std::string_view key, size_t count, const NumberRange& range,
                                 const std::string& expected) const {
         const toml::node& n = require(key, expected);
         const auto* a = n.as_array();
         std::vector<double> out;
         if (a && a->size() == count)
             for (const toml::node& e : *a) {
-                const auto v = number(e);
-                if (!v || (positive && *v <= 0)) break;
+                const auto v = number(e, range);
+                if (!v) break;
                 out.push_back(*v);
             }
         if (out.size() != count) fail(key, "expected " + expected + ", got " + describe(n));
@@ -136,15 +141,17 @@ void read_bezels(const Reader& r, std::string_view key, T& left, T& right, T& to
     if (!n) return;
     const bool integer = std::is_integral_v<T>;
     const std::string expected =
-        integer ? "an integer or a table {left, right, top, bottom} of integers"
-                : "a number or a table {left, right, top, bottom} of numbers";
+        integer
+            ? "an integer or a table {left, right, top, bottom} of integers, each in [-1e6, 1e6]"
+            : "a number or a table {left, right, top, bottom} of numbers, each in [-1e6, 1e6]";
     auto value = [&](const toml::node& v) -> std::optional<T> {
         if (integer) {
             const auto* i = v.as_integer();
-            if (!i || std::abs(i->get()) > kMaxBezelPx) return std::nullopt;
+            // Not std::abs: it overflows on the most negative int64.
+            if (!i || i->get() < -kMaxBezelPx || i->get() > kMaxBezelPx) return std::nullopt;
             return static_cast<T>(i->get());
         }
-        const auto d = Reader::number(v);
+        const auto d = Reader::number(v, kBezelMm);
         return d ? std::optional<T>(static_cast<T>(*d)) : std::nullopt;
     };
     if (const auto* t = n->as_table()) {
@@ -159,7 +166,7 @@ void read_bezels(const Reader& r, std::string_view key, T& left, T& right, T& to
                 if (!v)
                     sides.fail(name, "expected " +
                                          std::string(integer ? "an integer" : "a number") +
-                                         ", got " + describe(*s));
+                                         " in [-1e6, 1e6], got " + describe(*s));
                 *out = *v;
             }
         return;
@@ -186,7 +193,8 @@ PhysicalSize read_physical(const Reader& top, WallSpec& spec) {
     const Reader r(top.where(), *t, "physical.");
     r.check_keys({"tile_size_mm", "bezel_mm", "viewer_mm"});
     PhysicalSize p;
-    const auto size = r.numbers("tile_size_mm", 2, true, "two positive numbers (width, height)");
+    const auto size =
+        r.numbers("tile_size_mm", 2, kTileMm, "two numbers in [1e-3, 1e6] (width, height)");
     p.tile_width_mm = size[0];
     p.tile_height_mm = size[1];
     if (r.find("bezel_mm")) {
@@ -198,23 +206,21 @@ PhysicalSize read_physical(const Reader& top, WallSpec& spec) {
         // the wall's true proportions and lines stay straight across the mullions.
         const double pitch_x = p.tile_width_mm / spec.tile_width_px;
         const double pitch_y = p.tile_height_mm / spec.tile_height_px;
-        // Checked before the rounding: a bezel of 1e300 mm (or a pitch of almost 0) is no int.
-        auto px = [&](double mm, double pitch) {
-            const double v = mm / pitch;
-            if (!(std::abs(v) <= kMaxBezelPx))
-                r.fail("bezel_mm", "expected bezels of at most a million pixels either way, got " +
-                                       describe(*r.find("bezel_mm")) + " mm at " +
-                                       std::to_string(pitch) + " mm per pixel");
-            return static_cast<int>(std::lround(v));
+        const auto px = [&](double mm, double pitch) {
+            const double v = std::round(mm / pitch);
+            if (!(std::abs(v) <= double(kMaxBezelPx)))
+                r.fail("bezel_mm", "a bezel of " + describe(*r.find("bezel_mm")) +
+                                       " mm is more than 1e6 px at this tile's pixel pitch");
+            return static_cast<int>(v);
         };
         spec.bezel_px = {px(b.left, pitch_x), px(b.right, pitch_x), px(b.top, pitch_y),
                          px(b.bottom, pitch_y)};
     }
     if (r.find("viewer_mm")) {
-        const auto v = r.numbers("viewer_mm", 3, false, "three numbers (x, y, z) with z > 0");
+        const std::string expected = "three numbers (x, y, z) in [-1e7, 1e7] with z > 0";
+        const auto v = r.numbers("viewer_mm", 3, kViewerMm, expected);
         if (v[2] <= 0)
-            r.fail("viewer_mm", "expected three numbers (x, y, z) with z > 0, got " +
-                                    describe(*r.find("viewer_mm")));
+            r.fail("viewer_mm", "expected " + expected + ", got " + describe(*r.find("viewer_mm")));
         p.viewer_mm = glm::dvec3(v[0], v[1], v[2]);
     }
     return p;
@@ -246,7 +252,7 @@ void read_overrides(const Reader& top, WallSpec& spec) {
         }
         if (r.find("offset_px")) {
             const auto off = r.ints("offset_px", 2, -kMaxBezelPx, kMaxBezelPx,
-                                    "two integers (x right, y down) of at most a million");
+                                    "two integers in [-1e6, 1e6] (x right, y down)");
             o.offset_x_px = off[0];
             o.offset_y_px = off[1];
         }
@@ -259,18 +265,20 @@ void read_overrides(const Reader& top, WallSpec& spec) {
     if (rank_count(spec) == 1) top.fail("tile", "every tile is disabled; expected at least one");
 }
 
-// The virtual screen's sides, computed here in 64 bits, must fit the int geometry of
-// wall_geometry.cpp: a million tiles of 32768 pixels would overflow it.
-void check_screen_size(const Reader& r, const WallSpec& spec) {
+// In 64-bit arithmetic, before anything computes it in int. Named for the tiles when they alone
+// are too wide, else for the bezels that make them so.
+void check_screen_size(const std::string& where, const std::string& bezel_field,
+                       const WallSpec& spec) {
     const Bezels& b = spec.bezel_px;
-    const long long width = static_cast<long long>(spec.columns) * spec.tile_width_px +
-                            (spec.columns - 1LL) * (static_cast<long long>(b.left) + b.right);
-    const long long height = static_cast<long long>(spec.rows) * spec.tile_height_px +
-                             (spec.rows - 1LL) * (static_cast<long long>(b.top) + b.bottom);
-    if (width > kMaxScreenSide || height > kMaxScreenSide)
-        r.fail("tiles", "expected a virtual screen of at most " + std::to_string(kMaxScreenSide) +
-                            " pixels a side, got " + std::to_string(width) + "x" +
-                            std::to_string(height));
+    const long long tiles_w = 1LL * spec.columns * spec.tile_width_px;
+    const long long tiles_h = 1LL * spec.rows * spec.tile_height_px;
+    const long long w = tiles_w + (spec.columns - 1LL) * (b.left + b.right);
+    const long long h = tiles_h + (spec.rows - 1LL) * (b.top + b.bottom);
+    if (w <= kMaxScreenPx && h <= kMaxScreenPx) return;
+    const bool tiles = tiles_w > kMaxScreenPx || tiles_h > kMaxScreenPx;
+    throw InputError(where, tiles ? "tiles" : bezel_field,
+                     "the virtual screen would be " + std::to_string(w) + "x" + std::to_string(h) +
+                         " px; expected at most " + std::to_string(kMaxScreenPx) + " a side");
 }
 
 }  // namespace
@@ -310,7 +318,7 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
     if (static_cast<long long>(spec.columns) * spec.rows > 1'000'000)
         r.fail("tiles", "expected at most a million tiles, got " + describe(*r.find("tiles")));
     const auto size =
-        r.ints("tile_size_px", 2, 1, kMaxTileSide, "two integers (width, height) in [1, 32768]");
+        r.ints("tile_size_px", 2, 1, kMaxTilePx, "two integers in [1, 32768] (width, height)");
     spec.tile_width_px = size[0];
     spec.tile_height_px = size[1];
     Bezels& b = spec.bezel_px;
@@ -331,17 +339,13 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
             "expected vertical overlap (-(top + bottom) = " + std::to_string(-(b.top + b.bottom)) +
                 " px) less than the tile height " + std::to_string(spec.tile_height_px));
 
-    check_screen_size(r, spec);
+    check_screen_size(where, bezel_field, spec);
     if (r.find("tile")) read_overrides(r, spec);
     return spec;
 }
 
 WallSpec load_wall(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string(), "file", "cannot be opened");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_wall(text.str(), path.string());
+    return parse_wall(read_input_file(path, "file", kMaxWallFileBytes), path.string());
 }
 
 }  // namespace isowall

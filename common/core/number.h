@@ -1,0 +1,52 @@
+#pragma once
+// Every number that enters the program (an option, a script line, a wall file) is read here: the
+// whole text must spell one finite number, and the number must lie in a documented range. NaN,
+// infinity, "1e999" and values that would make the view degenerate stop at the door with one line
+// naming the source and the field, instead of a black image and exit 0.
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace isowall {
+
+struct NumberRange {
+    double lo = 0, hi = 0;
+    bool lo_open = false;  // (lo, hi] rather than [lo, hi]
+    bool integer = false;  // whole numbers only
+
+    bool contains(double v) const;
+    // "a number in [1e-06, 1e+06]", "an integer in [0, 9.0072e+15]", "a number in (0, 180]"
+    std::string describe() const;
+};
+
+// The ranges of the program's numbers, in one place (README, "Numbers").
+namespace limits {
+inline constexpr double kMaxFinite = 1.7976931348623157e308;
+inline constexpr NumberRange kAnyFinite{-kMaxFinite, kMaxFinite};
+// Orbit angles are reduced modulo 360; past a million degrees a float has lost the fraction.
+inline constexpr NumberRange kAngleDeg{-1e6, 1e6};
+inline constexpr NumberRange kZoom{1e-6, 1e6};
+inline constexpr NumberRange kPan{-1e3, 1e3};         // screen widths / heights
+inline constexpr NumberRange kCoordinate{-1e6, 1e6};  // look-at eye and target, object units
+inline constexpr NumberRange kPercent{0, 100, true};  // --snapshots
+inline constexpr NumberRange kSeconds{0, 1e6, true};  // --timeout, --startup-timeout
+inline constexpr NumberRange kWaitSeconds{0, 1e6};    // `wait time`
+inline constexpr NumberRange kRayCount{0, 9007199254740992.0, false, true};  // 2^53
+inline constexpr NumberRange kCutoffDeg{0, 180, true};
+inline constexpr NumberRange kFoldbackDeg{0, 180};
+inline constexpr NumberRange kCellCount{1, 2147483647.0, false, true};
+}  // namespace limits
+
+// The finite number `text` spells, all of it (decimal or exponent form, an optional sign), or
+// nullopt: "nan", "inf", "1e999", "0x10", "5abc" and "" are not numbers.
+std::optional<double> parse_number(std::string_view text);
+
+// Why `text` is not a number in `range`, or empty: e.g.
+// `expected a number in [1e-06, 1e+06], got "0"`.
+std::string number_problem(std::string_view text, const NumberRange& range);
+
+// The number, or InputError(where, field, number_problem(...)).
+double checked_number(std::string_view text, const NumberRange& range, const std::string& where,
+                      const std::string& field);
+
+}  // namespace isowall
