@@ -115,8 +115,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
 // A tile waits for the master's start (the volume is loaded and its octree cached, so the tile
 // maps the same files rather than building its own), for at most the start-up limit.
 void await_start(Comm& comm, double timeout_s) {
-    // Tiles after the first wait a little longer, so that one names a lost master, not all.
-    const double limit_s = timeout_s + 0.5 * std::min(comm.rank() - 1, 8);
+    const double limit_s = timeout_s + tile_grace_s(comm.rank());
     Stopwatch waited;
     while (waited.seconds() < limit_s) {
         auto e = comm.receive(kMasterRank, 0.05);

@@ -71,9 +71,7 @@ class Receiver {
         }
     }
 
-    // Tiles other than the first wait a little longer, so that when the master is gone one tile
-    // names it before mpirun ends the others.
-    double limit_s() const { return timeout_s_ + 0.5 * std::min(comm_.rank() - 1, 8); }
+    double limit_s() const { return timeout_s_ + tile_grace_s(comm_.rank()); }
 
     std::runtime_error silent_master() const {
         char msg[200];

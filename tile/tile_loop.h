@@ -34,6 +34,12 @@ struct TileSetup {
     int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up
 };
 
+// How much longer than a limit a tile rank waits before it names a silent master: ranks after the
+// first wait a little longer each, so that one names it before mpirun ends the others.
+inline double tile_grace_s(int rank) {
+    return 0.5 * (rank <= 1 ? 0 : rank - 1 < 8 ? rank - 1 : 8);
+}
+
 // Returns 0 after quit; throws on any failure (the caller's single failure path reports it).
 int run_tile(Comm& comm, TileSetup& setup);
 
