@@ -113,6 +113,24 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
     return true;
 }
 
+// Teem formats its parse errors, which quote the field's value, into a fixed buffer of about
+// 1 KiB (biff), and overflows it for a long value (found by fuzz/fuzz_nrrd.cpp: a "type:" of 1.7
+// KB ended in a fortify abort). A field line Teem parses is at most kMaxTeemLine bytes; comments
+// and key/value pairs, which Teem keeps without parsing, may be longer.
+constexpr std::size_t kMaxTeemLine = 512;
+
+void check_teem_line(std::string_view line, const std::string& where) {
+    if (line.size() <= kMaxTeemLine || line.substr(0, 1) == "#" ||
+        line.find(":=") != std::string_view::npos)
+        return;
+    const std::size_t colon = line.find(':');
+    const std::string field =
+        colon == std::string_view::npos ? "header" : std::string(trim(line.substr(0, colon)));
+    throw InputError(where, field,
+                     "a line of " + std::to_string(line.size()) + " bytes; expected at most " +
+                         std::to_string(kMaxTeemLine));
+}
+
 }  // namespace
 
 NrrdHeaderText split_nrrd_header(std::span<const std::byte> file, const std::string& where) {
@@ -136,6 +154,7 @@ NrrdHeaderText split_nrrd_header(std::span<const std::byte> file, const std::str
         const std::size_t end = std::min(text.find('\n', pos), text.size());
         const std::string_view line = text.substr(pos, end - pos);
         if (!take_field(h, line, where, seen)) {
+            check_teem_line(line, where);
             h.teem_text += line;
             h.teem_text += '\n';
         }
