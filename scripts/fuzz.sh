@@ -5,6 +5,8 @@
 # build-fuzz/fuzz-findings/NAME/ (crash-*, timeout-*, oom-*, leak-*). Exits 1 when any harness
 # found something; copy the finding to fuzz/regressions/NAME/ and fix it.
 #   scripts/fuzz.sh [SECONDS] [HARNESS...]     e.g. scripts/fuzz.sh 300 wire
+# ISOWALL_FUZZ_SEED=N fixes libFuzzer's seed (CI does, so that a run finds something only when the
+# code changed); unset, every run explores anew.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-30}
@@ -46,7 +48,7 @@ for h in "${HARNESSES[@]}"; do
     echo "fuzz: $h for ${SECONDS_EACH}s"
     if ! ASAN_OPTIONS="$(asan_options "$h")" \
         UBSAN_OPTIONS=print_stacktrace=1 "$BUILD/fuzz/fuzz_$h" "$work" "${seeds[@]}" \
-        -max_total_time="$SECONDS_EACH" -timeout=5 -rss_limit_mb=2048 \
+        -max_total_time="$SECONDS_EACH" -timeout=5 -rss_limit_mb=2048 -seed="${ISOWALL_FUZZ_SEED:-0}" \
         $(harness_flags "$h") "${dict[@]}" \
         -artifact_prefix="$findings/" -print_final_stats=1 > "$findings/log.txt" 2>&1; then
         failed+=("$h")
