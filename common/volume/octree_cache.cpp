@@ -8,6 +8,9 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <stdexcept>
+
+#include "common/core/output_files.h"
 
 namespace isowall {
 
@@ -150,32 +153,26 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
            const FiniteRange& range, std::string* why) {
     std::error_code ec;
     std::filesystem::create_directories(file.parent_path(), ec);
-    // A per-process temporary name, renamed at the end: ranks that build at once never read a
-    // half-written file, and the last rename wins with identical content.
-    auto tmp = file;
-    tmp += ".tmp" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        Header h = header_for(key, nodes.size());
-        h.node_checksum = checksum(nodes);
-        h.has_finite = range.any ? 1 : 0;
-        h.finite_min = range.min;
-        h.finite_max = range.max;
-        char pad[kNodeOffset] = {};
-        std::memcpy(pad, &h, sizeof(h));
-        out.write(pad, kNodeOffset);
-        out.write(reinterpret_cast<const char*>(nodes.data()),
-                  static_cast<std::streamsize>(nodes.size()));
-        if (!out) {
-            if (why) *why = "cannot write cache file " + tmp.string();
-            std::filesystem::remove(tmp, ec);
-            return false;
-        }
-    }
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) {
-        if (why) *why = "cannot rename cache file: " + ec.message();
-        std::filesystem::remove(tmp, ec);
+    // Through the one temp-then-rename helper: ranks that build at once never read a half-written
+    // file (each writes its own temporary, the last rename wins with identical content), and a
+    // signal mid-write leaves no temporary. A cache that cannot be written is a note, not an error.
+    try {
+        write_output(file, [&](const std::filesystem::path& tmp) {
+            std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+            Header h = header_for(key, nodes.size());
+            h.node_checksum = checksum(nodes);
+            h.has_finite = range.any ? 1 : 0;
+            h.finite_min = range.min;
+            h.finite_max = range.max;
+            char pad[kNodeOffset] = {};
+            std::memcpy(pad, &h, sizeof(h));
+            out.write(pad, kNodeOffset);
+            out.write(reinterpret_cast<const char*>(nodes.data()),
+                      static_cast<std::streamsize>(nodes.size()));
+            if (!out) throw std::runtime_error("cannot write cache file " + file.string());
+        });
+    } catch (const std::exception& e) {
+        if (why) *why = e.what();
         return false;
     }
     return true;
