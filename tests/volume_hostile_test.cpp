@@ -189,6 +189,9 @@ std::vector<BadCase> field_cases([[maybe_unused]] const Scene& s) {
          "NRRD0004\ntype: int64\ndimension: 3\nsizes: 2 2 2\nendian: little\n" + raw +
              "data file: v.raw\n",
          "type", "unsupported"},
+        {"content_long_kv_mark.nhdr",
+         kU8 + s222 + "content: " + std::string(1500, 'x') + " :=1\n" + raw + "data file: v.raw\n",
+         "content", "expected at most 512"},
         {"zrl.nrrd", kU8 + s222 + "encoding: zrl\n\n" + std::string(8, '\0'), "encoding",
          "not supported"},
         {"spacing_inf.nhdr", kU8 + s222 + "spacings: 1e300 1 1\n" + raw + "data file: v.raw\n",

@@ -119,10 +119,15 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
 // and key/value pairs, which Teem keeps without parsing, may be longer.
 constexpr std::size_t kMaxTeemLine = 512;
 
+// Teem reads a line as a key/value pair only when its ":=" comes before any ": "; a line such as
+// "type: <long value> :=" is a field to Teem, and so is bounded (found by fuzz/fuzz_nrrd.cpp).
+bool is_key_value(std::string_view line) {
+    const std::size_t equals = line.find(":=");
+    return equals != std::string_view::npos && equals < line.find(": ");
+}
+
 void check_teem_line(std::string_view line, const std::string& where) {
-    if (line.size() <= kMaxTeemLine || line.substr(0, 1) == "#" ||
-        line.find(":=") != std::string_view::npos)
-        return;
+    if (line.size() <= kMaxTeemLine || line.substr(0, 1) == "#" || is_key_value(line)) return;
     const std::size_t colon = line.find(':');
     const std::string field =
         colon == std::string_view::npos ? "header" : std::string(trim(line.substr(0, colon)));
