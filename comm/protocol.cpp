@@ -130,6 +130,33 @@ static ImageMsg decode_image(std::span<const std::byte> bytes) {
     return m;
 }
 
+std::vector<std::byte> encode(const PreviewMsg& m) {
+    MessageWriter w(PreviewMsg::kVersion);
+    w.put(m.generation);
+    w.put(m.width);
+    w.put(m.height);
+    w.put_bytes(std::as_bytes(std::span(m.rgb)));
+    return w.take();
+}
+
+static PreviewMsg decode_preview(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, PreviewMsg::kVersion, "preview message");
+    PreviewMsg m;
+    m.generation = r.get<std::uint64_t>();
+    // At least one pixel: the control window scales a preview to its tile, dividing by its size.
+    m.width = get_side(r, "width", 1, kMaxPreviewSide);
+    m.height = get_side(r, "height", 1, kMaxPreviewSide);
+    const std::uint64_t expected = std::uint64_t(m.width) * std::uint64_t(m.height) * 3;
+    const auto rgb = r.get_bytes();  // its length is checked against the message first
+    if (rgb.size() != expected)
+        r.fail("rgb: expected " + std::to_string(expected) + " bytes, got " +
+               std::to_string(rgb.size()));
+    const auto* first = reinterpret_cast<const std::uint8_t*>(rgb.data());
+    m.rgb.assign(first, first + rgb.size());
+    r.finish();
+    return m;
+}
+
 std::vector<std::byte> encode(const QuitMsg&) {
     return MessageWriter(QuitMsg::kVersion).take();
 }
@@ -230,6 +257,8 @@ const char* to_string(Tag tag) {
             return "start";
         case Tag::alive:
             return "alive";
+        case Tag::preview:
+            return "preview";
         case Tag::job:
             return "job";
         case Tag::job_done:
@@ -265,6 +294,8 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_start(bytes);
         case Tag::alive:
             return job_wire::decode_alive(bytes);
+        case Tag::preview:
+            return decode_preview(bytes);
         case Tag::job:
             return job_wire::decode_job(bytes);
         case Tag::job_done:
@@ -275,7 +306,7 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_landed(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
-                    ": unknown tag, expected 1..10 or 16..19");
+                    ": unknown tag, expected 1..11 or 16..19");
 }
 
 }  // namespace isowall

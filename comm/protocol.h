@@ -27,6 +27,7 @@ enum class Tag : std::int32_t {
     release = 8,      // master -> tile: every rank has sent its result; exit now
     start = 9,        // master -> tile: the volume and its octree cache are ready; load them
     alive = 10,       // both ways, every kAliveIntervalS: the sender's message loop is running
+    preview = 11,     // tile -> master (--control): a small copy of what the tile shows now
     job = 16,         // master -> worker: fill a screen region of a tile (its own or another's)
     job_done = 17,    // worker -> master: the job's figures; the worker is free for the next
     region = 18,      // worker -> owner: colour and depth of a region it filled for the owner
@@ -124,6 +125,21 @@ struct AliveMsg {
     static constexpr std::uint8_t kVersion = 1;
 };
 
+// Largest side of a preview: a whole wall fits in a control window of 1024x768
+// (common/wall/control_layout.h), so a tile never needs more.
+inline constexpr int kMaxPreviewSide = 1024;
+
+// With --control, each tile sends the master a scaled-down copy of what it shows (comm/preview.h:
+// make_preview) while a frame builds and when it ends; the master's control window shows them
+// as a live mosaic of the wall. RGB, not RGBA: a preview is only looked at.
+struct PreviewMsg {
+    static constexpr Tag kTag = Tag::preview;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;            // of the view the tile shows
+    std::int32_t width = 1, height = 1;      // 1..kMaxPreviewSide each
+    std::vector<std::uint8_t> rgb{0, 0, 0};  // width * height * 3, row 0 at the top
+};
+
 // Which ray-order levels of a region a job casts: the coarse levels (until about 1/16 of the
 // region's rays) or the rest. Coarse jobs of every tile go before fine jobs anywhere.
 enum class Band : std::uint8_t { coarse = 0, fine = 1 };
@@ -169,9 +185,9 @@ struct LandedMsg {
     std::uint32_t job = 0;
 };
 
-using Message =
-    std::variant<HelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg, TileResultMsg,
-                 ReleaseMsg, StartMsg, AliveMsg, JobMsg, JobDoneMsg, RegionMsg, LandedMsg>;
+using Message = std::variant<HelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
+                             TileResultMsg, ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg,
+                             JobDoneMsg, RegionMsg, LandedMsg>;
 
 std::vector<std::byte> encode(const HelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -183,6 +199,7 @@ std::vector<std::byte> encode(const TileResultMsg& m);
 std::vector<std::byte> encode(const ReleaseMsg& m);
 std::vector<std::byte> encode(const StartMsg& m);
 std::vector<std::byte> encode(const AliveMsg& m);
+std::vector<std::byte> encode(const PreviewMsg& m);
 std::vector<std::byte> encode(const JobMsg& m);
 std::vector<std::byte> encode(const JobDoneMsg& m);
 std::vector<std::byte> encode(const RegionMsg& m);

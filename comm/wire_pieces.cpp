@@ -79,10 +79,15 @@ Frustum get_frustum(MessageReader& r) {
 }  // namespace
 
 std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px) {
+    return get_side(r, field, min_px, kMaxImageSide);
+}
+
+std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px,
+                      std::int32_t max_px) {
     const auto v = r.get<std::int32_t>();
-    if (v < min_px || v > kMaxImageSide)
+    if (v < min_px || v > max_px)
         r.fail(std::string(field) + ": expected " + std::to_string(min_px) + ".." +
-               std::to_string(kMaxImageSide) + ", got " + std::to_string(v));
+               std::to_string(max_px) + ", got " + std::to_string(v));
     return v;
 }
 

@@ -24,9 +24,11 @@ F get_finite(MessageReader& r, const char* field) {
 
 void put_frame_view(MessageWriter& w, const FrameView& v);
 FrameView get_frame_view(MessageReader& r);
-// A side read from the wire, checked against [min_px, kMaxImageSide] before anything is sized
-// from it.
+// A side read from the wire, checked against [min_px, max_px] (by default kMaxImageSide) before
+// anything is sized from it.
 std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px);
+std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px,
+                      std::int32_t max_px);
 void put_pixel_rect(MessageWriter& w, const PixelRect& p);
 PixelRect get_pixel_rect(MessageReader& r);
 // p lies inside a width x height screen (computed in 64 bits).

@@ -75,7 +75,7 @@ TEST(ProtocolMalformed, TrailingByteThrows) {
 
 TEST(ProtocolMalformed, UnknownTagThrows) {
     const Bytes bytes = encode(QuitMsg{});
-    for (std::int32_t tag : {0, 11, 15, 20, 31, -1, std::numeric_limits<std::int32_t>::max()})
+    for (std::int32_t tag : {0, 12, 15, 20, 31, -1, std::numeric_limits<std::int32_t>::max()})
         EXPECT_THROW(decode_message(static_cast<Tag>(tag), bytes), WireError) << "tag " << tag;
 }
 
@@ -230,6 +230,50 @@ TEST(ProtocolMalformed, ImageWithAHugeCountThrowsWithoutAllocating) {
     }
 }
 
+// ---- preview ------------------------------------------------------------------------------------
+
+struct PreviewFault {
+    const char* field;
+    void (*apply)(PreviewMsg&);
+};
+
+TEST(ProtocolMalformed, PreviewFaultsThrowNamingTheField) {
+    const PreviewFault faults[] = {
+        {"width", [](PreviewMsg& m) { m.width = 0; }},  // the window divides by the size
+        {"width", [](PreviewMsg& m) { m.width = -1; }},
+        {"width", [](PreviewMsg& m) { m.width = kMaxPreviewSide + 1; }},
+        {"height", [](PreviewMsg& m) { m.height = 0; }},
+        {"height", [](PreviewMsg& m) { m.height = std::numeric_limits<std::int32_t>::max(); }},
+        {"rgb", [](PreviewMsg& m) { m.rgb.pop_back(); }},
+        {"rgb", [](PreviewMsg& m) { m.rgb.push_back(0); }},
+        {"rgb", [](PreviewMsg& m) { m.rgb.clear(); }},
+        {"rgb", [](PreviewMsg& m) { m.rgb.resize(3 * 2 * 4); }},  // RGBA, not RGB
+        {"rgb", [](PreviewMsg& m) { m.width = 2; }},              // sizes no longer match
+    };
+    for (const PreviewFault& f : faults) {
+        PreviewMsg m = sample_preview();
+        f.apply(m);
+        SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
+        expect_wire_error(Tag::preview, encode(m), f.field);
+    }
+}
+
+TEST(ProtocolMalformed, PreviewWithAHugeLengthThrowsWithoutAllocating) {
+    for (std::uint64_t length : {kHugeCount, std::numeric_limits<std::uint64_t>::max(),
+                                 std::uint64_t{kMaxPreviewSide} * kMaxPreviewSide * 3}) {
+        MessageWriter w(PreviewMsg::kVersion);
+        w.put(std::uint64_t{1});
+        w.put(std::int32_t{kMaxPreviewSide});
+        w.put(std::int32_t{kMaxPreviewSide});
+        w.put(length);
+        w.put(std::uint32_t{0});  // 4 bytes of pixels, far fewer than the length
+        const Bytes bytes = w.take();
+        const auto largest =
+            largest_allocation_in([&] { expect_wire_error(Tag::preview, bytes, "length"); });
+        EXPECT_LT(largest, 4096u) << "length " << length;
+    }
+}
+
 // ---- tile result --------------------------------------------------------------------------------
 
 TEST(ProtocolMalformed, TileResultWithABadStageThrows) {
@@ -310,8 +354,8 @@ std::string mutate(Bytes& b, Tag& tag, std::mt19937_64& rng) {
             return "word at " + std::to_string(at);
         }
         default: {
-            // 1..11: every frame tag and one unknown one
-            tag = static_cast<Tag>(1 + rng() % 11);
+            // 1..12: every frame tag and one unknown one
+            tag = static_cast<Tag>(1 + rng() % 12);
             return "tag " + std::to_string(static_cast<int>(tag));
         }
     }

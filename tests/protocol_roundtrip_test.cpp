@@ -33,6 +33,7 @@ TEST(Protocol, DegenerateMessagesRoundTrip) {
     expect_round_trip(ReleaseMsg{});
     expect_round_trip(StartMsg{});
     expect_round_trip(AliveMsg{});
+    expect_round_trip(PreviewMsg{});  // one black pixel
     expect_round_trip(JobDoneMsg{});
     expect_round_trip(LandedMsg{});
 }
@@ -71,6 +72,18 @@ TEST(Protocol, QuitRoundTrips) {
 }
 TEST(Protocol, TileResultRoundTrips) {
     expect_round_trip(sample_tile_result());
+}
+TEST(Protocol, PreviewRoundTrips) {
+    expect_round_trip(sample_preview());
+}
+TEST(Protocol, PreviewAtTheLimitsRoundTrips) {
+    PreviewMsg m;
+    m.width = kMaxPreviewSide;
+    m.height = 1;
+    m.rgb.assign(std::size_t{kMaxPreviewSide} * 3, 0xab);
+    expect_round_trip(m);
+    std::swap(m.width, m.height);
+    expect_round_trip(m);
 }
 TEST(Protocol, JobRoundTrips) {
     expect_round_trip(sample_job());
@@ -126,12 +139,13 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::release), "release");
     EXPECT_STREQ(to_string(Tag::start), "start");
     EXPECT_STREQ(to_string(Tag::alive), "alive");
+    EXPECT_STREQ(to_string(Tag::preview), "preview");
     EXPECT_STREQ(to_string(Tag::job), "job");
     EXPECT_STREQ(to_string(Tag::job_done), "job_done");
     EXPECT_STREQ(to_string(Tag::region), "region");
     EXPECT_STREQ(to_string(Tag::landed), "landed");
     EXPECT_STREQ(to_string(static_cast<Tag>(0)), "unknown");
-    EXPECT_STREQ(to_string(static_cast<Tag>(11)), "unknown");
+    EXPECT_STREQ(to_string(static_cast<Tag>(12)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(20)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }

@@ -83,6 +83,10 @@ inline bool operator==(const StartMsg&, const StartMsg&) {
 inline bool operator==(const AliveMsg&, const AliveMsg&) {
     return true;
 }
+inline bool operator==(const PreviewMsg& a, const PreviewMsg& b) {
+    return a.generation == b.generation && a.width == b.width && a.height == b.height &&
+           a.rgb == b.rgb;
+}
 inline bool operator==(const JobMsg& a, const JobMsg& b) {
     return a.generation == b.generation && a.job == b.job && a.owner == b.owner &&
            a.band == b.band && a.view == b.view && a.rect == b.rect;
@@ -145,6 +149,10 @@ inline void PrintTo(const StartMsg&, std::ostream* os) {
 }
 inline void PrintTo(const AliveMsg&, std::ostream* os) {
     *os << "AliveMsg{}";
+}
+inline void PrintTo(const PreviewMsg& m, std::ostream* os) {
+    *os << "PreviewMsg{generation " << m.generation << ", " << m.width << "x" << m.height << ", "
+        << m.rgb.size() << " rgb bytes}";
 }
 inline void PrintTo(const JobMsg& m, std::ostream* os) {
     *os << "JobMsg{generation " << m.generation << ", job " << m.job << ", owner " << m.owner
@@ -241,6 +249,16 @@ inline ImageMsg sample_image() {
     return m;
 }
 
+inline PreviewMsg sample_preview() {
+    PreviewMsg m;
+    m.generation = 0x0807060504030201ULL;
+    m.width = 3;
+    m.height = 2;
+    m.rgb.clear();
+    for (int i = 0; i < 3 * 2 * 3; ++i) m.rgb.push_back(static_cast<std::uint8_t>(13 * i + 5));
+    return m;
+}
+
 inline TileResultMsg sample_tile_result() {
     TileResultMsg m;
     m.host = "tile-07.cluster";
@@ -280,6 +298,7 @@ inline std::vector<Sample> samples() {
             {"release", Tag::release, encode(ReleaseMsg{})},
             {"start", Tag::start, encode(StartMsg{})},
             {"alive", Tag::alive, encode(AliveMsg{})},
+            {"preview", Tag::preview, encode(sample_preview())},
             {"job", Tag::job, encode(sample_job())},
             {"job_done", Tag::job_done, encode(sample_job_done())},
             {"region", Tag::region, encode(sample_region())},

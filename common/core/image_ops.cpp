@@ -1,5 +1,7 @@
 #include "common/core/image_ops.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 
 namespace isowall {
@@ -21,6 +23,58 @@ void place(Image& dst, const Image& src, const PixelRect& where) {
         if (depth) dst.depth[d] = src.depth[s];
         for (int k = 0; k < 4; ++k) dst.rgba[4 * d + k] = src.rgba[4 * s + k];
     });
+}
+
+int shrink_factor(int width, int height, int max_side) {
+    const int side = std::max({width, height, 1});
+    const int limit = std::max(max_side, 1);
+    return (side + limit - 1) / limit;
+}
+
+Image shrink_box(const Image& src, int factor) {
+    const int f = std::max(factor, 1);
+    Image out;
+    out.width = (src.width + f - 1) / f;
+    out.height = (src.height + f - 1) / f;
+    out.rgba.assign(out.pixel_count() * 4, 255);
+    for (int oy = 0; oy < out.height; ++oy) {
+        const int y0 = oy * f, y1 = std::min(y0 + f, src.height);
+        for (int ox = 0; ox < out.width; ++ox) {
+            const int x0 = ox * f, x1 = std::min(x0 + f, src.width);
+            std::uint32_t sum[3] = {0, 0, 0};
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) {
+                    const std::size_t s = 4 * (static_cast<std::size_t>(y) * src.width + x);
+                    for (int k = 0; k < 3; ++k) sum[k] += src.rgba[s + k];
+                }
+            const auto n = static_cast<std::uint32_t>((y1 - y0) * (x1 - x0));
+            const std::size_t o = 4 * (static_cast<std::size_t>(oy) * out.width + ox);
+            for (int k = 0; k < 3; ++k)
+                out.rgba[o + k] = static_cast<std::uint8_t>((sum[k] + n / 2) / n);
+        }
+    }
+    return out;
+}
+
+Image resample_nearest(const Image& src, int width, int height) {
+    Image out;
+    out.width = std::max(width, 0);
+    out.height = std::max(height, 0);
+    out.rgba.assign(out.pixel_count() * 4, 0);
+    for (std::size_t i = 0; i < out.pixel_count(); ++i) out.rgba[4 * i + 3] = 255;
+    if (src.width < 1 || src.height < 1) return out;
+    for (int y = 0; y < out.height; ++y) {
+        // The source pixel under the centre of this one, in 64 bits (sides up to 32768 each).
+        const auto sy = static_cast<int>((2 * std::int64_t{y} + 1) * src.height / (2 * out.height));
+        for (int x = 0; x < out.width; ++x) {
+            const auto sx =
+                static_cast<int>((2 * std::int64_t{x} + 1) * src.width / (2 * out.width));
+            const std::size_t s = 4 * (static_cast<std::size_t>(sy) * src.width + sx);
+            const std::size_t o = 4 * (static_cast<std::size_t>(y) * out.width + x);
+            for (int k = 0; k < 3; ++k) out.rgba[o + k] = src.rgba[s + k];
+        }
+    }
+    return out;
 }
 
 }  // namespace isowall

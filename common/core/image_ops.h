@@ -34,4 +34,20 @@ void composite_by_depth(Image& dst, const Image& src, const PixelRect& where);
 // Copies `src` into `where` of dst, colour and depth (where dst has depth).
 void place(Image& dst, const Image& src, const PixelRect& where);
 
+// The smallest integer factor f >= 1 that brings both sides of a width x height image to at most
+// max_side pixels once divided by f (rounded up): the factor shrink_box needs for a preview of at
+// most max_side a side. max_side < 1 counts as 1.
+int shrink_factor(int width, int height, int max_side);
+
+// `src` made `factor` times smaller (each side rounded up): each pixel is the rounded mean colour
+// of its factor x factor box of src, boxes at the right and bottom edges clipped to the image (a
+// box filter, so a thin line fades instead of vanishing as with point sampling). Alpha is 255,
+// no depth. factor < 1 counts as 1 (a copy).
+Image shrink_box(const Image& src, int factor);
+
+// `src` stretched or squeezed to width x height by nearest-neighbour sampling (each output pixel
+// takes the src pixel under its centre); colour only, alpha 255, no depth. An empty src gives
+// black.
+Image resample_nearest(const Image& src, int width, int height);
+
 }  // namespace isowall
