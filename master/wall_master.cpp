@@ -34,6 +34,7 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     if (std::string p = camera_problem(camera_); !p.empty())
         throw InputError("--orbit/--zoom/--pan", "value", p);
     tiles_.resize(static_cast<std::size_t>(comm.size()));
+    previews_.resize(tiles_.size());
 }
 
 void WallMaster::handle(const Envelope& e) {
@@ -66,6 +67,11 @@ void WallMaster::handle(const Envelope& e) {
                 std::to_string(img->width) + "x" + std::to_string(img->height) + ", expected " +
                 std::to_string(r.width) + "x" + std::to_string(r.height) + ")");
         t.image = std::move(*img);
+    } else if (auto* pv = std::get_if<PreviewMsg>(&m)) {
+        if (pv->generation == generation_) {  // an older one shows a view the wall has left
+            previews_[static_cast<std::size_t>(e.from)] = std::move(*pv);
+            ++previews_taken_;
+        }
     } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
         raise_test_signal(o_.fault, "gather");
         t.result = std::move(*res);

@@ -60,6 +60,17 @@ class WallMaster {
 
     std::uint64_t generation() const { return generation_; }
     std::uint64_t total_rays() const;
+    // Every tile has finished the current frame.
+    bool frame_done() const { return board_ && board_->complete(); }
+    double iso() const { return iso_; }
+    double value_min() const { return lo_; }
+    double value_max() const { return hi_; }
+    // For the control window (--control): the latest preview of each tile rank ([0], the
+    // master's, stays empty). A preview of an older frame than the current one is dropped when it
+    // comes; one already kept stays until its tile sends one of the new frame, so the window
+    // keeps a picture while a frame starts. previews_taken() grows with every preview kept.
+    const std::vector<std::optional<PreviewMsg>>& previews() const { return previews_; }
+    std::uint64_t previews_taken() const { return previews_taken_; }
 
   private:
     struct TileState {
@@ -77,7 +88,6 @@ class WallMaster {
     void handle_job(int from, const Message& m);
     // Hands `rank` jobs until it holds as many as the board allows.
     void fill(int rank);
-    bool frame_done() const { return board_ && board_->complete(); }
     // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
     // naming the tiles still awaited.
     void wait_until(const std::function<bool()>& done, double timeout_s);
@@ -113,7 +123,9 @@ class WallMaster {
     std::optional<JobBoard> board_;      // the current generation's jobs
     std::vector<Migration> migrations_;  // of the current generation
     Stopwatch alive_sent_, alive_checked_;
-    std::function<bool(const TileState&)> awaited_;  // set by wait_for_tiles, for waiting_on
+    std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on
+    std::vector<std::optional<PreviewMsg>> previews_;  // by rank
+    std::uint64_t previews_taken_ = 0;
 };
 
 }  // namespace isowall

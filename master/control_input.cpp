@@ -1,0 +1,133 @@
+#include "master/control_input.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <utility>
+
+namespace isowall {
+namespace {
+
+// %g of a number that is a sum of small steps: no "-0".
+std::string number(double v, int digits = 6) {
+    char buf[40];
+    std::snprintf(buf, sizeof(buf), "%.*g", digits, v + 0.0);
+    return buf;
+}
+
+// How many isovalue steps a key is worth (0: not an isovalue key).
+double iso_steps_of(const std::string& key) {
+    if (key == "Up" || key == "plus" || key == "KP_Add" || key == "equal") return 1;
+    if (key == "Down" || key == "minus" || key == "KP_Subtract") return -1;
+    if (key == "Page_Up" || key == "Prior") return 10;
+    if (key == "Page_Down" || key == "Next") return -10;
+    return 0;
+}
+
+}  // namespace
+
+std::string snapshot_name(int n) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "control-%03d", n);
+    return buf;
+}
+
+std::string iso_line(double iso, double lo, double hi) {
+    for (int digits : {6, 9, 17}) {
+        const std::string v = number(iso, digits);
+        const double back = std::strtod(v.c_str(), nullptr);
+        if ((back >= lo && back <= hi) || digits == 17) return "iso " + v;
+    }
+    return "iso " + number(iso, 17);  // not reached
+}
+
+void ControlInput::accumulate(Pending kind, std::vector<std::string>& out) {
+    if (pending_ != kind) flush(out);
+    pending_ = kind;
+}
+
+void ControlInput::flush(std::vector<std::string>& out) {
+    const Pending kind = std::exchange(pending_, Pending::none);
+    if (kind == Pending::orbit && (drag_x_ != 0 || drag_y_ != 0)) {
+        out.push_back("orbit " + number(-drag_x_ * kOrbitDegPerPx) + " " +
+                      number(-drag_y_ * kOrbitDegPerPx));
+    } else if (kind == Pending::pan && (drag_x_ != 0 || drag_y_ != 0)) {
+        out.push_back("pan " + number(-drag_x_ / std::max(state_.mosaic_width, 1)) + " " +
+                      number(drag_y_ / std::max(state_.mosaic_height, 1)));
+    } else if (kind == Pending::zoom && zoom_steps_ != 0) {
+        out.push_back("zoom " + number(std::pow(kZoomStep, zoom_steps_)));
+    } else if (kind == Pending::iso && iso_steps_ != 0) {
+        const double range = state_.value_max - state_.value_min;
+        const double iso = std::clamp(state_.iso + iso_steps_ * kIsoStep * range,
+                                      state_.value_min, state_.value_max);
+        if (iso != state_.iso) {
+            out.push_back(iso_line(iso, state_.value_min, state_.value_max));
+            // The next iso key of this poll starts from the value just asked for.
+            state_.iso = std::strtod(out.back().c_str() + 4, nullptr);
+        }
+    }
+    drag_x_ = drag_y_ = 0;
+    zoom_steps_ = 0;
+    iso_steps_ = 0;
+}
+
+void ControlInput::drag_to(int x, int y) {
+    if (left_down_ || right_down_) {
+        drag_x_ += x - last_x_;
+        drag_y_ += y - last_y_;
+    }
+    last_x_ = x;
+    last_y_ = y;
+}
+
+void ControlInput::key(const std::string& name, std::vector<std::string>& out) {
+    if (const double steps = iso_steps_of(name); steps != 0) {
+        accumulate(Pending::iso, out);
+        iso_steps_ += steps;
+    } else if (name == "s" || name == "S") {
+        flush(out);
+        out.push_back("snapshot " + snapshot_name(next_snapshot_++));
+    } else if (name == "Escape") {
+        flush(out);
+        out.push_back("quit");
+        quit_ = true;
+    }
+}
+
+std::vector<std::string> ControlInput::commands(const std::vector<WindowEvent>& events,
+                                                const ControlState& state) {
+    std::vector<std::string> out;
+    state_ = state;
+    pending_ = Pending::none;
+    quit_ = false;
+    for (const WindowEvent& e : events) {
+        if (quit_) break;
+        using Kind = WindowEvent::Kind;
+        if (e.kind == Kind::motion || (e.kind == Kind::release && (e.button == 1 || e.button == 3))) {
+            if (left_down_ || right_down_) accumulate(left_down_ ? Pending::orbit : Pending::pan, out);
+            drag_to(e.x, e.y);
+            if (e.kind == Kind::release) (e.button == 1 ? left_down_ : right_down_) = false;
+        } else if (e.kind == Kind::press && (e.button == 1 || e.button == 3)) {
+            // A drag starts here; one with the other button held goes on as it was.
+            if (!left_down_ && !right_down_) {
+                last_x_ = e.x;
+                last_y_ = e.y;
+            }
+            (e.button == 1 ? left_down_ : right_down_) = true;
+        } else if (e.kind == Kind::press && (e.button == 4 || e.button == 5)) {
+            accumulate(Pending::zoom, out);
+            zoom_steps_ += e.button == 4 ? 1 : -1;
+        } else if (e.kind == Kind::key) {
+            key(e.key, out);
+        } else if (e.kind == Kind::close) {
+            flush(out);
+            out.push_back("quit");
+            quit_ = true;
+        }
+    }
+    flush(out);
+    return out;
+}
+
+}  // namespace isowall

@@ -1,0 +1,70 @@
+#pragma once
+// The control window's input as script lines: every mouse drag, wheel step and key becomes the
+// text of a command (orbit, pan, zoom, iso, snapshot, quit) that goes through parse_command and
+// WallMaster::execute like a line of a script or of the console, so the three drive one code
+// path and the operator can replay what the window printed as a script. Pure: no display.
+//
+//   left drag      orbit: kOrbitDegPerPx degrees per pixel (drag right turns the surface right,
+//                  drag down tilts its top towards the viewer)
+//   right drag     pan: the picture follows the pointer
+//   wheel up/down  zoom kZoomStep / 1/kZoomStep
+//   Up, plus       iso + kIsoStep of the value range (Down, minus: -); Page_Up/Page_Down: x10;
+//                  clamped to the range
+//   s              snapshot control-NNN (beside --out)
+//   Escape, close  quit
+#include <string>
+#include <vector>
+
+#include "display/x_window.h"
+
+namespace isowall {
+
+inline constexpr double kOrbitDegPerPx = 0.5;
+inline constexpr double kZoomStep = 1.25;
+inline constexpr double kIsoStep = 0.01;  // of the volume's value range, per key
+
+// What the mapping needs to know of the wall when the events are taken.
+struct ControlState {
+    double iso = 0, value_min = 0, value_max = 0;
+    int mosaic_width = 1, mosaic_height = 1;  // the wall in the window (pan is in screen sizes)
+};
+
+// "control-001" ...: the name of snapshot n.
+std::string snapshot_name(int n);
+
+// "iso V" with V written so that it reads back as itself inside [lo, hi] (six significant
+// digits when that suffices, so the line stays readable).
+std::string iso_line(double iso, double lo, double hi);
+
+class ControlInput {
+  public:
+    // Snapshots are numbered from `first_snapshot` (the first name not taken beside --out).
+    explicit ControlInput(int first_snapshot = 1) : next_snapshot_(first_snapshot) {}
+
+    // The script lines for the events of one poll, in order. Consecutive events of one kind
+    // merge into one command: a drag's motions into one orbit (or pan), wheel steps into one
+    // zoom, isovalue keys into one iso, so a burst of input starts one frame, not dozens.
+    // Nothing follows quit. Keys and buttons it does not know are ignored.
+    std::vector<std::string> commands(const std::vector<WindowEvent>& events,
+                                      const ControlState& state);
+
+  private:
+    enum class Pending { none, orbit, pan, zoom, iso };
+    void accumulate(Pending kind, std::vector<std::string>& out);
+    void flush(std::vector<std::string>& out);
+    void drag_to(int x, int y);
+    void key(const std::string& name, std::vector<std::string>& out);
+
+    int next_snapshot_;
+    bool left_down_ = false, right_down_ = false;  // drags last across polls
+    int last_x_ = 0, last_y_ = 0;
+    // Within one call:
+    ControlState state_;
+    Pending pending_ = Pending::none;
+    double drag_x_ = 0, drag_y_ = 0;  // pixels
+    int zoom_steps_ = 0;
+    double iso_steps_ = 0;  // in kIsoStep of the range
+    bool quit_ = false;
+};
+
+}  // namespace isowall

@@ -1,0 +1,45 @@
+#pragma once
+// The picture in the control window (isowall wall --control): the wall as a live mosaic of the
+// tiles' previews, bezels in grey, and a status bar with the isovalue, the frame and the keys.
+// Pure: composed from values, so it is tested without a display.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/core/image.h"
+#include "common/wall/control_layout.h"
+#include "master/control_text.h"
+
+namespace isowall {
+
+// Grey enough to tell apart from a black background and from a dark surface.
+inline constexpr Rgb kControlBezel{96, 96, 96};
+inline constexpr Rgb kControlStatusBackground{24, 24, 24};
+inline constexpr Rgb kControlStatusText{230, 230, 230};
+inline constexpr int kControlTextScale = 2;
+// Two lines of text under the mosaic.
+inline constexpr int kControlStatusHeight = 2 * (kGlyphHeight + 2) * kControlTextScale + 4;
+
+// What the status bar says.
+struct ControlStatus {
+    double iso = 0, value_min = 0, value_max = 0;
+    std::uint64_t frame = 0;  // the master's generation
+    bool done = false;        // every tile has finished the frame
+    std::string last;         // the last command the window gave, e.g. "orbit -30 0"
+};
+
+// The two lines of the status bar: the isovalue, its range, the frame and the last command;
+// then the keys.
+std::vector<std::string> status_lines(const ControlStatus& s);
+
+// The window's size for `layout`: the mosaic with the status bar under it.
+PixelSize control_window_size(const ControlLayout& layout);
+
+// The window's picture: bezel grey, each tile's preview (by tile index; an image of 0x0 when none
+// has come yet, shown black) scaled into its rect of the layout, a one-pixel grey frame round
+// every tile (so a seamless wall shows its seams too), and the status lines under the mosaic,
+// each cut to the window's width.
+Image compose_control(const ControlLayout& layout, const std::vector<Image>& previews,
+                      const std::vector<std::string>& status);
+
+}  // namespace isowall
