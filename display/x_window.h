@@ -29,6 +29,8 @@ struct WindowOptions {
     bool fullscreen = false;
     int width = 640, height = 480;
     bool input = false;  // deliver mouse and key events to poll()
+    // Try MIT-SHM first (off: always XPutImage, as with a display on another host).
+    bool shared_memory = true;
 };
 
 // One input event in window pixels (x right, y down).
@@ -57,7 +59,7 @@ class XWindow {
     std::vector<WindowEvent> poll();
     std::uint64_t id() const;  // the X window id (xdotool, xwd)
     const std::string& display_name() const;
-    bool shared_memory() const;  // presents through MIT-SHM
+    bool shared_memory() const;  // the last present went through MIT-SHM
 
   private:
     struct Impl;
