@@ -59,8 +59,8 @@ void ControlInput::flush(std::vector<std::string>& out) {
         out.push_back("zoom " + number(std::pow(kZoomStep, zoom_steps_)));
     } else if (kind == Pending::iso && iso_steps_ != 0) {
         const double range = state_.value_max - state_.value_min;
-        const double iso = std::clamp(state_.iso + iso_steps_ * kIsoStep * range,
-                                      state_.value_min, state_.value_max);
+        const double iso = std::clamp(state_.iso + iso_steps_ * kIsoStep * range, state_.value_min,
+                                      state_.value_max);
         if (iso != state_.iso) {
             out.push_back(iso_line(iso, state_.value_min, state_.value_max));
             // The next iso key of this poll starts from the value just asked for.
@@ -104,8 +104,10 @@ std::vector<std::string> ControlInput::commands(const std::vector<WindowEvent>& 
     for (const WindowEvent& e : events) {
         if (quit_) break;
         using Kind = WindowEvent::Kind;
-        if (e.kind == Kind::motion || (e.kind == Kind::release && (e.button == 1 || e.button == 3))) {
-            if (left_down_ || right_down_) accumulate(left_down_ ? Pending::orbit : Pending::pan, out);
+        if (e.kind == Kind::motion ||
+            (e.kind == Kind::release && (e.button == 1 || e.button == 3))) {
+            if (left_down_ || right_down_)
+                accumulate(left_down_ ? Pending::orbit : Pending::pan, out);
             drag_to(e.x, e.y);
             if (e.kind == Kind::release) (e.button == 1 ? left_down_ : right_down_) = false;
         } else if (e.kind == Kind::press && (e.button == 1 || e.button == 3)) {

@@ -66,6 +66,15 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     return re_cmd;
 }
 
+void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
+    wall_cmd.add_flag("--control", wall.control,
+                      "Open the control window on the master's display: a live mosaic of the "
+                      "wall; drag orbits, wheel zooms, Up/Down change the isovalue, s snapshots, "
+                      "Escape quits (after --script FILE, if given)");
+    wall_cmd.add_option("--control-display", wall.control_display,
+                        "X display of the control window (default $DISPLAY)");
+}
+
 CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     auto* wall_cmd = app.add_subcommand(
         "wall",
@@ -86,6 +95,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         "--script", wall.script,
         "Commands (orbit, look-at, zoom, pan, iso, wait, snapshot, quit), one per line; "
         "- reads them from the master's console");
+    add_control_options(*wall_cmd, wall);
     wall_cmd
         ->add_option("--timeout", wall.timeout_s,
                      "Seconds a silent tile rank may take before the job ends")

@@ -18,6 +18,7 @@
 #include "common/wall/script.h"
 #include "common/wall/wall.h"
 #include "master/console.h"
+#include "master/control_window.h"
 #include "master/wall_master.h"
 #include "master/wall_outputs.h"
 #include "tile/renderer.h"
@@ -56,6 +57,11 @@ MasterInput check_master_input(const WallOptions& o) {
             ov.file ? ov.file->string() : "phantom", "--iso",
             "isovalue " + std::to_string(in.iso) + " is outside the volume's value range");
     to_engine_options(o.engine);
+    // The console and the window would both take the operator's commands; one at a time.
+    if (o.control && o.script == "-")
+        throw InputError("--control", "--script",
+                         "the console (--script -) and the control "
+                         "window cannot both drive the wall; give one, or a script file");
     // A folder, a device or a missing file is an error naming --script (a folder read as empty).
     if (!o.script.empty() && o.script != "-") in.script = load_script(o.script);
     check_wall_outputs(o, load_wall(o.wall), in.script);
@@ -81,8 +87,12 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.measure = o.measure;
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),
                       in.extractor->value_max());
+    // Opened before the tiles load: a display that cannot open ends the job at once.
+    std::optional<ControlWindow> control;
+    if (o.control) control.emplace(spec, o.control_display, o.out);
     master.start();
     const std::string where = o.script.empty() ? std::string("--script") : o.script;
+    bool quit = false;
     if (o.script == "-") {
         run_console(
             STDIN_FILENO,
@@ -90,9 +100,15 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
             [&] { master.idle(); });
     } else {
         for (const ScriptLine& l : in.script)
-            if (!master.execute(l.command, where + ":" + std::to_string(l.line))) break;
+            if (!master.execute(l.command, where + ":" + std::to_string(l.line))) {
+                quit = true;
+                break;
+            }
     }
-    if (o.script.empty()) master.execute(WaitCmd{WaitCmd::Until::done, 0}, where);
+    if (control && !quit)
+        control->run(master);
+    else if (o.script.empty())
+        master.execute(WaitCmd{WaitCmd::Until::done, 0}, where);
     return master.finish();
 }
 

@@ -21,7 +21,12 @@ struct WallOptions {
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";
     EngineCli engine;
-    std::string script;              // script file, "-" for the master's console, empty: one frame
+    std::string script;  // script file, "-" for the master's console, empty: one frame
+    // The control window on the master's display (master/control_window.h): after the script,
+    // if any, the operator drives the wall from it until Escape. Every rank parses the same
+    // command line, so tiles know from this that the master wants their previews.
+    bool control = false;
+    std::string control_display;     // empty: $DISPLAY
     double timeout_s = 120;          // a wall silent this long ends the job
     double startup_timeout_s = 600;  // the same while the tiles load the volume and start
     std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv

@@ -102,7 +102,7 @@ TEST(ControlView, TilesWithoutAPreviewAreBlackAndBezelsGrey) {
     EXPECT_EQ(size.height, 30 + kControlStatusHeight);
     EXPECT_EQ(pixel(img, 45, 15), kControlBezel);  // in the gap
     EXPECT_EQ(pixel(img, 10, 10), (Rgb{0, 0, 0}));
-    EXPECT_EQ(pixel(img, 0, 10), kControlBezel);   // each tile's frame
+    EXPECT_EQ(pixel(img, 0, 10), kControlBezel);  // each tile's frame
     EXPECT_EQ(pixel(img, 60, 29), kControlBezel);
     EXPECT_EQ(pixel(img, 2, 40), kControlStatusBackground);
 }
@@ -117,8 +117,8 @@ TEST(ControlView, EachPreviewIsScaledIntoItsTile) {
     EXPECT_EQ(pixel(img, 41, 1), (Rgb{200, 0, 0}));  // inside tile 1, past its frame
     EXPECT_EQ(pixel(img, 78, 28), (Rgb{200, 0, 0}));
     EXPECT_EQ(pixel(img, 20, 45), (Rgb{0, 200, 0}));
-    EXPECT_EQ(pixel(img, 20, 15), (Rgb{0, 0, 0}));   // tile 0: none yet
-    EXPECT_EQ(pixel(img, 40, 15), kControlBezel);    // the seam between tiles 0 and 1
+    EXPECT_EQ(pixel(img, 20, 15), (Rgb{0, 0, 0}));  // tile 0: none yet
+    EXPECT_EQ(pixel(img, 40, 15), kControlBezel);   // the seam between tiles 0 and 1
 }
 
 TEST(ControlView, TheStatusBarShowsTheIsovalue) {

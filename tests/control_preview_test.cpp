@@ -39,7 +39,8 @@ TEST(ControlPreview, ShrinkBoxAveragesEachBoxAndClipsTheEdges) {
     Image img = solid(5, 3, 0, 7, 200);
     for (int y = 0; y < 3; ++y)
         for (int x = 0; x < 5; ++x)
-            img.rgba[4 * (static_cast<std::size_t>(y) * 5 + x)] = static_cast<std::uint8_t>(x * 10 + y);
+            img.rgba[4 * (static_cast<std::size_t>(y) * 5 + x)] =
+                static_cast<std::uint8_t>(x * 10 + y);
     const Image small = shrink_box(img, 2);
     ASSERT_EQ(small.width, 3);
     ASSERT_EQ(small.height, 2);

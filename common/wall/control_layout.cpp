@@ -18,8 +18,8 @@ ControlLayout control_layout(const WallSpec& spec, PixelSize max) {
     const PixelSize vs = virtual_screen_size(spec);
     const int max_w = std::max(max.width, 1), max_h = std::max(max.height, 1);
     ControlLayout l;
-    l.scale = std::min({1.0, double(max_w) / std::max(vs.width, 1),
-                        double(max_h) / std::max(vs.height, 1)});
+    l.scale = std::min(
+        {1.0, double(max_w) / std::max(vs.width, 1), double(max_h) / std::max(vs.height, 1)});
     // Rounded, then clamped: the fitted side is max_w or max_h up to float rounding.
     l.mosaic.width = std::clamp(static_cast<int>(std::lround(vs.width * l.scale)), 1, max_w);
     l.mosaic.height = std::clamp(static_cast<int>(std::lround(vs.height * l.scale)), 1, max_h);
