@@ -31,8 +31,8 @@ using test::run;
 const test::CompareOptions kColour{.coverage = test::Coverage::colour};
 
 std::string wall_file(const std::string& display, int w, int h) {
-    std::string s = "tiles = [2, 2]\ntile_size_px = [" + std::to_string(w) + ", " +
-                    std::to_string(h) + "]\n";
+    std::string s =
+        "tiles = [2, 2]\ntile_size_px = [" + std::to_string(w) + ", " + std::to_string(h) + "]\n";
     for (int t = 0; t < 4; ++t)
         s += "[[tile]]\ncolumn = " + std::to_string(t % 2) + "\nrow = " + std::to_string(t / 2) +
              "\ndisplay = \"" + display + "." + std::to_string(t) + "\"\n";
@@ -77,11 +77,11 @@ TEST(TileWindows, ShowTheFrameAsItBuildsAndThenExactlyTheTileImage) {
     int rc = -1;
     // --max-count 8: many small groups, so the frame takes long enough to be seen building.
     std::thread wall([&] {
-        rc = run(mpirun(5) + "wall --windows --max-count 8 --wall '" +
-                     (dir / "wall.toml").string() + "' --script '" + (dir / "show.txt").string() +
-                     "' --tiles-out '" + dir.string() + "' --out '" + (dir / "m.png").string() +
-                     "'",
-                 dir / "log.txt");
+        rc =
+            run(mpirun(5) + "wall --windows --max-count 8 --wall '" + (dir / "wall.toml").string() +
+                    "' --script '" + (dir / "show.txt").string() + "' --tiles-out '" +
+                    dir.string() + "' --out '" + (dir / "m.png").string() + "'",
+                dir / "log.txt");
         running = false;
     });
     const auto seen = watch(x, running);
@@ -116,9 +116,9 @@ TEST(TileWindows, ADisplayThatDoesNotExistIsOneLineNamingRankHostAndDisplay) {
     if (!x.ok()) GTEST_SKIP() << "no Xvfb: " << x.why_not();
     const auto dir = test::scratch_dir("tile_windows_missing");
     // Tile 0's display works; tile 1's does not exist.
-    std::ofstream(dir / "wall.toml") << "tiles = [2, 1]\ntile_size_px = [64, 48]\ndisplay = \""
-                                     << x.display()
-                                     << "\"\n[[tile]]\ncolumn = 1\nrow = 0\ndisplay = \":9998\"\n";
+    std::ofstream(dir / "wall.toml")
+        << "tiles = [2, 1]\ntile_size_px = [64, 48]\ndisplay = \"" << x.display()
+        << "\"\n[[tile]]\ncolumn = 1\nrow = 0\ndisplay = \":9998\"\n";
     const int rc = run(mpirun(3) + "wall --windows --wall '" + (dir / "wall.toml").string() +
                            "' --out '" + (dir / "m.png").string() + "' --timeout 10",
                        dir / "log.txt", 60);

@@ -285,21 +285,6 @@ TEST(Wall, TileOverridesParse) {
     EXPECT_EQ(tile_display(w, 0), "") << "no display key: each rank's $DISPLAY";
 }
 
-TEST(Wall, TileDisplaysComeFromTheTileElseTheWall) {
-    const WallSpec w = parse_wall(R"(
-        tiles = [2, 1]
-        tile_size_px = [100, 50]
-        display = "node7:0"
-        [[tile]]
-        column = 1
-        row = 0
-        display = ":0.1"
-    )",
-                                  "inline.toml");
-    EXPECT_EQ(tile_display(w, 0), "node7:0");
-    EXPECT_EQ(tile_display(w, 1), ":0.1");
-}
-
 struct BadWall {
     std::string name;
     std::string text;
@@ -373,15 +358,6 @@ TEST(Wall, MalformedInputNamesFileAndField) {
         {"offset past a million",
          "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\noffset_px = [2147483647, 0]\n",
          "tile[0].offset_px", "got [2147483647, 0]"},
-        {"display not a string", "tiles = [2, 2]\n" + size + "display = 0\n", "display",
-         "expected an X display"},
-        {"display without number", "tiles = [2, 2]\n" + size + "display = \"node7\"\n", "display",
-         "got \"node7\""},
-        {"tile display with a space",
-         "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\ndisplay = \"a b:0\"\n",
-         "tile[0].display", "got \"a b:0\""},
-        {"display screen not a number", "tiles = [2, 2]\n" + size + "display = \":0.x\"\n",
-         "display", "got \":0.x\""},
     };
     for (const BadWall& c : cases) {
         try {
