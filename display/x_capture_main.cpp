@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
         } else {
             id = isowall::find_window(display, title);
         }
-        if (!id) throw isowall::DisplayError("no mapped window named \"" + title + "\" on " + display);
+        if (!id)
+            throw isowall::DisplayError("no mapped window named \"" + title + "\" on " + display);
         isowall::write_image(argv[3], isowall::capture_window(display, id));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "isowall-xcapture: error: %s\n", e.what());

@@ -4,7 +4,9 @@
 
 namespace isowall {
 
-std::string tile_window_title(int tile) { return "isowall tile " + std::to_string(tile); }
+std::string tile_window_title(int tile) {
+    return "isowall tile " + std::to_string(tile);
+}
 
 TileWindow::TileWindow(const std::string& display, int tile, const std::string& host) {
     WindowOptions o;
