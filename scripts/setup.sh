@@ -9,7 +9,7 @@ PACKAGES=(
     libglm-dev libteem-dev zlib1g-dev libbz2-dev libtomlplusplus-dev libcli11-dev
     libopenimageio-dev openimageio-tools
     libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev
-    libopenmpi-dev openmpi-bin
+    libopenmpi-dev openmpi-bin iproute2
     libgtest-dev libgmock-dev libbenchmark-dev
     python3 python3-numpy python3-matplotlib
 )
