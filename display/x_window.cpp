@@ -43,12 +43,15 @@ bool x_ok(Display* dpy, F&& call) {
     return !g_x_error;
 }
 
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+std::string quoted(const std::string& s) {
+    return "\"" + s + "\"";
+}
 
 Display* open_display(const std::string& name) {
     if (name.empty())
-        throw DisplayError("no X display: --windows and --control need a display (set $DISPLAY "
-                           "or the wall file's display key)");
+        throw DisplayError(
+            "no X display: --windows and --control need a display (set $DISPLAY "
+            "or the wall file's display key)");
     Display* dpy = XOpenDisplay(name.c_str());
     if (!dpy)
         throw DisplayError("cannot open X display " + quoted(name) +
@@ -133,7 +136,8 @@ struct XWindow::Impl {
         if (use_shm) return;
         image = XCreateImage(dpy, visual, depth, ZPixmap, 0, nullptr, w, h, 32, 0);
         if (!image) throw DisplayError("X display " + quoted(name) + ": XCreateImage failed");
-        image->data = static_cast<char*>(std::calloc(static_cast<std::size_t>(image->bytes_per_line) * h, 1));
+        image->data =
+            static_cast<char*>(std::calloc(static_cast<std::size_t>(image->bytes_per_line) * h, 1));
     }
 
     void wait_mapped() {
@@ -170,23 +174,21 @@ XWindow::XWindow(const WindowOptions& o) : impl_(std::make_unique<Impl>()) {
     m.visual = DefaultVisual(m.dpy, m.screen);
     m.depth = DefaultDepth(m.dpy, m.screen);
     if (m.visual->c_class != TrueColor || m.depth < 24)
-        throw DisplayError("X display " + quoted(m.name) + ": screen " +
-                           std::to_string(m.screen) + " is not 24-bit TrueColor (depth " +
-                           std::to_string(m.depth) + ")");
-    m.format = PixelFormat::from_masks(m.visual->red_mask, m.visual->green_mask,
-                                       m.visual->blue_mask);
+        throw DisplayError("X display " + quoted(m.name) + ": screen " + std::to_string(m.screen) +
+                           " is not 24-bit TrueColor (depth " + std::to_string(m.depth) + ")");
+    m.format =
+        PixelFormat::from_masks(m.visual->red_mask, m.visual->green_mask, m.visual->blue_mask);
     const Window root = RootWindow(m.dpy, m.screen);
     XSetWindowAttributes a{};
     a.background_pixel = BlackPixel(m.dpy, m.screen);
     a.override_redirect = o.fullscreen ? True : False;
-    a.event_mask = StructureNotifyMask | ExposureMask |
-                   (o.input ? ButtonPressMask | ButtonReleaseMask | PointerMotionMask |
-                                  KeyPressMask
-                            : 0);
+    a.event_mask =
+        StructureNotifyMask | ExposureMask |
+        (o.input ? ButtonPressMask | ButtonReleaseMask | PointerMotionMask | KeyPressMask : 0);
     const int w = o.fullscreen ? DisplayWidth(m.dpy, m.screen) : o.width;
     const int h = o.fullscreen ? DisplayHeight(m.dpy, m.screen) : o.height;
-    m.window = XCreateWindow(m.dpy, root, 0, 0, static_cast<unsigned>(w),
-                             static_cast<unsigned>(h), 0, m.depth, InputOutput, m.visual,
+    m.window = XCreateWindow(m.dpy, root, 0, 0, static_cast<unsigned>(w), static_cast<unsigned>(h),
+                             0, m.depth, InputOutput, m.visual,
                              CWBackPixel | CWOverrideRedirect | CWEventMask, &a);
     m.note_size(w, h);
     XStoreName(m.dpy, m.window, o.title.c_str());
@@ -199,11 +201,21 @@ XWindow::XWindow(const WindowOptions& o) : impl_(std::make_unique<Impl>()) {
 
 XWindow::~XWindow() = default;
 
-int XWindow::width() const { return impl_->width; }
-int XWindow::height() const { return impl_->height; }
-std::uint64_t XWindow::id() const { return impl_->window; }
-const std::string& XWindow::display_name() const { return impl_->name; }
-bool XWindow::shared_memory() const { return impl_->use_shm; }
+int XWindow::width() const {
+    return impl_->width;
+}
+int XWindow::height() const {
+    return impl_->height;
+}
+std::uint64_t XWindow::id() const {
+    return impl_->window;
+}
+const std::string& XWindow::display_name() const {
+    return impl_->name;
+}
+bool XWindow::shared_memory() const {
+    return impl_->use_shm;
+}
 
 void XWindow::present(const Image& img, int x, int y) {
     Impl& m = *impl_;
@@ -230,8 +242,8 @@ std::vector<WindowEvent> XWindow::poll() {
         switch (e.type) {
             case ButtonPress:
             case ButtonRelease:
-                ev.kind = e.type == ButtonPress ? WindowEvent::Kind::press
-                                                : WindowEvent::Kind::release;
+                ev.kind =
+                    e.type == ButtonPress ? WindowEvent::Kind::press : WindowEvent::Kind::release;
                 ev.x = e.xbutton.x;
                 ev.y = e.xbutton.y;
                 ev.button = static_cast<int>(e.xbutton.button);
@@ -275,8 +287,7 @@ Image capture_window(const std::string& display, std::uint64_t id) {
                         static_cast<unsigned>(a.height), AllPlanes, ZPixmap);
     });
     if (ok && img) {
-        unpack_pixels(*img,
-                      PixelFormat::from_masks(img->red_mask, img->green_mask, img->blue_mask),
+        unpack_pixels(*img, PixelFormat::from_masks(img->red_mask, img->green_mask, img->blue_mask),
                       out);
     }
     if (img) XDestroyImage(img);
@@ -314,22 +325,6 @@ std::uint64_t find_window(const std::string& display, const std::string& title) 
     x_ok(dpy, [&] { found = find_named(dpy, DefaultRootWindow(dpy), title); });
     XCloseDisplay(dpy);
     return found;
-}
-
-bool PresentPacer::changed(double now) {
-    pending_ = true;
-    return due(now);
-}
-
-bool PresentPacer::due(double now) {
-    if (!pending_ || now - last_s_ < interval_s_) return false;
-    shown(now);
-    return true;
-}
-
-void PresentPacer::shown(double now) {
-    pending_ = false;
-    last_s_ = now;
 }
 
 }  // namespace isowall

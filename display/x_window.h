@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/core/image.h"
+#include "common/core/pacer.h"  // PresentPacer, for callers that present
 
 namespace isowall {
 
@@ -69,24 +70,6 @@ class XWindow {
 // The display a window opens when WindowOptions::display is `name`: `name`, else $DISPLAY, else
 // empty (which XWindow refuses with a DisplayError naming $DISPLAY).
 std::string resolve_display(const std::string& name);
-
-// Pacing of presents: at most one per `interval_s` (a display refresh); a change that came too
-// soon is kept as pending and shown by the next due() or by flush time. Pure; times in seconds.
-class PresentPacer {
-  public:
-    explicit PresentPacer(double interval_s) : interval_s_(interval_s) {}
-    // Something changed at `now`: true when it may be presented now (then it counts as shown).
-    bool changed(double now);
-    // Whether a pending change is due at `now` (then it counts as shown).
-    bool due(double now);
-    bool pending() const { return pending_; }
-    void shown(double now);
-
-  private:
-    double interval_s_;
-    double last_s_ = -1e300;
-    bool pending_ = false;
-};
 
 // For tests and tools: the pixels of window `id` on `display` (XGetImage), as RGBA8 (alpha 255,
 // depth empty); and the id of the first mapped window whose title is `title` (0 when none).

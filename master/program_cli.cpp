@@ -146,6 +146,9 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->transform(
             CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
         ->default_str("on");
+    wall_cmd->add_flag("--windows", wall.windows,
+                       "Each tile shows its frame as it builds in a borderless window covering "
+                       "its X screen (the wall file's display keys, else $DISPLAY)");
     wall_cmd->add_flag("--measure", wall.measure,
                        "Measure wall-wide correctness against emulated time (each rank on its own "
                        "core, from thread CPU time); costs a read-back per job");

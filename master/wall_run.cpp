@@ -19,6 +19,7 @@
 #include "common/wall/wall.h"
 #include "master/console.h"
 #include "master/control_window.h"
+#include "master/tile_window.h"
 #include "master/wall_master.h"
 #include "master/wall_outputs.h"
 #include "tile/renderer.h"
@@ -125,6 +126,12 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
+    std::optional<TileWindow> window;
+    if (o.windows) {
+        const int t = tile_of_rank(spec, comm.rank());
+        window.emplace(tile_display(spec, t), t, comm.host());
+        setup.shows.push_back(&*window);
+    }
     return run_tile(comm, setup);
 }
 

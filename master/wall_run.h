@@ -35,6 +35,7 @@ struct WallOptions {
     bool balance = true;            // the screen-region scheduler migrates jobs
     std::string region = "128x96";  // region size WxH, or "tile" (the study's best)
     bool measure = false;           // emulated wall-wide correctness curves
+    bool windows = false;           // each tile shows its frame in a window on its display
     bool region_clip = true;        // propagation stays within each job's region
     // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
     // so this is the rank's budget, not the machine's core count.

@@ -100,9 +100,8 @@ TEST_F(Display, MouseAndKeyEventsArriveInWindowPixels) {
     if (system("command -v xdotool > /dev/null") != 0) GTEST_SKIP() << "no xdotool";
     XWindow w({x_.display(), "events", false, 200, 150, true});
     const std::string cmd = "DISPLAY=" + x_.display() + " xdotool mousemove --window " +
-                            std::to_string(w.id()) +
-                            " 30 40 mousedown 1 mousemove --window " + std::to_string(w.id()) +
-                            " 70 40 mouseup 1 click 5 key Escape";
+                            std::to_string(w.id()) + " 30 40 mousedown 1 mousemove --window " +
+                            std::to_string(w.id()) + " 70 40 mouseup 1 click 5 key Escape";
     ASSERT_EQ(system(cmd.c_str()), 0) << cmd;
     std::vector<WindowEvent> all;
     for (int i = 0; i < 100 && (all.empty() || all.back().key != "Escape"); ++i) {

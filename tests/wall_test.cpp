@@ -282,6 +282,7 @@ TEST(Wall, TileOverridesParse) {
     const PixelRect r = tile_rect(w, 5);
     EXPECT_EQ(r.x, 2 * 108 + 3) << r;
     EXPECT_EQ(r.y, 1 * 58 - 2) << r;
+    EXPECT_EQ(tile_display(w, 0), "") << "no display key: each rank's $DISPLAY";
 }
 
 struct BadWall {

@@ -31,8 +31,8 @@ class Xvfb {
             why_ = "pipe failed";
             return;
         }
-        std::vector<std::string> args = {"Xvfb", "-displayfd", std::to_string(fds[1]),
-                                         "-nolisten", "tcp", "-noreset"};
+        std::vector<std::string> args = {"Xvfb",      "-displayfd", std::to_string(fds[1]),
+                                         "-nolisten", "tcp",        "-noreset"};
         for (std::size_t i = 0; i < screens.size(); ++i) {
             args.push_back("-screen");
             args.push_back(std::to_string(i));

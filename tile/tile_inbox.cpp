@@ -1,5 +1,6 @@
 #include "tile/tile_inbox.h"
 
+#include <chrono>
 #include <stdexcept>
 #include <utility>
 
@@ -49,6 +50,12 @@ std::optional<Message> TileInbox::pop() {
     if (interrupts(m)) --interrupts_;
     stop_ = closed_ || interrupts_ > 0;
     return m;
+}
+
+bool TileInbox::wait_for(double seconds) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, std::chrono::duration<double>(seconds),
+                             [&] { return !queue_.empty() || snapshots_ > 0 || closed_; });
 }
 
 int TileInbox::take_snapshots() {

@@ -29,6 +29,9 @@ class TileInbox {
     // once closed, throws the close() error (or a runtime_error when there was none). The stop
     // flag is up while a view or quit is queued: jobs popped before it end at once.
     std::optional<Message> pop();
+    // Waits at most `seconds` for something pop() would return at once (a message, a snapshot
+    // request, or the close); true when there is such a thing.
+    bool wait_for(double seconds);
     // The number of snapshot requests waiting, which are then taken.
     int take_snapshots();
     // Blocks until close() (a rank told to stop answering, for the fault tests).

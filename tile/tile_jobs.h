@@ -49,6 +49,9 @@ class TileJobs {
     // copy is not counted as busy.
     void measure_point();
     static constexpr double kShotIntervalS = 0.002;
+    // CPU the caller spent inside a job on something that is not the job's (showing the frame in
+    // a window): left out of the job's time and the emulated clock.
+    void exclude_cpu(double cpu_s) { job_measure_cpu_ += cpu_s; }
 
     // A helper's result for this rank's tile, composited by depth into what the tile shows.
     // Throws WireError when the rect is not inside the tile.

@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/core/pacer.h"
 #include "common/core/util.h"
 #include "common/progressive/trace.h"
 #include "tile/tile_inbox.h"
@@ -95,7 +96,9 @@ class TileRank {
         : comm_(comm),
           setup_(setup),
           engine_(setup.extractor, setup.renderer, options()),
-          jobs_(engine_, setup.renderer, setup.help_renderer, setup.measure) {}
+          jobs_(engine_, setup.renderer, setup.help_renderer, setup.measure) {
+        for (FrameShow* f : setup.shows) shows_.push_back({f, PresentPacer(f->interval_s())});
+    }
 
     int run() {
         if (setup_.tile_width > 0) jobs_.prepare(setup_.tile_width, setup_.tile_height);
@@ -104,6 +107,7 @@ class TileRank {
         bool quit = false;
         for (;;) {
             trace_.switch_to(Stage::idle);
+            show_pending();
             std::optional<Message> m = inbox_.pop();
             trace_.switch_to(Stage::comm);
             if (!m) {
@@ -150,6 +154,7 @@ class TileRank {
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             jobs_.measure_point();
+            changed(/*in_job=*/true);
             if (s.time_s - last_progress_s_ < kProgressIntervalS) return;
             last_progress_s_ = s.time_s;
             const Stage left = trace_.switch_to(Stage::comm);
@@ -198,6 +203,7 @@ class TileRank {
             ++result_.jobs_own;
         }
         send_message(comm_, kMasterRank, out.done);
+        changed(/*in_job=*/false);
     }
 
     // A helper's result can overtake the master's view of its frame (they come from different
@@ -210,6 +216,47 @@ class TileRank {
         if (r.generation != jobs_.generation()) return;
         jobs_.land(r);
         send_message(comm_, kMasterRank, LandedMsg{r.generation, r.job});
+        changed(/*in_job=*/false);
+    }
+
+    // What the tile shows changed: each show whose pacer allows it gets the frame now; the others
+    // keep the change pending. Inside a job its CPU is left out of the job's.
+    void changed(bool in_job) {
+        if (shows_.empty() || !jobs_.started()) return;
+        const double now = shown_clock_.seconds();
+        std::vector<FrameShow*> due;
+        for (Shown& s : shows_)
+            if (s.pacer.changed(now)) due.push_back(s.show);
+        show_to(due, in_job);
+    }
+
+    // Before the frame thread waits for work: pending changes are shown when due, so the last
+    // change of a frame reaches every show even when no more work comes.
+    void show_pending() {
+        for (;;) {
+            double wait = -1;
+            for (const Shown& s : shows_)
+                if (s.pacer.pending()) {
+                    const double w = s.pacer.wait_s(shown_clock_.seconds());
+                    wait = wait < 0 ? w : std::min(wait, w);
+                }
+            if (wait < 0 || inbox_.wait_for(wait)) return;
+            const double now = shown_clock_.seconds();
+            std::vector<FrameShow*> due;
+            for (Shown& s : shows_)
+                if (s.pacer.due(now)) due.push_back(s.show);
+            show_to(due, false);
+        }
+    }
+
+    void show_to(const std::vector<FrameShow*>& due, bool in_job) {
+        if (due.empty()) return;
+        const Stage left = trace_.switch_to(Stage::show);
+        const double c0 = thread_cpu_seconds();
+        const Image img = jobs_.image();
+        for (FrameShow* f : due) f->show(img, jobs_.generation());
+        if (in_job) jobs_.exclude_cpu(thread_cpu_seconds() - c0);
+        trace_.switch_to(left);
     }
 
     void land_early() {
@@ -251,6 +298,12 @@ class TileRank {
     TileInbox inbox_;
     TileResultMsg result_;
     std::vector<RegionMsg> early_;  // helpers' results that came before their frame's view
+    struct Shown {
+        FrameShow* show;
+        PresentPacer pacer;
+    };
+    std::vector<Shown> shows_;
+    Stopwatch shown_clock_;
     double cpu0_ = 0, last_progress_s_ = -1;
     bool interrupted_ = false;
 };

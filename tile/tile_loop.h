@@ -7,9 +7,11 @@
 // and at quit sends its figures, trace and final image, then stays until the master releases it
 // (a helper's result may still be on its way to it).
 #include <string>
+#include <vector>
 
 #include "comm/comm.h"
 #include "common/extract/surface_extractor.h"
+#include "tile/frame_show.h"
 #include "tile/progressive_engine.h"
 #include "tile/renderer.h"
 
@@ -32,6 +34,9 @@ struct TileSetup {
     bool measure = false;    // keep each job's result for the emulated correctness curve
     double timeout_s = 120;  // the master silent this long (not even alive messages) ends the job
     int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up
+    // Where the frame is shown as it builds (a window, a preview for the control window); each
+    // is paced on its own (tile/frame_show.h).
+    std::vector<FrameShow*> shows = {};
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

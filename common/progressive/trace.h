@@ -20,9 +20,20 @@ struct TraceSpan {
     double cpu_s = 0;
 };
 
+// show: presenting the frame in a window or as a preview as it builds (not part of the emulated
+// busy time).
 inline constexpr const char* kTraceStages[] = {"intersection", "propagation", "render", "comm",
-                                               "idle",         "compose",     "setup"};
-enum class Stage : std::uint8_t { intersection, propagation, render, comm, idle, compose, setup };
+                                               "idle",         "compose",     "setup",  "show"};
+enum class Stage : std::uint8_t {
+    intersection,
+    propagation,
+    render,
+    comm,
+    idle,
+    compose,
+    setup,
+    show
+};
 
 double thread_cpu_seconds();
 // Wall clock, seconds since the Unix epoch: the time base of spans (aligned across ranks).

@@ -53,6 +53,7 @@ struct TileOverride {
     int column = 0, row = 0;
     bool disabled = false;
     int offset_x_px = 0, offset_y_px = 0;  // x right, y down
+    std::string display = {};              // X display of this tile's window; empty: the wall's
 };
 
 struct WallSpec {
@@ -62,6 +63,9 @@ struct WallSpec {
     std::optional<PhysicalSize> physical;
     RankOrder rank_order = RankOrder::row_major;
     std::vector<TileOverride> overrides;  // at most one per (column, row)
+    // The X display (and screen) every tile's window opens with --windows, as "[host]:D[.S]";
+    // empty: each tile rank's $DISPLAY.
+    std::string display;
 };
 
 struct PixelSize {
@@ -96,6 +100,9 @@ Frustum tile_frustum(const Frustum& wall, const WallSpec& spec, int tile_index);
 // Rank 0 is the master (kNoTile); ranks 1..T own the enabled tiles in rank order. Ranks outside
 // [0, rank_count) and tile indices outside [0, tile_count) throw std::out_of_range.
 int tile_of_rank(const WallSpec& spec, int rank);
+// The X display of tile `tile_index`'s window: its [[tile]] display, else the wall's, else empty
+// (the rank's $DISPLAY).
+std::string tile_display(const WallSpec& spec, int tile_index);
 int rank_of_tile(const WallSpec& spec, int tile_index);  // kNoRank for a disabled tile
 
 std::ostream& operator<<(std::ostream& os, const WallSpec& spec);

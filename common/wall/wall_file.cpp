@@ -3,7 +3,9 @@
 #include "common/wall/wall.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <initializer_list>
 #include <limits>
 #include <sstream>
@@ -226,6 +228,33 @@ PhysicalSize read_physical(const Reader& top, WallSpec& spec) {
     return p;
 }
 
+// An X display name: "[host]:D[.S]" (host letters, digits, '.', '-', '_' or a unix: prefix).
+bool valid_display(const std::string& d) {
+    const auto colon = d.rfind(':');
+    if (colon == std::string::npos || d.size() > 255) return false;
+    for (std::size_t i = 0; i < colon; ++i)
+        if (!std::isalnum(static_cast<unsigned char>(d[i])) && !std::strchr(".-_", d[i]))
+            return false;
+    const std::string rest = d.substr(colon + 1);
+    const auto dot = rest.find('.');
+    const auto digits = [](const std::string& t) {
+        return !t.empty() && t.size() <= 6 &&
+               std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    return digits(rest.substr(0, dot)) &&
+           (dot == std::string::npos || digits(rest.substr(dot + 1)));
+}
+
+std::string read_display(const Reader& r) {
+    const toml::node* n = r.find("display");
+    if (!n) return {};
+    const auto* s = n->as_string();
+    if (!s || !valid_display(s->get()))
+        r.fail("display",
+               "expected an X display such as \":0\" or \"node7:0.1\", got " + describe(*n));
+    return s->get();
+}
+
 void read_overrides(const Reader& top, WallSpec& spec) {
     const toml::node* n = top.find("tile");
     const auto* a = n->as_array();
@@ -233,7 +262,7 @@ void read_overrides(const Reader& top, WallSpec& spec) {
         top.fail("tile", "expected [[tile]] tables, got " + describe(*n));
     for (size_t i = 0; i < a->size(); ++i) {
         const Reader r(top.where(), *a->get(i)->as_table(), "tile[" + std::to_string(i) + "].");
-        r.check_keys({"column", "row", "disabled", "offset_px"});
+        r.check_keys({"column", "row", "disabled", "offset_px", "display"});
         TileOverride o;
         auto index = [&](std::string_view key, int count) {
             const std::string expected = "an integer in [0, " + std::to_string(count - 1) + "]";
@@ -256,6 +285,7 @@ void read_overrides(const Reader& top, WallSpec& spec) {
             o.offset_x_px = off[0];
             o.offset_y_px = off[1];
         }
+        o.display = read_display(r);
         for (const TileOverride& prev : spec.overrides)
             if (prev.column == o.column && prev.row == o.row)
                 r.fail("column", "tile (" + std::to_string(o.column) + ", " +
@@ -308,7 +338,8 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
             "TOML syntax: " + msg);
     }
     const Reader r(where, doc, "");
-    r.check_keys({"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile"});
+    r.check_keys(
+        {"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile", "display"});
 
     WallSpec spec;
     const auto tiles = r.ints("tiles", 2, 1, std::numeric_limits<int>::max(),
@@ -324,6 +355,7 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
     Bezels& b = spec.bezel_px;
     read_bezels(r, "bezel_px", b.left, b.right, b.top, b.bottom);
     spec.rank_order = read_rank_order(r);
+    spec.display = read_display(r);
     if (r.find("physical")) spec.physical = read_physical(r, spec);
 
     // Overlap of a whole tile or more would reorder the tiles on the virtual screen.

@@ -126,4 +126,10 @@ std::ostream& operator<<(std::ostream& os, const PixelRect& r) {
     return os << "PixelRect{" << r.x << ", " << r.y << ", " << r.width << "x" << r.height << "}";
 }
 
+std::string tile_display(const WallSpec& spec, int tile_index) {
+    check_tile(spec, tile_index);
+    const TileOverride* o = override_of(spec, tile_index);
+    return o && !o->display.empty() ? o->display : spec.display;
+}
+
 }  // namespace isowall

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Open MPI's launch agent for emulated hosts (scripts/netns_hosts.sh): used in place of ssh with
+# `mpirun --mca plm_rsh_agent scripts/netns_agent.sh`. Usage: netns_agent.sh HOST COMMAND...
+#
+# HOST is a host's address or name as the hostfile gives it. The map file named by
+# $ISOWALL_NETNS_MAP says where it lives, one host a line: ADDRESS NAMESPACE HOSTNAME. Like ssh,
+# the agent joins COMMAND into one line and hands it to the host's shell, because Open MPI quotes
+# the daemon's arguments for a remote shell. The shell runs in the host's network namespace and in
+# a UTS namespace of its own named HOSTNAME, so every rank there reports that host.
+set -euo pipefail
+
+fail() {
+    echo "netns_agent: error: $*" >&2
+    exit 255 # what ssh returns when it cannot reach the host
+}
+
+map=${ISOWALL_NETNS_MAP:-}
+[ -n "$map" ] || fail "ISOWALL_NETNS_MAP: expected the map file of scripts/netns_hosts.sh, got nothing"
+[ -r "$map" ] || fail "ISOWALL_NETNS_MAP: expected a readable file, got '$map'"
+[ $# -ge 2 ] || fail "expected HOST COMMAND..., got $# arguments"
+host=$1
+shift
+
+entry=$(awk -v h="$host" '!/^#/ && ($1 == h || $3 == h) { print $2, $3; exit }' "$map")
+[ -n "$entry" ] || fail "$map: host '$host' is not in the map"
+read -r ns name <<<"$entry"
+
+# shellcheck disable=SC2016  # $1 and $2 are the inner shell's, not ours
+exec ip netns exec "$ns" unshare --uts bash -c 'hostname "$1" && exec bash -c "$2"' \
+    netns_agent "$name" "$*"
