@@ -25,9 +25,12 @@ std::vector<std::string> status_lines(const ControlStatus& s) {
                   s.done ? "done" : "running");
     std::string line = first;
     if (!s.last.empty()) line += "   last: " + s.last;
-    return {line,
-            "drag orbit  right-drag pan  wheel zoom  up/down iso  pgup/pgdn iso x10  s snapshot  "
-            "esc quit"};
+    return {line, keys_line()};
+}
+
+std::string keys_line() {
+    return "drag orbit  right-drag pan  wheel zoom  up/down iso  pgup/pgdn iso x10  s snapshot  "
+           "esc quit";
 }
 
 PixelSize control_window_size(const ControlLayout& layout) {

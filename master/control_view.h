@@ -29,8 +29,9 @@ struct ControlStatus {
 };
 
 // The two lines of the status bar: the isovalue, its range, the frame and the last command;
-// then the keys.
+// then the keys (keys_line).
 std::vector<std::string> status_lines(const ControlStatus& s);
+std::string keys_line();
 
 // The window's size for `layout`: the mosaic with the status bar under it.
 PixelSize control_window_size(const ControlLayout& layout);

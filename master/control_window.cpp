@@ -50,7 +50,10 @@ ControlWindow::ControlWindow(const WallSpec& spec, const std::string& display,
     : spec_(spec),
       layout_(control_layout(spec)),
       window_(window_options(layout_, display)),
-      input_(first_free_snapshot(out)) {}
+      input_(first_free_snapshot(out)) {
+    // The wall's layout at once, so the operator sees the window is theirs while the tiles load.
+    window_.present(compose_control(layout_, {}, {"starting the wall", keys_line()}));
+}
 
 void ControlWindow::present(const WallMaster& master) {
     std::vector<Image> previews(layout_.tiles.size());
