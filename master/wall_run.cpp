@@ -15,6 +15,7 @@
 #include "common/core/util.h"
 #include "common/extract/surface_extractor.h"
 #include "common/volume/phantom.h"
+#include "common/wall/control_layout.h"
 #include "common/wall/script.h"
 #include "common/wall/wall.h"
 #include "master/console.h"
@@ -22,6 +23,7 @@
 #include "master/tile_window.h"
 #include "master/wall_master.h"
 #include "master/wall_outputs.h"
+#include "tile/preview_show.h"
 #include "tile/renderer.h"
 #include "tile/tile_loop.h"
 
@@ -131,6 +133,11 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
         const int t = tile_of_rank(spec, comm.rank());
         window.emplace(tile_display(spec, t), t, comm.host());
         setup.shows.push_back(&*window);
+    }
+    std::optional<PreviewShow> preview;
+    if (o.control) {
+        preview.emplace(comm, preview_max_side(spec));
+        setup.shows.push_back(&*preview);
     }
     return run_tile(comm, setup);
 }

@@ -18,9 +18,13 @@
 #include <string>
 #include <thread>
 
+#include "comm/preview.h"
 #include "common/core/util.h"
 #include "common/io/image_io.h"
+#include "common/wall/control_layout.h"
+#include "display/x_window.h"
 #include "master/control_input.h"
+#include "master/control_view.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
@@ -123,6 +127,47 @@ class ControlWindowTest : public testing::Test {
     std::filesystem::path dir_ = test::scratch_dir("control_window");
 };
 
+// The part of `img` in rect r.
+Image crop(const Image& img, const PixelRect& r) {
+    Image out;
+    out.resize(r.width, r.height);
+    for (int y = 0; y < r.height; ++y)
+        for (int x = 0; x < r.width; ++x)
+            for (int c = 0; c < 4; ++c)
+                out.rgba[(static_cast<std::size_t>(y) * r.width + x) * 4 + c] =
+                    img.rgba[(static_cast<std::size_t>(y + r.y) * img.width + x + r.x) * 4 + c];
+    out.depth.clear();
+    return out;
+}
+
+// The mosaic part of the control window (status bar aside), as it should show `mosaic`: each
+// tile's previews composed by the window's own layout (tiles at full size on this small wall).
+Image expected_control_mosaic(const WallSpec& spec, const Image& mosaic) {
+    const ControlLayout layout = control_layout(spec);
+    std::vector<Image> previews;
+    for (int t = 0; t < tile_count(spec); ++t)
+        previews.push_back(preview_image(
+            make_preview(crop(mosaic, tile_rect(spec, t)), 1, preview_max_side(spec))));
+    const Image all = compose_control(layout, previews, {});
+    return crop(all, {0, 0, layout.mosaic.width, layout.mosaic.height});
+}
+
+// Captures the control window until its mosaic matches `expected` (previews arrive paced), at
+// most `limit_s`; returns the last comparison.
+test::ImageComparison wait_for_previews(const std::string& display, const std::string& window,
+                                        const Image& expected, double limit_s) {
+    test::ImageComparison m;
+    Stopwatch waited;
+    do {
+        const Image shown = capture_window(display, std::stoull(window));
+        m = test::compare_images(crop(shown, {0, 0, expected.width, expected.height}), expected,
+                                 kFromFiles);
+        if (m.equal_share >= 0.999) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    } while (waited.seconds() < limit_s);
+    return m;
+}
+
 TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) {
     std::ofstream(dir_ / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
     Stopwatch took;
@@ -141,6 +186,15 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
     ASSERT_TRUE(wait_for(
         wall.log(), [](const std::string& t) { return contains(t, "snapshot: "); }, 60))
         << slurp(wall.log());
+    // The window shows the tiles' previews of that frame: the wall as it stands.
+    const test::ImageComparison live = wait_for_previews(
+        x_.display(), w,
+        expected_control_mosaic(load_wall(dir_ / "2x2.toml"), read_image(dir_ / "control-001.png")),
+        20);
+    std::printf("control window vs the snapshot's previews: %s\n",
+                testing::PrintToString(live).c_str());
+    EXPECT_GT(live.covered_both, 1000u) << live;
+    EXPECT_GE(live.equal_share, 0.999) << live;
     // The drag, the wheel step, the isovalue key.
     ASSERT_EQ(xdotool("mousemove --window " + w + " 100 100 mousedown 1 mousemove --window " + w +
                       " " + std::to_string(100 + kDragPx) + " 100 mouseup 1"),

@@ -46,21 +46,18 @@ std::size_t covered(const Image& img) {
     return n;
 }
 
-// Every distinct picture each tile window showed while `running` holds.
-std::vector<std::vector<Image>> watch(const test::Xvfb& x, const std::atomic<bool>& running) {
-    std::vector<std::vector<Image>> seen(4);
-    std::vector<std::uint64_t> ids(4, 0);
+// Every distinct picture tile `t`'s window showed while `running` holds.
+std::vector<Image> watch(const test::Xvfb& x, int t, const std::atomic<bool>& running) {
+    std::vector<Image> seen;
+    std::uint64_t id = 0;
     while (running) {
-        for (int t = 0; t < 4; ++t) {
-            try {
-                if (!ids[t]) ids[t] = find_window(x.screen(t), tile_window_title(t));
-                if (!ids[t]) continue;
-                Image img = capture_window(x.screen(t), ids[t]);
-                if (seen[t].empty() || img.rgba != seen[t].back().rgba)
-                    seen[t].push_back(std::move(img));
-            } catch (const DisplayError&) {
-                ids[t] = 0;  // the window has closed (the run is ending)
-            }
+        try {
+            if (!id) id = find_window(x.screen(t), tile_window_title(t));
+            if (!id) continue;
+            Image img = capture_window(x.screen(t), id);
+            if (seen.empty() || img.rgba != seen.back().rgba) seen.push_back(std::move(img));
+        } catch (const DisplayError&) {
+            id = 0;  // the window has closed (the run is ending)
         }
     }
     return seen;
@@ -75,17 +72,24 @@ TEST(TileWindows, ShowTheFrameAsItBuildsAndThenExactlyTheTileImage) {
     std::ofstream(dir / "show.txt") << "wait done\nwait time 3\nquit\n";
     std::atomic<bool> running{true};
     int rc = -1;
-    // --max-count 8: many small groups, so the frame takes long enough to be seen building.
+    // --max-count 4: many small groups, so the frame takes long enough to be seen building.
     std::thread wall([&] {
         rc =
-            run(mpirun(5) + "wall --windows --max-count 8 --wall '" + (dir / "wall.toml").string() +
+            run(mpirun(5) + "wall --windows --max-count 4 --wall '" + (dir / "wall.toml").string() +
                     "' --script '" + (dir / "show.txt").string() + "' --tiles-out '" +
                     dir.string() + "' --out '" + (dir / "m.png").string() + "'",
                 dir / "log.txt");
         running = false;
     });
-    const auto seen = watch(x, running);
-    wall.join();
+    // One watcher per window, so each is captured as often as the X server allows.
+    std::vector<std::vector<Image>> seen(4);
+    {
+        std::vector<std::thread> watchers;
+        for (int t = 0; t < 4; ++t)
+            watchers.emplace_back([&, t] { seen[t] = watch(x, t, running); });
+        wall.join();
+        for (auto& w : watchers) w.join();
+    }
     ASSERT_EQ(rc, 0) << test::slurp(dir / "log.txt");
     for (int t = 0; t < 4; ++t) {
         SCOPED_TRACE("tile " + std::to_string(t));

@@ -142,6 +142,10 @@ class TileRank {
         // Every sample point: the measurement's shots want them; progress messages go out
         // every kProgressIntervalS.
         opt.progress_interval_s = setup_.measure ? 0.0 : kProgressIntervalS;
+        // A window shows the frame as often as its display refreshes, so the engine stops by
+        // that often (progress messages still go out every kProgressIntervalS).
+        for (const FrameShow* f : setup_.shows)
+            opt.progress_interval_s = std::min(opt.progress_interval_s, f->interval_s());
         opt.trace = &trace_;
         return opt;
     }

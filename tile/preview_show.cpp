@@ -1,0 +1,11 @@
+#include "tile/preview_show.h"
+
+#include "comm/preview.h"
+
+namespace isowall {
+
+void PreviewShow::show(const Image& tile, std::uint64_t generation) {
+    send_message(comm_, kMasterRank, make_preview(tile, generation, max_side_));
+}
+
+}  // namespace isowall
