@@ -61,7 +61,9 @@ class FrameRun {
         cursor_ = &c;
         params_ = opt_.propagation;
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
-        const std::size_t limit = c.rays + ray_limit;
+        // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
+        // c.rays, so a region's second band would cast nothing.
+        const std::size_t limit = ray_limit > SIZE_MAX - c.rays ? SIZE_MAX : c.rays + ray_limit;
         while (!c.done && c.rays < limit) {
             // The order sees the region as a screen of its own (pixels and coverage local to it):
             // a region's coverage is then its own pixels, not a copy of the whole screen.
