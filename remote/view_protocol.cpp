@@ -1,0 +1,347 @@
+// Each message's encoder sits right above its decoder, so a field added to one is seen in the
+// other. The decoders are static: callers go through decode_payload, which picks one by type.
+#include "remote/view_protocol.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <type_traits>
+
+#include "comm/wire_pieces.h"
+
+namespace isowall::remote {
+
+using wire_pieces::get_finite;
+
+namespace {
+
+// Text that ends up in logs and error lines: bounded and printable, so a hostile peer can neither
+// make a receiver hold much nor break a log line. Checked on the span before a string is made.
+void put_text(MessageWriter& w, std::string_view s) {
+    w.put_string(s);
+}
+
+std::string get_text(MessageReader& r, const char* field, std::size_t max_bytes,
+                     bool may_be_empty) {
+    const auto b = r.get_bytes();  // its length is checked against the message first
+    if (b.size() > max_bytes)
+        r.fail(std::string(field) + ": " + std::to_string(b.size()) + " bytes, expected at most " +
+               std::to_string(max_bytes));
+    if (b.empty() && !may_be_empty) r.fail(std::string(field) + ": expected a name, got none");
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        const auto c = static_cast<unsigned>(b[i]);
+        if (c < 0x20 || c > 0x7e)
+            r.fail(std::string(field) + ": byte " + std::to_string(i) + " is " + std::to_string(c) +
+                   ", expected printable ASCII (32..126)");
+    }
+    return {reinterpret_cast<const char*>(b.data()), b.size()};
+}
+
+glm::vec3 get_finite_vec3(MessageReader& r, const std::string& field) {
+    glm::vec3 v;
+    v.x = get_finite<float>(r, (field + ".x").c_str());
+    v.y = get_finite<float>(r, (field + ".y").c_str());
+    v.z = get_finite<float>(r, (field + ".z").c_str());
+    return v;
+}
+
+std::int32_t get_int_in(MessageReader& r, const std::string& field, std::int32_t lo,
+                        std::int32_t hi) {
+    const auto v = r.get<std::int32_t>();
+    if (v < lo || v > hi)
+        r.fail(field + ": expected " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+               std::to_string(v));
+    return v;
+}
+
+// seed (3 x i32) + level (i32) + iso (f64) + refinement (u8): the bytes of one key, for counts.
+constexpr std::size_t kGroupKeyWireBytes = 3 * 4 + 4 + 8 + 1;
+
+void put_group_key(MessageWriter& w, const GroupKey& k) {
+    w.put(static_cast<std::int32_t>(k.seed.x));
+    w.put(static_cast<std::int32_t>(k.seed.y));
+    w.put(static_cast<std::int32_t>(k.seed.z));
+    w.put(static_cast<std::int32_t>(k.level));
+    w.put(k.iso);
+    w.put(static_cast<std::uint8_t>(k.refinement));
+}
+
+// The name of a key's field in errors: "key.level", or "keys[2].level" in a list. Built only on
+// failure: a visible message may hold a million keys.
+struct KeyName {
+    const char* base;
+    std::size_t index = SIZE_MAX;
+    std::string operator()(const char* field) const {
+        // Appended piece by piece: `"[" + std::string&&` trips GCC 12's false -Wrestrict.
+        std::string s = base;
+        if (index != SIZE_MAX) {
+            s += '[';
+            s += std::to_string(index);
+            s += ']';
+        }
+        s += '.';
+        s += field;
+        return s;
+    }
+};
+
+GroupKey get_group_key(MessageReader& r, const KeyName& name) {
+    GroupKey k;
+    int* const ints[] = {&k.seed.x, &k.seed.y, &k.seed.z, &k.level};
+    const char* const fields[] = {"seed.x", "seed.y", "seed.z", "level"};
+    for (int i = 0; i < 4; ++i) {
+        const auto v = r.get<std::int32_t>();
+        const std::int32_t hi = i == 3 ? kMaxGroupLevel : std::numeric_limits<std::int32_t>::max();
+        if (v < 0 || v > hi)
+            r.fail(name(fields[i]) + ": expected 0.." + std::to_string(hi) + ", got " +
+                   std::to_string(v));
+        *ints[i] = v;
+    }
+    k.iso = r.get<double>();
+    if (!std::isfinite(k.iso))
+        r.fail(name("iso") + ": expected a finite number, got " + std::to_string(k.iso));
+    const auto refinement = r.get<std::uint8_t>();
+    if (refinement > 1)
+        r.fail(name("refinement") + ": expected 0 or 1, got " + std::to_string(refinement));
+    k.refinement = refinement == 1;
+    return k;
+}
+
+bool get_flag(MessageReader& r, const char* field) {
+    const auto v = r.get<std::uint8_t>();
+    if (v > 1) r.fail(std::string(field) + ": expected 0 or 1, got " + std::to_string(v));
+    return v == 1;
+}
+
+}  // namespace
+
+// ---- one encoder and its decoder per message ---------------------------------------------------
+
+static std::vector<std::byte> encode(const HelloMsg& m) {
+    MessageWriter w(HelloMsg::kVersion);
+    w.put(m.protocol_version);
+    put_text(w, m.dataset);
+    put_text(w, m.token);
+    w.put(m.encoding);
+    return w.take();
+}
+
+static HelloMsg decode_hello(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, HelloMsg::kVersion, "hello message");
+    HelloMsg m;
+    m.protocol_version = r.get<std::uint16_t>();
+    m.dataset = get_text(r, "dataset", kMaxDatasetNameBytes, false);
+    m.token = get_text(r, "token", kMaxTokenBytes, true);
+    m.encoding = r.get<std::uint8_t>();
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const ReadyMsg& m) {
+    MessageWriter w(ReadyMsg::kVersion);
+    w.put(m.bounds.min);
+    w.put(m.bounds.max);
+    w.put(m.value_min);
+    w.put(m.value_max);
+    for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(m.dims[a]));
+    w.put(m.spacing);
+    return w.take();
+}
+
+static ReadyMsg decode_ready(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, ReadyMsg::kVersion, "ready message");
+    ReadyMsg m;
+    m.bounds.min = get_finite_vec3(r, "bounds.min");
+    m.bounds.max = get_finite_vec3(r, "bounds.max");
+    if (m.bounds.empty()) r.fail("bounds: expected min <= max on every axis");
+    m.value_min = get_finite<double>(r, "value_min");
+    m.value_max = get_finite<double>(r, "value_max");
+    if (m.value_min > m.value_max) r.fail("value_max: expected >= value_min");
+    const char* dims[] = {"dims.x", "dims.y", "dims.z"};
+    for (int a = 0; a < 3; ++a)
+        m.dims[a] = get_int_in(r, dims[a], 1, std::numeric_limits<std::int32_t>::max());
+    m.spacing = get_finite_vec3(r, "spacing");
+    if (!(m.spacing.x > 0 && m.spacing.y > 0 && m.spacing.z > 0))
+        r.fail("spacing: expected positive numbers");
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const RequestMsg& m) {
+    MessageWriter w(RequestMsg::kVersion);
+    w.put(m.request_id);
+    wire_pieces::put_frame_view(w, m.view);
+    w.put(static_cast<std::uint8_t>(m.progressive_lod));
+    w.put(static_cast<std::uint8_t>(m.cached_groups));
+    return w.take();
+}
+
+static RequestMsg decode_request(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, RequestMsg::kVersion, "request message");
+    RequestMsg m;
+    m.request_id = r.get<std::uint64_t>();
+    m.view = wire_pieces::get_frame_view(r);
+    // The server would cast rays from it; a camera that cannot be drawn is the client's error.
+    if (const std::string problem = camera_problem(m.view.camera); !problem.empty())
+        r.fail("view.camera: " + problem);
+    m.progressive_lod = get_flag(r, "progressive_lod");
+    m.cached_groups = get_flag(r, "cached_groups");
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const GroupMsg& m) {
+    MessageWriter w(GroupMsg::kVersion);
+    w.put(m.request_id);
+    put_group_key(w, m.key);
+    w.put(static_cast<std::uint8_t>(m.draw_from_next_frame));
+    w.put_bytes(m.encoded);
+    return w.take();
+}
+
+static GroupMsg decode_group(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, GroupMsg::kVersion, "group message");
+    GroupMsg m;
+    m.request_id = r.get<std::uint64_t>();
+    m.key = get_group_key(r, {"key"});
+    m.draw_from_next_frame = get_flag(r, "draw_from_next_frame");
+    const auto encoded = r.get_bytes();  // checked against the message: no allocation yet
+    if (encoded.size() > kMaxGroupBytes)
+        r.fail("encoded: " + std::to_string(encoded.size()) + " bytes, expected at most " +
+               std::to_string(kMaxGroupBytes));
+    m.encoded.assign(encoded.begin(), encoded.end());
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const VisibleMsg& m) {
+    MessageWriter w(VisibleMsg::kVersion);
+    w.put(m.request_id);
+    w.put(static_cast<std::uint64_t>(m.keys.size()));
+    for (const GroupKey& k : m.keys) put_group_key(w, k);
+    return w.take();
+}
+
+static VisibleMsg decode_visible(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, VisibleMsg::kVersion, "visible message");
+    VisibleMsg m;
+    m.request_id = r.get<std::uint64_t>();
+    const std::size_t n = r.get_count(kGroupKeyWireBytes);  // against the bytes left
+    if (n > kMaxVisibleKeys)
+        r.fail("keys: " + std::to_string(n) + " keys, expected at most " +
+               std::to_string(kMaxVisibleKeys));
+    m.keys.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) m.keys.push_back(get_group_key(r, {"keys", i}));
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const EndOfFrameMsg& m) {
+    MessageWriter w(EndOfFrameMsg::kVersion);
+    for (std::uint64_t v : {m.request_id, m.rays, m.groups, m.triangles, m.bytes}) w.put(v);
+    return w.take();
+}
+
+static EndOfFrameMsg decode_end_of_frame(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, EndOfFrameMsg::kVersion, "end_of_frame message");
+    EndOfFrameMsg m;
+    for (std::uint64_t* v : {&m.request_id, &m.rays, &m.groups, &m.triangles, &m.bytes})
+        *v = r.get<std::uint64_t>();
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const ErrorMsg& m) {
+    MessageWriter w(ErrorMsg::kVersion);
+    w.put(static_cast<std::uint16_t>(m.code));
+    put_text(w, m.text);
+    return w.take();
+}
+
+static ErrorMsg decode_error(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, ErrorMsg::kVersion, "error message");
+    ErrorMsg m;
+    const auto code = r.get<std::uint16_t>();
+    if (code < 1 || code > kLastErrorCode)
+        r.fail("code: expected 1.." + std::to_string(kLastErrorCode) + ", got " +
+               std::to_string(code));
+    m.code = static_cast<ErrorCode>(code);
+    m.text = get_text(r, "text", kMaxErrorTextBytes, true);
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const ByeMsg&) {
+    return MessageWriter(ByeMsg::kVersion).take();
+}
+
+static ByeMsg decode_bye(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, ByeMsg::kVersion, "bye message");
+    r.finish();
+    return {};
+}
+
+// ---- dispatch ----------------------------------------------------------------------------------
+
+ErrorMsg make_error(ErrorCode code, std::string_view text) {
+    ErrorMsg m{code, std::string(text.substr(0, kMaxErrorTextBytes))};
+    for (char& c : m.text)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+    return m;
+}
+
+const char* to_string(MsgType type) {
+    switch (type) {
+        case MsgType::hello:
+            return "hello";
+        case MsgType::ready:
+            return "ready";
+        case MsgType::request:
+            return "request";
+        case MsgType::group:
+            return "group";
+        case MsgType::visible:
+            return "visible";
+        case MsgType::end_of_frame:
+            return "end_of_frame";
+        case MsgType::error:
+            return "error";
+        case MsgType::bye:
+            return "bye";
+    }
+    return "unknown";
+}
+
+std::vector<std::byte> encode_payload(const ViewMessage& m) {
+    return std::visit([](const auto& msg) { return encode(msg); }, m);
+}
+
+MsgType type_of(const ViewMessage& m) {
+    return std::visit([](const auto& msg) { return std::decay_t<decltype(msg)>::kType; }, m);
+}
+
+ViewMessage decode_payload(MsgType type, std::span<const std::byte> payload) {
+    switch (type) {
+        case MsgType::hello:
+            return decode_hello(payload);
+        case MsgType::ready:
+            return decode_ready(payload);
+        case MsgType::request:
+            return decode_request(payload);
+        case MsgType::group:
+            return decode_group(payload);
+        case MsgType::visible:
+            return decode_visible(payload);
+        case MsgType::end_of_frame:
+            return decode_end_of_frame(payload);
+        case MsgType::error:
+            return decode_error(payload);
+        case MsgType::bye:
+            return decode_bye(payload);
+    }
+    throw WireError("view protocol: unknown message type " +
+                    std::to_string(static_cast<unsigned>(type)));
+}
+
+}  // namespace isowall::remote

@@ -1,0 +1,136 @@
+#pragma once
+// The messages between `isowall serve` and `isowall view` (issue 12): one typed struct per
+// message, encode and decode side by side in view_protocol.cpp. A payload starts with its layout
+// version byte (MessageWriter), then the fields, little-endian. Decoding checks every value, not
+// only lengths (finite numbers, enum ranges, bounded printable text, counts against the bytes
+// left before anything is allocated, no trailing bytes) and throws WireError naming the message
+// and the field, so a message that decodes is one the receiver can use as is. The framing of
+// these payloads on a byte stream is in view_framing.h.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "common/core/box.h"
+#include "common/core/view.h"
+#include "common/core/wire.h"
+#include "common/extract/group.h"
+
+namespace isowall::remote {
+
+// The type field of a frame's header. Numbers are never reused: a retired type stays retired.
+enum class MsgType : std::uint16_t {
+    hello = 1,         // client -> server, first: protocol version, dataset, token, encoding
+    ready = 2,         // server -> client: the dataset is loaded; its bounds and range
+    request = 3,       // client -> server: a view to draw; interrupts the current one
+    group = 4,         // server -> client: one encoded group of a request
+    visible = 5,       // server -> client: cached groups the request's view sees
+    end_of_frame = 6,  // server -> client: the request is complete; its figures
+    error = 7,         // either way: what was wrong; the sender closes the connection after it
+    bye = 8,           // either way: the sender closes the connection, nothing was wrong
+};
+inline constexpr std::uint16_t kLastMsgType = 8;
+const char* to_string(MsgType type);
+
+// ---- limits: each is checked by the decoder before anything is sized from the bytes -----------
+inline constexpr std::size_t kMaxDatasetNameBytes = 256;  // printable ASCII, not empty
+inline constexpr std::size_t kMaxTokenBytes = 256;        // printable ASCII, may be empty
+inline constexpr std::size_t kMaxErrorTextBytes = 256;    // one printable ASCII line
+// An encoded group. Groups of the default propagation (2000 cells) take a few hundred KiB; the
+// bound keeps every valid group message under the framing's default payload limit (64 MiB).
+inline constexpr std::size_t kMaxGroupBytes = std::size_t{32} << 20;
+inline constexpr std::size_t kMaxVisibleKeys = std::size_t{1} << 20;
+// A group's level: meta-cells of 2^level cells per side, so anything past 30 overflows an int.
+inline constexpr int kMaxGroupLevel = 30;
+
+struct HelloMsg {
+    static constexpr MsgType kType = MsgType::hello;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint16_t protocol_version = 1;  // the newest the client speaks
+    std::string dataset;                 // the name the server loaded the volume under
+    std::string token;                   // empty unless the server asks for one (--token)
+    std::uint8_t encoding = 0;           // the group encoding the client wants (remote codec's id)
+};
+
+struct ReadyMsg {
+    static constexpr MsgType kType = MsgType::ready;
+    static constexpr std::uint8_t kVersion = 1;
+    Box3 bounds{glm::vec3(0), glm::vec3(1)};  // object space; finite, min <= max
+    double value_min = 0, value_max = 0;      // finite, min <= max
+    glm::ivec3 dims{1};                       // samples per axis, each >= 1
+    glm::vec3 spacing{1};                     // finite, each > 0
+};
+
+struct RequestMsg {
+    static constexpr MsgType kType = MsgType::request;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t request_id = 0;  // grows with every request of a connection
+    // Camera, frustum, image size (each side 1..kMaxImageSide) and isovalue; the camera must be
+    // one that can be drawn (camera_problem is empty).
+    FrameView view;
+    bool progressive_lod = false;  // case 3: start two levels coarser
+    bool cached_groups = false;    // case 4: the client caches groups per isovalue
+};
+
+struct GroupMsg {
+    static constexpr MsgType kType = MsgType::group;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t request_id = 0;
+    GroupKey key;  // seed >= 0 on each axis, level 0..kMaxGroupLevel, finite iso
+    // A late coarse group (section 4.1.4): cached now, drawn only from the next frame.
+    bool draw_from_next_frame = false;
+    std::vector<std::byte> encoded;  // the group in the hello's encoding; <= kMaxGroupBytes
+};
+
+struct VisibleMsg {
+    static constexpr MsgType kType = MsgType::visible;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t request_id = 0;
+    std::vector<GroupKey> keys;  // <= kMaxVisibleKeys, each checked as in GroupMsg
+};
+
+struct EndOfFrameMsg {
+    static constexpr MsgType kType = MsgType::end_of_frame;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t request_id = 0;
+    std::uint64_t rays = 0, groups = 0, triangles = 0;
+    std::uint64_t bytes = 0;  // of every frame the server sent for this request, headers included
+};
+
+enum class ErrorCode : std::uint16_t {
+    malformed = 1,            // a message did not decode (the text says which field)
+    unsupported_version = 2,  // the header's or hello's protocol version
+    bad_token = 3,
+    unknown_dataset = 4,
+    too_large = 5,  // a frame's payload over the receiver's limit
+    internal = 6,   // the sender failed (loading, extracting); the text says how
+};
+inline constexpr std::uint16_t kLastErrorCode = 6;
+
+struct ErrorMsg {
+    static constexpr MsgType kType = MsgType::error;
+    static constexpr std::uint8_t kVersion = 1;
+    ErrorCode code = ErrorCode::malformed;
+    std::string text;  // one printable ASCII line, <= kMaxErrorTextBytes
+};
+// An ErrorMsg that encodes to a valid message whatever `text` holds: cut to kMaxErrorTextBytes,
+// every byte outside printable ASCII (a newline, UTF-8) replaced by '?'.
+ErrorMsg make_error(ErrorCode code, std::string_view text);
+
+struct ByeMsg {
+    static constexpr MsgType kType = MsgType::bye;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+using ViewMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
+                                 EndOfFrameMsg, ErrorMsg, ByeMsg>;
+
+// The payload of a message (what follows the frame header).
+std::vector<std::byte> encode_payload(const ViewMessage& m);
+MsgType type_of(const ViewMessage& m);
+// Throws WireError naming the message and the field; an unknown type is an error too.
+ViewMessage decode_payload(MsgType type, std::span<const std::byte> payload);
+
+}  // namespace isowall::remote
