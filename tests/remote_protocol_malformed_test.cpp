@@ -1,0 +1,201 @@
+// The remote-viewing protocol, malformed fields: each check of each decoder throws a WireError
+// naming the message and the field, and a claimed huge count or length throws before anything is
+// allocated (the largest allocation is measured by replacing operator new, as in
+// protocol_malformed_test.cpp).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <limits>
+#include <new>
+#include <string>
+
+#include "tests/remote_protocol_test_util.h"
+
+namespace {
+std::atomic<std::size_t> g_largest_allocation{0};
+
+std::size_t largest_allocation_in(const std::function<void()>& f) {
+    g_largest_allocation = 0;
+    f();
+    return g_largest_allocation;
+}
+}  // namespace
+
+void* operator new(std::size_t n) {
+    std::size_t seen = g_largest_allocation.load(std::memory_order_relaxed);
+    while (n > seen && !g_largest_allocation.compare_exchange_weak(seen, n)) {
+    }
+    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    throw std::bad_alloc();
+}
+// Not inlined: GCC 12 would see free() meet a pointer from new and warn (-Wmismatched-new-delete).
+[[gnu::noinline]] void operator delete(void* p) noexcept {
+    std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace isowall::remote {
+namespace {
+
+using namespace remote_testing;
+using Bytes = std::vector<std::byte>;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// A valid sample with one field broken, and what the error must name. The encoders write what
+// they are given, so a broken message is a sample with one field changed.
+template <class M>
+struct Fault {
+    const char* field;
+    void (*apply)(M&);
+};
+
+template <class M>
+void expect_faults(const M& sample, std::initializer_list<Fault<M>> faults) {
+    for (const Fault<M>& f : faults) {
+        M m = sample;
+        f.apply(m);
+        expect_view_wire_error(M::kType, encode_payload(m), f.field);
+    }
+}
+
+TEST(RemoteProtocolMalformed, AllocationsAreSeen) {
+    GroupMsg m = sample_group();
+    m.encoded.assign(100000, std::byte{7});
+    const Bytes bytes = encode_payload(m);
+    EXPECT_GE(largest_allocation_in([&] { decode_payload(MsgType::group, bytes); }), 100000u);
+}
+
+TEST(RemoteProtocolMalformed, HelloFields) {
+    expect_faults<HelloMsg>(
+        sample_hello(),
+        {{"dataset: expected a name", [](HelloMsg& m) { m.dataset.clear(); }},
+         {"dataset: 257 bytes, expected at most 256",
+          [](HelloMsg& m) { m.dataset.assign(257, 'a'); }},
+         {"dataset: byte 2 is 10", [](HelloMsg& m) { m.dataset[2] = '\n'; }},
+         {"dataset: byte 0 is 195", [](HelloMsg& m) { m.dataset = "\xc3\xa9"; }},
+         {"token: 257 bytes", [](HelloMsg& m) { m.token.assign(257, 't'); }},
+         {"token: byte 1 is 0", [](HelloMsg& m) { m.token = std::string("a\0b", 3); }}});
+    HelloMsg ok = sample_hello();
+    ok.token.clear();
+    ok.dataset.assign(kMaxDatasetNameBytes, '~');
+    EXPECT_NO_THROW(decode_payload(MsgType::hello, encode_payload(ok)));
+}
+
+TEST(RemoteProtocolMalformed, ReadyFields) {
+    expect_faults<ReadyMsg>(
+        sample_ready(),
+        {{"bounds.min.y: expected a finite number", [](ReadyMsg& m) { m.bounds.min.y = kNaN; }},
+         {"bounds.max.z: expected a finite number", [](ReadyMsg& m) { m.bounds.max.z = kInf; }},
+         {"bounds: expected min <= max", [](ReadyMsg& m) { m.bounds.min.x = 5; }},
+         {"value_min: expected a finite number", [](ReadyMsg& m) { m.value_min = kNaN; }},
+         {"value_max: expected >= value_min", [](ReadyMsg& m) { m.value_max = -2000; }},
+         {"dims.y: expected 1..2147483647, got 0", [](ReadyMsg& m) { m.dims.y = 0; }},
+         {"dims.z: expected 1..2147483647, got -3", [](ReadyMsg& m) { m.dims.z = -3; }},
+         {"spacing: expected positive", [](ReadyMsg& m) { m.spacing.x = 0; }},
+         {"spacing.z: expected a finite number", [](ReadyMsg& m) { m.spacing.z = -kInf; }}});
+}
+
+TEST(RemoteProtocolMalformed, RequestFields) {
+    expect_faults<RequestMsg>(
+        sample_request(),
+        {{"camera.eye: expected finite", [](RequestMsg& m) { m.view.camera.eye.x = kNaN; }},
+         {"frustum.top: expected a finite number",
+          [](RequestMsg& m) { m.view.frustum.top = kInf; }},
+         {"view.width: expected 1..32768, got 0", [](RequestMsg& m) { m.view.width = 0; }},
+         {"view.height: expected 1..32768, got 40000",
+          [](RequestMsg& m) { m.view.height = 40000; }},
+         {"view.iso: expected a finite number", [](RequestMsg& m) { m.view.iso = kNaN; }},
+         {"view.camera: ", [](RequestMsg& m) { m.view.camera.target = m.view.camera.eye; }},
+         {"camera.projection: expected 0",
+          [](RequestMsg& m) { m.view.camera.projection = static_cast<Projection>(2); }}});
+    Bytes bytes = encode_payload(sample_request());
+    bytes[bytes.size() - 2] = std::byte{2};  // progressive_lod
+    expect_view_wire_error(MsgType::request, bytes, "progressive_lod: expected 0 or 1, got 2");
+    bytes[bytes.size() - 2] = std::byte{1};
+    bytes.back() = std::byte{255};  // cached_groups
+    expect_view_wire_error(MsgType::request, bytes, "cached_groups: expected 0 or 1, got 255");
+}
+
+TEST(RemoteProtocolMalformed, GroupFields) {
+    expect_faults<GroupMsg>(
+        sample_group(),
+        {{"key.seed.x: expected 0..2147483647, got -1", [](GroupMsg& m) { m.key.seed.x = -1; }},
+         {"key.level: expected 0..30, got 31", [](GroupMsg& m) { m.key.level = 31; }},
+         {"key.level: expected 0..30, got -1", [](GroupMsg& m) { m.key.level = -1; }},
+         {"key.iso: expected a finite number", [](GroupMsg& m) { m.key.iso = -kInf; }}});
+    Bytes bytes = encode_payload(sample_group());
+    const std::size_t refinement_at = 1 + 8 + 12 + 4 + 8;
+    bytes[refinement_at] = std::byte{3};
+    expect_view_wire_error(MsgType::group, bytes, "key.refinement: expected 0 or 1, got 3");
+    bytes[refinement_at] = std::byte{0};
+    bytes[refinement_at + 1] = std::byte{2};
+    expect_view_wire_error(MsgType::group, bytes, "draw_from_next_frame: expected 0 or 1, got 2");
+    GroupMsg big = sample_group();
+    big.encoded.assign(kMaxGroupBytes + 1, std::byte{1});
+    expect_view_wire_error(MsgType::group, encode_payload(big), "encoded: 33554433 bytes");
+}
+
+TEST(RemoteProtocolMalformed, GroupWithAHugeLengthThrowsWithoutAllocating) {
+    for (std::uint64_t length :
+         {std::uint64_t{5}, std::uint64_t{1} << 40, std::numeric_limits<std::uint64_t>::max()}) {
+        Bytes bytes = encode_payload(sample_group());
+        bytes.resize(bytes.size() - 4 - 8);  // drop the blob and its length
+        MessageWriter w(0);
+        w.put(length);
+        w.put(std::uint32_t{0x01020304});  // 4 bytes, fewer than the length
+        bytes.insert(bytes.end(), w.bytes().begin() + 1, w.bytes().end());
+        const auto largest = largest_allocation_in(
+            [&] { expect_view_wire_error(MsgType::group, bytes, "longer than the message"); });
+        EXPECT_LT(largest, 4096u) << "length " << length;
+    }
+}
+
+TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
+    for (std::uint64_t count :
+         {std::uint64_t{4}, std::uint64_t{1} << 50, std::numeric_limits<std::uint64_t>::max()}) {
+        MessageWriter w(VisibleMsg::kVersion);
+        w.put(std::uint64_t{9});
+        w.put(count);
+        w.put(std::uint64_t{0});  // 8 bytes, less than one key
+        const Bytes bytes = w.take();
+        const auto largest = largest_allocation_in(
+            [&] { expect_view_wire_error(MsgType::visible, bytes, "larger than the message"); });
+        EXPECT_LT(largest, 4096u) << "count " << count;
+    }
+    VisibleMsg many{1, std::vector<GroupKey>(kMaxVisibleKeys + 1)};
+    expect_view_wire_error(MsgType::visible, encode_payload(many), "keys: 1048577 keys");
+    VisibleMsg bad_key = sample_visible();
+    bad_key.keys[2].level = 99;
+    expect_view_wire_error(MsgType::visible, encode_payload(bad_key), "keys[2].level");
+}
+
+TEST(RemoteProtocolMalformed, ErrorFields) {
+    expect_faults<ErrorMsg>(
+        sample_error(),
+        {{"code: expected 1..6, got 0", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(0); }},
+         {"code: expected 1..6, got 7", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(7); }},
+         {"text: byte 3 is 10", [](ErrorMsg& m) { m.text = "one\ntwo"; }},
+         {"text: 257 bytes", [](ErrorMsg& m) { m.text.assign(257, 'e'); }}});
+}
+
+TEST(RemoteProtocolMalformed, WrongLayoutVersionThrows) {
+    for (const ViewMessage& m : samples()) {
+        Bytes bytes = encode_payload(m);
+        bytes[0] = std::byte{99};
+        expect_view_wire_error(type_of(m), bytes, "version 99, expected 1");
+    }
+}
+
+TEST(RemoteProtocolMalformed, AnUnknownTypeThrows) {
+    EXPECT_THROW(decode_payload(static_cast<MsgType>(0), encode_payload(ByeMsg{})), WireError);
+    EXPECT_THROW(decode_payload(static_cast<MsgType>(9), encode_payload(ByeMsg{})), WireError);
+}
+
+}  // namespace
+}  // namespace isowall::remote
