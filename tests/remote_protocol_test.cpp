@@ -4,6 +4,8 @@
 // any size, one byte included.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -219,6 +221,24 @@ TEST(RemoteProtocolFraming, AClaimedLengthIsNotBufferedBeforeItsBytesCome) {
     EXPECT_NE(wire_error_of([&] { second.next(c2); }, "length").find("over the limit"),
               std::string::npos);
     EXPECT_EQ(second.buffered_capacity(), kHeaderBytes);
+}
+
+TEST(RemoteProtocolFraming, TheCommittedFuzzSeedsDecode) {
+    // fuzz/corpus/view_protocol/stream-all (fuzz_view_protocol_seeds): a mode byte, a chunk seed,
+    // then one frame of every type. Seeds that no longer decode would fuzz only the error paths.
+    std::ifstream in(std::string(ISOWALL_SOURCE_DIR) + "/fuzz/corpus/view_protocol/stream-all",
+                     std::ios::binary);
+    ASSERT_TRUE(in) << "missing seed";
+    const std::vector<char> raw{std::istreambuf_iterator<char>(in), {}};
+    ASSERT_GT(raw.size(), 2u);
+    std::span<const std::byte> chunk = std::as_bytes(std::span(raw)).subspan(2);
+    FrameParser parser;
+    std::vector<MsgType> types;
+    while (!chunk.empty())
+        if (auto m = parser.next(chunk)) types.push_back(type_of(*m));
+    ASSERT_EQ(types.size(), std::size_t{kLastMsgType});
+    for (std::uint16_t t = 1; t <= kLastMsgType; ++t)
+        EXPECT_EQ(types[t - 1], static_cast<MsgType>(t));
 }
 
 }  // namespace
