@@ -16,6 +16,7 @@ namespace {
 
 constexpr float kQuantMax = 65535.0f;
 constexpr float kSnormMax = 32767.0f;
+constexpr unsigned kFifoCache = 16;  // vertices: below any GPU cache, as meshoptimizer advises
 
 std::int16_t to_snorm16(float v) {
     return static_cast<std::int16_t>(std::lround(std::clamp(v, -1.0f, 1.0f) * kSnormMax));
@@ -29,7 +30,9 @@ float sign_not_zero(float v) {
 
 // The extractor's mesh put in the order the index codec codes best: triangles in vertex cache
 // order, then vertices in the order those triangles first use them (so most new indices are
-// "next vertex", a few bits each). Vertices no triangle uses are dropped.
+// "next vertex", a few bits each). Vertices no triangle uses are dropped. The FIFO cache order
+// is meshoptimizer's fast one: on the phantom's frame (isowall_bench_codec) it gives 6.78 bytes
+// a triangle at 8.5 M triangles/s, the full optimizer 6.62 at 2.7 M/s, no reordering 8.23.
 struct Reordered {
     std::vector<std::uint32_t> indices;
     std::vector<std::uint32_t> old_of_new;  // the mesh's vertex behind each new vertex
@@ -39,7 +42,7 @@ Reordered reorder(const Mesh& mesh) {
     Reordered out;
     const std::size_t n = mesh.indices.size(), v = mesh.vertex_count();
     out.indices.resize(n);
-    meshopt_optimizeVertexCache(out.indices.data(), mesh.indices.data(), n, v);
+    meshopt_optimizeVertexCacheFifo(out.indices.data(), mesh.indices.data(), n, v, kFifoCache);
     std::vector<std::uint32_t> remap(v);
     const std::size_t used =
         meshopt_optimizeVertexFetchRemap(remap.data(), out.indices.data(), n, v);

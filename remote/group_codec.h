@@ -50,9 +50,9 @@ inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
 }
 
 inline constexpr std::uint8_t kGroupCodecVersion = 1;
-// One propagation pass makes a few thousand triangles (max_count 2000 cells); a whole-surface
-// group of the shared CT head at iso 40 is about 1.6 M. 4 M triangles (288 MiB as `vertices`)
-// bounds what one group may claim, and so what a decoder may allocate for one.
+// One propagation pass makes a few thousand triangles (max_count 2000 cells); the whole skin of
+// the shared CT head at iso 40 is 0.72 M. 4 M triangles (288 MiB as `vertices`) bounds what one
+// group may claim, and so what a decoder may allocate for one.
 inline constexpr std::uint32_t kMaxGroupTriangles = 1u << 22;
 inline constexpr std::uint32_t kMaxGroupVertices = 3 * kMaxGroupTriangles;
 // zstd level: 1-3 are the fast ones; the compact bytes are already dense, so higher levels
