@@ -1,0 +1,74 @@
+#pragma once
+// How a group travels from the extraction server to the client (issue 12; the dissertation's
+// section 4.2 and its open problem 5.2.3). Four encodings, from the base case to ours:
+//   vertices      every triangle as three separate vertices, float32 position + normal each,
+//                 no index (section 4.2's case 1): 72 bytes a triangle
+//   indexed       the indexed face set the extractor makes: float32 positions and normals,
+//                 uint32 indices (case 2)
+//   compact       positions quantised to 16 bits per axis inside the group's bounding box (sent
+//                 as floats), normals as octahedral 2 x 16 bits, indices through meshoptimizer's
+//                 index codec after its vertex cache and vertex fetch orders
+//   compact_zstd  the compact bytes through zstd (level kZstdLevel)
+//
+// Bytes: [version u8][encoding u8][group header][body]; compact_zstd's body is the u64 size of
+// the compact message, then one zstd frame holding that whole message (its own version and
+// encoding bytes included). The group header is id u32, seed 3 x i32, level i32, iso f64,
+// refinement u8. Group::cells is not sent: it is the server's bookkeeping of which cells a pass
+// took, and the client draws only the mesh.
+//
+// What decoding gives back: `vertices` gives an unindexed mesh (indices 0, 1, 2, ...); `indexed`
+// gives the mesh as it was; `compact` and `compact_zstd` give the same triangles with the same
+// winding, but vertices reordered, triangles reordered and rotated (first corner changes), and
+// vertices no triangle uses dropped. Positions are within the box's extent / 65535 per axis of
+// the original (half of that, plus float rounding), normals within kOctNormalMaxErrorDeg.
+//
+// Decoding is for hostile input: every count is checked against the limits below and against
+// the bytes left before anything is allocated, indices against the vertex count, and every float
+// must be finite; anything else throws WireError naming the field.
+#include <cstdint>
+#include <ostream>
+#include <span>
+#include <vector>
+
+#include "common/core/wire.h"
+#include "common/extract/group.h"
+
+namespace isowall::remote {
+
+enum class GroupEncoding : std::uint8_t {
+    vertices = 0,
+    indexed = 1,
+    compact = 2,
+    compact_zstd = 3
+};
+inline constexpr GroupEncoding kAllGroupEncodings[] = {
+    GroupEncoding::vertices, GroupEncoding::indexed, GroupEncoding::compact,
+    GroupEncoding::compact_zstd};
+const char* to_string(GroupEncoding e);
+inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
+    return os << to_string(e);
+}
+
+inline constexpr std::uint8_t kGroupCodecVersion = 1;
+// One propagation pass makes a few thousand triangles (max_count 2000 cells); the whole skin of
+// the shared CT head at iso 40 is 0.72 M. 4 M triangles (288 MiB as `vertices`) bounds what one
+// group may claim, and so what a decoder may allocate for one.
+inline constexpr std::uint32_t kMaxGroupTriangles = 1u << 22;
+inline constexpr std::uint32_t kMaxGroupVertices = 3 * kMaxGroupTriangles;
+// zstd level: 1-3 are the fast ones; the compact bytes are already dense, so higher levels
+// gain little and cost the server's time per group.
+inline constexpr int kZstdLevel = 3;
+// A zstd frame may claim at most this many times its own size once decompressed. Compact bytes
+// shrink by well under 2x; the cap keeps a few hostile bytes from claiming a huge buffer.
+inline constexpr std::uint64_t kMaxZstdExpansion = 64;
+// The largest angle between a unit normal and its 2 x 16-bit octahedral code, decoded (measured
+// over every code direction in tests/remote_codec_test.cpp, with margin).
+inline constexpr double kOctNormalMaxErrorDeg = 0.01;
+
+std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding);
+// Throws WireError on anything malformed, truncated, of another version, or with trailing bytes.
+Group decode_group(std::span<const std::uint8_t> bytes);
+// The encoding named by encoded bytes (their second byte), checked.
+GroupEncoding encoding_of(std::span<const std::uint8_t> bytes);
+
+}  // namespace isowall::remote
