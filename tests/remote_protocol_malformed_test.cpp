@@ -145,7 +145,10 @@ TEST(RemoteProtocolMalformed, GroupWithAHugeLengthThrowsWithoutAllocating) {
     for (std::uint64_t length :
          {std::uint64_t{5}, std::uint64_t{1} << 40, std::numeric_limits<std::uint64_t>::max()}) {
         Bytes bytes = encode_payload(sample_group());
-        bytes.resize(bytes.size() - 4 - 8);  // drop the blob and its length
+        ASSERT_GE(bytes.size(), 12u);
+        // Drop the blob (4 bytes) and its length (8): erase, not resize, which GCC 12 under
+        // -O2 and sanitizers mistakes for a memset of a wrapped size (-Wstringop-overflow).
+        bytes.erase(bytes.end() - 12, bytes.end());
         MessageWriter w(0);
         w.put(length);
         w.put(std::uint32_t{0x01020304});  // 4 bytes, fewer than the length
