@@ -15,36 +15,12 @@
 #include "common/volume/phantom.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
-
-// ---- the largest single allocation (as tests/protocol_malformed_test.cpp) --------------------
-// Replacing the global operator new affects the whole remote_codec_test executable; it only
-// records sizes.
-namespace {
-std::atomic<std::size_t> g_largest_allocation{0};
-
-std::size_t largest_allocation_in(const std::function<void()>& f) {
-    g_largest_allocation = 0;
-    f();
-    return g_largest_allocation;
-}
-}  // namespace
-
-void* operator new(std::size_t n) {
-    std::size_t seen = g_largest_allocation.load(std::memory_order_relaxed);
-    while (n > seen && !g_largest_allocation.compare_exchange_weak(seen, n)) {
-    }
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept {
-    std::free(p);
-}
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
+#include "tests/largest_allocation.h"
 
 namespace isowall::remote {
 namespace {
+
+using test::largest_allocation_in;
 
 using Bytes = std::vector<std::uint8_t>;
 constexpr std::size_t kHeaderEnd = 2 + 29;  // version, encoding, group header
