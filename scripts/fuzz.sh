@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-30}
 shift || true
 HARNESSES=("$@")
-[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd wall script wire view_protocol)
+[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd wall script wire view_protocol group_codec)
 BUILD=${ISOWALL_FUZZ_BUILD_DIR:-build-fuzz}
 
 cmake -S . -B "$BUILD" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
