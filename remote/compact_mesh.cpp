@@ -60,14 +60,17 @@ void put_positions(ByteWriter& w, const Mesh& mesh, const std::vector<std::uint3
     w.put_raw(std::span<const float>(&box.min.x, 3));
     w.put_raw(std::span<const float>(&box.max.x, 3));
     const glm::vec3 extent = box.max - box.min;
-    glm::vec3 scale(0);
-    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? kQuantMax / extent[a] : 0.0f;
+    // The scale in double: 65535 / extent overflows a float for an extent under about 2e-34 (a
+    // decoded hostile box can be that small), and an infinite scale put every position on one of
+    // the box's ends (fuzz/regressions/group_codec/compact-tiny-extent-snaps-to-box-ends).
+    glm::dvec3 scale(0);
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0 ? kQuantMax / double{extent[a]} : 0.0;
     std::vector<std::uint16_t> q(3 * old_of_new.size());
     for (std::size_t i = 0; i < old_of_new.size(); ++i) {
-        const glm::vec3 p = (mesh.positions[old_of_new[i]] - box.min) * scale;
+        const glm::dvec3 p = glm::dvec3(mesh.positions[old_of_new[i]] - box.min) * scale;
         for (int a = 0; a < 3; ++a)
             q[3 * i + a] =
-                static_cast<std::uint16_t>(std::lround(std::clamp(p[a], 0.0f, kQuantMax)));
+                static_cast<std::uint16_t>(std::lround(std::clamp(p[a], 0.0, double{kQuantMax})));
     }
     w.put_raw(std::span<const std::uint16_t>(q));
 }
@@ -84,13 +87,16 @@ void get_positions(ByteReader& r, std::uint32_t vertex_count, std::vector<glm::v
             r.fail("box: expected finite min <= max, got axis " + std::to_string(a) + " [" +
                    std::to_string(lo[a]) + ", " + std::to_string(hi[a]) + "]");
     }
-    const glm::vec3 step = (hi - lo) / kQuantMax;
+    // In double, rounded to float once: a float step of a denormal extent is off by up to half
+    // the smallest denormal, which 65535 steps multiplied past the quantisation bound
+    // (fuzz/regressions/group_codec/compact-denormal-box-step-rounding).
+    const glm::dvec3 step = (glm::dvec3(hi) - glm::dvec3(lo)) / double{kQuantMax};
     std::vector<std::uint16_t> q(3 * std::size_t{vertex_count});
     r.get_raw(std::span(q));
     out.resize(vertex_count);
     for (std::size_t i = 0; i < vertex_count; ++i)
         for (int a = 0; a < 3; ++a)
-            out[i][a] = std::min(lo[a] + static_cast<float>(q[3 * i + a]) * step[a], hi[a]);
+            out[i][a] = std::min(static_cast<float>(lo[a] + q[3 * i + a] * step[a]), hi[a]);
 }
 
 void get_indices(ByteReader& r, std::uint32_t triangle_count, std::uint32_t vertex_count,

@@ -3,6 +3,7 @@
 // throw WireError; a huge claimed count throws before anything of its size is allocated.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -153,6 +154,30 @@ TEST(RemoteCodecMalformed, InvertedBoxThrows) {
     const float lo = 1e6f;  // min.x above max.x
     std::memcpy(bytes.data() + kHeaderEnd + 8, &lo, sizeof lo);
     EXPECT_THROW(decode_group(bytes), WireError);
+}
+
+// A box whose extent is under about 2e-34 made the encoder's float scale 65535 / extent
+// infinite, so a decoded group encoded again had every position on one of the box's ends
+// (fuzz_group_codec's first finding). Each axis's sorted corner coordinates stay within a step.
+TEST(RemoteCodecMalformed, TinyBoxEncodesAgainWithinAStep) {
+    Bytes bytes = encode_group(small_group(), GroupEncoding::compact);
+    const float box[6] = {0, 0, 0, 1e-35f, 1e-35f, 1e-35f};
+    std::memcpy(bytes.data() + kHeaderEnd + 8, box, sizeof box);
+    const Group once = decode_group(bytes);
+    const Group twice = decode_group(encode_group(once, GroupEncoding::compact));
+    ASSERT_EQ(twice.mesh.triangle_count(), once.mesh.triangle_count());
+    for (int a = 0; a < 3; ++a) {
+        auto corners = [a](const Mesh& m) {
+            std::vector<float> c;
+            for (std::uint32_t i : m.indices) c.push_back(m.positions[i][a]);
+            std::sort(c.begin(), c.end());
+            return c;
+        };
+        const std::vector<float> c1 = corners(once.mesh), c2 = corners(twice.mesh);
+        ASSERT_GT(c1.back(), c1.front()) << "axis " << a << ": the positions spread over the box";
+        for (std::size_t i = 0; i < c1.size(); ++i)
+            ASSERT_NEAR(c2[i], c1[i], 1e-35 / 65535 + 1e-44) << "axis " << a << " corner " << i;
+    }
 }
 
 }  // namespace

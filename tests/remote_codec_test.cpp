@@ -47,16 +47,17 @@ using QTriangle = std::array<std::array<std::uint32_t, 3>, 3>;
 // The encoder's own formula (remote/compact_mesh.cpp), so an original corner and its decoded
 // copy get the same code.
 struct Quantiser {
-    glm::vec3 lo, step, scale;
+    glm::vec3 lo, step;
+    glm::dvec3 scale{0};
     explicit Quantiser(const Box3& box) : lo(box.min), step((box.max - box.min) / 65535.0f) {
         for (int a = 0; a < 3; ++a)
-            scale[a] = box.max[a] > box.min[a] ? 65535.0f / (box.max[a] - box.min[a]) : 0.0f;
+            if (box.max[a] > box.min[a]) scale[a] = 65535.0 / double{box.max[a] - box.min[a]};
     }
     std::array<std::uint32_t, 3> operator()(glm::vec3 p) const {
         std::array<std::uint32_t, 3> q{};
-        const glm::vec3 s = (p - lo) * scale;
+        const glm::dvec3 s = glm::dvec3(p - lo) * scale;
         for (int a = 0; a < 3; ++a)
-            q[a] = static_cast<std::uint32_t>(std::lround(std::clamp(s[a], 0.0f, 65535.0f)));
+            q[a] = static_cast<std::uint32_t>(std::lround(std::clamp(s[a], 0.0, 65535.0)));
         return q;
     }
 };
