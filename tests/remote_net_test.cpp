@@ -54,6 +54,14 @@ TEST(RemoteNet, ListenerTakesAnEphemeralPortAndNamesThePeer) {
     EXPECT_EQ(link.server_peer.rfind("127.0.0.1:", 0), 0u) << link.server_peer;
 }
 
+TEST(RemoteNet, ConnectsByName) {
+    Listener l = Listener::open("127.0.0.1", 0);
+    // "localhost" may name ::1 first, where nothing listens: connect_tcp tries each address.
+    Socket s = connect_tcp("localhost", l.port(), kTimeout_s);
+    EXPECT_TRUE(s.valid());
+    EXPECT_TRUE(l.accept(kTimeout_s));
+}
+
 TEST(RemoteNet, EveryMessageRoundTripsBothWays) {
     Loopback link;
     auto server = link.server_connection();
@@ -223,6 +231,8 @@ TEST(RemoteNet, AcceptTimesOutAndBadAddressesAreNetErrors) {
     EXPECT_FALSE(l.accept(0.02));
     EXPECT_THROW(Listener::open("not an address", 0), NetError);
     EXPECT_THROW(connect_tcp("127.0.0.1", 0, kTimeout_s), NetError);
+    EXPECT_THROW(connect_tcp("127.0.0.1", 65536, kTimeout_s), NetError);
+    EXPECT_THROW(Listener::open("127.0.0.1", -1), NetError);
 }
 
 TEST(RemoteNet, ConcurrentSendersNeverInterleaveFrames) {

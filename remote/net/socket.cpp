@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <sstream>
@@ -181,7 +182,9 @@ bool recv_some(const Socket& s, std::span<std::byte> buf, double timeout_s, std:
 Socket connect_tcp(const std::string& host, int port, double timeout_s) {
     const std::string peer = host_port(host, port);
     const auto deadline = deadline_after(timeout_s);
-    const AddrInfo addrs = resolve(host, port, AI_ADDRCONFIG, peer);
+    if (port < 1 || port > 65535) throw NetError(peer + ": connect: expected a port 1..65535");
+    // No AI_ADDRCONFIG: on a host with only loopback up it would hide "localhost" itself.
+    const AddrInfo addrs = resolve(host, port, 0, peer);
     int err = 0;
     for (const addrinfo* a = addrs.get(); a != nullptr; a = a->ai_next) {
         Socket s = connect_one(*a, deadline, peer, err);
@@ -198,6 +201,7 @@ Socket connect_tcp(const std::string& host, int port, double timeout_s) {
 
 Listener Listener::open(const std::string& address, int port, int backlog) {
     const std::string where = host_port(address, port);
+    if (port < 0 || port > 65535) throw NetError(where + ": listen: expected a port 0..65535");
     const AddrInfo addrs = resolve(address, port, AI_PASSIVE, where);
     const addrinfo& a = *addrs;
     Socket s(::socket(a.ai_family, a.ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a.ai_protocol));
