@@ -1,0 +1,22 @@
+#pragma once
+// "HOST:PORT" as a user writes it on the command line (`isowall view 127.0.0.1:5000`).
+#include <string>
+#include <string_view>
+
+namespace isowall::remote {
+
+struct Endpoint {
+    std::string host;  // a name or a numeric address, IPv6 without its brackets
+    int port = 0;      // 1..65535
+};
+
+// "HOST:PORT", or "[IPV6]:PORT" (an IPv6 address has colons of its own, so it goes in brackets).
+// Throws InputError(source, field, ...) saying what was expected and quoting what was found, e.g.
+// InputError("--connect", "endpoint", "port: expected an integer 1..65535, got \"0\"").
+Endpoint parse_endpoint(std::string_view text, std::string_view source, std::string_view field);
+
+// "host:port", with an IPv6 host in brackets: the name of a peer in error lines.
+std::string to_string(const Endpoint& e);
+std::string host_port(std::string_view host, int port);
+
+}  // namespace isowall::remote
