@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
         if (cli.info_cmd->parsed()) return run_info(cli.info);
         if (cli.ex_cmd->parsed()) return run_extract(cli.ex);
         if (cli.re_cmd->parsed()) return run_render(cli.re);
+        if (cli.serve_cmd->parsed()) return run_serve(cli.serve);
+        if (cli.view_cmd->parsed()) return run_view(cli.view);
         if (cli.wall_cmd->parsed() && cli.ranks_needed) {
             std::printf("%d\n", rank_count(load_wall(cli.wall.wall)));
             return 0;

@@ -172,6 +172,8 @@ ProgramCli::ProgramCli() {
 
     re_cmd = add_render_command(app, re);
     wall_cmd = add_wall_command(app, wall);
+    serve_cmd = add_serve_command(app, serve);
+    view_cmd = add_view_command(app, view);
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");
 }

@@ -5,6 +5,7 @@
 
 #include "master/commands.h"
 #include "master/wall_run.h"
+#include "remote/remote_commands.h"
 
 namespace isowall {
 
@@ -18,11 +19,15 @@ struct ProgramCli {
     ExtractOptions ex;
     RenderOptions re;
     WallOptions wall;
+    ServeCommand serve;
+    ViewCommand view;
     bool ranks_needed = false;
     CLI::App* info_cmd = nullptr;
     CLI::App* ex_cmd = nullptr;
     CLI::App* re_cmd = nullptr;
     CLI::App* wall_cmd = nullptr;
+    CLI::App* serve_cmd = nullptr;
+    CLI::App* view_cmd = nullptr;
 };
 
 }  // namespace isowall

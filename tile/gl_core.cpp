@@ -246,6 +246,15 @@ void GlCore::clear() {
     check("glClear");
 }
 
+void GlCore::clear_depth() {
+    require_size("clear_depth");
+    bind_frame();
+    gl_->ClearDepth(1.0);
+    gl_->DepthMask(GL_TRUE);
+    gl_->Clear(GL_DEPTH_BUFFER_BIT);
+    check("glClear");
+}
+
 void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) {
     require_size("draw");
     if (mesh.normals.size() != mesh.positions.size()) {

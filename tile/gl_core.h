@@ -33,6 +33,7 @@ class GlCore {
     int width() const { return width_; }
     int height() const { return height_; }
     void clear();
+    void clear_depth();
     void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection);
     void read_back(Image& out, const PixelRect& rect);
     void finish();
@@ -75,6 +76,10 @@ class GlRenderer : public Renderer {
     void clear() override {
         make_current();
         core_->clear();
+    }
+    void clear_depth() override {
+        make_current();
+        core_->clear_depth();
     }
     void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) override {
         make_current();

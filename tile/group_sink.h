@@ -29,6 +29,12 @@ class GroupSink {
     virtual bool coverage(std::vector<std::uint8_t>& /*covered*/, const PixelRect& /*rect*/) {
         return false;
     }
+    // Whether seen() is wanted: the engine then looks up the group of every visited cell a ray
+    // meets (a hash lookup per such ray), else it does not.
+    virtual bool wants_seen() const { return false; }
+    // A ray met a cell that group `group_id` took earlier in this frame, or before it when the
+    // frame went on from cached groups (EngineOptions::begin_extractor_frame).
+    virtual void seen(std::uint32_t /*group_id*/) {}
 };
 
 // Draws every group into a renderer's frame, which begin() resizes and clears.

@@ -126,14 +126,17 @@ class FrameRun {
         stage(Stage::setup);
         start_ = Clock::now();
         ResolutionLevels levels;
-        if (opt_.adaptive) {
+        if (opt_.uniform_level > 0) {
+            levels = uniform_levels(opt_.uniform_level);
+        } else if (opt_.adaptive) {
             // D[] depends on the eye, the frustum and the pixel size only: once per frame (every
             // tile of a wall has the same pixel size, so one frame serves all of them).
             levels = resolution_levels(view.camera, view.frustum, view.height,
                                        ex_.volume().spacing(), opt_.adaptive_max_level);
             levels.refine = opt_.adaptive_refine;
         }
-        ex_.begin_frame(view.iso, levels);
+        if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
+        frame_.group_count = 0;
         extra_ = opt_.sample_at_rays;
         std::sort(extra_.begin(), extra_.end());
         stage(Stage::intersection);
@@ -163,14 +166,18 @@ class FrameRun {
         // A meta-cell whose triangles miss this pixel's surface gets its full-resolution triangles
         // drawn over (adaptive resolution only); any other unvisited hit seeds a pass.
         if (hit.found) ++cursor_->hits;
-        if (!hit.found || (!hit.refine && ex_.visited(hit.cell))) return true;
+        if (!hit.found) return true;
+        if (!hit.refine && ex_.visited(hit.cell)) {
+            if (sink_->wants_seen()) sink_->seen(ex_.group_of(hit.cell));
+            return true;
+        }
         return seed(hit, ray);
     }
 
     bool seed(const RayHit& hit, const Ray& ray) {
         stage(Stage::propagation);
         const auto t0 = Clock::now();
-        const auto id = static_cast<std::uint32_t>(frame_.group_count);
+        const auto id = opt_.first_group_id + static_cast<std::uint32_t>(frame_.group_count);
         Group g = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
                              : ex_.propagate(hit.cell, id, params_, ray, interrupted_);
         const double pass_s = since(t0);

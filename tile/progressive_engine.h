@@ -52,6 +52,15 @@ struct EngineOptions {
     double progress_interval_s = 0.5;
     // Extra samples exactly when these ray counts are reached (snapshots by rays).
     std::vector<std::size_t> sample_at_rays;
+    // Remote viewing (sections 4.1.3-4.1.4). uniform_level > 0: every unit is a meta-cell of
+    // 2^uniform_level cells per side (where the meta-cell is complete; the volume's border falls
+    // back to cells), with no refinement: a coarse level of progressive LOD. Overrides adaptive.
+    int uniform_level = 0;
+    // False: the frame goes on from the extractor's visited cells instead of forgetting them (the
+    // caller began the extractor's frame at the view's isovalue and may have marked cells taken
+    // by groups a client caches); new groups' ids then start at first_group_id.
+    bool begin_extractor_frame = true;
+    std::uint32_t first_group_id = 0;
 };
 
 struct FrameResult {

@@ -28,6 +28,9 @@ class Renderer {
     virtual void resize(int width, int height) = 0;
     // Black background, depth 1 everywhere.
     virtual void clear() = 0;
+    // Depth 1 everywhere, colours kept: what is drawn next covers what is there (a finer level of
+    // detail over a coarser one, section 4.1.4).
+    virtual void clear_depth() = 0;
     // Adds `mesh` to the current frame without clearing it, so a caller can draw only the groups
     // that changed since the last frame.
     virtual void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection) = 0;

@@ -85,6 +85,19 @@ ResolutionLevels resolution_levels(const Camera& camera, const Frustum& frustum,
 
 std::ostream& operator<<(std::ostream& os, const ResolutionLevels& r);
 
+// Every unit at meta-cells of 2^level cells per side wherever the meta-cell is complete (the
+// volume's border falls back to cells), without refinement: a coarse level of progressive LOD
+// (section 4.1.3). level 0 is full resolution.
+inline ResolutionLevels uniform_levels(int level) {
+    ResolutionLevels levels;
+    if (level <= 0) return levels;
+    level = level < kMaxMetaLevel ? level : kMaxMetaLevel;
+    levels.d[static_cast<std::size_t>(level)] = 0;  // every distance is past D[level]
+    levels.max_level = level;
+    levels.refine = false;
+    return levels;
+}
+
 // ResolutionLevels in voxel space for one volume: the level of each cell. Default-constructed, it
 // is full resolution everywhere (level 0), and the walk and the propagation take exactly their
 // full-resolution paths.

@@ -171,7 +171,6 @@ class Propagator {
         return g;
     }
 
-  private:
     // Marks every cell of the unit of `level` at `base`; false when it was taken already.
     static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
         if (!visited.insert(base, group_id)) return false;
@@ -183,6 +182,7 @@ class Propagator {
         return true;
     }
 
+  private:
     // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
     int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
         double corner[8];

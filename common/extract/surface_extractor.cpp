@@ -1,5 +1,6 @@
 #include "common/extract/surface_extractor.h"
 
+#include <memory>
 #include <vector>
 
 #include "common/extract/extractor_parts.h"
@@ -14,7 +15,11 @@ class TypedExtractor final : public SurfaceExtractor {
   public:
     TypedExtractor(const Volume& volume, const OctreeSource& source, OctreeStats* stats,
                    int workers, ThreadBudget build)
-        : data_(volume, source, stats, build), frame_(data_.view.cell_dims()) {
+        : TypedExtractor(std::make_shared<const ExtractionData<T>>(volume, source, stats, build),
+                         workers) {}
+
+    TypedExtractor(std::shared_ptr<const ExtractionData<T>> data, int workers)
+        : data_holder_(std::move(data)), data_(*data_holder_), frame_(data_.view.cell_dims()) {
         // Reserved once and never resized: workers are not moved while the frame runs.
         workers_.reserve(static_cast<std::size_t>(workers));
         for (int i = 0; i < workers; ++i) workers_.emplace_back(data_);
@@ -58,10 +63,19 @@ class TypedExtractor final : public SurfaceExtractor {
         return isowall::extract_full(data_.view, data_.octree, iso, stats);
     }
 
+    bool mark_taken(glm::ivec3 base, int level, std::uint32_t group_id) override {
+        return Propagator<T>::insert(frame_.visited, base, level, group_id);
+    }
+
+    std::unique_ptr<SurfaceExtractor> share() const override {
+        return std::make_unique<TypedExtractor<T>>(data_holder_, threads());
+    }
+
   private:
     ExtractWorker<T>& worker() { return workers_.front(); }
 
-    ExtractionData<T> data_;
+    std::shared_ptr<const ExtractionData<T>> data_holder_;
+    const ExtractionData<T>& data_;
     FrameState frame_;
     std::vector<ExtractWorker<T>> workers_;  // at least one
 };

@@ -56,6 +56,16 @@ class SurfaceExtractor {
     virtual double last_extract_s() const = 0;
     // Every triangle of the surface at `iso` (the oracle; does not touch visited cells).
     virtual Mesh extract_full(double iso, ExtractStats* stats = nullptr) const = 0;
+
+    // Marks the unit of `level` at `base` (its first cell) as taken by `group_id` in this frame,
+    // as a propagation pass would have: a frame that goes on from groups a client already holds
+    // (cached primitives, the dissertation's section 4.1.4). False when a cell of it was taken.
+    virtual bool mark_taken(glm::ivec3 base, int level, std::uint32_t group_id) = 0;
+
+    // Another extractor of the same volume and octree (shared, read-only, never copied) with a
+    // frame state and workers of its own: one per client of a server, or per level of detail.
+    // This extractor must outlive the new one.
+    virtual std::unique_ptr<SurfaceExtractor> share() const = 0;
 };
 
 // Builds (or maps from the cache) the octree of `volume`, which must outlive the extractor.

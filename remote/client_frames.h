@@ -1,0 +1,103 @@
+#pragma once
+// The drawing side of `isowall view`, apart from sockets: the messages of a request go in, the
+// frame is drawn as they arrive, and a timeline of what the client had on screen is kept (bytes
+// received, groups, triangles, and after the frame both correctness measures by a replay).
+//
+// What is drawn (the dissertation's section 4.1.4):
+//   - groups are drawn as they arrive, each decoded once; with progressive LOD the depth buffer
+//     is cleared when a finer level begins, so the finer surface covers the coarser one;
+//   - a group coarser than what the frame already shows is not drawn (it could not be drawn over
+//     the finer groups), nor one sent with draw_from_next_frame; both are cached when caching;
+//   - VisibleMsg names cached groups to draw: the client must hold each (a protocol error if not);
+//   - at the end of a frame that drew any coarse group, the frame is drawn again from its
+//     full-resolution groups alone, so the final image holds no coarse leftovers and equals the
+//     image of the same view without LOD.
+// The cache holds the groups of one isovalue, as decoded meshes, and is dropped when a request
+// asks for another isovalue or for no caching.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "common/core/image.h"
+#include "common/progressive/correctness.h"
+#include "remote/view_protocol.h"
+#include "tile/renderer.h"
+
+namespace isowall::remote {
+
+struct ClientSample {
+    double time_s = 0;         // since the request was sent
+    std::uint64_t bytes = 0;   // received for this request, headers included
+    std::uint64_t groups = 0;  // received (new groups) for this request
+    std::uint64_t named = 0;   // cached groups named visible
+    std::uint64_t triangles = 0;  // drawn
+    std::size_t ops = 0;          // draw steps done by then (for the replay)
+    Correctness correctness;      // against the final image; filled by measure()
+};
+
+struct ClientFrameResult {
+    bool completed = false;
+    EndOfFrameMsg end;  // the server's figures
+    std::vector<ClientSample> timeline;
+    Image final_image;
+};
+
+class ClientFrames {
+  public:
+    explicit ClientFrames(Renderer& renderer) : renderer_(renderer) {}
+
+    // A request was sent at `now_s`: a new frame of its view (the previous one is abandoned).
+    void begin(const RequestMsg& request, double now_s);
+    // A message from the server, `wire_bytes` long, that arrived at `now_s`. True when it ended
+    // the current frame (then result() holds it). Messages of older requests only fill the cache.
+    // Throws WireError for a group that does not decode or names an unknown cached group, and
+    // RemoteError (below) for an ErrorMsg.
+    bool handle(const ViewMessage& m, std::size_t wire_bytes, double now_s);
+    // The last frame ended; measure() first fills the correctness of its samples.
+    const ClientFrameResult& result() const { return result_; }
+    // Replays the frame's draw steps and measures each sample against the final image.
+    void measure();
+    // What is on screen now.
+    void read_back(Image& out) { renderer_.read_back(out); }
+
+    std::size_t cached_groups() const { return cache_.size(); }
+
+  private:
+    struct Cached {
+        std::shared_ptr<const Mesh> mesh;
+        int level = 0;
+    };
+    struct Op {
+        std::shared_ptr<const Mesh> mesh;  // null: clear the depth buffer
+    };
+    void draw(const std::shared_ptr<const Mesh>& mesh, int level);
+    void sample(double now_s, bool force);
+    void finish_frame(const EndOfFrameMsg& end, double now_s);
+
+    Renderer& renderer_;
+    RequestMsg request_;
+    bool active_ = false;
+    double start_s_ = 0, last_sample_s_ = -1;
+    std::uint64_t last_sample_bytes_ = 0;
+    ClientSample now_;
+    int draw_level_ = 1 << 30;  // the finest level drawn in this frame so far
+    bool drew_coarse_ = false;
+    std::size_t redraw_op_ = SIZE_MAX;  // where the end-of-frame redraw began, if any
+    std::vector<Op> ops_;
+    std::vector<std::shared_ptr<const Mesh>> finals_;  // full-resolution groups of the frame
+    std::unordered_map<GroupKey, Cached> cache_;
+    bool cache_valid_ = false;
+    double cache_iso_ = 0;
+    ClientFrameResult result_;
+};
+
+// The server's ErrorMsg, as an exception: the text names the server's complaint.
+struct RemoteError : std::runtime_error {
+    RemoteError(ErrorCode c, const std::string& text) : std::runtime_error(text), code(c) {}
+    ErrorCode code;
+};
+
+}  // namespace isowall::remote

@@ -1,0 +1,50 @@
+#pragma once
+// `isowall serve` and `isowall view` (issue 12): their options, command lines and runs.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "master/engine_cli.h"
+
+namespace isowall {
+
+struct ServeCommand {
+    std::vector<std::string> datasets;  // NAME=PATH (NRRD); "phantom" is always offered
+    std::string listen = "127.0.0.1";
+    int port = 7878;
+    std::string token;
+    double rate_mbps = 0;
+    int max_clients = 8;
+    double lod_rays_percent = 0.25;
+    std::string cache_dir;
+    EngineCli engine;
+    bool quiet = false;
+};
+
+struct ViewCommand {
+    std::string connect = "127.0.0.1:7878";
+    std::string dataset = "phantom";
+    std::string token;
+    int test_case = 0;  // 1-5: the study's cases; 0: the options below
+    std::string encoding = "compact-zstd";
+    bool lod = false, cache = false;
+    std::optional<double> iso;
+    std::string size = "800x600";
+    std::vector<double> orbit;
+    double zoom = 1.0;
+    std::string script;
+    std::string out = "view.png";
+    std::string timeline;
+    std::string gl = "osmesa";
+    double timeout_s = 120;
+    bool quiet = false;
+};
+
+CLI::App* add_serve_command(CLI::App& app, ServeCommand& o);
+CLI::App* add_view_command(CLI::App& app, ViewCommand& o);
+int run_serve(const ServeCommand& o);
+int run_view(const ViewCommand& o);
+
+}  // namespace isowall

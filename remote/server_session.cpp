@@ -1,0 +1,216 @@
+#include "remote/server_session.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
+
+#include "common/core/ray.h"
+#include "remote/view_framing.h"
+
+namespace isowall::remote {
+namespace {
+
+// The server extracts and never draws: the engine's renderer (which it only warms up) is this.
+class NullRenderer final : public Renderer {
+  public:
+    void resize(int, int) override {}
+    void clear() override {}
+    void clear_depth() override {}
+    void draw(const Mesh&, const glm::mat4&, const glm::mat4&) override {}
+    void read_back(Image& out) override { out = Image{}; }
+    void read_back(Image& out, const PixelRect&) override { out = Image{}; }
+    void finish() override {}
+    std::string_view name() const override { return "none"; }
+};
+
+// The pixel whose centre sees `p` (object space), if it is on the screen.
+std::optional<glm::ivec2> pixel_of(const FrameView& v, glm::vec3 p) {
+    const glm::vec4 clip = v.frustum.matrix() * v.camera.view() * glm::vec4(p, 1.0f);
+    if (!(clip.w > 0)) return std::nullopt;
+    const float x = (clip.x / clip.w * 0.5f + 0.5f) * float(v.width);
+    const float y = (0.5f - clip.y / clip.w * 0.5f) * float(v.height);
+    if (!(x >= 0 && y >= 0 && x < float(v.width) && y < float(v.height))) return std::nullopt;
+    return glm::ivec2(int(x), int(y));
+}
+
+}  // namespace
+
+// One level of detail: its extractor (own visited cells, shared octree) and what was sent.
+struct ServerSession::Level {
+    int lod = 0;
+    std::unique_ptr<SurfaceExtractor> ex;
+    struct Sent {
+        GroupKey key;
+        std::vector<glm::ivec3> cells;  // the first cell of each unit the group took
+    };
+    std::vector<Sent> sent;  // index = the group's id in this level's frames
+    std::vector<char> named;  // per sent group: named (or sent) in the current request
+};
+
+// Sends each group as it is made, and names cached groups that rays meet.
+class ServerSession::Sink final : public GroupSink {
+  public:
+    Sink(ServerSession& s, Level& lv, const RequestMsg& r, bool keep, RequestFigures& f)
+        : s_(s), lv_(lv), r_(r), keep_(keep), f_(f) {}
+
+    void add(const Group& g) override {
+        GroupMsg m;
+        m.request_id = r_.request_id;
+        m.key = g.key();
+        m.draw_from_next_frame = keep_ && lv_.lod > 0;
+        const std::vector<std::uint8_t> bytes = encode_group(g, s_.options_.encoding);
+        m.encoded.resize(bytes.size());
+        std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
+                       [](std::uint8_t b) { return std::byte{b}; });
+        f_.bytes += s_.send_(m);
+        ++f_.groups;
+        f_.triangles += g.mesh.triangle_count();
+        if (!r_.cached_groups) return;
+        // The engine numbers a frame's groups from first_group_id = sent.size(), one per add().
+        if (g.id != lv_.sent.size())
+            throw std::logic_error("server session: group ids out of step with the cache");
+        lv_.sent.push_back({g.key(), g.cells});
+        lv_.named.push_back(1);
+    }
+
+    bool wants_seen() const override { return r_.cached_groups; }
+
+    void seen(std::uint32_t id) override {
+        if (id >= lv_.named.size() || lv_.named[id]) return;
+        lv_.named[id] = 1;
+        VisibleMsg m;
+        m.request_id = r_.request_id;
+        m.keys.push_back(lv_.sent[id].key);
+        f_.bytes += s_.send_(m);
+        ++f_.named;
+    }
+
+  private:
+    ServerSession& s_;
+    Level& lv_;
+    const RequestMsg& r_;
+    const bool keep_;
+    RequestFigures& f_;
+};
+
+ServerSession::ServerSession(const SurfaceExtractor& prototype, SessionOptions options,
+                             SendMessage send)
+    : prototype_(prototype), options_(std::move(options)), send_(std::move(send)) {
+    options_.lod_levels = std::clamp(options_.lod_levels, 0, kMaxMetaLevel);
+}
+
+ServerSession::~ServerSession() = default;
+
+ServerSession::Level& ServerSession::level(int l) {
+    while (levels_.size() <= static_cast<std::size_t>(l)) {
+        auto lv = std::make_unique<Level>();
+        lv->lod = static_cast<int>(levels_.size());
+        lv->ex = prototype_.share();
+        levels_.push_back(std::move(lv));
+    }
+    return *levels_[static_cast<std::size_t>(l)];
+}
+
+void ServerSession::begin_cached(Level& lv, const RequestMsg& r, bool keep) {
+    lv.ex->begin_frame(r.view.iso, uniform_levels(lv.lod));
+    if (!keep) lv.sent.clear();
+    for (std::size_t i = 0; i < lv.sent.size(); ++i)
+        for (const glm::ivec3 c : lv.sent[i].cells)
+            lv.ex->mark_taken(c, lv.sent[i].key.level, static_cast<std::uint32_t>(i));
+    lv.named.assign(lv.sent.size(), 0);
+}
+
+// Step 2 of a cached isovalue: one ray towards each cached group's seed, coarse levels first.
+void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
+    const FrameView& v = r.view;
+    const glm::mat4 view_inv = glm::inverse(v.camera.view());
+    const glm::vec3 spacing = prototype_.volume().spacing();
+    const int top = r.progressive_lod ? options_.lod_levels : 0;
+    for (int l = top; l >= 0; --l) {
+        Level& lv = level(l);
+        VisibleMsg m;
+        m.request_id = r.request_id;
+        for (const Level::Sent& s : lv.sent) {
+            const float half = 0.5f * float(1 << s.key.level);
+            const auto px = pixel_of(v, (glm::vec3(s.key.seed) + half) * spacing);
+            if (!px) continue;
+            const Ray ray = pixel_ray(view_inv, v.frustum, v.width, v.height, *px);
+            const RayHit hit = lv.ex->cast(ray, IntersectMode::exact);
+            ++f.rays;
+            if (!hit.found || !lv.ex->visited(hit.cell)) continue;
+            const std::uint32_t id = lv.ex->group_of(hit.cell);
+            if (id >= lv.named.size() || lv.named[id]) continue;
+            lv.named[id] = 1;
+            m.keys.push_back(lv.sent[id].key);
+        }
+        if (m.keys.empty()) continue;
+        f.named += m.keys.size();
+        f.bytes += send_(m);
+    }
+}
+
+bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep,
+                               const std::atomic<bool>& stop, RequestFigures& f) {
+    Level& lv = level(l);
+    EngineOptions eo = options_.engine;
+    eo.uniform_level = l;
+    eo.adaptive = false;
+    eo.begin_extractor_frame = false;  // begin_cached began it, with the cached cells taken
+    eo.first_group_id = static_cast<std::uint32_t>(lv.sent.size());
+    eo.trace = nullptr;
+    eo.sample_at_rays.clear();
+    NullRenderer none;
+    ProgressiveEngine engine(*lv.ex, none, eo);
+    Sink sink(*this, lv, r, keep, f);
+    EngineFrame frame(engine, r.view, stop);
+    RegionCursor c = frame.cursor(r.view, r.view.screen());
+    std::size_t limit = SIZE_MAX;
+    if (l > 0) {
+        const double pixels = double(r.view.width) * double(r.view.height);
+        limit = std::max<std::size_t>(1, static_cast<std::size_t>(options_.lod_ray_share * pixels));
+    }
+    const bool ok = frame.cast(r.view, c, sink, limit);
+    f.rays += frame.finish(ok).rays_cast;
+    return ok && !stop.load();
+}
+
+RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& stop) {
+    RequestFigures f;
+    const bool keep = r.cached_groups && cache_valid_ && cache_iso_ == r.view.iso;
+    cache_valid_ = r.cached_groups;
+    cache_iso_ = r.view.iso;
+    if (!keep)
+        for (auto& lv : levels_) lv->sent.clear();
+    const int top = r.progressive_lod ? options_.lod_levels : 0;
+    for (int l = top; l >= 0; --l) begin_cached(level(l), r, keep);
+    if (keep) name_by_seed_rays(r, f);
+    for (int l = top; l >= 0; --l)
+        if (stop.load() || !cast_level(l, r, keep, stop, f)) return f;
+    EndOfFrameMsg end;
+    end.request_id = r.request_id;
+    end.rays = f.rays;
+    end.groups = f.groups;
+    end.triangles = f.triangles;
+    end.bytes = f.bytes + kHeaderBytes + encode_payload(end).size();
+    f.bytes += send_(end);
+    f.completed = true;
+    return f;
+}
+
+std::size_t ServerSession::cached_groups() const {
+    std::size_t n = 0;
+    for (const auto& lv : levels_) n += lv->sent.size();
+    return n;
+}
+
+std::size_t ServerSession::cached_bytes() const {
+    std::size_t n = 0;
+    for (const auto& lv : levels_)
+        for (const Level::Sent& s : lv->sent)
+            n += sizeof(Level::Sent) + s.cells.capacity() * sizeof(glm::ivec3);
+    return n;
+}
+
+}  // namespace isowall::remote

@@ -1,0 +1,94 @@
+#pragma once
+// The extraction side of one client of `isowall serve` (the dissertation's chapter 4), apart from
+// sockets and threads: a request goes in, messages come out through a callback. The server
+// (view_server.h) runs one session per connection on a thread of its own.
+//
+// A request is cast level by level: with progressive LOD (section 4.1.3) first at meta-cells of
+// 4 and then 2 cells per side, each with about lod_ray_share of the view's rays, then at full
+// resolution with a ray for every pixel the volume covers. Every group goes out as it is made.
+//
+// Cached primitives (section 4.1.4). The client keeps every group it receives for the current
+// isovalue; the session keeps, per level, what it sent: each group's key and the cells it took.
+// A request at the same isovalue then
+//   1. begins each level's frame with those cells taken again, under their groups' ids,
+//   2. casts one ray towards each cached group's seed and names (VisibleMsg) the groups those
+//      rays meet first, coarse levels first,
+//   3. casts as usual: a ray that meets a cell of a cached group not named yet names it (the
+//      engine's GroupSink::seen), a ray that meets a new part of the surface makes a new group.
+// So every group is sent once per isovalue, and at full resolution every pixel's ray names or
+// makes the group it sees: the final image is the one without a cache. New coarse groups of a
+// cached isovalue are sent with draw_from_next_frame (the client cannot draw them over the finer
+// groups it already shows). A group cut short by an interrupt is not sent and its cells are not
+// kept, so a later request makes it again.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "common/extract/surface_extractor.h"
+#include "remote/group_codec.h"
+#include "remote/view_protocol.h"
+#include "tile/progressive_engine.h"
+
+namespace isowall::remote {
+
+struct SessionOptions {
+    EngineOptions engine;  // ray order, intersection, propagation; levels are set per level
+    GroupEncoding encoding = GroupEncoding::compact_zstd;
+    int lod_levels = 2;  // coarse levels of progressive LOD before the full resolution
+    // Rays of each coarse level, as a share of the view's pixels (the text: 0.1% - 1%). Whole
+    // levels of the ray order are cast, so a level may take up to about 4x this.
+    double lod_ray_share = 0.0025;
+};
+
+// Sends one message; returns its bytes on the wire. Throws when the connection is gone.
+using SendMessage = std::function<std::size_t(const ViewMessage&)>;
+
+struct RequestFigures {
+    bool completed = false;   // false: stopped by a newer request or a closed connection
+    std::uint64_t rays = 0;   // every level's rays, the seed rays of step 2 included
+    std::uint64_t groups = 0;  // groups sent
+    std::uint64_t named = 0;   // cached groups named visible
+    std::uint64_t triangles = 0;
+    std::uint64_t bytes = 0;  // of every message sent for the request
+};
+
+class ServerSession {
+  public:
+    // `prototype` (the dataset's extractor) must outlive the session; the session's extractors
+    // share its octree (SurfaceExtractor::share).
+    ServerSession(const SurfaceExtractor& prototype, SessionOptions options, SendMessage send);
+    ~ServerSession();
+    ServerSession(const ServerSession&) = delete;
+    ServerSession& operator=(const ServerSession&) = delete;
+
+    // Casts the request's view and sends its groups, then an EndOfFrameMsg (not when stopped).
+    // `stop` is read between rays (a newer request, a closed connection).
+    RequestFigures run(const RequestMsg& request, const std::atomic<bool>& stop);
+
+    // Groups the session holds as sent for the cached isovalue, over every level.
+    std::size_t cached_groups() const;
+    // Bytes the session holds for them (keys and cells): what a connection costs beyond the
+    // extractors' visited cells (1 bit per cell per level).
+    std::size_t cached_bytes() const;
+
+  private:
+    struct Level;
+    class Sink;
+    Level& level(int l);
+    void begin_cached(Level& lv, const RequestMsg& r, bool keep);
+    void name_by_seed_rays(const RequestMsg& r, RequestFigures& f);
+    bool cast_level(int l, const RequestMsg& r, bool drawn, const std::atomic<bool>& stop,
+                    RequestFigures& f);
+
+    const SurfaceExtractor& prototype_;
+    SessionOptions options_;
+    SendMessage send_;
+    std::vector<std::unique_ptr<Level>> levels_;  // index = level of detail (0 = full)
+    bool cache_valid_ = false;
+    double cache_iso_ = 0;
+};
+
+}  // namespace isowall::remote

@@ -1,0 +1,15 @@
+# isowall_remote_view: the extraction server (server_session.cpp: a client's requests, levels of
+# detail and cached groups; view_server.cpp: connections and their threads) and the client
+# (client_frames.cpp: drawing and the timeline; view_client.cpp: its connection).
+add_library(isowall_remote_view
+    ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)
+target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
+target_link_libraries(isowall_remote_view
+    PUBLIC isowall_engine isowall_remote_codec isowall_remote_net PRIVATE isowall_warnings)
+
+# isowall_remote_app: `isowall serve` and `isowall view` (options, datasets, scripts, outputs).
+add_library(isowall_remote_app
+    ${CMAKE_CURRENT_LIST_DIR}/serve_command.cpp ${CMAKE_CURRENT_LIST_DIR}/view_command.cpp)
+target_link_libraries(isowall_remote_app
+    PUBLIC isowall_remote_view isowall_cli isowall_io isowall_wall_spec PRIVATE isowall_warnings)

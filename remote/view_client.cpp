@@ -1,0 +1,79 @@
+#include "remote/view_client.h"
+
+#include "remote/net/endpoint.h"
+#include "remote/net/socket.h"
+
+namespace isowall::remote {
+
+ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(renderer) {
+    Socket s = connect_tcp(h.host, h.port, h.connect_timeout_s);
+    conn_ = std::make_unique<Connection>(std::move(s), host_port(h.host, h.port));
+    HelloMsg hello;
+    hello.dataset = h.dataset;
+    hello.token = h.token;
+    hello.encoding = static_cast<std::uint8_t>(h.encoding);
+    conn_->send(hello);
+    std::optional<ViewMessage> m = conn_->receive(h.connect_timeout_s);
+    if (!m)
+        throw NetError(conn_->peer() + ": no answer to hello within " +
+                       std::to_string(h.connect_timeout_s) + " s");
+    if (const auto* e = std::get_if<ErrorMsg>(&*m)) throw RemoteError(e->code, e->text);
+    const auto* r = std::get_if<ReadyMsg>(&*m);
+    if (!r)
+        throw WireError(std::string("view protocol: expected ready, got ") +
+                        to_string(type_of(*m)) + " message");
+    ready_ = *r;
+}
+
+double ViewClient::now_s() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+void ViewClient::request(const FrameView& view, bool progressive_lod, bool cached_groups) {
+    RequestMsg r;
+    r.request_id = next_id_++;
+    r.view = view;
+    r.progressive_lod = progressive_lod;
+    r.cached_groups = cached_groups;
+    frames_.begin(r, now_s());
+    conn_->send(r);
+    active_ = true;
+}
+
+bool ViewClient::receive_one(double timeout_s) {
+    std::optional<ViewMessage> m = conn_->receive(timeout_s);
+    if (!m) return false;
+    // Its bytes on the wire: a payload that decodes encodes back to exactly its bytes.
+    const std::size_t bytes = kHeaderBytes + encode_payload(*m).size();
+    if (frames_.handle(*m, bytes, now_s())) active_ = false;
+    return true;
+}
+
+const ClientFrameResult& ViewClient::wait_done(double timeout_s) {
+    while (active_)
+        if (!receive_one(timeout_s))
+            throw NetError(conn_->peer() + ": nothing received for " +
+                           std::to_string(timeout_s) + " s while waiting for the end of frame");
+    frames_.measure();
+    return frames_.result();
+}
+
+bool ViewClient::receive_for(double seconds) {
+    const double end = now_s() + seconds;
+    while (active_) {
+        const double left = end - now_s();
+        if (left <= 0) break;
+        receive_one(left);
+    }
+    return !active_;
+}
+
+void ViewClient::close() {
+    try {
+        conn_->send(ByeMsg{});
+    } catch (const NetError&) {
+    }
+    conn_->shutdown();
+}
+
+}  // namespace isowall::remote

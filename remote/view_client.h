@@ -1,0 +1,56 @@
+#pragma once
+// The network side of `isowall view`: one connection to `isowall serve`, its hello, and requests
+// whose messages go to ClientFrames (client_frames.h), which draws them. Used by the program and,
+// in process, by the tests.
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "remote/client_frames.h"
+#include "remote/group_codec.h"
+#include "remote/net/connection.h"
+
+namespace isowall::remote {
+
+struct ClientHello {
+    std::string host = "127.0.0.1";
+    int port = 7878;
+    std::string dataset = "phantom";
+    std::string token;
+    GroupEncoding encoding = GroupEncoding::compact_zstd;
+    double connect_timeout_s = 10;
+};
+
+class ViewClient {
+  public:
+    // Connects, says hello and waits for ready: NetError when the server cannot be reached,
+    // RemoteError when it refuses (the server's text), WireError when it speaks nonsense.
+    ViewClient(Renderer& renderer, const ClientHello& hello);
+    const ReadyMsg& ready() const { return ready_; }
+
+    // Sends a request for `view`; the frame it starts interrupts the one in progress.
+    void request(const FrameView& view, bool progressive_lod, bool cached_groups);
+    // Receives until the current request's end of frame: the frame, measured. Throws NetError
+    // when nothing arrives for `timeout_s`.
+    const ClientFrameResult& wait_done(double timeout_s);
+    // Receives for `seconds` (or until the frame ends); true when it ended.
+    bool receive_for(double seconds);
+    bool frame_active() const { return active_; }
+    ClientFrames& frames() { return frames_; }
+    std::uint64_t bytes_received() const { return conn_->bytes_received(); }
+    // Says bye and closes.
+    void close();
+
+  private:
+    bool receive_one(double timeout_s);
+    double now_s() const;
+
+    ClientFrames frames_;
+    std::unique_ptr<Connection> conn_;
+    ReadyMsg ready_;
+    std::uint64_t next_id_ = 1;
+    bool active_ = false;
+    std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace isowall::remote

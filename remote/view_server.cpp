@@ -1,0 +1,259 @@
+#include "remote/view_server.h"
+
+#include <condition_variable>
+#include <cstdio>
+#include <list>
+#include <optional>
+
+#include "common/core/error.h"
+#include "remote/net/connection.h"
+#include "remote/net/socket.h"
+
+namespace isowall::remote {
+namespace {
+
+// Equal tokens, in time that does not depend on where they differ.
+bool same_token(const std::string& a, const std::string& b) {
+    unsigned diff = a.size() == b.size() ? 0u : 1u;
+    for (std::size_t i = 0; i < b.size(); ++i)
+        diff |= static_cast<unsigned>(static_cast<unsigned char>(i < a.size() ? a[i] : 0) ^
+                                      static_cast<unsigned char>(b[i]));
+    return diff == 0;
+}
+
+// The error code of a broken stream: the framing's and decoders' WireError texts name the field.
+ErrorCode code_of(const WireError& e) {
+    const std::string_view what = e.what();
+    if (what.find("version") != std::string_view::npos) return ErrorCode::unsupported_version;
+    if (what.find("over the limit") != std::string_view::npos) return ErrorCode::too_large;
+    return ErrorCode::malformed;
+}
+
+bool is_loopback(const std::string& address) {
+    return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
+}
+
+}  // namespace
+
+struct ViewServer::Impl {
+    explicit Impl(Listener l) : listener(std::move(l)) {}
+    Listener listener;
+    std::mutex mutex;
+    std::list<std::unique_ptr<Client>> clients;
+};
+
+// One connection: this reader thread, and the worker it starts once the hello is accepted.
+class ViewServer::Client {
+  public:
+    Client(ViewServer& server, Socket s, std::string peer)
+        : server_(server), conn_(std::move(s), peer, server.options_.max_payload_bytes) {
+        thread_ = std::thread([this] { run(); });
+    }
+    ~Client() {
+        conn_.shutdown();
+        if (thread_.joinable()) thread_.join();
+    }
+    bool done() const { return done_.load(); }
+
+  private:
+    void say(const char* fmt, const std::string& a, const std::string& b = {}) const {
+        if (!server_.options_.verbose) return;
+        std::printf(fmt, conn_.peer().c_str(), a.c_str(), b.c_str());
+        std::fflush(stdout);
+    }
+
+    // Sends the error (if the peer still listens) and says it; the caller then closes.
+    void refuse(ErrorCode code, const std::string& text) {
+        say("serve: %s: error: %s%s\n", text);
+        try {
+            conn_.send(make_error(code, text));
+        } catch (const std::exception&) {
+        }
+    }
+
+    const Dataset* hello() {
+        const double timeout = server_.options_.hello_timeout_s;
+        std::optional<ViewMessage> m = conn_.receive(timeout);
+        if (!m) {
+            refuse(ErrorCode::malformed, "no hello within " + std::to_string(timeout) + " s");
+            return nullptr;
+        }
+        const auto* h = std::get_if<HelloMsg>(&*m);
+        if (!h) {
+            refuse(ErrorCode::malformed, std::string("expected hello, got ") +
+                                             to_string(type_of(*m)) + " message");
+            return nullptr;
+        }
+        if (h->protocol_version != kProtocolVersion) {
+            refuse(ErrorCode::unsupported_version,
+                   "hello: protocol_version: " + std::to_string(h->protocol_version) +
+                       " (this server speaks " + std::to_string(kProtocolVersion) + ")");
+            return nullptr;
+        }
+        if (!server_.options_.token.empty() && !same_token(h->token, server_.options_.token)) {
+            refuse(ErrorCode::bad_token, "hello: token: wrong token");
+            return nullptr;
+        }
+        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::compact_zstd)) {
+            refuse(ErrorCode::malformed,
+                   "hello: encoding: unknown group encoding " + std::to_string(h->encoding));
+            return nullptr;
+        }
+        for (const Dataset& d : server_.datasets_)
+            if (d.name == h->dataset) {
+                encoding_ = static_cast<GroupEncoding>(h->encoding);
+                return &d;
+            }
+        refuse(ErrorCode::unknown_dataset, "hello: dataset: no dataset named " + quote(h->dataset));
+        return nullptr;
+    }
+
+    void run() {
+        try {
+            if (const Dataset* d = hello()) serve(*d);
+        } catch (const WireError& e) {
+            refuse(code_of(e), e.what());
+        } catch (const PeerClosed&) {
+        } catch (const std::exception& e) {
+            refuse(ErrorCode::internal, e.what());
+        }
+        stop_worker();
+        conn_.shutdown();
+        --server_.open_;
+        done_ = true;
+    }
+
+    void serve(const Dataset& d) {
+        ReadyMsg ready;
+        ready.bounds = d.volume->bounds();
+        ready.value_min = d.extractor->value_min();
+        ready.value_max = d.extractor->value_max();
+        ready.dims = d.volume->dims();
+        ready.spacing = d.volume->spacing();
+        conn_.send(ready);
+        if (server_.options_.rate_bits_per_s > 0) conn_.set_rate(server_.options_.rate_bits_per_s);
+        say("serve: %s: dataset %s%s\n", d.name);
+        SessionOptions so = server_.options_.session;
+        so.encoding = encoding_;
+        session_ = std::make_unique<ServerSession>(
+            *d.extractor, so, [this](const ViewMessage& m) { return conn_.send(m); });
+        worker_ = std::thread([this] { work(); });
+        for (;;) {
+            std::optional<ViewMessage> m = conn_.receive(0.5);
+            if (!m) continue;
+            if (std::holds_alternative<ByeMsg>(*m)) return;
+            const auto* r = std::get_if<RequestMsg>(&*m);
+            if (!r) {
+                refuse(ErrorCode::malformed, std::string("unexpected ") + to_string(type_of(*m)) +
+                                                 " message from a client");
+                return;
+            }
+            std::lock_guard lock(mutex_);
+            pending_ = *r;
+            stop_frame_ = true;  // under the lock: the worker resets it only when it takes pending_
+            wake_.notify_one();
+        }
+    }
+
+    void work() {
+        for (;;) {
+            RequestMsg r;
+            {
+                std::unique_lock lock(mutex_);
+                wake_.wait(lock, [this] { return pending_ || closing_; });
+                if (closing_) return;
+                r = *pending_;
+                pending_.reset();
+                stop_frame_ = false;
+            }
+            try {
+                const RequestFigures f = session_->run(r, stop_frame_);
+                if (server_.options_.verbose)
+                    std::printf("serve: %s: request %llu %s: %llu groups, %llu named, %llu "
+                                "triangles, %llu bytes\n",
+                                conn_.peer().c_str(), static_cast<unsigned long long>(r.request_id),
+                                f.completed ? "done" : "interrupted",
+                                static_cast<unsigned long long>(f.groups),
+                                static_cast<unsigned long long>(f.named),
+                                static_cast<unsigned long long>(f.triangles),
+                                static_cast<unsigned long long>(f.bytes));
+            } catch (const NetError&) {
+                conn_.shutdown();  // the reader then ends the connection
+                return;
+            } catch (const std::exception& e) {
+                refuse(ErrorCode::internal, e.what());
+                conn_.shutdown();
+                return;
+            }
+        }
+    }
+
+    void stop_worker() {
+        {
+            std::lock_guard lock(mutex_);
+            closing_ = true;
+            stop_frame_ = true;
+            wake_.notify_one();
+        }
+        if (worker_.joinable()) worker_.join();
+    }
+
+    ViewServer& server_;
+    remote::Connection conn_;
+    GroupEncoding encoding_ = GroupEncoding::compact_zstd;
+    std::unique_ptr<ServerSession> session_;
+    std::thread thread_, worker_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::optional<RequestMsg> pending_;
+    bool closing_ = false;
+    std::atomic<bool> stop_frame_{false};
+    std::atomic<bool> done_{false};
+};
+
+ViewServer::ViewServer(std::vector<Dataset> datasets, ServerOptions options)
+    : datasets_(std::move(datasets)), options_(std::move(options)) {
+    if (options_.token.empty() && !is_loopback(options_.address))
+        throw InputError("--listen", "address",
+                         "listening on " + options_.address +
+                             " (not loopback) needs --token, which every client must present");
+    impl_ = std::make_unique<Impl>(Listener::open(options_.address, options_.port));
+}
+
+ViewServer::~ViewServer() {
+    reap(true);
+}
+
+int ViewServer::port() const {
+    return impl_->listener.port();
+}
+
+void ViewServer::reap(bool all) {
+    std::lock_guard lock(impl_->mutex);
+    impl_->clients.remove_if([all](const std::unique_ptr<Client>& c) { return all || c->done(); });
+}
+
+void ViewServer::serve(const std::atomic<bool>& stop) {
+    while (!stop.load()) {
+        std::string peer;
+        std::optional<Socket> s = impl_->listener.accept(0.1, &peer);
+        reap(false);
+        if (!s) continue;
+        ++accepted_;
+        if (open_.load() >= options_.max_clients) {
+            remote::Connection busy(std::move(*s), peer);
+            try {
+                busy.send(make_error(ErrorCode::internal,
+                                     "server busy: " + std::to_string(options_.max_clients) +
+                                         " clients connected (--max-clients)"));
+            } catch (const std::exception&) {
+            }
+            continue;
+        }
+        ++open_;  // here, not in the thread: the next accept already counts it
+        std::lock_guard lock(impl_->mutex);
+        impl_->clients.push_back(std::make_unique<Client>(*this, std::move(*s), peer));
+    }
+}
+
+}  // namespace isowall::remote

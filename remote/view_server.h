@@ -1,0 +1,75 @@
+#pragma once
+// `isowall serve`: the extraction server of remote viewing (the dissertation's chapter 4). It
+// listens on TCP, and each connection gets two threads: a reader, which checks every message and
+// raises the stop flag when a new request arrives (Figure 4.3: a request interrupts the current
+// one at once), and a worker, which runs the connection's ServerSession on the latest request.
+//
+// A connection begins with a hello within hello_timeout_s: protocol version, dataset, token
+// (when the server has one; compared in constant time), group encoding; the server answers
+// ready, or an error naming what was wrong and closes. Any message that does not decode, a
+// frame over the payload limit, another version, or a message a client may not send gets an
+// error and a closed connection; other connections go on.
+//
+// Memory per connection: the reader's frame buffer (a header and at most max_payload_bytes,
+// which a client's messages never need: a request is under 200 bytes), one visited-cell bitset
+// per level of detail in use (1 bit per cell: 1.7 MiB for a 256 x 256 x 209 volume) with a hash
+// of the visited cells' group ids, and with caching, each sent group's key and cells (12 bytes a
+// cell). The octree is shared by every connection.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/extract/surface_extractor.h"
+#include "remote/server_session.h"
+
+namespace isowall::remote {
+
+struct Dataset {
+    std::string name;  // what a hello names
+    std::unique_ptr<Volume> volume;
+    std::unique_ptr<SurfaceExtractor> extractor;  // the prototype each session shares
+};
+
+struct ServerOptions {
+    std::string address = "127.0.0.1";
+    int port = 7878;  // 0: any free port (see ViewServer::port)
+    std::string token;  // empty: none asked for (only allowed on a loopback address)
+    double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
+    int max_clients = 8;
+    double hello_timeout_s = 10;
+    std::uint32_t max_payload_bytes = 1 << 16;  // what a client's message may be
+    SessionOptions session;                     // the encoding comes from each hello
+    bool verbose = true;                        // a line per connection and request
+};
+
+class ViewServer {
+  public:
+    // Opens the listening socket at once (an address in use fails here).
+    ViewServer(std::vector<Dataset> datasets, ServerOptions options);
+    ~ViewServer();  // stops and joins every connection
+    ViewServer(const ViewServer&) = delete;
+    ViewServer& operator=(const ViewServer&) = delete;
+
+    int port() const;
+    // Accepts connections until `stop` reads true (checked every 100 ms).
+    void serve(const std::atomic<bool>& stop);
+    // Connections accepted so far, and those open now.
+    int accepted() const { return accepted_.load(); }
+    int open_connections() const { return open_.load(); }
+
+  private:
+    class Client;
+    void reap(bool all);
+
+    std::vector<Dataset> datasets_;
+    ServerOptions options_;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    std::atomic<int> accepted_{0}, open_{0};
+};
+
+}  // namespace isowall::remote
