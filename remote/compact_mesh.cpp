@@ -53,10 +53,28 @@ Reordered reorder(const Mesh& mesh) {
     return out;
 }
 
-void put_positions(ByteWriter& w, const Mesh& mesh, const std::vector<std::uint32_t>& old_of_new) {
+// The box on the grid of `step`: its min a multiple of step, its max 65535 steps on, so a decoder's
+// step, (max - min) / 65535 in double, is `step` exactly and every position decodes to a multiple
+// of it. False when the mesh does not fit (or step is 0): the mesh's own box is used then.
+bool grid_box(const Box3& tight, float step, Box3& out) {
+    if (!(step > 0)) return false;
+    for (int a = 0; a < 3; ++a) {
+        const double lo = std::floor(double{tight.min[a]} / step) * step;
+        const double hi = lo + double{kQuantMax} * step;
+        if (!(double{tight.max[a]} <= hi - step) || float(lo) != lo || float(hi) != hi)
+            return false;
+        out.min[a] = float(lo);
+        out.max[a] = float(hi);
+    }
+    return true;
+}
+
+void put_positions(ByteWriter& w, const Mesh& mesh, const std::vector<std::uint32_t>& old_of_new,
+                   float grid_step) {
     Box3 box;
     for (std::uint32_t o : old_of_new) box.merge(mesh.positions[o]);
     if (old_of_new.empty()) box = Box3{glm::vec3(0), glm::vec3(0)};
+    if (Box3 on_grid; !old_of_new.empty() && grid_box(box, grid_step, on_grid)) box = on_grid;
     w.put_raw(std::span<const float>(&box.min.x, 3));
     w.put_raw(std::span<const float>(&box.max.x, 3));
     const glm::vec3 extent = box.max - box.min;
@@ -145,11 +163,11 @@ glm::vec3 oct_decode(std::array<std::int16_t, 2> code) {
     return glm::normalize(n);  // |n| >= 1/sqrt(3): never a division by zero
 }
 
-void put_compact_mesh(ByteWriter& w, const Mesh& mesh) {
+void put_compact_mesh(ByteWriter& w, const Mesh& mesh, float grid_step) {
     const Reordered ro = reorder(mesh);
     w.put(static_cast<std::uint32_t>(ro.old_of_new.size()));
     w.put(static_cast<std::uint32_t>(mesh.triangle_count()));
-    put_positions(w, mesh, ro.old_of_new);
+    put_positions(w, mesh, ro.old_of_new, grid_step);
     std::vector<std::int16_t> normals(2 * ro.old_of_new.size());
     for (std::size_t i = 0; i < ro.old_of_new.size(); ++i) {
         const auto c = oct_encode(mesh.normals[ro.old_of_new[i]]);

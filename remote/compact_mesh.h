@@ -22,7 +22,8 @@ std::array<std::int16_t, 2> oct_encode(glm::vec3 n);
 // Always finite and unit, for any code.
 glm::vec3 oct_decode(std::array<std::int16_t, 2> code);
 
-void put_compact_mesh(ByteWriter& w, const Mesh& mesh);
+// grid_step > 0: positions on one grid of that step (see encode_group), else in the mesh's own box.
+void put_compact_mesh(ByteWriter& w, const Mesh& mesh, float grid_step = 0);
 Mesh get_compact_mesh(ByteReader& r);
 
 }  // namespace isowall::remote

@@ -186,10 +186,16 @@ const char* to_string(GroupEncoding e) {
     return "unknown";
 }
 
-std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding) {
+float position_grid_step(float extent) {
+    if (!(extent > 0) || !std::isfinite(extent)) return 0;
+    return std::exp2(std::ceil(std::log2(double{extent} / 65534.0)));
+}
+
+std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
+                                       float grid_step) {
     check_encodable(group);
     if (encoding == GroupEncoding::compact_zstd) {
-        const auto compact = encode_group(group, GroupEncoding::compact);
+        const auto compact = encode_group(group, GroupEncoding::compact, grid_step);
         ByteWriter w;
         w.put(kGroupCodecVersion);
         w.put(static_cast<std::uint8_t>(encoding));
@@ -208,7 +214,7 @@ std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encodin
             put_indexed(w, group.mesh);
             break;
         default:
-            put_compact_mesh(w, group.mesh);
+            put_compact_mesh(w, group.mesh, grid_step);
             break;
     }
     return w.take();

@@ -65,7 +65,16 @@ inline constexpr std::uint64_t kMaxZstdExpansion = 64;
 // over every code direction in tests/remote_codec_test.cpp, with margin).
 inline constexpr double kOctNormalMaxErrorDeg = 0.01;
 
-std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding);
+// grid_step (compact encodings): 0 quantises each group in its own box, so a vertex two groups
+// share may decode to two points a quantum apart, and a pixel may see through the crack between
+// them. A step > 0 (a power of two, at least the whole volume's extent / 65534, see
+// position_grid_step) puts every group's positions on one grid: a shared vertex decodes alike in
+// every group, and no crack opens. A group too large for 65535 steps falls back to its own box.
+std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
+                                       float grid_step = 0);
+// The smallest power of two at least `extent` / 65534: the grid step for a volume of that largest
+// extent (object units).
+float position_grid_step(float extent);
 // Throws WireError on anything malformed, truncated, of another version, or with trailing bytes.
 Group decode_group(std::span<const std::uint8_t> bytes);
 // The encoding named by encoded bytes (their second byte), checked.

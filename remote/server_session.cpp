@@ -60,7 +60,7 @@ class ServerSession::Sink final : public GroupSink {
         m.request_id = r_.request_id;
         m.key = g.key();
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
-        const std::vector<std::uint8_t> bytes = encode_group(g, s_.options_.encoding);
+        const std::vector<std::uint8_t> bytes = encode_group(g, s_.options_.encoding, s_.grid_step_);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
@@ -99,6 +99,9 @@ ServerSession::ServerSession(const SurfaceExtractor& prototype, SessionOptions o
                              SendMessage send)
     : prototype_(prototype), options_(std::move(options)), send_(std::move(send)) {
     options_.lod_levels = std::clamp(options_.lod_levels, 0, kMaxMetaLevel);
+    const Box3 b = prototype.volume().bounds();
+    const glm::vec3 far = glm::max(glm::abs(b.min), glm::abs(b.max));
+    grid_step_ = position_grid_step(2 * std::max({far.x, far.y, far.z}));
 }
 
 ServerSession::~ServerSession() = default;

@@ -89,6 +89,7 @@ class ServerSession {
     std::vector<std::unique_ptr<Level>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;
+    float grid_step_ = 0;  // compact encodings: one position grid for every group (no cracks)
 };
 
 }  // namespace isowall::remote
