@@ -90,8 +90,9 @@ bool ClientFrames::handle(const ViewMessage& m, std::size_t wire_bytes, double n
         for (const GroupKey& k : v->keys) {
             const auto it = cache_.find(k);
             if (it == cache_.end())
-                throw WireError("visible message: keys: the server named a group the client "
-                                "does not hold");
+                throw WireError(
+                    "visible message: keys: the server named a group the client "
+                    "does not hold");
             ++now_.named;
             draw(it->second.mesh, it->second.level);
         }

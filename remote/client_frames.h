@@ -15,9 +15,9 @@
 // The cache holds the groups of one isovalue, as decoded meshes, and is dropped when a request
 // asks for another isovalue or for no caching.
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
-#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -29,10 +29,10 @@
 namespace isowall::remote {
 
 struct ClientSample {
-    double time_s = 0;         // since the request was sent
-    std::uint64_t bytes = 0;   // received for this request, headers included
-    std::uint64_t groups = 0;  // received (new groups) for this request
-    std::uint64_t named = 0;   // cached groups named visible
+    double time_s = 0;            // since the request was sent
+    std::uint64_t bytes = 0;      // received for this request, headers included
+    std::uint64_t groups = 0;     // received (new groups) for this request
+    std::uint64_t named = 0;      // cached groups named visible
     std::uint64_t triangles = 0;  // drawn
     std::size_t ops = 0;          // draw steps done by then (for the replay)
     Correctness correctness;      // against the final image; filled by measure()

@@ -40,13 +40,13 @@ remote::Dataset load_dataset(const std::string& name, const std::string& path,
 
 CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
     auto* c = app.add_subcommand(
-        "serve", "Extraction server for remote viewing: streams the groups of each view a client "
-                 "asks for (see isowall view)");
+        "serve",
+        "Extraction server for remote viewing: streams the groups of each view a client "
+        "asks for (see isowall view)");
     c->add_option("--dataset", o.datasets,
                   "Offer a volume as NAME=PATH (NRRD); repeat for more. The phantom is always "
                   "offered as 'phantom'");
-    c->add_option("--listen", o.listen,
-                  "Address to listen on; anything but loopback needs --token")
+    c->add_option("--listen", o.listen, "Address to listen on; anything but loopback needs --token")
         ->capture_default_str();
     c->add_option("--port", o.port, "TCP port (0: any free port, printed)")
         ->check(CLI::Range(0, 65535))
@@ -94,10 +94,10 @@ int run_serve(const ServeCommand& o) {
     remote::ViewServer server(std::move(datasets), so);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
-    std::printf("serve: listening on %s:%d%s%s\n", o.listen.c_str(), server.port(),
-                o.token.empty() ? "" : " (token required)",
-                o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str()
-                                : "");
+    std::printf(
+        "serve: listening on %s:%d%s%s\n", o.listen.c_str(), server.port(),
+        o.token.empty() ? "" : " (token required)",
+        o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
     std::fflush(stdout);
     server.serve(g_stop);
     std::printf("serve: stopped after %d connection(s)\n", server.accepted());

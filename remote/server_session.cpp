@@ -45,7 +45,7 @@ struct ServerSession::Level {
         GroupKey key;
         std::vector<glm::ivec3> cells;  // the first cell of each unit the group took
     };
-    std::vector<Sent> sent;  // index = the group's id in this level's frames
+    std::vector<Sent> sent;   // index = the group's id in this level's frames
     std::vector<char> named;  // per sent group: named (or sent) in the current request
 };
 
@@ -60,7 +60,8 @@ class ServerSession::Sink final : public GroupSink {
         m.request_id = r_.request_id;
         m.key = g.key();
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
-        const std::vector<std::uint8_t> bytes = encode_group(g, s_.options_.encoding, s_.grid_step_);
+        const std::vector<std::uint8_t> bytes =
+            encode_group(g, s_.options_.encoding, s_.grid_step_);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
@@ -154,8 +155,8 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
     }
 }
 
-bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep,
-                               const std::atomic<bool>& stop, RequestFigures& f) {
+bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std::atomic<bool>& stop,
+                               RequestFigures& f) {
     Level& lv = level(l);
     EngineOptions eo = options_.engine;
     eo.uniform_level = l;

@@ -47,8 +47,8 @@ struct SessionOptions {
 using SendMessage = std::function<std::size_t(const ViewMessage&)>;
 
 struct RequestFigures {
-    bool completed = false;   // false: stopped by a newer request or a closed connection
-    std::uint64_t rays = 0;   // every level's rays, the seed rays of step 2 included
+    bool completed = false;    // false: stopped by a newer request or a closed connection
+    std::uint64_t rays = 0;    // every level's rays, the seed rays of step 2 included
     std::uint64_t groups = 0;  // groups sent
     std::uint64_t named = 0;   // cached groups named visible
     std::uint64_t triangles = 0;

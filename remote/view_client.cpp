@@ -52,8 +52,8 @@ bool ViewClient::receive_one(double timeout_s) {
 const ClientFrameResult& ViewClient::wait_done(double timeout_s) {
     while (active_)
         if (!receive_one(timeout_s))
-            throw NetError(conn_->peer() + ": nothing received for " +
-                           std::to_string(timeout_s) + " s while waiting for the end of frame");
+            throw NetError(conn_->peer() + ": nothing received for " + std::to_string(timeout_s) +
+                           " s while waiting for the end of frame");
     frames_.measure();
     return frames_.result();
 }

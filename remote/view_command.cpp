@@ -64,11 +64,11 @@ struct Viewer {
     void report(const ClientFrameResult& r) {
         ++frames;
         const ClientSample& last = r.timeline.back();
-        std::printf("view: frame %d done in %.3f s: %llu bytes, %llu groups, %llu named, %llu "
-                    "triangles drawn\n",
-                    frames, last.time_s, (unsigned long long)last.bytes,
-                    (unsigned long long)last.groups, (unsigned long long)last.named,
-                    (unsigned long long)last.triangles);
+        std::printf(
+            "view: frame %d done in %.3f s: %llu bytes, %llu groups, %llu named, %llu "
+            "triangles drawn\n",
+            frames, last.time_s, (unsigned long long)last.bytes, (unsigned long long)last.groups,
+            (unsigned long long)last.named, (unsigned long long)last.triangles);
         for (double th : {0.90, 0.99, 0.999, 1.0}) {
             const ClientSample* hit = nullptr;
             for (const ClientSample& s : r.timeline)
@@ -147,8 +147,9 @@ struct Viewer {
 
 CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     auto* c = app.add_subcommand(
-        "view", "Remote-viewing client: asks isowall serve for views and draws their groups as "
-                "they arrive");
+        "view",
+        "Remote-viewing client: asks isowall serve for views and draws their groups as "
+        "they arrive");
     c->add_option("--connect", o.connect, "Server as HOST:PORT")->capture_default_str();
     c->add_option("--dataset", o.dataset, "Dataset name the server offers")->capture_default_str();
     c->add_option("--token", o.token, "The server's token, if it asks for one");
@@ -190,9 +191,9 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
 int run_view(const ViewCommand& o) {
     const auto size = parse_size(o.size);
     if (!size)
-        throw InputError("--size", "value",
-                         "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " +
-                             quote(o.size));
+        throw InputError(
+            "--size", "value",
+            "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
     std::vector<OutputPath> outputs{{"--out", o.out}};
     if (!o.timeline.empty()) outputs.push_back({"--timeline", o.timeline});
     check_outputs(outputs);
@@ -212,10 +213,10 @@ int run_view(const ViewCommand& o) {
     hello.token = o.token;
     hello.encoding = setting.encoding;
     ViewClient client(*renderer, hello);
-    std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n",
-                o.connect.c_str(), o.dataset.c_str(), client.ready().value_min,
-                client.ready().value_max, to_string(setting.encoding),
-                setting.lod ? ", progressive LOD" : "", setting.cache ? ", cached groups" : "");
+    std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
+                o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
+                to_string(setting.encoding), setting.lod ? ", progressive LOD" : "",
+                setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
     const float aspect = float(size->x) / float(size->y);
     v.camera = front_full_view(client.ready().bounds, aspect);
@@ -224,8 +225,8 @@ int run_view(const ViewCommand& o) {
     if (std::string p = camera_problem(v.camera); !p.empty())
         throw InputError("--zoom", "value", p);
     if (!o.iso && o.dataset != "phantom")
-        throw InputError("--iso", "value", "an isovalue is required for dataset " +
-                                               quote(o.dataset));
+        throw InputError("--iso", "value",
+                         "an isovalue is required for dataset " + quote(o.dataset));
     v.iso = o.iso.value_or(50.0);
     v.check_iso(v.iso, "--iso", "value");
     v.send();

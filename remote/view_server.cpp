@@ -1,9 +1,13 @@
 #include "remote/view_server.h"
 
+#include <array>
+#include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <list>
 #include <optional>
+
+#include <sys/socket.h>
 
 #include "common/core/error.h"
 #include "remote/net/connection.h"
@@ -80,8 +84,8 @@ class ViewServer::Client {
         }
         const auto* h = std::get_if<HelloMsg>(&*m);
         if (!h) {
-            refuse(ErrorCode::malformed, std::string("expected hello, got ") +
-                                             to_string(type_of(*m)) + " message");
+            refuse(ErrorCode::malformed,
+                   std::string("expected hello, got ") + to_string(type_of(*m)) + " message");
             return nullptr;
         }
         if (h->protocol_version != kProtocolVersion) {
@@ -113,12 +117,15 @@ class ViewServer::Client {
             if (const Dataset* d = hello()) serve(*d);
         } catch (const WireError& e) {
             refuse(code_of(e), e.what());
-        } catch (const PeerClosed&) {
+        } catch (const PeerClosed& e) {
+            // A client that stops sending inside a message may still read the reply.
+            if (std::string_view(e.what()).find("inside a message") != std::string_view::npos)
+                refuse(ErrorCode::malformed, e.what());
         } catch (const std::exception& e) {
             refuse(ErrorCode::internal, e.what());
         }
         stop_worker();
-        conn_.shutdown();
+        close_gracefully();
         --server_.open_;
         done_ = true;
     }
@@ -169,14 +176,15 @@ class ViewServer::Client {
             try {
                 const RequestFigures f = session_->run(r, stop_frame_);
                 if (server_.options_.verbose)
-                    std::printf("serve: %s: request %llu %s: %llu groups, %llu named, %llu "
-                                "triangles, %llu bytes\n",
-                                conn_.peer().c_str(), static_cast<unsigned long long>(r.request_id),
-                                f.completed ? "done" : "interrupted",
-                                static_cast<unsigned long long>(f.groups),
-                                static_cast<unsigned long long>(f.named),
-                                static_cast<unsigned long long>(f.triangles),
-                                static_cast<unsigned long long>(f.bytes));
+                    std::printf(
+                        "serve: %s: request %llu %s: %llu groups, %llu named, %llu "
+                        "triangles, %llu bytes\n",
+                        conn_.peer().c_str(), static_cast<unsigned long long>(r.request_id),
+                        f.completed ? "done" : "interrupted",
+                        static_cast<unsigned long long>(f.groups),
+                        static_cast<unsigned long long>(f.named),
+                        static_cast<unsigned long long>(f.triangles),
+                        static_cast<unsigned long long>(f.bytes));
             } catch (const NetError&) {
                 conn_.shutdown();  // the reader then ends the connection
                 return;
@@ -186,6 +194,25 @@ class ViewServer::Client {
                 return;
             }
         }
+    }
+
+    // Ends the sending side, then reads what the client still sends for a moment: closing with
+    // unread bytes would reset the connection, and the reset can discard the error just sent.
+    void close_gracefully() {
+        ::shutdown(conn_.socket().fd(), SHUT_WR);
+        std::array<std::byte, 4096> buf;
+        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+        try {
+            for (std::size_t total = 0; total < (std::size_t{1} << 20);) {
+                const double left =
+                    std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
+                std::size_t got = 0;
+                if (left <= 0 || !recv_some(conn_.socket(), buf, left, got, conn_.peer())) break;
+                total += got;
+            }
+        } catch (const std::exception&) {  // EOF or reset: the client is gone, as it should be
+        }
+        conn_.shutdown();
     }
 
     void stop_worker() {

@@ -36,8 +36,8 @@ struct Dataset {
 
 struct ServerOptions {
     std::string address = "127.0.0.1";
-    int port = 7878;  // 0: any free port (see ViewServer::port)
-    std::string token;  // empty: none asked for (only allowed on a loopback address)
+    int port = 7878;             // 0: any free port (see ViewServer::port)
+    std::string token;           // empty: none asked for (only allowed on a loopback address)
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
     int max_clients = 8;
     double hello_timeout_s = 10;
