@@ -278,15 +278,7 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
 }
 
 bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where) {
-    if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
-        camera_ = orbit(camera_, c->yaw_deg, c->pitch_deg);
-    } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
-        camera_.eye = c->eye;
-        camera_.target = c->target;
-    } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
-        camera_ = zoom(camera_, c->factor);
-    } else if (const auto* c = std::get_if<PanCmd>(&cmd)) {
-        camera_ = pan(camera_, c->dx, c->dy, aspect_);
+    if (apply_camera_command(cmd, camera_, aspect_)) {
     } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
         if (!(c->iso >= lo_ && c->iso <= hi_)) {
             char msg[160];

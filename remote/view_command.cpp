@@ -97,15 +97,7 @@ struct Viewer {
 
     // One script command; false for quit.
     bool execute(const ScriptCommand& cmd, const std::string& where) {
-        if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
-            camera = orbit(camera, c->yaw_deg, c->pitch_deg);
-        } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
-            camera.eye = c->eye;
-            camera.target = c->target;
-        } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
-            camera = zoom(camera, c->factor);
-        } else if (const auto* c = std::get_if<PanCmd>(&cmd)) {
-            camera = pan(camera, c->dx, c->dy, float(size.x) / float(size.y));
+        if (apply_camera_command(cmd, camera, float(size.x) / float(size.y))) {
         } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
             check_iso(c->iso, where, "iso");
             iso = c->iso;

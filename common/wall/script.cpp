@@ -122,3 +122,23 @@ std::vector<ScriptLine> load_script(const std::filesystem::path& path) {
 }
 
 }  // namespace isowall
+
+namespace isowall {
+
+bool apply_camera_command(const ScriptCommand& cmd, Camera& camera, float aspect) {
+    if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
+        camera = orbit(camera, c->yaw_deg, c->pitch_deg);
+    } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
+        camera.eye = c->eye;
+        camera.target = c->target;
+    } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
+        camera = zoom(camera, c->factor);
+    } else if (const auto* c = std::get_if<PanCmd>(&cmd)) {
+        camera = pan(camera, c->dx, c->dy, aspect);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+}  // namespace isowall

@@ -19,6 +19,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "common/core/camera.h"
+
 namespace isowall {
 
 struct OrbitCmd {
@@ -55,6 +57,9 @@ struct ScriptLine {
 
 // One command; throws InputError naming `where` (e.g. "demo.txt:3") and the command.
 ScriptCommand parse_command(std::string_view text, const std::string& where);
+// Moves `camera` as an orbit, look, zoom or pan command says (pan in screen sizes of `aspect`);
+// false, camera untouched, for any other command. The wall and the remote client share it.
+bool apply_camera_command(const ScriptCommand& cmd, Camera& camera, float aspect);
 // A whole script; blank and comment lines are skipped.
 std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file);
 // The script in `path` (a regular file of at most kMaxScriptBytes); errors name the file and
