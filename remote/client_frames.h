@@ -63,8 +63,6 @@ class ClientFrames {
     // What is on screen now.
     void read_back(Image& out) { renderer_.read_back(out); }
 
-    std::size_t cached_groups() const { return cache_.size(); }
-
   private:
     struct Cached {
         std::shared_ptr<const Mesh> mesh;

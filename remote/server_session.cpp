@@ -203,18 +203,4 @@ RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& 
     return f;
 }
 
-std::size_t ServerSession::cached_groups() const {
-    std::size_t n = 0;
-    for (const auto& lv : levels_) n += lv->sent.size();
-    return n;
-}
-
-std::size_t ServerSession::cached_bytes() const {
-    std::size_t n = 0;
-    for (const auto& lv : levels_)
-        for (const Level::Sent& s : lv->sent)
-            n += sizeof(Level::Sent) + s.cells.capacity() * sizeof(glm::ivec3);
-    return n;
-}
-
 }  // namespace isowall::remote

@@ -24,7 +24,6 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "common/extract/surface_extractor.h"
@@ -67,12 +66,6 @@ class ServerSession {
     // Casts the request's view and sends its groups, then an EndOfFrameMsg (not when stopped).
     // `stop` is read between rays (a newer request, a closed connection).
     RequestFigures run(const RequestMsg& request, const std::atomic<bool>& stop);
-
-    // Groups the session holds as sent for the cached isovalue, over every level.
-    std::size_t cached_groups() const;
-    // Bytes the session holds for them (keys and cells): what a connection costs beyond the
-    // extractors' visited cells (1 bit per cell per level).
-    std::size_t cached_bytes() const;
 
   private:
     struct Level;
