@@ -131,12 +131,17 @@ void ClientFrames::measure() {
     renderer_.clear();
     std::size_t done = 0;
     Image image;
+    // Pixels drawn before a depth clear: their colour stays on screen, so they count as drawn.
+    std::vector<std::uint8_t> drawn;
     for (ClientSample& s : result_.timeline) {
         for (; done < s.ops; ++done) {
             const Op& op = ops_[done];
             if (done == redraw_op_) {
                 renderer_.clear();
+                drawn.clear();
             } else if (!op.mesh) {
+                renderer_.read_back(image);
+                mark_drawn(image, drawn);
                 renderer_.clear_depth();
             } else {
                 renderer_.draw(*op.mesh, request_.view.camera.view(),
@@ -144,7 +149,7 @@ void ClientFrames::measure() {
             }
         }
         renderer_.read_back(image);
-        s.correctness = measure_correctness(image, result_.final_image);
+        s.correctness = measure_correctness(image, result_.final_image, 1, drawn);
     }
 }
 

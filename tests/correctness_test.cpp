@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "common/progressive/correctness.h"
 
@@ -155,6 +156,37 @@ TEST(Correctness, SizeMismatchThrowsNamingBothSizes) {
         EXPECT_NE(what.find("3x4"), std::string::npos) << what;
     }
     EXPECT_THROW(measure_correctness(background(0, 0), background(1, 1)), std::invalid_argument);
+}
+
+TEST(Correctness, PixelsDrawnBeforeADepthClearCountAsDrawn) {
+    // A coarse level drew (0,0) and (1,0) in a colour near the final one; then the client cleared
+    // depth to go finer, so their depth reads 1 but their colour is still on screen.
+    Image final_image = background(3, 1);
+    for (int x = 0; x < 3; ++x) draw(final_image, x, 0, 100, 100, 100);
+    Image coarse = background(3, 1);
+    draw(coarse, 0, 0, 110, 110, 110);
+    draw(coarse, 1, 0, 100, 100, 100);
+    std::vector<std::uint8_t> drawn;
+    mark_drawn(coarse, drawn);
+    EXPECT_EQ(drawn, (std::vector<std::uint8_t>{1, 1, 0}));
+    Image after_clear = coarse;
+    for (float& d : after_clear.depth) d = 1.0f;
+
+    // Without the mask, both coarse pixels would count as not drawn (e = 1).
+    EXPECT_NEAR(measure_correctness(after_clear, final_image).c, 0.0, 1e-12);
+    const Correctness m = measure_correctness(after_clear, final_image, 1, drawn);
+    // e^2: (10/255)^2 for (0,0), 0 for (1,0), 1 for (2,0) which nothing drew yet.
+    const double d = 10.0 / 255.0;
+    EXPECT_NEAR(m.c, 1.0 - std::sqrt((d * d + 0 + 1) / 3), 1e-12);
+    EXPECT_DOUBLE_EQ(m.final_pixels, 1.0 / 3);
+
+    // Marks accumulate: a later frame adds pixels and keeps the earlier ones.
+    Image later = background(3, 1);
+    draw(later, 2, 0, 1, 1, 1);
+    mark_drawn(later, drawn);
+    EXPECT_EQ(drawn, (std::vector<std::uint8_t>{1, 1, 1}));
+    EXPECT_THROW(measure_correctness(after_clear, final_image, 1, std::vector<std::uint8_t>(2)),
+                 std::invalid_argument);
 }
 
 TEST(Correctness, MalformedBuffersThrow) {

@@ -24,14 +24,18 @@ void check_buffers(const Image& image, const char* name) {
 
 }  // namespace
 
-Correctness measure_correctness(const Image& intermediate, const Image& final_image,
-                                int tolerance) {
+Correctness measure_correctness(const Image& intermediate, const Image& final_image, int tolerance,
+                                std::span<const std::uint8_t> drawn_before) {
     if (intermediate.width != final_image.width || intermediate.height != final_image.height)
         throw std::invalid_argument("measure_correctness: intermediate image is " +
                                     size_text(intermediate) + " but final image is " +
                                     size_text(final_image));
     check_buffers(intermediate, "intermediate");
     check_buffers(final_image, "final");
+    if (!drawn_before.empty() && drawn_before.size() != final_image.pixel_count())
+        throw std::invalid_argument("measure_correctness: drawn_before has " +
+                                    std::to_string(drawn_before.size()) + " entries for " +
+                                    size_text(final_image) + " pixels");
 
     std::size_t significant = 0;
     std::size_t matching = 0;
@@ -39,7 +43,9 @@ Correctness measure_correctness(const Image& intermediate, const Image& final_im
     for (std::size_t p = 0; p < final_image.pixel_count(); ++p) {
         if (!(final_image.depth[p] < 1.0f)) continue;
         ++significant;
-        if (!(intermediate.depth[p] < 1.0f)) {
+        const bool drawn =
+            intermediate.depth[p] < 1.0f || (!drawn_before.empty() && drawn_before[p]);
+        if (!drawn) {
             error_squared_sum += 1.0;  // not drawn yet: no information, e(P) = 1
             continue;
         }
@@ -67,6 +73,13 @@ Correctness measure_correctness(const Image& intermediate, const Image& final_im
     result.final_pixels = double(matching) / n;
     result.c = 1.0 - std::sqrt(error_squared_sum / n);
     return result;
+}
+
+void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn) {
+    check_buffers(frame, "drawn");
+    drawn.resize(frame.pixel_count(), 0);
+    for (std::size_t p = 0; p < frame.pixel_count(); ++p)
+        if (frame.depth[p] < 1.0f) drawn[p] = 1;
 }
 
 }  // namespace isowall

@@ -2,6 +2,9 @@
 // How close an intermediate frame is to the final one, in the two measures of the dissertation:
 // "final pixels" (chapters 2-3) and the correctness C = 1 - E (section 4.2).
 #include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
 
 #include "common/core/image.h"
 
@@ -21,8 +24,17 @@ struct Correctness {
 
 // Both measures are 1 when the final image has no significant pixel (nothing to match).
 // tolerance is in 8-bit units per channel and only affects final_pixels; C is exact.
-// Throws std::invalid_argument when the two images differ in size or are malformed.
+// A pixel of the intermediate frame counts as drawn where its depth is below 1, or where
+// `drawn_before` (empty, or one entry per pixel) is non-zero: drawn before the depth buffer was
+// cleared, as a client does when it goes to a finer level of detail. Its colour is still on
+// screen, so a screen capture (the text's measure) sees it as drawn.
+// Throws std::invalid_argument when the images differ in size or are malformed, or when
+// drawn_before is neither empty nor one entry per pixel.
 Correctness measure_correctness(const Image& intermediate, const Image& final_image,
-                                int tolerance = 1);
+                                int tolerance = 1, std::span<const std::uint8_t> drawn_before = {});
+
+// Marks in `drawn` (resized to one entry per pixel) every pixel of `frame` whose depth is below
+// 1; entries already set stay set.
+void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn);
 
 }  // namespace isowall

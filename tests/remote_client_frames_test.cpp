@@ -1,0 +1,100 @@
+// The client's frame without a server: groups of a coarse level and then the full-resolution
+// level, as progressive LOD sends them, and the correctness the client measures along the way.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <utility>
+
+#include "common/core/camera.h"
+#include "remote/client_frames.h"
+#include "remote/group_codec.h"
+#include "tile/renderer.h"
+
+namespace isowall::test {
+namespace {
+
+using namespace remote;
+
+// An axis-aligned box's six faces, counter-clockwise seen from outside.
+Mesh box_mesh(glm::vec3 lo, glm::vec3 hi) {
+    Mesh m;
+    for (int axis = 0; axis < 3; ++axis) {
+        for (int side = 0; side < 2; ++side) {
+            glm::vec3 n(0);
+            n[axis] = side ? 1.0f : -1.0f;
+            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            const auto base = static_cast<std::uint32_t>(m.positions.size());
+            for (int corner = 0; corner < 4; ++corner) {
+                glm::vec3 p;
+                p[axis] = side ? hi[axis] : lo[axis];
+                p[u] = (corner == 1 || corner == 2) ? hi[u] : lo[u];
+                p[v] = (corner >= 2) ? hi[v] : lo[v];
+                m.positions.push_back(p);
+                m.normals.push_back(n);
+            }
+            for (std::uint32_t t : {1u, 2u}) {  // triangles (0,1,2) and (0,2,3) of the quad
+                std::uint32_t a = base, b = base + t, c = base + t + 1;
+                const glm::vec3 face =
+                    glm::cross(m.positions[b] - m.positions[a], m.positions[c] - m.positions[a]);
+                if (glm::dot(face, n) < 0) std::swap(b, c);
+                m.indices.insert(m.indices.end(), {a, b, c});
+            }
+        }
+    }
+    return m;
+}
+
+GroupMsg group_msg(std::uint64_t request, const Mesh& mesh, int level, int seed_x, double iso) {
+    Group g;
+    g.seed = {seed_x, 0, 0};
+    g.level = level;
+    g.iso = iso;
+    g.mesh = mesh;
+    GroupMsg m;
+    m.request_id = request;
+    m.key = g.key();
+    const std::vector<std::uint8_t> bytes = encode_group(g, GroupEncoding::indexed);
+    m.encoded.resize(bytes.size());
+    std::memcpy(m.encoded.data(), bytes.data(), bytes.size());
+    return m;
+}
+
+TEST(ClientFrames, CoarsePixelsStayDrawnAfterTheDepthClearOfAFinerLevel) {
+    const Box3 bounds{glm::vec3(-1), glm::vec3(1)};
+    const int w = 160, h = 120;
+    Camera cam = fit_depth_range(front_full_view(bounds, float(w) / h), bounds);
+    RequestMsg req;
+    req.request_id = 1;
+    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
+    req.progressive_lod = true;
+
+    auto renderer = make_renderer("osmesa");
+    ClientFrames frames(*renderer);
+    frames.begin(req, 0.0);
+    // Level 2: one box around both halves of the final surface. Then level 0: the left half,
+    // then the right half. The depth clear before the left half must not make the coarse
+    // colour on the right half count as "not drawn".
+    const Mesh coarse = box_mesh(glm::vec3(-0.8f), glm::vec3(0.8f));
+    const Mesh left = box_mesh(glm::vec3(-0.7f), glm::vec3(-0.02f, 0.7f, 0.7f));
+    const Mesh right = box_mesh(glm::vec3(0.02f, -0.7f, -0.7f), glm::vec3(0.7f));
+    double t = 0;
+    for (const auto& [mesh, level] : {std::pair{coarse, 2}, {left, 0}, {right, 0}}) {
+        t += 1.0;  // past the sampling interval: one sample per group
+        EXPECT_FALSE(frames.handle(group_msg(1, mesh, level, int(t), 7.0), 1000, t));
+    }
+    EndOfFrameMsg end;
+    end.request_id = 1;
+    ASSERT_TRUE(frames.handle(end, 40, t + 1));
+    frames.measure();
+    const auto& line = frames.result().timeline;
+    ASSERT_GE(line.size(), 5u);  // begin, three groups, end
+    const double after_coarse = line[1].correctness.c;
+    const double after_left = line[2].correctness.c;
+    EXPECT_GT(after_coarse, 0.5) << "the coarse box covers every final pixel";
+    EXPECT_GE(after_left, after_coarse)
+        << "the left half is exact now and the right half still shows the coarse colour";
+    EXPECT_DOUBLE_EQ(line.back().correctness.c, 1.0);
+}
+
+}  // namespace
+}  // namespace isowall::test
