@@ -10,7 +10,7 @@ namespace isowall::remote {
 namespace {
 
 // Samples are taken as the frame grows by this factor in bytes, and at least this often.
-constexpr double kSampleBytesFactor = 1.05;
+constexpr double kSampleBytesFactor = 1.01;
 constexpr double kSampleIntervalS = 0.01;
 
 std::shared_ptr<const Mesh> decode_mesh(const GroupMsg& m) {

@@ -98,12 +98,23 @@ Mesh get_vertices(ByteReader& r) {
 
 // ---- indexed: the extractor's indexed face set -----------------------------------------------
 
+// Indices are uint16 when every one fits (at most 65536 vertices, as in every group the engine
+// makes), else uint32: what a GL program uploads. The decoder tells which from the vertex count.
+bool narrow_indices(std::size_t vertices) {
+    return vertices <= kMaxNarrowIndexedVertices;
+}
+
 void put_indexed(ByteWriter& w, const Mesh& m) {
     w.put(static_cast<std::uint32_t>(m.vertex_count()));
     w.put(static_cast<std::uint32_t>(m.triangle_count()));
     w.put_raw(std::span<const glm::vec3>(m.positions));
     w.put_raw(std::span<const glm::vec3>(m.normals));
-    w.put_raw(std::span<const std::uint32_t>(m.indices));
+    if (!narrow_indices(m.vertex_count())) {
+        w.put_raw(std::span<const std::uint32_t>(m.indices));
+        return;
+    }
+    const std::vector<std::uint16_t> narrow(m.indices.begin(), m.indices.end());
+    w.put_raw(std::span<const std::uint16_t>(narrow));
 }
 
 Mesh get_indexed(ByteReader& r) {
@@ -113,9 +124,17 @@ Mesh get_indexed(ByteReader& r) {
     Mesh m;
     get_finite_vec3s(r, m.positions, vertices, "position");
     get_finite_vec3s(r, m.normals, vertices, "normal");
-    r.need_elements(triangles, 3 * sizeof(std::uint32_t), "triangles");
-    m.indices.resize(3 * std::size_t{triangles});
-    r.get_raw(std::span(m.indices));
+    const std::size_t n = 3 * std::size_t{triangles};
+    if (narrow_indices(vertices)) {
+        r.need_elements(triangles, 3 * sizeof(std::uint16_t), "triangles");
+        std::vector<std::uint16_t> narrow(n);
+        r.get_raw(std::span(narrow));
+        m.indices.assign(narrow.begin(), narrow.end());
+    } else {
+        r.need_elements(triangles, 3 * sizeof(std::uint32_t), "triangles");
+        m.indices.resize(n);
+        r.get_raw(std::span(m.indices));
+    }
     for (std::uint32_t i : m.indices)
         if (i >= vertices)
             r.fail("index " + std::to_string(i) + " >= vertex count " + std::to_string(vertices));

@@ -4,7 +4,7 @@
 //   vertices      every triangle as three separate vertices, float32 position + normal each,
 //                 no index (section 4.2's case 1): 72 bytes a triangle
 //   indexed       the indexed face set the extractor makes: float32 positions and normals,
-//                 uint32 indices (case 2)
+//                 uint16 indices (uint32 for a group of more than 65536 vertices) (case 2)
 //   compact       positions quantised to 16 bits per axis inside the group's bounding box (sent
 //                 as floats), normals as octahedral 2 x 16 bits, indices through meshoptimizer's
 //                 index codec after its vertex cache and vertex fetch orders
@@ -49,7 +49,9 @@ inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
     return os << to_string(e);
 }
 
-inline constexpr std::uint8_t kGroupCodecVersion = 1;
+// 2: `indexed` sends uint16 indices for groups of at most kMaxNarrowIndexedVertices vertices.
+inline constexpr std::uint8_t kGroupCodecVersion = 2;
+inline constexpr std::size_t kMaxNarrowIndexedVertices = 65536;
 // One propagation pass makes a few thousand triangles (max_count 2000 cells); the whole skin of
 // the shared CT head at iso 40 is 0.72 M. 4 M triangles (288 MiB as `vertices`) bounds what one
 // group may claim, and so what a decoder may allocate for one.

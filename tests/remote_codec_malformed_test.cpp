@@ -84,9 +84,9 @@ TEST(RemoteCodecMalformed, SeededMutationsDecodeOrThrow) {
 TEST(RemoteCodecMalformed, AnotherVersionEncodingOrTrailingByteThrows) {
     for (GroupEncoding e : kAllGroupEncodings) {
         Bytes bytes = encode_group(small_group(), e);
-        for (std::uint8_t v : {0, 2, 255}) {
+        for (int v : {0, kGroupCodecVersion - 1, kGroupCodecVersion + 1, 255}) {
             Bytes b = bytes;
-            b[0] = v;
+            b[0] = static_cast<std::uint8_t>(v);
             EXPECT_THROW(decode_group(b), WireError) << e << " version " << int(v);
         }
         for (std::uint8_t k : {4, 5, 255}) {
@@ -125,7 +125,9 @@ TEST(RemoteCodecMalformed, HugeCountThrowsBeforeAllocating) {
 TEST(RemoteCodecMalformed, IndexPastTheVerticesThrows) {
     Bytes bytes = encode_group(small_group(), GroupEncoding::indexed);
     const std::size_t v = small_group().mesh.vertex_count();
-    put_u32(bytes, bytes.size() - 4, static_cast<std::uint32_t>(v));
+    ASSERT_LE(v, kMaxNarrowIndexedVertices);  // so the indices are uint16
+    const auto index = static_cast<std::uint16_t>(v);
+    std::memcpy(bytes.data() + bytes.size() - 2, &index, sizeof index);
     EXPECT_THROW(decode_group(bytes), WireError);
 }
 

@@ -233,6 +233,28 @@ TEST(RemoteCodec, EachStepIsSmallerOnAFrame) {
     EXPECT_LT(total[GroupEncoding::compact_zstd], total[GroupEncoding::compact]);
 }
 
+// Indices go as uint16 up to 65536 vertices (index 65535 included) and as uint32 beyond.
+TEST(RemoteCodec, IndexedSendsTwoByteIndicesUpTo65536Vertices) {
+    std::map<std::size_t, std::size_t> sizes;
+    for (std::size_t n : {std::size_t{65536}, std::size_t{65537}}) {
+        Group g;
+        g.iso = 3;
+        for (std::size_t i = 0; i < n; ++i) {
+            g.mesh.positions.emplace_back(float(i % 256), float(i / 256), 0.5f);
+            g.mesh.normals.emplace_back(0, 0, 1);
+        }
+        const auto last = static_cast<std::uint32_t>(n - 1);
+        g.mesh.indices = {0, 1, last, last, 1, 2, 256, last, 0};
+        const auto bytes = encode_group(g, GroupEncoding::indexed);
+        sizes[n] = bytes.size();
+        const Group back = decode_group(bytes);
+        EXPECT_EQ(back.mesh.indices, g.mesh.indices) << n << " vertices";
+        EXPECT_EQ(back.mesh.positions, g.mesh.positions) << n << " vertices";
+    }
+    // One more vertex (24 bytes) and nine indices of 4 bytes instead of 2.
+    EXPECT_EQ(sizes[65537] - sizes[65536], 24u + 9u * 2u);
+}
+
 TEST(RemoteCodec, WholeSurfaceRoundTripsAsOneGroup) {
     const Volume p = make_phantom();
     Group g;
