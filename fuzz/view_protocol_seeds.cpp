@@ -27,14 +27,15 @@ std::vector<ViewMessage> samples() {
     request.progressive_lod = true;
     request.cached_groups = true;
     const GroupKey key{{4, 5, 6}, 2, 105.5, true};
-    return {HelloMsg{1, "ct_head", "s3cret", 2},
-            ReadyMsg{{{0, 0, 0}, {1, 2, 3}}, -1024, 3071, {256, 256, 113}, {1, 1, 2}},
-            request,
-            GroupMsg{3, key, true, {std::byte{1}, std::byte{2}, std::byte{3}}},
-            VisibleMsg{3, {key, GroupKey{{7, 8, 9}, 0, 105.5, false}}},
-            EndOfFrameMsg{3, 480000, 120, 90000, 2400000},
-            make_error(ErrorCode::bad_token, "wrong token"),
-            ByeMsg{}};
+    return {
+        HelloMsg{1, "ct_head", "s3cret", 2},
+        ReadyMsg{{{0, 0, 0}, {1, 2, 3}}, -1024, 3071, {256, 256, 113}, {1, 1, 2}},
+        request,
+        GroupMsg{3, key, true, 3, {std::byte{1}, std::byte{2}, std::byte{3}}},
+        VisibleMsg{3, {0, 1, 2, 5, 7, 11}},  // a bitmap; the deltas form is in the fuzzer's reach
+        EndOfFrameMsg{3, 480000, 120, 90000, 2400000},
+        make_error(ErrorCode::bad_token, "wrong token"),
+        ByeMsg{}};
 }
 
 bool write(const std::filesystem::path& path, const std::vector<std::byte>& bytes) {

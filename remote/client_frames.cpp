@@ -1,6 +1,8 @@
 #include "remote/client_frames.h"
 
+#include <algorithm>
 #include <span>
+#include <string>
 #include <type_traits>
 
 #include "common/core/wire.h"
@@ -37,9 +39,6 @@ void ClientFrames::begin(const RequestMsg& request, double now_s) {
     ops_.clear();
     finals_.clear();
     result_ = ClientFrameResult{};
-    if (!request.cached_groups || !cache_valid_ || cache_iso_ != request.view.iso) cache_.clear();
-    cache_valid_ = request.cached_groups;
-    cache_iso_ = request.view.iso;
     renderer_.resize(request.view.width, request.view.height);
     renderer_.clear();
     sample(now_s, true);
@@ -70,33 +69,55 @@ void ClientFrames::sample(double now_s, bool force) {
     last_sample_bytes_ = now_.bytes;
 }
 
+void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, double now_s) {
+    const bool current = active_ && g.request_id == request_.request_id;
+    if (!current && g.cache_gen == 0) return;
+    auto mesh = decode_mesh(g);
+    if (g.cache_gen != 0) {
+        if (g.cache_gen != cache_gen_) {
+            cache_.clear();
+            cache_gen_ = g.cache_gen;
+        }
+        cache_.push_back({mesh, g.key.level});
+    }
+    if (!current) return;
+    now_.bytes += wire_bytes;
+    ++now_.groups;
+    if (!g.draw_from_next_frame) draw(mesh, g.key.level);
+    sample(now_s, false);
+}
+
+void ClientFrames::handle_visible(const VisibleMsg& v, std::size_t wire_bytes, double now_s) {
+    if (!active_ || v.request_id != request_.request_id) return;
+    now_.bytes += wire_bytes;
+    std::vector<const Cached*> named;
+    named.reserve(v.slots.size());
+    for (const std::uint32_t slot : v.slots) {
+        if (slot >= cache_.size())
+            throw WireError(
+                "visible message: slots: the server named a group the client does not "
+                "hold (slot " +
+                std::to_string(slot) + " of " + std::to_string(cache_.size()) + ")");
+        named.push_back(&cache_[slot]);
+    }
+    // Coarse first: draw() skips a group coarser than what the frame already shows.
+    std::stable_sort(named.begin(), named.end(),
+                     [](const Cached* a, const Cached* b) { return a->level > b->level; });
+    for (const Cached* c : named) {
+        ++now_.named;
+        draw(c->mesh, c->level);
+    }
+    sample(now_s, false);
+}
+
 bool ClientFrames::handle(const ViewMessage& m, std::size_t wire_bytes, double now_s) {
     if (const auto* e = std::get_if<ErrorMsg>(&m)) throw RemoteError(e->code, e->text);
     if (const auto* g = std::get_if<GroupMsg>(&m)) {
-        const bool current = active_ && g->request_id == request_.request_id;
-        if (!current && !(cache_valid_ && g->key.iso == cache_iso_)) return false;
-        auto mesh = decode_mesh(*g);
-        if (cache_valid_ && g->key.iso == cache_iso_) cache_[g->key] = {mesh, g->key.level};
-        if (!current) return false;
-        now_.bytes += wire_bytes;
-        ++now_.groups;
-        if (!g->draw_from_next_frame) draw(mesh, g->key.level);
-        sample(now_s, false);
+        handle_group(*g, wire_bytes, now_s);
         return false;
     }
     if (const auto* v = std::get_if<VisibleMsg>(&m)) {
-        if (!active_ || v->request_id != request_.request_id) return false;
-        now_.bytes += wire_bytes;
-        for (const GroupKey& k : v->keys) {
-            const auto it = cache_.find(k);
-            if (it == cache_.end())
-                throw WireError(
-                    "visible message: keys: the server named a group the client "
-                    "does not hold");
-            ++now_.named;
-            draw(it->second.mesh, it->second.level);
-        }
-        sample(now_s, false);
+        handle_visible(*v, wire_bytes, now_s);
         return false;
     }
     if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) {

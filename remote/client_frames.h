@@ -8,17 +8,22 @@
 //     is cleared when a finer level begins, so the finer surface covers the coarser one;
 //   - a group coarser than what the frame already shows is not drawn (it could not be drawn over
 //     the finer groups), nor one sent with draw_from_next_frame; both are cached when caching;
-//   - VisibleMsg names cached groups to draw: the client must hold each (a protocol error if not);
+//   - VisibleMsg names cached groups to draw by slot: the client must hold each (a protocol error
+//     if not) and draws them coarse levels first, as a finer group drawn first would keep the
+//     coarser ones off the screen;
 //   - at the end of a frame that drew any coarse group, the frame is drawn again from its
 //     full-resolution groups alone, so the final image holds no coarse leftovers and equals the
 //     image of the same view without LOD.
-// The cache holds the groups of one isovalue, as decoded meshes, and is dropped when a request
-// asks for another isovalue or for no caching.
+// The cache follows the server's stream, not the client's requests: the server's worker may skip
+// requests, so only it knows what the client must hold. A group with a cache generation
+// (GroupMsg::cache_gen, of any request, as late groups are cached too) is appended to the cache;
+// one of another generation first drops the cache. Groups arrive in the order the server gave
+// them slots, so a group's slot is its index. The cache is kept while requests do not cache: the
+// server may have skipped such a request and still name the generation's slots.
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "common/core/image.h"
@@ -74,6 +79,8 @@ class ClientFrames {
     void draw(const std::shared_ptr<const Mesh>& mesh, int level);
     void sample(double now_s, bool force);
     void finish_frame(const EndOfFrameMsg& end, double now_s);
+    void handle_group(const GroupMsg& g, std::size_t wire_bytes, double now_s);
+    void handle_visible(const VisibleMsg& v, std::size_t wire_bytes, double now_s);
 
     Renderer& renderer_;
     RequestMsg request_;
@@ -86,9 +93,8 @@ class ClientFrames {
     std::size_t redraw_op_ = SIZE_MAX;  // where the end-of-frame redraw began, if any
     std::vector<Op> ops_;
     std::vector<std::shared_ptr<const Mesh>> finals_;  // full-resolution groups of the frame
-    std::unordered_map<GroupKey, Cached> cache_;
-    bool cache_valid_ = false;
-    double cache_iso_ = 0;
+    std::vector<Cached> cache_;                        // index = slot in generation cache_gen_
+    std::uint64_t cache_gen_ = 0;                      // 0: none yet
     ClientFrameResult result_;
 };
 

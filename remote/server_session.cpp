@@ -44,6 +44,7 @@ struct ServerSession::Level {
     struct Sent {
         GroupKey key;
         std::vector<glm::ivec3> cells;  // the first cell of each unit the group took
+        std::uint32_t slot = 0;         // its index in the client's cache of the generation
     };
     std::vector<Sent> sent;   // index = the group's id in this level's frames
     std::vector<char> named;  // per sent group: named (or sent) in the current request
@@ -60,6 +61,7 @@ class ServerSession::Sink final : public GroupSink {
         m.request_id = r_.request_id;
         m.key = g.key();
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
+        m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const std::vector<std::uint8_t> bytes =
             encode_group(g, s_.options_.encoding, s_.grid_step_);
         m.encoded.resize(bytes.size());
@@ -68,22 +70,22 @@ class ServerSession::Sink final : public GroupSink {
         f_.bytes += s_.send_(m);
         ++f_.groups;
         f_.triangles += g.mesh.triangle_count();
-        if (!r_.cached_groups) return;
+        if (s_.cache_gen_ == 0) return;
         // The engine numbers a frame's groups from first_group_id = sent.size(), one per add().
         if (g.id != lv_.sent.size())
             throw std::logic_error("server session: group ids out of step with the cache");
-        lv_.sent.push_back({g.key(), g.cells});
+        lv_.sent.push_back({g.key(), g.cells, s_.next_slot_++});
         lv_.named.push_back(1);
     }
 
-    bool wants_seen() const override { return r_.cached_groups; }
+    bool wants_seen() const override { return s_.cache_gen_ != 0; }
 
     void seen(std::uint32_t id) override {
         if (id >= lv_.named.size() || lv_.named[id]) return;
         lv_.named[id] = 1;
         VisibleMsg m;
         m.request_id = r_.request_id;
-        m.keys.push_back(lv_.sent[id].key);
+        m.slots.push_back(lv_.sent[id].slot);
         f_.bytes += s_.send_(m);
         ++f_.named;
     }
@@ -126,16 +128,17 @@ void ServerSession::begin_cached(Level& lv, const RequestMsg& r, bool keep) {
     lv.named.assign(lv.sent.size(), 0);
 }
 
-// Step 2 of a cached isovalue: one ray towards each cached group's seed, coarse levels first.
+// Step 2 of a cached isovalue: one ray towards each cached group's seed, coarse levels first,
+// named in one message (the client orders its draws by level).
 void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
     const FrameView& v = r.view;
     const glm::mat4 view_inv = glm::inverse(v.camera.view());
     const glm::vec3 spacing = prototype_.volume().spacing();
     const int top = r.progressive_lod ? options_.lod_levels : 0;
+    VisibleMsg m;
+    m.request_id = r.request_id;
     for (int l = top; l >= 0; --l) {
         Level& lv = level(l);
-        VisibleMsg m;
-        m.request_id = r.request_id;
         for (const Level::Sent& s : lv.sent) {
             const float half = 0.5f * float(1 << s.key.level);
             const auto px = pixel_of(v, (glm::vec3(s.key.seed) + half) * spacing);
@@ -147,12 +150,13 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
             const std::uint32_t id = lv.ex->group_of(hit.cell);
             if (id >= lv.named.size() || lv.named[id]) continue;
             lv.named[id] = 1;
-            m.keys.push_back(lv.sent[id].key);
+            m.slots.push_back(lv.sent[id].slot);
         }
-        if (m.keys.empty()) continue;
-        f.named += m.keys.size();
-        f.bytes += send_(m);
     }
+    if (m.slots.empty()) return;
+    std::sort(m.slots.begin(), m.slots.end());  // the wire wants them ascending
+    f.named += m.slots.size();
+    f.bytes += send_(m);
 }
 
 bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std::atomic<bool>& stop,
@@ -182,11 +186,19 @@ bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std:
 
 RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& stop) {
     RequestFigures f;
-    const bool keep = r.cached_groups && cache_valid_ && cache_iso_ == r.view.iso;
-    cache_valid_ = r.cached_groups;
+    // A generation past half the slots a VisibleMsg may name begins again, so its slots stay
+    // nameable unless one request sends half a million groups.
+    const bool keep = r.cached_groups && cache_valid_ && cache_iso_ == r.view.iso &&
+                      next_slot_ < kMaxVisibleKeys / 2;
+    cache_valid_ = r.cached_groups && r.request_id != 0;
     cache_iso_ = r.view.iso;
-    if (!keep)
+    if (!keep) {
+        // A new generation, named by the request that began it: the client drops its cache when
+        // a group of another generation arrives, whichever requests either side skipped.
+        cache_gen_ = cache_valid_ ? r.request_id : 0;
+        next_slot_ = 0;
         for (auto& lv : levels_) lv->sent.clear();
+    }
     const int top = r.progressive_lod ? options_.lod_levels : 0;
     for (int l = top; l >= 0; --l) begin_cached(level(l), r, keep);
     if (keep) name_by_seed_rays(r, f);

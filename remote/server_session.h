@@ -7,19 +7,26 @@
 // 4 and then 2 cells per side, each with about lod_ray_share of the view's rays, then at full
 // resolution with a ray for every pixel the volume covers. Every group goes out as it is made.
 //
-// Cached primitives (section 4.1.4). The client keeps every group it receives for the current
-// isovalue; the session keeps, per level, what it sent: each group's key and the cells it took.
-// A request at the same isovalue then
+// Cached primitives (section 4.1.4). The session decides what the client caches, as only it
+// knows which requests its worker skipped (it takes the newest; a client that judged by the
+// requests it sent could drop groups the session goes on to name). A cached request that cannot
+// keep the cache (another isovalue, or the previous request did not cache) begins a generation
+// numbered by its request id; each group sent while it lasts carries it (GroupMsg::cache_gen) and
+// takes the next slot, the client's index of the group in its cache. The session keeps, per
+// level, what it sent: each group's key, slot and the cells it took. A request that keeps the
+// generation then
 //   1. begins each level's frame with those cells taken again, under their groups' ids,
-//   2. casts one ray towards each cached group's seed and names (VisibleMsg) the groups those
-//      rays meet first, coarse levels first,
+//   2. casts one ray towards each cached group's seed and names the slots of the groups those
+//      rays meet first, every level in one VisibleMsg (the client draws coarse levels first),
 //   3. casts as usual: a ray that meets a cell of a cached group not named yet names it (the
-//      engine's GroupSink::seen), a ray that meets a new part of the surface makes a new group.
-// So every group is sent once per isovalue, and at full resolution every pixel's ray names or
+//      engine's GroupSink::seen, a VisibleMsg of one slot), a ray that meets a new part of the
+//      surface makes a new group.
+// So every group is sent once per generation, and at full resolution every pixel's ray names or
 // makes the group it sees: the final image is the one without a cache. New coarse groups of a
-// cached isovalue are sent with draw_from_next_frame (the client cannot draw them over the finer
+// kept generation are sent with draw_from_next_frame (the client cannot draw them over the finer
 // groups it already shows). A group cut short by an interrupt is not sent and its cells are not
-// kept, so a later request makes it again.
+// kept, so a later request makes it again. Groups of a request that does not cache carry
+// generation 0. A cached request with id 0 is served uncached (0 names no generation).
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -82,6 +89,8 @@ class ServerSession {
     std::vector<std::unique_ptr<Level>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;
+    std::uint64_t cache_gen_ = 0;  // the generation groups are sent in; 0 while not caching
+    std::uint32_t next_slot_ = 0;  // the slot of the generation's next group
     float grid_step_ = 0;  // compact encodings: one position grid for every group (no cracks)
 };
 

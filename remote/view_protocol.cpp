@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "comm/wire_pieces.h"
+#include "remote/slot_list.h"
 
 namespace isowall::remote {
 
@@ -55,9 +56,6 @@ std::int32_t get_int_in(MessageReader& r, const std::string& field, std::int32_t
     return v;
 }
 
-// seed (3 x i32) + level (i32) + iso (f64) + refinement (u8): the bytes of one key, for counts.
-constexpr std::size_t kGroupKeyWireBytes = 3 * 4 + 4 + 8 + 1;
-
 void put_group_key(MessageWriter& w, const GroupKey& k) {
     w.put(static_cast<std::int32_t>(k.seed.x));
     w.put(static_cast<std::int32_t>(k.seed.y));
@@ -67,26 +65,9 @@ void put_group_key(MessageWriter& w, const GroupKey& k) {
     w.put(static_cast<std::uint8_t>(k.refinement));
 }
 
-// The name of a key's field in errors: "key.level", or "keys[2].level" in a list. Built only on
-// failure: a visible message may hold a million keys.
-struct KeyName {
-    const char* base;
-    std::size_t index = SIZE_MAX;
-    std::string operator()(const char* field) const {
-        // Appended piece by piece: `"[" + std::string&&` trips GCC 12's false -Wrestrict.
-        std::string s = base;
-        if (index != SIZE_MAX) {
-            s += '[';
-            s += std::to_string(index);
-            s += ']';
-        }
-        s += '.';
-        s += field;
-        return s;
-    }
-};
-
-GroupKey get_group_key(MessageReader& r, const KeyName& name) {
+// A group key's fields; errors name them "key.level" and so on.
+GroupKey get_group_key(MessageReader& r) {
+    const auto name = [](const char* field) { return std::string("key.") + field; };
     GroupKey k;
     int* const ints[] = {&k.seed.x, &k.seed.y, &k.seed.z, &k.level};
     const char* const fields[] = {"seed.x", "seed.y", "seed.z", "level"};
@@ -196,6 +177,7 @@ static std::vector<std::byte> encode(const GroupMsg& m) {
     w.put(m.request_id);
     put_group_key(w, m.key);
     w.put(static_cast<std::uint8_t>(m.draw_from_next_frame));
+    w.put(m.cache_gen);
     w.put_bytes(m.encoded);
     return w.take();
 }
@@ -204,8 +186,9 @@ static GroupMsg decode_group(std::span<const std::byte> bytes) {
     MessageReader r(bytes, GroupMsg::kVersion, "group message");
     GroupMsg m;
     m.request_id = r.get<std::uint64_t>();
-    m.key = get_group_key(r, {"key"});
+    m.key = get_group_key(r);
     m.draw_from_next_frame = get_flag(r, "draw_from_next_frame");
+    m.cache_gen = r.get<std::uint64_t>();
     const auto encoded = r.get_bytes();  // checked against the message: no allocation yet
     if (encoded.size() > kMaxGroupBytes)
         r.fail("encoded: " + std::to_string(encoded.size()) + " bytes, expected at most " +
@@ -218,8 +201,7 @@ static GroupMsg decode_group(std::span<const std::byte> bytes) {
 static std::vector<std::byte> encode(const VisibleMsg& m) {
     MessageWriter w(VisibleMsg::kVersion);
     w.put(m.request_id);
-    w.put(static_cast<std::uint64_t>(m.keys.size()));
-    for (const GroupKey& k : m.keys) put_group_key(w, k);
+    put_slots(w, m.slots);
     return w.take();
 }
 
@@ -227,12 +209,7 @@ static VisibleMsg decode_visible(std::span<const std::byte> bytes) {
     MessageReader r(bytes, VisibleMsg::kVersion, "visible message");
     VisibleMsg m;
     m.request_id = r.get<std::uint64_t>();
-    const std::size_t n = r.get_count(kGroupKeyWireBytes);  // against the bytes left
-    if (n > kMaxVisibleKeys)
-        r.fail("keys: " + std::to_string(n) + " keys, expected at most " +
-               std::to_string(kMaxVisibleKeys));
-    m.keys.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) m.keys.push_back(get_group_key(r, {"keys", i}));
+    m.slots = get_slots(r);
     r.finish();
     return m;
 }

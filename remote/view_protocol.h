@@ -41,6 +41,7 @@ inline constexpr std::size_t kMaxErrorTextBytes = 256;    // one printable ASCII
 // An encoded group. Groups of the default propagation (2000 cells) take a few hundred KiB; the
 // bound keeps every valid group message under the framing's default payload limit (64 MiB).
 inline constexpr std::size_t kMaxGroupBytes = std::size_t{32} << 20;
+// Slots of a generation's cached groups (VisibleMsg): each below this, so a bitmap is <= 128 KiB.
 inline constexpr std::size_t kMaxVisibleKeys = std::size_t{1} << 20;
 // A group's level: meta-cells of 2^level cells per side, so anything past 30 overflows an int.
 inline constexpr int kMaxGroupLevel = 30;
@@ -76,19 +77,26 @@ struct RequestMsg {
 
 struct GroupMsg {
     static constexpr MsgType kType = MsgType::group;
-    static constexpr std::uint8_t kVersion = 1;
+    static constexpr std::uint8_t kVersion = 2;
     std::uint64_t request_id = 0;
     GroupKey key;  // seed >= 0 on each axis, level 0..kMaxGroupLevel, finite iso
     // A late coarse group (section 4.1.4): cached now, drawn only from the next frame.
     bool draw_from_next_frame = false;
+    // 0: the client does not cache the group. Otherwise the server's cache generation (the id of
+    // the request that began it): a client holding another generation drops it and begins this
+    // one, then appends the group, whose slot (VisibleMsg) is its index in the generation. The
+    // server decides, as only it knows which requests it skipped.
+    std::uint64_t cache_gen = 0;
     std::vector<std::byte> encoded;  // the group in the hello's encoding; <= kMaxGroupBytes
 };
 
 struct VisibleMsg {
     static constexpr MsgType kType = MsgType::visible;
-    static constexpr std::uint8_t kVersion = 1;
+    static constexpr std::uint8_t kVersion = 2;
     std::uint64_t request_id = 0;
-    std::vector<GroupKey> keys;  // <= kMaxVisibleKeys, each checked as in GroupMsg
+    // Cached groups of the client's generation, by slot: strictly ascending, each below
+    // kMaxVisibleKeys; a bitmap or deltas on the wire, whichever is smaller (slot_list.h).
+    std::vector<std::uint32_t> slots;
 };
 
 struct EndOfFrameMsg {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
 #include <utility>
 
 #include "common/core/camera.h"
@@ -94,6 +95,55 @@ TEST(ClientFrames, CoarsePixelsStayDrawnAfterTheDepthClearOfAFinerLevel) {
     EXPECT_GE(after_left, after_coarse)
         << "the left half is exact now and the right half still shows the coarse colour";
     EXPECT_DOUBLE_EQ(line.back().correctness.c, 1.0);
+}
+
+// The cache follows the server's generations: a group of another generation drops the cache,
+// a named slot is an index into it, and named groups are drawn coarse levels first.
+TEST(ClientFrames, TheCacheFollowsTheServersGenerationsAndDrawsNamedSlotsCoarseFirst) {
+    const Box3 bounds{glm::vec3(-1), glm::vec3(1)};
+    const int w = 64, h = 48;
+    Camera cam = fit_depth_range(front_full_view(bounds, float(w) / h), bounds);
+    RequestMsg req;
+    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
+    req.progressive_lod = true;
+    req.cached_groups = true;
+    auto renderer = make_renderer("osmesa");
+    ClientFrames frames(*renderer);
+    const Mesh fine = box_mesh(glm::vec3(-0.5f), glm::vec3(0.5f));
+    const Mesh coarse = box_mesh(glm::vec3(-0.8f), glm::vec3(0.8f));
+    const auto cached = [&](std::uint64_t request, const Mesh& mesh, int level, int seed_x,
+                            std::uint64_t gen) {
+        GroupMsg m = group_msg(request, mesh, level, seed_x, 7.0);
+        m.cache_gen = gen;
+        return m;
+    };
+    req.request_id = 1;
+    frames.begin(req, 0);
+    frames.handle(cached(1, fine, 0, 0, 1), 100, 0);    // generation 1, slot 0
+    frames.handle(cached(1, coarse, 2, 1, 1), 100, 0);  // slot 1
+    req.request_id = 2;
+    frames.begin(req, 1);
+    // Slot 0 is finer than slot 1: in slot order the coarse one would be skipped.
+    frames.handle(VisibleMsg{2, {0, 1}}, 20, 1);
+    EndOfFrameMsg end;
+    end.request_id = 2;
+    ASSERT_TRUE(frames.handle(end, 40, 1));
+    EXPECT_EQ(frames.result().timeline.back().named, 2u);
+    EXPECT_EQ(frames.result().timeline.back().triangles, 24u) << "both named groups drawn";
+    // A late group of an older request in another generation: the cache holds it alone.
+    req.request_id = 3;
+    frames.begin(req, 2);
+    frames.handle(cached(2, fine, 0, 2, 2), 100, 2);
+    EXPECT_NO_THROW(frames.handle(VisibleMsg{3, {0}}, 20, 2));
+    try {
+        frames.handle(VisibleMsg{3, {0, 1}}, 20, 2);
+        ADD_FAILURE() << "slot 1 of generation 2 does not exist";
+    } catch (const WireError& e) {
+        EXPECT_NE(std::string(e.what()).find("visible message: slots: the server named a group "
+                                             "the client does not hold (slot 1 of 1)"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 }  // namespace

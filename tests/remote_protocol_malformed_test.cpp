@@ -12,6 +12,7 @@
 #include <new>
 #include <string>
 
+#include "remote/slot_list.h"
 #include "tests/largest_allocation.h"
 #include "tests/remote_protocol_test_util.h"
 
@@ -137,23 +138,82 @@ TEST(RemoteProtocolMalformed, GroupWithAHugeLengthThrowsWithoutAllocating) {
     }
 }
 
+// A visible message's bytes up to its slots: version, request id, form.
+MessageWriter visible_head(SlotForm form) {
+    MessageWriter w(VisibleMsg::kVersion);
+    w.put(std::uint64_t{9});
+    w.put(static_cast<std::uint8_t>(form));
+    return w;
+}
+
+TEST(RemoteProtocolMalformed, VisibleBitmapFields) {
+    MessageWriter past = visible_head(SlotForm::bitmap);
+    past.put(std::uint32_t{10});  // two bytes; bit 10 (byte 1, bit 2) is past the count
+    past.put(std::uint8_t{0x01});
+    past.put(std::uint8_t{0x06});
+    expect_view_wire_error(MsgType::visible, past.take(),
+                           "slots: bit 10 is set, expected none at or past the bit count 10");
+    MessageWriter cut = visible_head(SlotForm::bitmap);
+    cut.put(std::uint32_t{17});  // three bytes of bits, two given
+    cut.put(std::uint16_t{0xffff});
+    expect_view_wire_error(MsgType::visible, cut.take(),
+                           "slots: a bitmap of 17 bits takes 3 bytes, 2 left");
+    MessageWriter over = visible_head(SlotForm::bitmap);
+    over.put(static_cast<std::uint32_t>(kMaxVisibleKeys + 1));
+    expect_view_wire_error(MsgType::visible, over.take(),
+                           "slots: bit count 1048577, expected at most 1048576");
+    MessageWriter form = visible_head(SlotForm::bitmap);
+    Bytes bytes = form.take();
+    bytes.back() = std::byte{2};
+    expect_view_wire_error(MsgType::visible, bytes,
+                           "form: expected 0 (bitmap) or 1 (deltas), got 2");
+}
+
+// A deltas-form visible message of `count` with `varints` as raw bytes after it.
+Bytes visible_deltas(std::uint32_t count, std::initializer_list<std::uint8_t> varints) {
+    MessageWriter w = visible_head(SlotForm::deltas);
+    w.put(count);
+    for (const std::uint8_t b : varints) w.put(b);
+    return w.take();
+}
+
+TEST(RemoteProtocolMalformed, VisibleDeltasFields) {
+    struct Case {
+        Bytes bytes;
+        const char* field;
+    };
+    const Case cases[] = {
+        {visible_deltas(3, {5, 1, 0}), "slots[2]: gap 0, expected at least 1"},
+        {visible_deltas(1, {0x80, 0x80, 0x80, 0x80, 0x80, 0x01}),
+         "slots[0]: varint longer than 5 bytes"},
+        {visible_deltas(2, {1, 0x80, 0x80}), "slots[1]: the varint runs past the end"},
+        {visible_deltas(1, {0xff, 0xff, 0xff, 0xff, 0x1f}),
+         "slots[0]: varint 8589934591, expected less than 2^32"},
+        {visible_deltas(1, {0x80, 0x80, 0x40}), "slots[0]: slot 1048576, expected less than"},
+        {visible_deltas(2, {0xff, 0xff, 0x3f, 0x01}), "slots[1]: slot 1048576, expected less than"},
+        {visible_deltas(3, {1, 2}), "slots: count 3 is larger than the 2 bytes left"},
+    };
+    for (const Case& c : cases) expect_view_wire_error(MsgType::visible, c.bytes, c.field);
+    // The encoder writes what it is given: a slot over the limit goes out, and is refused.
+    VisibleMsg far{9, {1, static_cast<std::uint32_t>(kMaxVisibleKeys)}};
+    expect_view_wire_error(MsgType::visible, encode_payload(far),
+                           "slots[1]: slot 1048576, expected less than 1048576");
+}
+
 TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
-    for (std::uint64_t count :
-         {std::uint64_t{4}, std::uint64_t{1} << 50, std::numeric_limits<std::uint64_t>::max()}) {
-        MessageWriter w(VisibleMsg::kVersion);
-        w.put(std::uint64_t{9});
-        w.put(count);
-        w.put(std::uint64_t{0});  // 8 bytes, less than one key
-        const Bytes bytes = w.take();
-        const auto largest = largest_allocation_in(
-            [&] { expect_view_wire_error(MsgType::visible, bytes, "larger than the message"); });
+    for (std::uint32_t count : {std::uint32_t{4}, std::uint32_t{1} << 30, UINT32_MAX}) {
+        const Bytes bytes = visible_deltas(count, {1, 2, 3});
+        const auto largest = largest_allocation_in([&] {
+            expect_view_wire_error(MsgType::visible, bytes, "is larger than the 3 bytes left");
+        });
         EXPECT_LT(largest, 4096u) << "count " << count;
     }
-    VisibleMsg many{1, std::vector<GroupKey>(kMaxVisibleKeys + 1)};
-    expect_view_wire_error(MsgType::visible, encode_payload(many), "keys: 1048577 keys");
-    VisibleMsg bad_key = sample_visible();
-    bad_key.keys[2].level = 99;
-    expect_view_wire_error(MsgType::visible, encode_payload(bad_key), "keys[2].level");
+    MessageWriter w = visible_head(SlotForm::bitmap);
+    w.put(UINT32_MAX);
+    const Bytes bitmap = w.take();
+    const auto largest = largest_allocation_in(
+        [&] { expect_view_wire_error(MsgType::visible, bitmap, "slots: bit count 4294967295"); });
+    EXPECT_LT(largest, 4096u);
 }
 
 TEST(RemoteProtocolMalformed, ErrorFields) {
@@ -169,7 +229,9 @@ TEST(RemoteProtocolMalformed, WrongLayoutVersionThrows) {
     for (const ViewMessage& m : samples()) {
         Bytes bytes = encode_payload(m);
         bytes[0] = std::byte{99};
-        expect_view_wire_error(type_of(m), bytes, "version 99, expected 1");
+        const int version = std::visit([](const auto& msg) { return int(msg.kVersion); }, m);
+        expect_view_wire_error(type_of(m), bytes,
+                               "version 99, expected " + std::to_string(version));
     }
 }
 

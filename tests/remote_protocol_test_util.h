@@ -28,10 +28,11 @@ inline bool operator==(const RequestMsg& a, const RequestMsg& b) {
 }
 inline bool operator==(const GroupMsg& a, const GroupMsg& b) {
     return a.request_id == b.request_id && a.key == b.key &&
-           a.draw_from_next_frame == b.draw_from_next_frame && a.encoded == b.encoded;
+           a.draw_from_next_frame == b.draw_from_next_frame && a.cache_gen == b.cache_gen &&
+           a.encoded == b.encoded;
 }
 inline bool operator==(const VisibleMsg& a, const VisibleMsg& b) {
-    return a.request_id == b.request_id && a.keys == b.keys;
+    return a.request_id == b.request_id && a.slots == b.slots;
 }
 inline bool operator==(const EndOfFrameMsg& a, const EndOfFrameMsg& b) {
     return a.request_id == b.request_id && a.rays == b.rays && a.groups == b.groups &&
@@ -75,10 +76,14 @@ inline GroupKey sample_key(int i) {
     return {{4 + i, 5, 6 * i}, 2 + i % 3, 105.5, i % 2 == 0};
 }
 inline GroupMsg sample_group() {
-    return {9, sample_key(0), true, {std::byte{1}, std::byte{0}, std::byte{255}, std::byte{7}}};
+    return {9,
+            sample_key(0),
+            true,
+            0x0102030405060708,
+            {std::byte{1}, std::byte{0}, std::byte{255}, std::byte{7}}};
 }
 inline VisibleMsg sample_visible() {
-    return {9, {sample_key(0), sample_key(1), sample_key(2)}};
+    return {9, {0, 2, 3, 9, 10}};  // a bitmap: 2 bytes of bits, 5 of deltas
 }
 inline EndOfFrameMsg sample_end_of_frame() {
     return {9, 480000, 120, 90000, 0x100000002};
