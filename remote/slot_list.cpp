@@ -39,6 +39,10 @@ std::vector<std::uint32_t> get_bitmap(MessageReader& r) {
             slots.push_back(static_cast<std::uint32_t>(slot));
         }
     }
+    // One encoding per set (the harness and the byte counts rely on it): n is the highest slot + 1.
+    if (n > 0 && (slots.empty() || slots.back() != n - 1))
+        r.fail("slots: bit count " + std::to_string(n) + " but bit " + std::to_string(n - 1) +
+               " is clear, expected the highest slot + 1");
     return slots;
 }
 
@@ -82,6 +86,9 @@ std::uint32_t get_varint(MessageReader& r, const std::string& field) {
         const auto byte = r.get<std::uint8_t>();
         v |= std::uint64_t{byte & 0x7fu} << (7 * i);
         if (!(byte & 0x80)) {
+            if (i > 0 && byte == 0)
+                r.fail(field + ": varint of " + std::to_string(i + 1) +
+                       " bytes ends in a zero byte, expected the shortest form");
             if (v > UINT32_MAX)
                 r.fail(field + ": varint " + std::to_string(v) + ", expected less than 2^32");
             return static_cast<std::uint32_t>(v);
@@ -125,9 +132,20 @@ void put_slots(MessageWriter& w, std::span<const std::uint32_t> slots) {
 
 std::vector<std::uint32_t> get_slots(MessageReader& r) {
     const auto form = r.get<std::uint8_t>();
-    if (form == static_cast<std::uint8_t>(SlotForm::bitmap)) return get_bitmap(r);
-    if (form == static_cast<std::uint8_t>(SlotForm::deltas)) return get_deltas(r);
-    r.fail("form: expected 0 (bitmap) or 1 (deltas), got " + std::to_string(form));
+    std::vector<std::uint32_t> slots;
+    if (form == static_cast<std::uint8_t>(SlotForm::bitmap))
+        slots = get_bitmap(r);
+    else if (form == static_cast<std::uint8_t>(SlotForm::deltas))
+        slots = get_deltas(r);
+    else
+        r.fail("form: expected 0 (bitmap) or 1 (deltas), got " + std::to_string(form));
+    // The encoder's choice only, so that a set has one encoding.
+    if (static_cast<std::uint8_t>(smaller_form(slots)) != form)
+        r.fail("form: " + std::to_string(form) + ", but the slots take " +
+               std::to_string(bitmap_form_bytes(slots)) + " bytes as a bitmap and " +
+               std::to_string(deltas_form_bytes(slots)) +
+               " as deltas: expected the smaller (a tie: the bitmap)");
+    return slots;
 }
 
 }  // namespace isowall::remote

@@ -41,8 +41,10 @@ SlotForm smaller_form(std::span<const std::uint32_t> slots);
 // Writes the form byte and the smaller form. `slots` must be strictly ascending (the encoders
 // write what they are given: gaps are taken modulo 2^32, and a bitmap merges repeats).
 void put_slots(MessageWriter& w, std::span<const std::uint32_t> slots);
-// Reads what put_slots writes; strictly ascending, each < kMaxVisibleKeys. Errors name "slots"
-// (or "slots[i]"), and no count is trusted before it is checked against the bytes left.
+// Reads what put_slots writes; strictly ascending, each < kMaxVisibleKeys. Only the encoder's
+// bytes are accepted (the smaller form, n = the highest slot + 1, shortest varints), so a set has
+// one encoding. Errors name "slots" (or "slots[i]", or "form"), and no count is trusted before
+// it is checked against the bytes left.
 std::vector<std::uint32_t> get_slots(MessageReader& r);
 
 }  // namespace isowall::remote

@@ -200,6 +200,26 @@ TEST(RemoteProtocolMalformed, VisibleDeltasFields) {
                            "slots[1]: slot 1048576, expected less than 1048576");
 }
 
+// A set of slots has one encoding, the encoder's, so what decodes encodes back to its bytes (the
+// fuzz harness found a deltas form re-encoded as the smaller bitmap).
+TEST(RemoteProtocolMalformed, VisibleAcceptsOnlyTheEncodersBytes) {
+    MessageWriter slack = visible_head(SlotForm::bitmap);
+    slack.put(std::uint32_t{16});  // slot 0 only: the count should be 1
+    slack.put(std::uint16_t{0x0001});
+    expect_view_wire_error(MsgType::visible, slack.take(),
+                           "slots: bit count 16 but bit 15 is clear, expected the highest slot");
+    expect_view_wire_error(MsgType::visible, visible_deltas(1, {0x81, 0x00}),
+                           "slots[0]: varint of 2 bytes ends in a zero byte");
+    expect_view_wire_error(MsgType::visible, visible_deltas(10, {0, 1, 1, 1, 1, 1, 1, 1, 1, 1}),
+                           "form: 1, but the slots take 7 bytes as a bitmap and 15 as deltas");
+    MessageWriter sparse = visible_head(SlotForm::bitmap);
+    sparse.put(std::uint32_t{100});  // slot 99 alone: 13 bytes of bits, where one varint does
+    for (int i = 0; i < 12; ++i) sparse.put(std::uint8_t{0});
+    sparse.put(std::uint8_t{0x08});
+    expect_view_wire_error(MsgType::visible, sparse.take(),
+                           "form: 0, but the slots take 18 bytes as a bitmap and 6 as deltas");
+}
+
 TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
     for (std::uint32_t count : {std::uint32_t{4}, std::uint32_t{1} << 30, UINT32_MAX}) {
         const Bytes bytes = visible_deltas(count, {1, 2, 3});
