@@ -53,7 +53,7 @@ class StudyError(Exception):
     pass
 
 
-def default_volume(isowall_dir):
+def default_volume():
     src = os.path.join(ROOT, "..", "shared", "data", "vhp_ct_head.nhdr")
     if not os.path.exists(src):
         raise StudyError(f"--volume: the default needs {os.path.normpath(src)}, which is absent; "
@@ -288,7 +288,7 @@ def parse_args(argv):
     if not os.access(a.isowall, os.X_OK):
         raise StudyError(f"--isowall: {a.isowall} is not an executable (build first)")
     if a.volume is None:
-        a.volume = default_volume(os.path.dirname(a.isowall))
+        a.volume = default_volume()
     elif a.volume != "phantom" and not os.path.exists(a.volume):
         raise StudyError(f"--volume: {a.volume} does not exist")
     if a.iso is None:
