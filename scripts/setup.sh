@@ -14,17 +14,30 @@ PACKAGES=(
     libmeshoptimizer-dev libzstd-dev
     python3 python3-numpy python3-matplotlib
     libx11-dev libxext-dev xvfb xdotool x11-apps x11-utils iproute2
+    nodejs chromium
 )
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
 missing=()
 for p in "${PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
     echo "setup: installing ${missing[*]}"
-    SUDO=""
-    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
     $SUDO apt-get update -qq
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# npm: part of some nodejs packages (NodeSource's), a package of its own in Debian's.
+if ! command -v npm > /dev/null; then
+    echo "setup: installing npm"
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends npm
+fi
+# The page's packages (web/package-lock.json): the bundler, and playwright-core for the browser
+# tests. Installed again only when the lock file changed since the last install.
+if [ web/package-lock.json -nt web/node_modules/.package-lock.json ]; then
+    echo "setup: npm ci in web/"
+    npm ci --prefix web --no-audit --no-fund --loglevel=error
 fi
 
 BUILD_DIR=${ISOWALL_BUILD_DIR:-build}

@@ -1,0 +1,196 @@
+#!/usr/bin/env node
+// The browser page against `isowall view`, in one run (issue 13): time from sending a request to
+// the first group drawn and to the end of the frame, on the phantom and the shared CT head, over
+// loopback. One `isowall serve --http 0` serves both clients; each run is a fresh connection (a
+// fresh page, a fresh `isowall view` process) asking for the front view with progressive LOD and
+// the cache (the study's case 5, compact + zstd), so neither client starts with cached groups.
+// Runs alternate page / view, so load on this 2-core machine falls on both alike.
+//
+//   node scripts/bench_page.mjs [--isowall build/master/isowall] [--runs 5] [--size 800x600]
+//                               [--head ../shared/data/vhp_ct_head.nhdr] [--out out/bench-page]
+//
+// Prints a table of medians (and the fastest run) and writes bench.json and bench.md to --out.
+import { spawn, spawnSync } from 'node:child_process';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const requireWeb = createRequire(path.join(root, 'web', 'package.json'));
+
+function fail(text) {
+    console.error(`bench_page: ${text}`);
+    process.exit(1);
+}
+
+function parseArgs(argv) {
+    const o = {
+        isowall: path.join(root, 'build/master/isowall'),
+        runs: 5,
+        size: '800x600',
+        head: path.join(root, '../shared/data/vhp_ct_head.nhdr'),
+        headIso: 40,
+        out: path.join(root, 'out/bench-page'),
+        timeoutS: 120,
+    };
+    const numeric = { '--runs': 'runs', '--head-iso': 'headIso', '--timeout': 'timeoutS' };
+    const text = { '--isowall': 'isowall', '--size': 'size', '--head': 'head', '--out': 'out' };
+    for (let i = 0; i < argv.length; ++i) {
+        const a = argv[i];
+        if (a === '--help' || a === '-h') {
+            console.log(readFileSync(fileURLToPath(import.meta.url), 'utf8').split('\n')
+                .slice(1, 12).map((l) => l.replace(/^\/\/ ?/, '')).join('\n'));
+            process.exit(0);
+        }
+        const key = numeric[a] ?? text[a];
+        if (!key) fail(`unknown option ${a} (see --help)`);
+        if (i + 1 >= argv.length) fail(`${a}: expected a value`);
+        const v = argv[++i];
+        if (numeric[a]) {
+            const n = Number(v);
+            if (!Number.isFinite(n) || n <= 0) fail(`${a}: expected a positive number, got '${v}'`);
+            o[key] = a === '--runs' ? Math.floor(n) : n;
+        } else {
+            o[key] = v;
+        }
+    }
+    if (!/^\d+x\d+$/.test(o.size)) fail(`--size: expected WIDTHxHEIGHT, got '${o.size}'`);
+    if (!existsSync(o.isowall)) fail(`--isowall: no program at ${o.isowall} (build first)`);
+    return o;
+}
+
+// `isowall serve --port 0 --http 0`: resolves with the TCP port and the page's URL.
+function startServer(o, datasets) {
+    const args = ['serve', '--port', '0', '--http', '0', '--quiet'];
+    for (const d of datasets) if (d.path) args.push('--dataset', `${d.name}=${d.path}`);
+    const proc = spawn(o.isowall, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    let seen = '';
+    return new Promise((resolve, reject) => {
+        const timer = setTimeout(() => {
+            proc.kill('SIGKILL');
+            reject(new Error(`isowall serve: no page line within 120 s: ${seen.slice(-300)}`));
+        }, 120000);
+        const onData = (chunk) => {
+            seen += chunk.toString();
+            const tcp = /listening on [^:\s]+:(\d+)/.exec(seen);
+            const page = /page at (http:\/\/\S+?)\/? /.exec(seen);
+            if (tcp && page) {
+                clearTimeout(timer);
+                resolve({ proc, port: Number(tcp[1]), url: page[1] });
+            }
+        };
+        proc.stdout.on('data', onData);
+        proc.stderr.on('data', onData);
+        proc.on('exit', (code) => {
+            clearTimeout(timer);
+            reject(new Error(`isowall serve exited (${code}): ${seen.trim().split('\n').pop()}`));
+        });
+    });
+}
+
+async function pageRun(browser, url, d, o) {
+    const [w, h] = o.size.split('x').map(Number);
+    const page = await browser.newPage({ viewport: { width: w + 400, height: h + 200 } });
+    try {
+        const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1`;
+        await page.goto(`${url}/${q}`);
+        await page.waitForFunction(
+            () => window.isowall && (window.isowall.state === 'done' || window.isowall.state === 'error'),
+            null, { timeout: o.timeoutS * 1000 });
+        const s = await page.evaluate(() => ({ ...window.isowall.stats, state: window.isowall.state,
+                                               error: window.isowall.error }));
+        if (s.state === 'error') throw new Error(`page: ${s.error}`);
+        return { first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes,
+                 triangles: s.triangles, groups: s.groups };
+    } finally {
+        await page.close();
+    }
+}
+
+function viewRun(port, d, o, dir) {
+    const csv = path.join(dir, `view-${d.name}.csv`);
+    const args = ['view', '--connect', `127.0.0.1:${port}`, '--dataset', d.name, '--case', '5',
+                  '--size', o.size, '--iso', String(d.iso), '--timeline', csv,
+                  '-o', path.join(dir, `view-${d.name}.png`), '--timeout', String(o.timeoutS)];
+    const p = spawnSync(o.isowall, args, { encoding: 'utf8', timeout: o.timeoutS * 1000 });
+    if (p.status !== 0) throw new Error(`isowall view: ${(p.stderr || p.stdout).trim().split('\n').pop()}`);
+    const lines = readFileSync(csv, 'utf8').trim().split('\n');
+    const head = lines[0].split(',');
+    const col = (name) => head.indexOf(name);
+    const rows = lines.slice(1).map((l) => l.split(',').map(Number)).filter((r) => r[col('frame')] === 1);
+    const first = rows.find((r) => r[col('groups')] >= 1);
+    const last = rows[rows.length - 1];
+    if (!first || !last) throw new Error('isowall view: the timeline holds no group');
+    return { first_ms: 1000 * first[col('time_s')], frame_ms: 1000 * last[col('time_s')],
+             bytes: last[col('bytes')], triangles: last[col('triangles')], groups: last[col('groups')] };
+}
+
+const median = (xs) => {
+    const s = [...xs].sort((a, b) => a - b);
+    return s.length % 2 ? s[(s.length - 1) / 2] : 0.5 * (s[s.length / 2 - 1] + s[s.length / 2]);
+};
+
+function summarise(runs) {
+    return {
+        first_ms: median(runs.map((r) => r.first_ms)),
+        first_min_ms: Math.min(...runs.map((r) => r.first_ms)),
+        frame_ms: median(runs.map((r) => r.frame_ms)),
+        frame_min_ms: Math.min(...runs.map((r) => r.frame_ms)),
+        bytes: median(runs.map((r) => r.bytes)),
+        triangles: median(runs.map((r) => r.triangles)),
+        runs,
+    };
+}
+
+async function main() {
+    const o = parseArgs(process.argv.slice(2));
+    const datasets = [{ name: 'phantom', path: null, iso: 50 }];
+    if (existsSync(o.head)) datasets.push({ name: 'head', path: o.head, iso: o.headIso });
+    else console.log(`bench_page: ${o.head} is absent; the head is skipped`);
+    mkdirSync(o.out, { recursive: true });
+    const { chromium } = requireWeb('playwright-core');
+    const server = await startServer(o, datasets);
+    const browser = await chromium.launch({
+        executablePath: '/usr/bin/chromium', headless: true,
+        args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+    });
+    const results = {};
+    try {
+        for (const d of datasets) {
+            const page = [], view = [];
+            // One warm-up of each: the server's first request on a dataset pages in its octree.
+            await pageRun(browser, server.url, d, o);
+            viewRun(server.port, d, o, o.out);
+            for (let i = 0; i < o.runs; ++i) {
+                page.push(await pageRun(browser, server.url, d, o));
+                view.push(viewRun(server.port, d, o, o.out));
+                process.stdout.write(`bench_page: ${d.name} run ${i + 1}/${o.runs}: page ` +
+                    `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms, view ` +
+                    `${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms\n`);
+            }
+            results[d.name] = { iso: d.iso, page: summarise(page), view: summarise(view) };
+        }
+    } finally {
+        await browser.close();
+        server.proc.kill('SIGINT');
+    }
+    const rows = [`| dataset | client | first group ms (median, fastest) | end of frame ms (median, fastest) | bytes | triangles | page / view, end of frame |`,
+                  '|---|---|---|---|---|---|---|'];
+    for (const [name, r] of Object.entries(results)) {
+        for (const who of ['page', 'view']) {
+            const s = r[who];
+            rows.push(`| ${name} (iso ${r.iso}) | ${who === 'page' ? 'browser page' : 'isowall view'} | ` +
+                `${s.first_ms.toFixed(1)}, ${s.first_min_ms.toFixed(1)} | ${s.frame_ms.toFixed(1)}, ` +
+                `${s.frame_min_ms.toFixed(1)} | ${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
+                `${who === 'page' ? (s.frame_ms / r.view.frame_ms).toFixed(2) : ''} |`);
+        }
+    }
+    const header = `Front view ${o.size}, case 5 (compact + zstd, LOD, cache), fresh connection each run, ` +
+                   `${o.runs} runs after one warm-up, loopback, ${new Date().toISOString()}`;
+    console.log(`\n${header}\n\n${rows.join('\n')}`);
+    writeFileSync(path.join(o.out, 'bench.json'), JSON.stringify({ size: o.size, runs: o.runs, results }, null, 1));
+    writeFileSync(path.join(o.out, 'bench.md'), `${header}\n\n${rows.join('\n')}\n`);
+}
+
+main().catch((e) => fail(e.message));
