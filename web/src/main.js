@@ -356,7 +356,9 @@ el.canvas.addEventListener('pointermove', (e) => {
     if (dx === 0 && dy === 0) return;
     const v = api.view;
     // Drag right turns the volume right; drag down tips its top towards the viewer.
-    v.yaw = ((v.yaw - dx * kDegPerPixel + 540) % 360) - 180;
+    v.yaw -= dx * kDegPerPixel;
+    if (v.yaw > 180) v.yaw -= 360;
+    else if (v.yaw < -180) v.yaw += 360;
     v.pitch = Math.max(-89, Math.min(89, v.pitch - dy * kDegPerPixel));
     scheduleRequest();
   } else if (pointers.size === 2) {
