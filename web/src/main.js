@@ -276,7 +276,7 @@ function remoteErrorText(e) {
     [ErrorCode.too_large]: 'a message was too large',
     [ErrorCode.internal]: 'the server failed',
   }[e.code] ?? 'server error';
-  return e.message && e.message !== what ? `${what}: ${e.message}` : what;
+  return e.message && e.message !== what ? `${what} (${e.message})` : what;
 }
 
 function defaultIso(r, name) {
@@ -359,7 +359,8 @@ el.canvas.addEventListener('pointermove', (e) => {
     v.yaw -= dx * kDegPerPixel;
     if (v.yaw > 180) v.yaw -= 360;
     else if (v.yaw < -180) v.yaw += 360;
-    v.pitch = Math.max(-89, Math.min(89, v.pitch - dy * kDegPerPixel));
+    v.yaw = Math.round(v.yaw * 1e6) / 1e6;  // no drift of sums of 0.4 (a readable angle)
+    v.pitch = Math.round(Math.max(-89, Math.min(89, v.pitch - dy * kDegPerPixel)) * 1e6) / 1e6;
     scheduleRequest();
   } else if (pointers.size === 2) {
     const d = pinchSpan();

@@ -114,6 +114,15 @@ try {
     `drag: request ${last.id} with the new yaw/pitch completed (${s.request_id - beforeDrag} request(s) sent while dragging)`);
   const dragged = { ...s.view, stats: s.stats, png: await savePng('dragged.png') };
 
+  // The wheel zooms in.
+  const zoom0 = s.view.zoom, beforeWheel = s.request_id;
+  await page.mouse.move(cx, cy);
+  await page.mouse.wheel(0, -240);
+  await page.waitForFunction((b) => window.isowall.request_id > b, beforeWheel, { timeout: 10000 });
+  s = await waitDone();
+  check(s.view.zoom > zoom0 && s.requests[s.requests.length - 1].zoom === s.view.zoom, `wheel: zoom ${zoom0} -> ${s.view.zoom}, frame ${s.done_request_id} done`);
+  const zoomed = { ...s.view, stats: s.stats, png: await savePng('zoomed.png') };
+
   // A value outside the range: a readable message, nothing sent.
   const n = s.request_id;
   await page.locator('#iso-number').fill(String(s.range[1] + 1000));
@@ -124,7 +133,7 @@ try {
   const shown = await page.locator('#message').textContent();
   check(shown === s.error, 'bad isovalue message shown on the page');
 
-  writeFileSync(join(out, 'views.json'), JSON.stringify({ dataset: 'phantom', front, iso2: isoView, dragged }, null, 2));
+  writeFileSync(join(out, 'views.json'), JSON.stringify({ dataset: 'phantom', front, iso2: isoView, dragged, zoomed }, null, 2));
   console.log(`e2e_page: wrote ${join(out, 'views.json')}`);
 } catch (e) {
   failures.push(String(e && e.stack || e));

@@ -127,6 +127,7 @@ function relay(ws) {
       tcp.destroy();
       return;
     }
+    if (tcp.destroyed || tcp.writableEnded) return;
     if (open) tcp.write(b); else pending.push(b);
   });
   ws.on('close', () => tcp.end());
