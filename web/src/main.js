@@ -192,6 +192,13 @@ function closeConnection() {
 function connect(name) {
   closeConnection();
   readyMsg = null;
+  // A new connection is a new server session: its cache generations start afresh, so nothing of
+  // the old cache may be named by slot.
+  if (renderer) {
+    renderer.collect(new Set());
+    frames = new ClientFrames(renderer);
+    api.stats = frames.stats;
+  }
   api.dataset = name;
   api.range = [0, 0];
   api.frames_done = 0;

@@ -133,6 +133,17 @@ try {
   const shown = await page.locator('#message').textContent();
   check(shown === s.error, 'bad isovalue message shown on the page');
 
+  // The volume picker: no volume, then the phantom again (a new connection, a new cache).
+  await page.locator('#dataset').selectOption('');
+  s = await state();
+  check(s.state === 'idle', `picker: no volume -> state ${s.state}`);
+  const beforePick = s.request_id;
+  await page.locator('#dataset').selectOption('phantom');
+  await page.waitForFunction((b) => window.isowall.request_id > b, beforePick, { timeout: 20000 });
+  s = await waitDone();
+  check(s.state === 'done' && s.dataset === 'phantom' && s.stats.named === 0 && s.stats.groups > 0,
+    `picker: phantom again, frame ${s.done_request_id} done (${s.stats.groups} groups, ${s.stats.named} named)`);
+
   writeFileSync(join(out, 'views.json'), JSON.stringify({ dataset: 'phantom', front, iso2: isoView, dragged, zoomed }, null, 2));
   console.log(`e2e_page: wrote ${join(out, 'views.json')}`);
 } catch (e) {
