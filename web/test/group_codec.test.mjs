@@ -147,3 +147,20 @@ test('the C++ fuzz regressions decode as the C++ does', () => {
     for (const v of g.positions) assert.ok(Number.isFinite(v), name);
   }
 });
+
+test('a compact group whose indices are in index codec version 1 decodes too', async () => {
+  // Should the server's libmeshoptimizer move to version 1 (the default of newer releases),
+  // the page still reads it: the tetrahedron's indices re-coded by the npm encoder (version 1).
+  const { MeshoptEncoder } = await import('meshoptimizer/encoder');
+  await MeshoptEncoder.ready;
+  const b = read(dir, 'compact-tetrahedron');
+  const g = decodeGroup(b);
+  const at = 2 + 29 + 8 + 24 + 10 * 4;
+  const coded = MeshoptEncoder.encodeIndexBuffer(new Uint8Array(g.indices.buffer.slice(0)), g.indices.length, 4);
+  assert.equal(coded[0], 0xe1);
+  const out = new Uint8Array(at + 4 + coded.length);
+  out.set(b.subarray(0, at));
+  new DataView(out.buffer).setUint32(at, coded.length, true);
+  out.set(coded, at + 4);
+  assert.deepEqual(decodeGroup(out), g);
+});
