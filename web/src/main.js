@@ -342,7 +342,7 @@ function pinchSpan() {
 }
 
 function setZoom(z) {
-  api.view.zoom = Math.min(kMaxZoom, Math.max(kMinZoom, z));
+  api.view.zoom = Math.round(Math.min(kMaxZoom, Math.max(kMinZoom, z)) * 1e6) / 1e6;
   scheduleRequest();
 }
 

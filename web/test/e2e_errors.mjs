@@ -57,6 +57,39 @@ try {
   const datasets = await page.evaluate(() => [...document.querySelectorAll('#dataset option')].map((o) => o.value));
   check(datasets.includes('phantom'), `volume picker: ${JSON.stringify(datasets)}`);
 
+  // devicePixelRatio 2 and touch: size= is device pixels; one finger orbits, two pinch.
+  const ctx = await browser.newContext({ deviceScaleFactor: 2, hasTouch: true, viewport: { width: 900, height: 700 } });
+  const tpage = await ctx.newPage();
+  await tpage.goto(`${base}?dataset=phantom&token=${token}&size=400x300`);
+  s = await settle(tpage, () => window.isowall.state === 'done' || window.isowall.state === 'error');
+  const c2 = await tpage.evaluate(() => {
+    const c = document.getElementById('view');
+    const r = c.getBoundingClientRect();
+    return { w: c.width, h: c.height, cssW: r.width, cssH: r.height, x: r.x, y: r.y };
+  });
+  check(s.state === 'done' && c2.w === 400 && c2.h === 300 && c2.cssW === 200 && c2.cssH === 150,
+    `dpr 2, size=400x300: canvas ${c2.w}x${c2.h}, CSS ${c2.cssW}x${c2.cssH}`);
+  const cdp = await ctx.newCDPSession(tpage);
+  const cx = c2.x + 100, cy = c2.y + 75;
+  const touch = (type, points) => cdp.send('Input.dispatchTouchEvent', { type, touchPoints: points.map(([x, y], id) => ({ x, y, id })) });
+  let before = await tpage.evaluate(() => ({ ...window.isowall.view }));
+  await touch('touchStart', [[cx, cy]]);
+  for (let i = 1; i <= 5; ++i) await touch('touchMove', [[cx - 6 * i, cy]]);
+  await touch('touchEnd', []);
+  s = await settle(tpage, (y) => window.isowall.view.yaw !== y && window.isowall.state === 'done' &&
+    window.isowall.done_request_id === window.isowall.request_id, before.yaw);
+  let after = await tpage.evaluate(() => ({ ...window.isowall.view }));
+  check(after.yaw > before.yaw && after.zoom === before.zoom, `one finger: yaw ${before.yaw} -> ${after.yaw}`);
+  before = after;
+  await touch('touchStart', [[cx - 20, cy], [cx + 20, cy]]);
+  for (let i = 1; i <= 5; ++i) await touch('touchMove', [[cx - 20 - 6 * i, cy], [cx + 20 + 6 * i, cy]]);
+  await touch('touchEnd', []);
+  s = await settle(tpage, (z) => window.isowall.view.zoom !== z && window.isowall.state === 'done' &&
+    window.isowall.done_request_id === window.isowall.request_id, before.zoom);
+  after = await tpage.evaluate(() => ({ ...window.isowall.view }));
+  check(after.zoom > before.zoom, `pinch out: zoom ${before.zoom} -> ${after.zoom} (yaw ${before.yaw} -> ${after.yaw})`);
+  await ctx.close();
+
   const page2 = await browser.newPage();
   await page2.addInitScript(() => {
     const orig = HTMLCanvasElement.prototype.getContext;
