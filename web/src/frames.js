@@ -1,0 +1,166 @@
+// The drawing rules of remote/client_frames.{h,cpp} (the dissertation's section 4.1.4), for the
+// page: the messages of a request go in, the frame is drawn as they arrive.
+//   - groups are drawn as they arrive, each decoded once; with progressive LOD the depth buffer
+//     is cleared when a finer level begins, so the finer surface covers the coarser one;
+//   - a group coarser than what the frame already shows is not drawn, nor one sent with
+//     draw_from_next_frame; both are cached when they carry a cache generation;
+//   - a visible message names cached groups by slot: the client must hold each (a protocol error
+//     if not) and draws them coarse levels first;
+//   - at the end of a frame that drew any coarse group, the frame is drawn again from its
+//     full-resolution groups alone, so the final image equals the image without LOD.
+// The cache follows the server's stream, not the client's requests: a group with a cache
+// generation (of any request) is appended to the cache; one of another generation first drops
+// the cache. A group's slot is its index in the generation. The cache is kept while requests do
+// not cache.
+import { decodeGroup, triangleCount } from './group_codec.js';
+import { WireError } from './wire.js';
+import { viewMatrix, projectionMatrix } from './camera.js';
+
+// The server's error message, as an exception.
+export class RemoteError extends Error {
+  constructor(code, text) {
+    super(text);
+    this.name = 'RemoteError';
+    this.code = code;
+  }
+}
+
+function sameKey(g, k) {
+  return g.seed[0] === k.seed[0] && g.seed[1] === k.seed[1] && g.seed[2] === k.seed[2] &&
+    g.level === k.level && g.iso === k.iso && g.refinement === k.refinement;
+}
+
+export function decodeMesh(m) {
+  const g = decodeGroup(m.encoded);
+  if (!sameKey(g, m.key)) throw new WireError('group message: key: the encoded group is another group');
+  return g;
+}
+
+export function emptyStats() {
+  return { bytes: 0, groups: 0, named: 0, triangles: 0, first_group_ms: null, frame_ms: null };
+}
+
+export class ClientFrames {
+  // renderer: clear(), clearDepth(), draw(mesh, view, projection), resize(w, h), collect(live).
+  // now: a clock in milliseconds (performance.now()).
+  constructor(renderer, now = () => performance.now(), decode = decodeMesh) {
+    this.renderer = renderer;
+    this.now = now;
+    this.decode = decode;
+    this.request = null;
+    this.active = false;
+    this.startMs = 0;
+    this.stats = emptyStats();
+    this.drawLevel = 1 << 30;  // the finest level drawn in this frame so far
+    this.drewCoarse = false;
+    this.drewAny = false;
+    this.finals = [];  // full-resolution groups of the frame
+    this.cache = [];   // { mesh, level }; index = slot in generation cacheGen
+    this.cacheGen = 0;
+    this.lastEnd = null;
+  }
+
+  // A request was sent: a new frame of its view (the previous one is abandoned).
+  begin(request) {
+    this.request = request;
+    this.active = true;
+    this.startMs = this.now();
+    this.stats = emptyStats();
+    this.drawLevel = 1 << 30;
+    this.drewCoarse = false;
+    this.drewAny = false;
+    this.finals = [];
+    this.viewM = viewMatrix(request.view.camera);
+    this.projM = projectionMatrix(request.view.frustum);
+    this.renderer.resize(request.view.width, request.view.height);
+    this.renderer.clear();
+    this.collect();
+  }
+
+  collect() {
+    const live = new Set(this.cache.map((c) => c.mesh));
+    for (const m of this.finals) live.add(m);
+    this.renderer.collect?.(live);
+  }
+
+  draw(mesh, level) {
+    if (level > this.drawLevel) return;  // coarser than what shows: cached, drawn next frame
+    if (level < this.drawLevel && this.drewAny) this.renderer.clearDepth();
+    this.drawLevel = level;
+    this.drewCoarse = this.drewCoarse || level > 0;
+    this.renderer.draw(mesh, this.viewM, this.projM);
+    this.drewAny = true;
+    if (level === 0) this.finals.push(mesh);
+    this.stats.triangles += triangleCount(mesh);
+    if (this.stats.first_group_ms === null) this.stats.first_group_ms = this.now() - this.startMs;
+  }
+
+  handleGroup(g, wireBytes) {
+    const current = this.active && g.request_id === this.request.request_id;
+    if (!current && g.cache_gen === 0) return;
+    const mesh = this.decode(g);
+    if (g.cache_gen !== 0) {
+      if (g.cache_gen !== this.cacheGen) {
+        this.cache = [];
+        this.cacheGen = g.cache_gen;
+        this.collect();
+      }
+      this.cache.push({ mesh, level: g.key.level });
+    }
+    if (!current) return;
+    this.stats.bytes += wireBytes;
+    ++this.stats.groups;
+    if (!g.draw_from_next_frame) this.draw(mesh, g.key.level);
+  }
+
+  handleVisible(v, wireBytes) {
+    if (!this.active || v.request_id !== this.request.request_id) return;
+    this.stats.bytes += wireBytes;
+    const named = [];
+    for (const slot of v.slots) {
+      if (slot >= this.cache.length)
+        throw new WireError('visible message: slots: the server named a group the client does not ' +
+          `hold (slot ${slot} of ${this.cache.length})`);
+      named.push(this.cache[slot]);
+    }
+    // Coarse first (a stable sort): draw() skips a group coarser than what the frame shows.
+    named.sort((a, b) => b.level - a.level);
+    for (const c of named) {
+      ++this.stats.named;
+      this.draw(c.mesh, c.level);
+    }
+  }
+
+  // A decoded frame { name, msg } of `wireBytes` bytes. True when it ended the current frame.
+  // Throws for a group that does not decode or names an unknown cached group, and RemoteError
+  // for an error message.
+  handle(name, m, wireBytes) {
+    if (name === 'error') throw new RemoteError(m.code, m.text);
+    if (name === 'group') {
+      this.handleGroup(m, wireBytes);
+      return false;
+    }
+    if (name === 'visible') {
+      this.handleVisible(m, wireBytes);
+      return false;
+    }
+    if (name === 'end_of_frame') {
+      if (!this.active || m.request_id !== this.request.request_id) return false;
+      this.stats.bytes += wireBytes;
+      this.finishFrame(m);
+      return true;
+    }
+    return false;  // ready, hello, request, bye: not part of a frame
+  }
+
+  finishFrame(end) {
+    if (this.drewCoarse) {
+      // The full-resolution groups alone: no coarse surface outside the fine one stays.
+      this.renderer.clear();
+      for (const mesh of this.finals) this.renderer.draw(mesh, this.viewM, this.projM);
+    }
+    this.stats.frame_ms = this.now() - this.startMs;
+    this.active = false;
+    this.lastEnd = end;
+  }
+}

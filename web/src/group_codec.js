@@ -1,0 +1,222 @@
+// Decoding of the four group encodings of remote/group_codec.h:
+//   0 vertices      three separate float32 vertices (position + normal) a triangle
+//   1 indexed       float32 positions and normals, uint16 indices (uint32 past 65536 vertices)
+//   2 compact       positions quantised to 16 bits in a box, octahedral snorm16 normals,
+//                   indices through meshoptimizer's index codec
+//   3 compact_zstd  the whole compact message in one zstd frame
+// Bytes: [version u8 = 2][encoding u8][header: id u32, seed 3 x i32, level i32, iso f64,
+// refinement u8][body]; compact_zstd's body is the u64 size of the compact message, then the
+// frame. Decoding is for hostile input: every count is checked against the limits and the bytes
+// left before anything is allocated, indices against the vertex count, floats must be finite;
+// anything else throws an Error "group: <field>: <why>".
+//
+// A decoded group: { id, seed: [x, y, z], level, iso, refinement, positions: Float32Array(3V),
+// normals: Float32Array(3V), indices: Uint32Array(3T) }.
+import { decompress as zstdDecompress } from 'fzstd';
+import { MeshoptDecoder } from 'meshoptimizer/decoder';
+import { ByteReader } from './wire.js';
+
+export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd: 3 };
+export const kGroupCodecVersion = 2;
+export const kMaxNarrowIndexedVertices = 65536;
+export const kMaxGroupTriangles = 1 << 22;
+export const kMaxGroupVertices = 3 * kMaxGroupTriangles;
+export const kMaxZstdExpansion = 64;
+const kMaxLevel = 30;
+const kMaxCompactBytes = kMaxGroupVertices * 10 + kMaxGroupTriangles * 16 + 256;
+const WHAT = 'group';
+const f = Math.fround;
+
+// meshoptimizer's decoder is WebAssembly: await this once before decoding a compact group.
+export const ready = MeshoptDecoder.ready;
+
+export function encodingName(e) {
+  return ['vertices', 'indexed', 'compact', 'compact+zstd'][e] ?? 'unknown';
+}
+
+function getHeader(r) {
+  const g = {};
+  g.id = r.u32();
+  g.seed = [r.i32(), r.i32(), r.i32()];
+  g.level = r.i32();
+  if (g.level < 0 || g.level > kMaxLevel) r.fail(`level: expected 0..${kMaxLevel}, got ${g.level}`);
+  g.iso = r.f64();
+  if (!Number.isFinite(g.iso)) r.fail(`iso: expected a finite number, got ${g.iso}`);
+  const refinement = r.u8();
+  if (refinement > 1) r.fail(`refinement: expected 0 or 1, got ${refinement}`);
+  g.refinement = refinement === 1;
+  return g;
+}
+
+function getCount(r, limit, field) {
+  const n = r.u32();
+  if (n > limit) r.fail(`${field} ${n} over the limit ${limit}`);
+  return n;
+}
+
+// n float32 triples, each finite.
+function getFiniteVec3s(r, n, field) {
+  const bytes = r.span(n * 12);
+  const out = new Float32Array(n * 3);
+  new Uint8Array(out.buffer).set(bytes);
+  for (let i = 0; i < out.length; ++i)
+    if (!Number.isFinite(out[i])) r.fail(`${field} ${Math.floor(i / 3)}: expected a finite number, got ${out[i]}`);
+  return out;
+}
+
+function getVertices(r) {
+  const triangles = getCount(r, kMaxGroupTriangles, 'triangle count');
+  r.needElements(triangles, 3 * 2 * 12, 'triangles');
+  const n = 3 * triangles;
+  const positions = getFiniteVec3s(r, n, 'position');
+  const normals = getFiniteVec3s(r, n, 'normal');
+  const indices = new Uint32Array(n);
+  for (let i = 0; i < n; ++i) indices[i] = i;
+  return { positions, normals, indices };
+}
+
+function getIndexed(r) {
+  const vertices = getCount(r, kMaxGroupVertices, 'vertex count');
+  const triangles = getCount(r, kMaxGroupTriangles, 'triangle count');
+  r.needElements(vertices, 2 * 12, 'vertices');
+  const positions = getFiniteVec3s(r, vertices, 'position');
+  const normals = getFiniteVec3s(r, vertices, 'normal');
+  const n = 3 * triangles;
+  const indices = new Uint32Array(n);
+  if (vertices <= kMaxNarrowIndexedVertices) {
+    r.needElements(triangles, 3 * 2, 'triangles');
+    const b = r.span(2 * n);
+    const dv = new DataView(b.buffer, b.byteOffset, b.byteLength);
+    for (let i = 0; i < n; ++i) indices[i] = dv.getUint16(2 * i, true);
+  } else {
+    r.needElements(triangles, 3 * 4, 'triangles');
+    const b = r.span(4 * n);
+    const dv = new DataView(b.buffer, b.byteOffset, b.byteLength);
+    for (let i = 0; i < n; ++i) indices[i] = dv.getUint32(4 * i, true);
+  }
+  for (let i = 0; i < n; ++i)
+    if (indices[i] >= vertices) r.fail(`index ${indices[i]} >= vertex count ${vertices}`);
+  return { positions, normals, indices };
+}
+
+// oct_decode of remote/compact_mesh.cpp, in float32.
+function fromSnorm16(v) {
+  return Math.max(f(v / 32767), -1);
+}
+export function octDecode(cx, cy, out, o) {
+  let x = fromSnorm16(cx), y = fromSnorm16(cy);
+  const z = f(f(1 - Math.abs(x)) - Math.abs(y));
+  const t = Math.max(-z, 0);
+  x = f(x >= 0 ? x - t : x + t);
+  y = f(y >= 0 ? y - t : y + t);
+  const inv = f(1 / f(Math.sqrt(f(f(f(x * x) + f(y * y)) + f(z * z)))));
+  out[o] = f(x * inv);
+  out[o + 1] = f(y * inv);
+  out[o + 2] = f(z * inv);
+}
+
+function getCompact(r) {
+  const vertexCount = r.u32();
+  const triangleCount = r.u32();
+  if (vertexCount > kMaxGroupVertices) r.fail(`vertex count ${vertexCount} over the limit ${kMaxGroupVertices}`);
+  if (triangleCount > kMaxGroupTriangles) r.fail(`triangle count ${triangleCount} over the limit ${kMaxGroupTriangles}`);
+  r.needElements(vertexCount, 10, 'vertices');
+  // The box: finite, min <= max, a finite extent (in float).
+  const lo = [r.f32(), r.f32(), r.f32()];
+  const hi = [r.f32(), r.f32(), r.f32()];
+  for (let a = 0; a < 3; ++a)
+    if (!Number.isFinite(lo[a]) || !Number.isFinite(hi[a]) || !Number.isFinite(f(hi[a] - lo[a])) || lo[a] > hi[a])
+      r.fail(`box: expected finite min <= max, got axis ${a} [${lo[a]}, ${hi[a]}]`);
+  const step = [0, 1, 2].map((a) => (hi[a] - lo[a]) / 65535);  // in double, as the C++
+  const qb = r.span(6 * vertexCount);
+  const qv = new DataView(qb.buffer, qb.byteOffset, qb.byteLength);
+  const positions = new Float32Array(3 * vertexCount);
+  for (let i = 0; i < 3 * vertexCount; ++i) {
+    const a = i % 3;
+    positions[i] = Math.min(f(lo[a] + qv.getUint16(2 * i, true) * step[a]), hi[a]);
+  }
+  const nb = r.span(4 * vertexCount);
+  const nv = new DataView(nb.buffer, nb.byteOffset, nb.byteLength);
+  const normals = new Float32Array(3 * vertexCount);
+  for (let i = 0; i < vertexCount; ++i) octDecode(nv.getInt16(4 * i, true), nv.getInt16(4 * i + 2, true), normals, 3 * i);
+  const size = r.u32();
+  const coded = r.span(size);
+  let indices = new Uint32Array(0);
+  if (triangleCount === 0) {
+    if (size !== 0) r.fail(`indices: ${size} bytes for no triangle`);
+  } else {
+    if (triangleCount > size) r.fail(`indices: ${triangleCount} triangles in ${size} coded bytes`);
+    indices = new Uint32Array(3 * triangleCount);
+    try {
+      MeshoptDecoder.decodeIndexBuffer(new Uint8Array(indices.buffer), indices.length, 4, coded);
+    } catch (e) {
+      r.fail(`indices: meshopt_decodeIndexBuffer failed (${e.message})`);
+    }
+    for (let i = 0; i < indices.length; ++i)
+      if (indices[i] >= vertexCount) r.fail(`indices: index ${indices[i]} >= vertex count ${vertexCount}`);
+  }
+  return { positions, normals, indices };
+}
+
+// ZSTD_getFrameContentSize: the frame header's content size, or -1 when it has none / is bad.
+export function zstdFrameContentSize(b) {
+  if (b.length < 5 || b[0] !== 0x28 || b[1] !== 0xb5 || b[2] !== 0x2f || b[3] !== 0xfd) return -1;
+  const fhd = b[4];
+  const fcsFlag = fhd >> 6, single = (fhd >> 5) & 1, dictFlag = fhd & 3;
+  if (fhd & 0x08) return -1;  // reserved bit
+  let p = 5 + (single ? 0 : 1) + [0, 1, 2, 4][dictFlag];
+  const fcsBytes = fcsFlag === 0 ? (single ? 1 : 0) : [0, 2, 4, 8][fcsFlag];
+  if (fcsBytes === 0) return -1;
+  if (b.length < p + fcsBytes) return -1;
+  let v = 0;
+  for (let i = fcsBytes - 1; i >= 0; --i) v = v * 256 + b[p + i];
+  return fcsBytes === 2 ? v + 256 : v;
+}
+
+function getZstd(r) {
+  const lo = r.u32(), hi = r.u32();
+  const size = hi * 4294967296 + lo;
+  const frame = r.span(r.remaining());
+  if (size > kMaxCompactBytes || size > frame.length * kMaxZstdExpansion)
+    r.fail(`zstd: ${size} bytes claimed from a frame of ${frame.length}`);
+  if (zstdFrameContentSize(frame) !== size) r.fail(`zstd: the frame's content size is not the ${size} bytes claimed`);
+  let out;
+  try {
+    out = zstdDecompress(frame, new Uint8Array(size));
+  } catch (e) {
+    r.fail(`zstd: ${e.message}`);
+  }
+  if (out.length !== size) r.fail(`zstd: ${out.length} bytes, ${size} claimed`);
+  return out;
+}
+
+// The encoding named by encoded bytes (their second byte), checked.
+export function encodingOf(bytes) {
+  const r = new ByteReader(bytes, WHAT);
+  const version = r.u8();
+  if (version !== kGroupCodecVersion) r.fail(`version ${version}, expected ${kGroupCodecVersion}`);
+  const e = r.u8();
+  if (e > GroupEncoding.compact_zstd) r.fail(`encoding: expected 0..3, got ${e}`);
+  return e;
+}
+
+export function decodeGroup(bytes) {
+  const encoding = encodingOf(bytes);
+  const r = new ByteReader(bytes.subarray(2), WHAT);
+  if (encoding === GroupEncoding.compact_zstd) {
+    const compact = getZstd(r);
+    const inner = encodingOf(compact);
+    if (inner !== GroupEncoding.compact)
+      r.fail(`zstd: the frame holds a ${encodingName(inner)} group, expected compact`);
+    return decodeGroup(compact);
+  }
+  const g = getHeader(r);
+  const mesh = encoding === GroupEncoding.vertices ? getVertices(r)
+    : encoding === GroupEncoding.indexed ? getIndexed(r) : getCompact(r);
+  r.finish();
+  return Object.assign(g, mesh);
+}
+
+export function triangleCount(g) {
+  return g.indices.length / 3;
+}

@@ -1,0 +1,109 @@
+// The ClientFrames rules (remote/client_frames.cpp) with a recording renderer and fake meshes.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { ClientFrames, RemoteError } from '../src/frames.js';
+import { frontFullView, fitDepthRange, frustum } from '../src/camera.js';
+
+class Recorder {
+  constructor() { this.ops = []; this.live = null; }
+  resize(w, h) { this.ops.push(`resize ${w}x${h}`); }
+  clear() { this.ops.push('clear'); }
+  clearDepth() { this.ops.push('depth'); }
+  draw(mesh) { this.ops.push(`draw ${mesh.name}`); }
+  collect(live) { this.live = live; }
+}
+
+const bounds = { min: [0, 0, 0], max: [10, 10, 10] };
+function request(id, cache = true) {
+  const c = fitDepthRange(frontFullView(bounds, 1), bounds);
+  return { request_id: id, view: { camera: c, frustum: frustum(c, 1), width: 4, height: 4, iso: 1 }, progressive_lod: true, cached_groups: cache };
+}
+// A group message whose "encoded" bytes are the mesh itself (the decoder is replaced).
+function group(id, name, level, { gen = 0, late = false, tris = 1 } = {}) {
+  return { request_id: id, key: { seed: [0, 0, 0], level, iso: 1, refinement: false }, draw_from_next_frame: late, cache_gen: gen,
+    encoded: { name, indices: new Uint32Array(3 * tris) } };
+}
+function make() {
+  const r = new Recorder();
+  let t = 0;
+  const f = new ClientFrames(r, () => (t += 1), (m) => m.encoded);
+  return { r, f };
+}
+
+test('progressive LOD: a depth clear when a finer level begins, coarser groups skipped, redraw at the end', () => {
+  const { r, f } = make();
+  f.begin(request(1));
+  f.handle('group', group(1, 'a2', 2, { tris: 2 }), 100);
+  f.handle('group', group(1, 'b2', 2), 100);
+  f.handle('group', group(1, 'c1', 1), 100);
+  f.handle('group', group(1, 'd2', 2), 100);  // coarser than what shows: not drawn
+  f.handle('group', group(1, 'e0', 0), 100);
+  f.handle('group', group(1, 'f0', 0), 100);
+  f.handle('group', group(1, 'g1', 1), 100);  // coarser: skipped
+  assert.equal(f.handle('end_of_frame', { request_id: 1 }, 50), true);
+  assert.deepEqual(r.ops, ['resize 4x4', 'clear', 'draw a2', 'draw b2', 'depth', 'draw c1', 'depth', 'draw e0', 'draw f0',
+    'clear', 'draw e0', 'draw f0']);
+  assert.deepEqual({ ...f.stats, first_group_ms: 0, frame_ms: 0 }, { bytes: 750, groups: 7, named: 0, triangles: 6, first_group_ms: 0, frame_ms: 0 });
+  assert.ok(f.stats.first_group_ms > 0 && f.stats.frame_ms > f.stats.first_group_ms);
+});
+
+test('no coarse group: no redraw; late groups cached but not drawn', () => {
+  const { r, f } = make();
+  f.begin(request(1));
+  f.handle('group', group(1, 'a0', 0, { gen: 1 }), 10);
+  f.handle('group', group(1, 'late', 1, { gen: 1, late: true }), 10);
+  f.handle('end_of_frame', { request_id: 1 }, 10);
+  assert.deepEqual(r.ops, ['resize 4x4', 'clear', 'draw a0']);
+  assert.equal(f.cache.length, 2);
+  assert.equal(f.stats.groups, 2);
+});
+
+test('visible: cached groups by slot, coarse first; generations; stale messages only fill the cache', () => {
+  const { r, f } = make();
+  f.begin(request(1));
+  f.handle('group', group(1, 's0', 0, { gen: 1 }), 10);
+  f.handle('group', group(1, 's1', 2, { gen: 1 }), 10);
+  f.handle('end_of_frame', { request_id: 1 }, 10);
+  f.begin(request(2));
+  // A group of request 1 arriving late, with the generation: cached (slot 2), not drawn.
+  f.handle('group', group(1, 's2', 1, { gen: 1 }), 10);
+  f.handle('visible', { request_id: 1, slots: [0] }, 10);  // an older request's: ignored
+  r.ops = [];
+  f.handle('visible', { request_id: 2, slots: [0, 1, 2] }, 20);
+  assert.deepEqual(r.ops, ['draw s1', 'depth', 'draw s2', 'depth', 'draw s0']);
+  assert.equal(f.stats.named, 3);
+  assert.equal(f.stats.bytes, 20);
+  assert.throws(() => f.handle('visible', { request_id: 2, slots: [3] }, 5),
+    /visible message: slots: the server named a group the client does not hold \(slot 3 of 3\)/);
+  // A new generation drops the cache.
+  f.handle('group', group(2, 'n0', 0, { gen: 2 }), 10);
+  assert.deepEqual(f.cache.map((c) => c.mesh.name), ['n0']);
+  assert.equal(f.cacheGen, 2);
+  // Requests that do not cache keep the cache.
+  f.begin(request(3, false));
+  f.handle('group', group(3, 'u0', 0), 10);
+  assert.deepEqual(f.cache.map((c) => c.mesh.name), ['n0']);
+  f.handle('end_of_frame', { request_id: 3 }, 10);
+  // The frames' end-of-frame redraw keeps groups of the frame alive on the GPU; dropped ones go.
+  f.begin(request(4));
+  assert.ok([...r.live].every((m) => m.name === 'n0'));
+});
+
+test('an end of frame of another request does not end this one; errors throw', () => {
+  const { f } = make();
+  f.begin(request(5));
+  assert.equal(f.handle('end_of_frame', { request_id: 4 }, 10), false);
+  assert.equal(f.handle('ready', {}, 10), false);
+  assert.throws(() => f.handle('error', { code: 3, text: 'wrong token' }, 10), (e) => e instanceof RemoteError && e.code === 3 && e.message === 'wrong token');
+});
+
+test('a group whose encoded key is another group is refused', async () => {
+  const { decodeMesh } = await import('../src/frames.js');
+  const { readFileSync } = await import('node:fs');
+  const { ready } = await import('../src/group_codec.js');
+  await ready;
+  const encoded = new Uint8Array(readFileSync(new URL('../../fuzz/corpus/group_codec/compact_zstd-tetrahedron', import.meta.url)));
+  const key = { seed: [4, -5, 6], level: 0, iso: 105.5, refinement: false };
+  assert.equal(decodeMesh({ key, encoded }).indices.length, 12);
+  assert.throws(() => decodeMesh({ key: { ...key, level: 1 }, encoded }), /group message: key: the encoded group is another group/);
+});

@@ -1,0 +1,31 @@
+// `npm run build`: bundles src/ into dist/app.js (esbuild, minified, no source map) and copies
+// index.html and app.css (minified) beside it. Deterministic: the same sources give the same bytes.
+import { build } from 'esbuild';
+import { copyFileSync, mkdirSync, readdirSync, rmSync } from 'node:fs';
+import { dirname, join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..');
+const dist = join(root, 'dist');
+mkdirSync(dist, { recursive: true });
+for (const f of readdirSync(dist)) rmSync(join(dist, f), { recursive: true });
+
+await build({
+  entryPoints: [join(root, 'src/main.js')],
+  outfile: join(dist, 'app.js'),
+  bundle: true,
+  format: 'iife',
+  target: ['es2020', 'chrome90', 'firefox90', 'safari15'],
+  minify: true,
+  sourcemap: false,
+  legalComments: 'eof',
+  logLevel: 'warning',
+});
+await build({
+  entryPoints: [join(root, 'src/app.css')],
+  outfile: join(dist, 'app.css'),
+  minify: true,
+  logLevel: 'warning',
+});
+copyFileSync(join(root, 'src/index.html'), join(dist, 'index.html'));
+console.log(`build: ${readdirSync(dist).sort().join(', ')} in ${dist}`);
