@@ -323,7 +323,7 @@ export function decodeFrame(bytes, maxPayloadBytes = kDefaultMaxPayloadBytes) {
   return { type: h.type, name: typeNames[h.type], msg };
 }
 
-// Splits a byte stream into whole frames (for the bridge and the tests): feed chunks, get frames.
+// Splits a byte stream into whole frames (for the tests): feed chunks, get frames.
 export class FrameSplitter {
   constructor(maxPayloadBytes = kDefaultMaxPayloadBytes) {
     this.max = maxPayloadBytes;

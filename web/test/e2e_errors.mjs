@@ -1,10 +1,9 @@
-// The page's error lines, end to end: starts its own bridge (tools/bridge.mjs) in front of
-// `isowall serve --token`, then checks in headless Chromium: a missing token, an unknown dataset,
-// the server going away, WebGL2 missing, and a window-filling canvas.
+// The page's error lines, end to end: starts its own `isowall serve --http 0 --token`, then
+// checks in headless Chromium: a missing token, an unknown dataset, the server going away, WebGL2
+// missing, a window-filling canvas, device pixel ratio 2 and touch.
 //   ISOWALL_BIN=/work/build-h13p/master/isowall node test/e2e_errors.mjs
 import { chromium } from 'playwright-core';
-import { spawn } from 'node:child_process';
-import { fileURLToPath } from 'node:url';
+import { startServe } from './serve.mjs';
 
 const bin = process.env.ISOWALL_BIN;
 if (!bin) {
@@ -12,17 +11,9 @@ if (!bin) {
   process.exit(process.env.NODE_TEST_CONTEXT ? 0 : 2);
 }
 const token = 'secret';
-const bridge = spawn(process.execPath, [fileURLToPath(new URL('../tools/bridge.mjs', import.meta.url)), '--spawn', bin, '--token', token],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
-const base = await new Promise((resolve, reject) => {
-  let text = '';
-  bridge.stdout.on('data', (d) => {
-    text += d;
-    const m = /page at (http:\/\/\S+)/.exec(text);
-    if (m) resolve(m[1]);
-  });
-  bridge.on('exit', () => reject(new Error('the bridge exited')));
-});
+const served = await startServe(bin, ['--token', token]);
+const base = served.url;
+const server = served.proc;
 
 const failures = [];
 function check(ok, what) {
@@ -101,7 +92,7 @@ try {
   await page2.waitForFunction(() => window.isowall && window.isowall.state === 'error', null, { timeout: 10000 }).catch(() => {});
   s = await page2.evaluate(() => ({ state: window.isowall?.state, error: window.isowall?.error })).catch((e) => ({ error: String(e) }));
   check(s.state === 'error' && /WebGL2/.test(s.error), `WebGL2 missing: "${s.error}"`);
-  bridge.kill('SIGTERM');
+  server.kill('SIGINT');
   s = await settle(page, () => window.isowall.state === 'error');
   check(/server gone/.test(s.error), `server gone: "${s.error}"`);
 
@@ -110,7 +101,7 @@ try {
   console.error(e);
 } finally {
   await browser.close();
-  bridge.kill('SIGTERM');
+  server.kill('SIGINT');
 }
 if (failures.length) {
   console.error(`e2e_errors: ${failures.length} check(s) failed`);

@@ -1,5 +1,5 @@
 // End-to-end check of the page in headless Chromium (WebGL2 through SwiftShader), against a
-// running page server (the real `isowall serve --http` or tools/bridge.mjs):
+// running `isowall serve --http` (tools/run_e2e.sh starts one):
 //   ISOWALL_PAGE_URL=http://127.0.0.1:PORT/ ISOWALL_OUT=out/e2e node test/e2e_page.mjs
 // Opens ?dataset=phantom&size=800x600&iso=ISO, waits for the frame, saves the canvas; moves the
 // isovalue slider (a real input event) and waits for that request's frame; drags on the canvas and

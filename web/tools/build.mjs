@@ -1,12 +1,13 @@
 // `npm run build`: bundles src/ into dist/app.js (esbuild, minified, no source map) and copies
 // index.html and app.css (minified) beside it. Deterministic: the same sources give the same bytes.
+// `node tools/build.mjs DIR` builds into DIR instead (tools/check_dist.mjs compares the two).
 import { build } from 'esbuild';
 import { copyFileSync, mkdirSync, readdirSync, rmSync } from 'node:fs';
-import { dirname, join } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
-const dist = join(root, 'dist');
+const dist = process.argv[2] ? resolve(process.argv[2]) : join(root, 'dist');
 mkdirSync(dist, { recursive: true });
 for (const f of readdirSync(dist)) rmSync(join(dist, f), { recursive: true });
 
