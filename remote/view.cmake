@@ -3,6 +3,7 @@
 # (client_frames.cpp: drawing and the timeline; view_client.cpp: its connection).
 add_library(isowall_remote_view
     ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/tcp_channel.cpp
     ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)
 target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_view
