@@ -13,4 +13,5 @@ target_link_libraries(isowall_remote_view
 add_library(isowall_remote_app
     ${CMAKE_CURRENT_LIST_DIR}/serve_command.cpp ${CMAKE_CURRENT_LIST_DIR}/view_command.cpp)
 target_link_libraries(isowall_remote_app
-    PUBLIC isowall_remote_view isowall_cli isowall_io isowall_wall_spec PRIVATE isowall_warnings)
+    PUBLIC isowall_remote_view isowall_remote_http isowall_cli isowall_io isowall_wall_spec
+    PRIVATE isowall_warnings)
