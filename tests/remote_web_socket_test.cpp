@@ -1,6 +1,8 @@
 // `isowall serve --http`: the protocol over WebSocket (issue 13). A session gives the same frame
 // as over TCP; a wrong token, a text message, a frame whose header disagrees with its message
 // and one that does not decode each get an ErrorMsg and a close; max_clients counts both kinds.
+#include <chrono>
+
 #include <gtest/gtest.h>
 
 #include "remote/net/connection.h"
@@ -139,6 +141,48 @@ TEST(RemoteWebSocket, AFrameWhoseLengthDisagreesGetsAnError) {
     WsTestClient ws(server.http_port());
     send_message(ws, hello());
     EXPECT_TRUE(std::holds_alternative<ReadyMsg>(receive_message(ws)));
+}
+
+// On a paced link (--rate-mbps) a request interrupts the one in progress over WebSocket as over
+// TCP: no group of the old request follows the new one's first, and the frame takes at least
+// its bytes at the link's rate.
+TEST(RemoteWebSocket, ARequestInterruptsAPacedFrame) {
+    ServerOptions o;
+    o.rate_bits_per_s = 8e6;
+    WebTestServer server(o);
+    WsTestClient ws(server.http_port());
+    send_message(ws, hello());
+    ASSERT_TRUE(std::holds_alternative<ReadyMsg>(receive_message(ws)));
+    RequestMsg first = request();
+    send_message(ws, first);
+    ViewMessage m = receive_message(ws);
+    ASSERT_TRUE(std::holds_alternative<GroupMsg>(m)) << to_string(type_of(m));
+    RequestMsg second = first;
+    second.request_id = 2;
+    second.view = phantom_view(200, 150, 90);
+    const auto sent = std::chrono::steady_clock::now();
+    send_message(ws, second);
+    bool second_began = false;
+    for (;;) {
+        m = receive_message(ws);
+        if (const auto* g = std::get_if<GroupMsg>(&m)) {
+            if (g->request_id == 2) second_began = true;
+            EXPECT_FALSE(second_began && g->request_id == 1) << "a group of the old request";
+        }
+        if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) {
+            EXPECT_EQ(e->request_id, 2u) << "the interrupted frame was ended";
+            const double took_s =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+            const double link_s = double(e->bytes) * 8 / o.rate_bits_per_s;
+            EXPECT_GE(took_s, 0.8 * link_s - 0.05) << e->bytes << " bytes";
+            std::printf(
+                "[ measured ] paced WebSocket frame: %llu bytes in %.2f s (%.2f s at "
+                "8 Mbit/s)\n",
+                static_cast<unsigned long long>(e->bytes), took_s, link_s);
+            break;
+        }
+    }
+    EXPECT_TRUE(second_began);
 }
 
 TEST(RemoteWebSocket, MaxClientsCountsBothKinds) {

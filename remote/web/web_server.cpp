@@ -157,6 +157,7 @@ WebServer::WebServer(WebOptions options, WebCallbacks callbacks) : impl_(std::ma
     e.init_asio();
     e.set_reuse_addr(true);
     e.set_max_message_size(impl_->options.max_message_bytes);
+    e.set_max_http_body_size(impl_->options.max_message_bytes);  // only GET is served
     impl_->install_handlers();
     websocketpp::lib::error_code ec;
     e.listen(impl_->options.address, std::to_string(impl_->options.port), ec);
