@@ -137,6 +137,13 @@ TEST(RemoteWebSocket, AFrameWhoseLengthDisagreesGetsAnError) {
         send_frame(ws, *frame);
         EXPECT_EQ(expect_error_then_close(ws).code, ErrorCode::malformed);
     }
+    // A message over a header and the payload limit is refused by the WebSocket layer itself.
+    {
+        WsTestClient ws(server.http_port());
+        const std::vector<std::byte> huge(kHeaderBytes + ServerOptions{}.max_payload_bytes + 1);
+        send_frame(ws, huge);
+        EXPECT_TRUE(ws.wait_closed(10)) << "a message over the limit was taken";
+    }
     // The server goes on.
     WsTestClient ws(server.http_port());
     send_message(ws, hello());

@@ -193,9 +193,14 @@ void WebServer::stop() {
         websocketpp::lib::asio::post(im.endpoint.get_io_service(), [&im] {
             websocketpp::lib::error_code ec;
             im.endpoint.stop_listening(ec);
-            std::lock_guard lock(im.mutex);
-            for (const auto& [id, h] : im.handles)
-                im.endpoint.close(h, websocketpp::close::status::going_away, "server stops", ec);
+            std::map<ConnectionId, Handle> open;
+            {
+                std::lock_guard lock(im.mutex);  // not held while closing: a handler may run
+                open = im.handles;
+            }
+            for (const auto& entry : open)
+                im.endpoint.close(entry.second, websocketpp::close::status::going_away,
+                                  "server stops", ec);
         });
         std::unique_lock lock(im.mutex);
         im.changed.wait_for(lock, kCloseGrace, [&im] { return im.handles.empty(); });
@@ -221,6 +226,8 @@ bool WebServer::send(ConnectionId id, const void* bytes, std::size_t size,
     if (ec) return false;
     {
         // Back-pressure: a slow reader holds at most max_buffered_bytes (plus one message) here.
+        // get_buffered_amount() reads a size_t that the io thread updates; websocketpp takes no
+        // lock for it either, and a stale value only delays the next look by kDrainPoll.
         std::unique_lock lock(impl_->mutex);
         while (con->get_buffered_amount() > impl_->options.max_buffered_bytes) {
             if (impl_->stopped || !impl_->handles.count(id) || (cancel && cancel->load()))
