@@ -14,6 +14,7 @@ struct ServeCommand {
     std::vector<std::string> datasets;  // NAME=PATH (NRRD); "phantom" is always offered
     std::string listen = "127.0.0.1";
     int port = 7878;
+    int http_port = -1;  // --http: the page and WebSocket on this port (0: any free); -1: none
     std::string token;
     double rate_mbps = 0;
     int max_clients = 8;

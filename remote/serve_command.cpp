@@ -1,6 +1,7 @@
 // `isowall serve`: options, the datasets it loads, and the accept loop until SIGINT or SIGTERM.
 #include <csignal>
 #include <cstdio>
+#include <optional>
 
 #include "common/core/error.h"
 #include "common/core/number.h"
@@ -9,6 +10,7 @@
 #include "master/volume_options.h"
 #include "remote/remote_commands.h"
 #include "remote/view_server.h"
+#include "remote/web/http_front.h"
 
 namespace isowall {
 namespace {
@@ -36,6 +38,11 @@ remote::Dataset load_dataset(const std::string& name, const std::string& path,
     return d;
 }
 
+// "127.0.0.1" stays as it is; an IPv6 address goes in brackets, as a URL needs it.
+std::string url_host(const std::string& address) {
+    return address.find(':') == std::string::npos ? address : "[" + address + "]";
+}
+
 }  // namespace
 
 CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
@@ -51,6 +58,10 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
     c->add_option("--port", o.port, "TCP port (0: any free port, printed)")
         ->check(CLI::Range(0, 65535))
         ->capture_default_str();
+    c->add_option("--http", o.http_port,
+                  "Also serve the browser page and the protocol over WebSocket (/ws) on this "
+                  "port, at the --listen address (0: any free port, printed)")
+        ->check(CLI::Range(0, 65535));
     c->add_option("--token", o.token, "A secret every client must present in its hello");
     c->add_option("--rate-mbps", o.rate_mbps,
                   "Emulate a link of this many Mbit/s (token bucket on every send); 0: no limit")
@@ -92,12 +103,19 @@ int run_serve(const ServeCommand& o) {
         datasets.push_back(load_dataset(name, spec.substr(eq + 1), o.cache_dir));
     }
     remote::ViewServer server(std::move(datasets), so);
+    // After the server, so it goes first: no WebSocket is handed to a server being destroyed.
+    // A port in use throws here, and the TCP listener closes with `server`.
+    std::optional<remote::HttpFrontEnd> http;
+    if (o.http_port >= 0) http.emplace(server, o.http_port);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
     std::printf(
         "serve: listening on %s:%d%s%s\n", o.listen.c_str(), server.port(),
         o.token.empty() ? "" : " (token required)",
         o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
+    if (http)
+        std::printf("serve: page at http://%s:%d/ (WebSocket /ws)\n", url_host(o.listen).c_str(),
+                    http->port());
     std::fflush(stdout);
     server.serve(g_stop);
     std::printf("serve: stopped after %d connection(s)\n", server.accepted());

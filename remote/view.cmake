@@ -3,6 +3,7 @@
 # (client_frames.cpp: drawing and the timeline; view_client.cpp: its connection).
 add_library(isowall_remote_view
     ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/tcp_channel.cpp
     ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)
 target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_view
@@ -12,4 +13,5 @@ target_link_libraries(isowall_remote_view
 add_library(isowall_remote_app
     ${CMAKE_CURRENT_LIST_DIR}/serve_command.cpp ${CMAKE_CURRENT_LIST_DIR}/view_command.cpp)
 target_link_libraries(isowall_remote_app
-    PUBLIC isowall_remote_view isowall_cli isowall_io isowall_wall_spec PRIVATE isowall_warnings)
+    PUBLIC isowall_remote_view isowall_remote_http isowall_cli isowall_io isowall_wall_spec
+    PRIVATE isowall_warnings)

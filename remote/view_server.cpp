@@ -1,22 +1,15 @@
 #include "remote/view_server.h"
 
-#include <array>
-#include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <list>
 #include <optional>
 
-#include <sys/socket.h>
-
 #include "common/core/error.h"
-#include "remote/net/connection.h"
 #include "remote/net/socket.h"
 
 namespace isowall::remote {
-namespace {
 
-// Equal tokens, in time that does not depend on where they differ.
 bool same_token(const std::string& a, const std::string& b) {
     unsigned diff = a.size() == b.size() ? 0u : 1u;
     for (std::size_t i = 0; i < b.size(); ++i)
@@ -25,16 +18,18 @@ bool same_token(const std::string& a, const std::string& b) {
     return diff == 0;
 }
 
+bool is_loopback(const std::string& address) {
+    return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
+}
+
+namespace {
+
 // The error code of a broken stream: the framing's and decoders' WireError texts name the field.
 ErrorCode code_of(const WireError& e) {
     const std::string_view what = e.what();
     if (what.find("version") != std::string_view::npos) return ErrorCode::unsupported_version;
     if (what.find("over the limit") != std::string_view::npos) return ErrorCode::too_large;
     return ErrorCode::malformed;
-}
-
-bool is_loopback(const std::string& address) {
-    return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
 }
 
 }  // namespace
@@ -49,8 +44,8 @@ struct ViewServer::Impl {
 // One connection: this reader thread, and the worker it starts once the hello is accepted.
 class ViewServer::Client {
   public:
-    Client(ViewServer& server, Socket s, std::string peer)
-        : server_(server), conn_(std::move(s), peer, server.options_.max_payload_bytes) {
+    Client(ViewServer& server, std::unique_ptr<MessageChannel> channel)
+        : server_(server), channel_(std::move(channel)), conn_(*channel_) {
         thread_ = std::thread([this] { run(); });
     }
     ~Client() {
@@ -125,7 +120,7 @@ class ViewServer::Client {
             refuse(ErrorCode::internal, e.what());
         }
         stop_worker();
-        close_gracefully();
+        conn_.close_gracefully();
         --server_.open_;
         done_ = true;
     }
@@ -196,25 +191,6 @@ class ViewServer::Client {
         }
     }
 
-    // Ends the sending side, then reads what the client still sends for a moment: closing with
-    // unread bytes would reset the connection, and the reset can discard the error just sent.
-    void close_gracefully() {
-        ::shutdown(conn_.socket().fd(), SHUT_WR);
-        std::array<std::byte, 4096> buf;
-        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(1);
-        try {
-            for (std::size_t total = 0; total < (std::size_t{1} << 20);) {
-                const double left =
-                    std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
-                std::size_t got = 0;
-                if (left <= 0 || !recv_some(conn_.socket(), buf, left, got, conn_.peer())) break;
-                total += got;
-            }
-        } catch (const std::exception&) {  // EOF or reset: the client is gone, as it should be
-        }
-        conn_.shutdown();
-    }
-
     void stop_worker() {
         {
             std::lock_guard lock(mutex_);
@@ -226,7 +202,8 @@ class ViewServer::Client {
     }
 
     ViewServer& server_;
-    remote::Connection conn_;
+    std::unique_ptr<MessageChannel> channel_;
+    MessageChannel& conn_;
     GroupEncoding encoding_ = GroupEncoding::compact_zstd;
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
@@ -266,21 +243,33 @@ void ViewServer::serve(const std::atomic<bool>& stop) {
         std::optional<Socket> s = impl_->listener.accept(0.1, &peer);
         reap(false);
         if (!s) continue;
-        ++accepted_;
-        if (open_.load() >= options_.max_clients) {
-            remote::Connection busy(std::move(*s), peer);
-            try {
-                busy.send(make_error(ErrorCode::internal,
-                                     "server busy: " + std::to_string(options_.max_clients) +
-                                         " clients connected (--max-clients)"));
-            } catch (const std::exception&) {
-            }
-            continue;
-        }
-        ++open_;  // here, not in the thread: the next accept already counts it
-        std::lock_guard lock(impl_->mutex);
-        impl_->clients.push_back(std::make_unique<Client>(*this, std::move(*s), peer));
+        adopt(std::make_unique<TcpChannel>(std::move(*s), peer, options_.max_payload_bytes));
     }
+}
+
+bool ViewServer::adopt(std::unique_ptr<MessageChannel> channel) {
+    {
+        std::lock_guard lock(impl_->mutex);
+        ++accepted_;
+        if (open_.load() < options_.max_clients) {
+            ++open_;  // here, under the lock, not in the thread: the next adopt already counts it
+            impl_->clients.push_back(std::make_unique<Client>(*this, std::move(channel)));
+            return true;
+        }
+    }
+    try {  // the channel closes as it goes out of scope
+        channel->send(
+            make_error(ErrorCode::internal, "server busy: " + std::to_string(options_.max_clients) +
+                                                " clients connected (--max-clients)"));
+    } catch (const std::exception&) {
+    }
+    return false;
+}
+
+std::vector<std::string> ViewServer::dataset_names() const {
+    std::vector<std::string> names;
+    for (const Dataset& d : datasets_) names.push_back(d.name);
+    return names;
 }
 
 }  // namespace isowall::remote

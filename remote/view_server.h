@@ -3,6 +3,8 @@
 // listens on TCP, and each connection gets two threads: a reader, which checks every message and
 // raises the stop flag when a new request arrives (Figure 4.3: a request interrupts the current
 // one at once), and a worker, which runs the connection's ServerSession on the latest request.
+// Both see the connection as a MessageChannel, so a WebSocket (remote/web/, `serve --http`)
+// handed to adopt() is served by the same code as a TCP connection.
 //
 // A connection begins with a hello within hello_timeout_s: protocol version, dataset, token
 // (when the server has one; compared in constant time), group encoding; the server answers
@@ -24,9 +26,15 @@
 #include <vector>
 
 #include "common/extract/surface_extractor.h"
+#include "remote/message_channel.h"
 #include "remote/server_session.h"
 
 namespace isowall::remote {
+
+// Equal tokens, in time that does not depend on where they differ.
+bool same_token(const std::string& a, const std::string& b);
+// Whether listening on `address` reaches this machine only (no token needed there).
+bool is_loopback(const std::string& address);
 
 struct Dataset {
     std::string name;  // what a hello names
@@ -57,7 +65,14 @@ class ViewServer {
     int port() const;
     // Accepts connections until `stop` reads true (checked every 100 ms).
     void serve(const std::atomic<bool>& stop);
-    // Connections accepted so far, and those open now.
+    // Serves a connection that arrived another way (a WebSocket) with its own reader and worker
+    // threads, as serve() does each TCP one; max_clients counts both kinds. When that many are
+    // open, sends the busy error, drops the channel and returns false. Any thread may call it.
+    bool adopt(std::unique_ptr<MessageChannel> channel);
+    // The datasets' names, in the order they were loaded.
+    std::vector<std::string> dataset_names() const;
+    const ServerOptions& options() const { return options_; }
+    // Connections accepted so far (both kinds), and those open now.
     int accepted() const { return accepted_.load(); }
     int open_connections() const { return open_.load(); }
 

@@ -11,7 +11,7 @@ PACKAGES=(
     libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev
     libopenmpi-dev openmpi-bin
     libgtest-dev libgmock-dev libbenchmark-dev
-    libmeshoptimizer-dev libzstd-dev
+    libmeshoptimizer-dev libzstd-dev libwebsocketpp-dev libasio-dev
     python3 python3-numpy python3-matplotlib
     libx11-dev libxext-dev xvfb xdotool x11-apps x11-utils iproute2
     nodejs chromium

@@ -1,0 +1,55 @@
+#pragma once
+// The seam between a client of `isowall serve` and how its messages travel: a TCP connection
+// (TcpChannel, one framed byte stream) or a WebSocket (remote/web/, one frame per binary
+// message). ViewServer's per-connection logic (hello, worker, interrupts) sees only this.
+//
+// Threads, as for Connection: any number of senders, one receiver, shutdown() from anywhere.
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include "remote/net/connection.h"
+#include "remote/view_protocol.h"
+
+namespace isowall::remote {
+
+class MessageChannel {
+  public:
+    virtual ~MessageChannel() = default;
+
+    // Who is at the other end, for log lines ("127.0.0.1:51234", "ws 127.0.0.1:51234").
+    virtual const std::string& peer() const = 0;
+    // Sends one whole message; returns the bytes it took on the wire, frame header included.
+    // Throws NetError or PeerClosed (also after shutdown()).
+    virtual std::size_t send(const ViewMessage& m) = 0;
+    // The next whole message within `timeout_s`, or nullopt. Throws WireError when what arrived
+    // does not decode, PeerClosed when the peer has gone or after shutdown().
+    virtual std::optional<ViewMessage> receive(double timeout_s) = 0;
+    // The emulated link (token bucket on every send); 0: none.
+    virtual void set_rate(double bits_per_second) = 0;
+    // Wakes a blocked receive and a blocked or paced send; later calls throw PeerClosed.
+    virtual void shutdown() = 0;
+    // The end of a connection: lets what was sent (an error) reach the peer, then closes.
+    virtual void close_gracefully() = 0;
+};
+
+// A TCP connection of the protocol: a framed byte stream (remote/net/connection.h).
+class TcpChannel final : public MessageChannel {
+  public:
+    TcpChannel(Socket s, std::string peer, std::uint32_t max_payload_bytes)
+        : conn_(std::move(s), std::move(peer), max_payload_bytes) {}
+
+    const std::string& peer() const override { return conn_.peer(); }
+    std::size_t send(const ViewMessage& m) override { return conn_.send(m); }
+    std::optional<ViewMessage> receive(double timeout_s) override {
+        return conn_.receive(timeout_s);
+    }
+    void set_rate(double bits_per_second) override { conn_.set_rate(bits_per_second); }
+    void shutdown() override { conn_.shutdown(); }
+    void close_gracefully() override;
+
+  private:
+    Connection conn_;
+};
+
+}  // namespace isowall::remote

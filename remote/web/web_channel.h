@@ -1,0 +1,69 @@
+#pragma once
+// A WebSocket of `isowall serve --http` as a MessageChannel: one protocol frame (view_framing.h)
+// per binary message each way, so ViewServer serves it with the same Client code as TCP.
+//
+// The io thread (web_server.h) puts each arriving message into the connection's WebInbox; the
+// channel's reader takes them from there. A text message, or bytes that are not exactly one
+// frame, break the channel: receive() throws WireError (the Client answers with an ErrorMsg and
+// closes), as a broken TCP stream does.
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "remote/message_channel.h"
+#include "remote/net/token_bucket.h"
+#include "remote/web/web_server.h"
+
+namespace isowall::remote {
+
+// What the io thread hands a WebSocket's channel: its messages and its end.
+struct WebInbox {
+    struct Message {
+        std::string bytes;
+        bool binary = true;
+    };
+    std::mutex mutex;
+    std::condition_variable changed;
+    std::deque<Message> messages;
+    bool closed = false;
+
+    void push(std::string bytes, bool binary);
+    void close();
+};
+
+class WebChannel final : public MessageChannel {
+  public:
+    WebChannel(std::shared_ptr<web::WebServer> server, web::ConnectionId id, std::string peer,
+               std::shared_ptr<WebInbox> inbox, std::uint32_t max_payload_bytes);
+    ~WebChannel() override;  // closes the WebSocket
+
+    const std::string& peer() const override { return peer_; }
+    // Blocks while the connection has more than a few MiB unsent (web::WebOptions), and for the
+    // emulated link's tokens; both waits end at shutdown() or when the peer goes.
+    std::size_t send(const ViewMessage& m) override;
+    std::optional<ViewMessage> receive(double timeout_s) override;
+    void set_rate(double bits_per_second) override;
+    void shutdown() override;
+    // The closing handshake goes after every message already queued (the error just sent).
+    void close_gracefully() override { shutdown(); }
+
+  private:
+    ViewMessage decode(const WebInbox::Message& message);
+    void pace(std::size_t bytes);  // send_mutex_ held
+    [[noreturn]] void throw_closed() const;
+
+    std::shared_ptr<web::WebServer> server_;  // kept alive while a worker may still send
+    web::ConnectionId id_;
+    std::string peer_;
+    std::shared_ptr<WebInbox> inbox_;
+    std::uint32_t max_payload_bytes_;
+    std::optional<std::string> broken_;  // the WireError that broke the channel, if one did
+    std::mutex send_mutex_;
+    TokenBucket bucket_;  // guarded by send_mutex_
+    std::atomic<bool> shut_down_{false};
+};
+
+}  // namespace isowall::remote

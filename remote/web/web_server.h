@@ -1,0 +1,84 @@
+#pragma once
+// An HTTP and WebSocket server on one port (websocketpp over standalone asio, one io thread),
+// behind callbacks. This header is C++17 and includes neither websocketpp nor asio: websocketpp
+// 0.8.2 does not compile as C++20, so web_server.cpp is built as C++17 in a target of its own
+// (isowall_remote_web) and the C++20 side (remote/http_front.h) sees only this.
+//
+// Upgrades are accepted only on `ws_path`, and only when the Origin header is absent or is
+// http://<Host header> (a page of another site cannot drive the server); anything else is
+// refused (403 for the Origin, 404 for the path) before the handshake completes. Plain HTTP
+// requests go to the `http` callback. Every WebSocket message over `max_message_bytes` closes
+// its connection (1009, message too big) without reaching `message`.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace isowall::web {
+
+using ConnectionId = std::uint64_t;
+
+struct HttpRequest {
+    std::string method;  // "GET", ...
+    std::string path;    // the resource before any '?': "/datasets"
+    std::string query;   // after the '?', undecoded: "token=abc"
+};
+
+struct HttpResponse {
+    int status = 200;
+    std::string content_type = "text/plain; charset=utf-8";
+    std::string body;
+};
+
+struct WebCallbacks {
+    std::function<HttpResponse(const HttpRequest&)> http;
+    // A WebSocket opened (`peer` is "ADDR:PORT"), a message arrived, it closed (either side).
+    // All run on the io thread; `closed` comes once for each `opened`.
+    std::function<void(ConnectionId, const std::string& peer)> opened;
+    std::function<void(ConnectionId, std::string bytes, bool binary)> message;
+    std::function<void(ConnectionId)> closed;
+};
+
+struct WebOptions {
+    std::string address = "127.0.0.1";
+    int port = 0;  // 0: any free port (see WebServer::port)
+    std::string ws_path = "/ws";
+    std::size_t max_message_bytes = 1 << 16;
+    // A send blocks while more than this many bytes wait to go out on its connection.
+    std::size_t max_buffered_bytes = std::size_t{4} << 20;
+};
+
+// Whether a WebSocket upgrade with these headers may go on ("" when a header is absent).
+bool origin_allowed(const std::string& origin, const std::string& host);
+
+class WebServer {
+  public:
+    // Binds and listens at once; throws std::runtime_error ("address in use" and the like).
+    WebServer(WebOptions options, WebCallbacks callbacks);
+    ~WebServer();  // stop()
+    WebServer(const WebServer&) = delete;
+    WebServer& operator=(const WebServer&) = delete;
+
+    int port() const;
+    // Starts the io thread.
+    void start();
+    // Closes every connection (their `closed` callbacks run), stops the io thread and joins it;
+    // later sends return false at once.
+    void stop();
+
+    // Sends one binary message; any thread. Blocks while the connection holds more than
+    // max_buffered_bytes unsent, until they drain, the connection closes, the server stops or
+    // `*cancel` reads true. Returns false when the message was not queued (closed, cancelled).
+    bool send(ConnectionId id, const void* bytes, std::size_t size,
+              const std::atomic<bool>* cancel = nullptr);
+    // Starts the closing handshake (after every message already queued); any thread.
+    void close(ConnectionId id, const std::string& reason);
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace isowall::web

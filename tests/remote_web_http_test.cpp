@@ -1,0 +1,175 @@
+// `isowall serve --http`: the HTTP side (issue 13). The routes as pure functions, then over
+// loopback: the page, its content type, /datasets with and without a token, 404 and 405, and
+// the WebSocket upgrade's Origin and path rules.
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "common/core/error.h"
+#include "remote/net/socket.h"
+#include "remote/web/web_routes.h"
+#include "tests/remote_web_util.h"
+
+namespace isowall::test {
+
+HttpReply http_exchange(int port, const std::string& request_head, double timeout_s) {
+    remote::Socket s = remote::connect_tcp("127.0.0.1", port, timeout_s);
+    const std::string request = request_head + "\r\n\r\n";
+    remote::send_all(s, std::as_bytes(std::span(request.data(), request.size())), "server");
+    std::string raw;
+    std::array<std::byte, 4096> buf;
+    try {
+        for (;;) {
+            std::size_t got = 0;
+            if (!remote::recv_some(s, buf, timeout_s, got, "server")) break;
+            raw.append(reinterpret_cast<const char*>(buf.data()), got);
+        }
+    } catch (const remote::PeerClosed&) {  // the end of the reply
+    }
+    HttpReply r;
+    const std::size_t head_end = raw.find("\r\n\r\n");
+    std::istringstream head(raw.substr(0, head_end));
+    std::string line, version;
+    std::getline(head, line);
+    std::istringstream(line) >> version >> r.status;
+    while (std::getline(head, line)) {
+        const std::size_t colon = line.find(':');
+        if (colon == std::string::npos) continue;
+        std::string name = line.substr(0, colon), value = line.substr(colon + 1);
+        for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        value.erase(0, value.find_first_not_of(' '));
+        if (!value.empty() && value.back() == '\r') value.pop_back();
+        r.headers[name] = value;
+    }
+    if (head_end != std::string::npos) r.body = raw.substr(head_end + 4);
+    return r;
+}
+
+namespace {
+
+using namespace remote;
+
+std::string placeholder_page() {
+    std::ifstream in(std::string(ISOWALL_SOURCE_DIR) + "/web/dist/index.html", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(RemoteWebRoutes, ContentTypesQueriesAndJson) {
+    EXPECT_EQ(content_type_for("index.html"), "text/html; charset=utf-8");
+    EXPECT_EQ(content_type_for("app.js"), "text/javascript; charset=utf-8");
+    EXPECT_EQ(content_type_for("app.css"), "text/css; charset=utf-8");
+    EXPECT_EQ(content_type_for("a/b.png"), "image/png");
+    EXPECT_EQ(content_type_for("icon.svg"), "image/svg+xml");
+    EXPECT_EQ(content_type_for("app.js.map"), "application/json");
+    EXPECT_EQ(content_type_for("x.json"), "application/json");
+    EXPECT_EQ(content_type_for("README"), "application/octet-stream");
+    EXPECT_EQ(content_type_for(".js"), "application/octet-stream");
+
+    EXPECT_EQ(query_value("a=1&token=x%20y+z", "token"), "x y z");
+    EXPECT_EQ(query_value("token=", "token"), "");
+    EXPECT_EQ(query_value("tokens=1", "token"), std::nullopt);
+    EXPECT_EQ(query_value("token=%4", "token"), std::nullopt);
+    EXPECT_EQ(query_value("token=%zz", "token"), std::nullopt);
+    EXPECT_EQ(query_value("", "token"), std::nullopt);
+
+    EXPECT_EQ(datasets_json({"phantom", "head"}, false),
+              R"({"datasets":["phantom","head"],"token_required":false})");
+    EXPECT_EQ(datasets_json({}, true), R"({"datasets":[],"token_required":true})");
+    EXPECT_EQ(datasets_json({"a\"b\\c\n"}, false),
+              R"({"datasets":["a\"b\\c\u000a"],"token_required":false})");
+}
+
+TEST(RemoteWebRoutes, EveryRouteWithoutASocket) {
+    const unsigned char js[] = {'x', '=', '1'};
+    const WebAsset assets[] = {{"app.js", js}, {"index.html", js}};
+    const RouteContext c{{"phantom"}, "sesame", assets};
+    EXPECT_EQ(route({"GET", "/app.js", ""}, c).content_type, "text/javascript; charset=utf-8");
+    EXPECT_EQ(route({"GET", "/", ""}, c).body, "x=1");
+    EXPECT_EQ(route({"GET", "/index.html", ""}, c).status, 200);
+    EXPECT_EQ(route({"GET", "/app.css", ""}, c).status, 404);
+    EXPECT_EQ(route({"GET", "/../app.js", ""}, c).status, 404);
+    EXPECT_EQ(route({"POST", "/", ""}, c).status, 405);
+    EXPECT_EQ(route({"GET", "/datasets", ""}, c).status, 403);
+    EXPECT_EQ(route({"GET", "/datasets", "token=sesam"}, c).status, 403);
+    EXPECT_EQ(route({"GET", "/datasets", "token=sesame"}, c).status, 200);
+}
+
+TEST(RemoteWebHttp, ThePageItsTypeAndNoStore) {
+    WebTestServer server;
+    const std::string page = placeholder_page();
+    ASSERT_FALSE(page.empty());
+    for (const char* path : {"/", "/index.html"}) {
+        HttpReply r = http_get(server.http_port(), path);
+        EXPECT_EQ(r.status, 200) << path;
+        EXPECT_EQ(r.headers["content-type"], "text/html; charset=utf-8") << path;
+        EXPECT_EQ(r.headers["cache-control"], "no-store") << path;
+        EXPECT_EQ(r.body, page) << path;
+    }
+    HttpReply missing = http_get(server.http_port(), "/no-such-file.js");
+    EXPECT_EQ(missing.status, 404);
+    EXPECT_EQ(missing.headers["cache-control"], "no-store");
+    EXPECT_NE(missing.body.find("not found"), std::string::npos) << missing.body;
+    const HttpReply post = http_exchange(server.http_port(),
+                                         "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+                                         "Connection: close\r\nContent-Length: 0");
+    EXPECT_EQ(post.status, 405);
+}
+
+TEST(RemoteWebHttp, DatasetsWithAndWithoutAToken) {
+    {
+        WebTestServer open_server;
+        HttpReply r = http_get(open_server.http_port(), "/datasets");
+        EXPECT_EQ(r.status, 200);
+        EXPECT_EQ(r.headers["content-type"], "application/json");
+        EXPECT_EQ(r.body, R"({"datasets":["phantom"],"token_required":false})");
+    }
+    ServerOptions o;
+    o.token = "open sesame";
+    WebTestServer server(o);
+    for (const char* path : {"/datasets", "/datasets?token=", "/datasets?token=open%20sesam"}) {
+        HttpReply r = http_get(server.http_port(), path);
+        EXPECT_EQ(r.status, 403) << path;
+        EXPECT_EQ(r.headers["content-type"], "application/json") << path;
+        EXPECT_EQ(r.body, R"({"error":"wrong token"})") << path;
+    }
+    HttpReply r = http_get(server.http_port(), "/datasets?token=open%20sesame");
+    EXPECT_EQ(r.status, 200);
+    EXPECT_EQ(r.body, R"({"datasets":["phantom"],"token_required":true})");
+}
+
+// A WebSocket handshake by hand, to see the status of a refused one.
+int upgrade_status(int port, const std::string& path, const std::string& origin) {
+    std::string head = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                       "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                       "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13";
+    if (!origin.empty()) head += "\r\nOrigin: " + origin;
+    return http_exchange(port, head, 1).status;  // a 101 stays open: read for 1 s
+}
+
+TEST(RemoteWebHttp, UpgradesOnlyAtWsFromTheSameOrigin) {
+    WebTestServer server;
+    const int port = server.http_port();
+    const std::string self = "http://127.0.0.1:" + std::to_string(port);
+    EXPECT_EQ(upgrade_status(port, "/ws", ""), 101);
+    EXPECT_EQ(upgrade_status(port, "/ws", self), 101);
+    EXPECT_EQ(upgrade_status(port, "/ws", "http://evil.example"), 403);
+    EXPECT_EQ(upgrade_status(port, "/ws", "https://127.0.0.1:" + std::to_string(port)), 403);
+    EXPECT_EQ(upgrade_status(port, "/other", self), 404);
+    EXPECT_EQ(upgrade_status(port, "/", ""), 404);
+}
+
+TEST(RemoteWebHttp, APortInUseNamesHttp) {
+    WebTestServer server;
+    TestServer other;
+    try {
+        HttpFrontEnd second(other.server(), server.http_port());
+        FAIL() << "a second front end listened on a port in use";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--http"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace isowall::test
