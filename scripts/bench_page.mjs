@@ -11,7 +11,7 @@
 //
 // Prints a table of medians (and the fastest run) and writes bench.json and bench.md to --out.
 import { spawn, spawnSync } from 'node:child_process';
-import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -89,8 +89,12 @@ function startServer(o, datasets) {
     });
 }
 
-async function pageRun(browser, url, d, o) {
+async function pageRun(browser, server, d, o) {
+    const url = server.url;
     const [w, h] = o.size.split('x').map(Number);
+    // The browser's processes are this script's children, beside the server.
+    const browserCpu = () => cpuOfTree(process.pid, { skip: [server.proc.pid], withSelf: false });
+    const cpu0 = { client: browserCpu(), server: cpuOfTree(server.proc.pid) };
     const page = await browser.newPage({ viewport: { width: w + 400, height: h + 200 } });
     try {
         const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1`;
@@ -101,20 +105,29 @@ async function pageRun(browser, url, d, o) {
         const s = await page.evaluate(() => ({ ...window.isowall.stats, state: window.isowall.state,
                                                error: window.isowall.error }));
         if (s.state === 'error') throw new Error(`page: ${s.error}`);
-        return { first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes,
-                 triangles: s.triangles, groups: s.groups };
+        const cpu = { client_s: browserCpu() - cpu0.client, server_s: cpuOfTree(server.proc.pid) - cpu0.server };
+        return { ...cpu, first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes,
+                 triangles: s.triangles, groups: s.groups, decode_ms: s.decode_ms, draw_ms: s.draw_ms, gl_wait_ms: s.gl_wait_ms };
     } finally {
         await page.close();
     }
 }
 
-function viewRun(port, d, o, dir) {
+function viewRun(server, d, o, dir) {
+    const port = server.port;
     const csv = path.join(dir, `view-${d.name}.csv`);
     const args = ['view', '--connect', `127.0.0.1:${port}`, '--dataset', d.name, '--case', '5',
                   '--size', o.size, '--iso', String(d.iso), '--timeline', csv,
                   '-o', path.join(dir, `view-${d.name}.png`), '--timeout', String(o.timeoutS)];
-    const p = spawnSync(o.isowall, args, { encoding: 'utf8', timeout: o.timeoutS * 1000 });
-    if (p.status !== 0) throw new Error(`isowall view: ${(p.stderr || p.stdout).trim().split('\n').pop()}`);
+    // bash's `times` prints its children's CPU time (user and system) on its second line.
+    const server0 = cpuOfTree(server.proc.pid);
+    const p = spawnSync('bash', ['-c', '"$@"; rc=$?; times >&2; exit $rc', 'bash', o.isowall, ...args],
+                        { encoding: 'utf8', timeout: o.timeoutS * 1000 });
+    const server_s = cpuOfTree(server.proc.pid) - server0;
+    if (p.status !== 0) throw new Error(`isowall view: ${(p.stderr || p.stdout).trim().split('\n').slice(-2)[0]}`);
+    const times = p.stderr.trim().split('\n').pop().match(/(\d+)m([\d.]+)s\s+(\d+)m([\d.]+)s/);
+    if (!times) throw new Error(`isowall view: no CPU times from bash: ${p.stderr.trim().split('\n').pop()}`);
+    const client_s = 60 * Number(times[1]) + Number(times[2]) + 60 * Number(times[3]) + Number(times[4]);
     const lines = readFileSync(csv, 'utf8').trim().split('\n');
     const head = lines[0].split(',');
     const col = (name) => head.indexOf(name);
@@ -122,8 +135,43 @@ function viewRun(port, d, o, dir) {
     const first = rows.find((r) => r[col('groups')] >= 1);
     const last = rows[rows.length - 1];
     if (!first || !last) throw new Error('isowall view: the timeline holds no group');
-    return { first_ms: 1000 * first[col('time_s')], frame_ms: 1000 * last[col('time_s')],
+    return { client_s, server_s, first_ms: 1000 * first[col('time_s')], frame_ms: 1000 * last[col('time_s')],
              bytes: last[col('bytes')], triangles: last[col('triangles')], groups: last[col('groups')] };
+}
+
+// CPU seconds (user + system) of a process and all its descendants, from /proc: what a run cost
+// the browser (its browser, GPU, renderer and network processes) or the server, whatever the
+// wall clock on 2 shared cores says.
+const kTicks = 100;  // USER_HZ: /proc/PID/stat counts clock ticks of 1/100 s on Linux
+function cpuOfTree(pid, { skip = [], withSelf = true } = {}) {
+    const children = new Map();
+    for (const d of readdirSync('/proc')) {
+        if (!/^\d+$/.test(d)) continue;
+        try {
+            const stat = readFileSync(`/proc/${d}/stat`, 'utf8');
+            const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+            const ppid = Number(f[1]);
+            if (!children.has(ppid)) children.set(ppid, []);
+            children.get(ppid).push({ pid: Number(d), cpu: (Number(f[11]) + Number(f[12])) / kTicks });
+        } catch { /* the process ended meanwhile */ }
+    }
+    let total = 0;
+    const self = (() => {
+        try {
+            const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
+            const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+            return (Number(f[11]) + Number(f[12])) / kTicks;
+        } catch { return 0; }
+    })();
+    const walk = (p) => {
+        for (const c of children.get(p) ?? []) {
+            if (skip.includes(c.pid)) continue;
+            total += c.cpu;
+            walk(c.pid);
+        }
+    };
+    walk(pid);
+    return total + (withSelf ? self : 0);
 }
 
 const median = (xs) => {
@@ -139,6 +187,8 @@ function summarise(runs) {
         frame_min_ms: Math.min(...runs.map((r) => r.frame_ms)),
         bytes: median(runs.map((r) => r.bytes)),
         triangles: median(runs.map((r) => r.triangles)),
+        client_cpu_s: median(runs.map((r) => r.client_s)),
+        server_cpu_s: median(runs.map((r) => r.server_s)),
         runs,
     };
 }
@@ -160,11 +210,11 @@ async function main() {
         for (const d of datasets) {
             const page = [], view = [];
             // One warm-up of each: the server's first request on a dataset pages in its octree.
-            await pageRun(browser, server.url, d, o);
-            viewRun(server.port, d, o, o.out);
+            await pageRun(browser, server, d, o);
+            viewRun(server, d, o, o.out);
             for (let i = 0; i < o.runs; ++i) {
-                page.push(await pageRun(browser, server.url, d, o));
-                view.push(viewRun(server.port, d, o, o.out));
+                page.push(await pageRun(browser, server, d, o));
+                view.push(viewRun(server, d, o, o.out));
                 process.stdout.write(`bench_page: ${d.name} run ${i + 1}/${o.runs}: page ` +
                     `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms, view ` +
                     `${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms\n`);
@@ -175,14 +225,14 @@ async function main() {
         await browser.close();
         server.proc.kill('SIGINT');
     }
-    const rows = [`| dataset | client | first group ms (median, fastest) | end of frame ms (median, fastest) | bytes | triangles | page / view, end of frame |`,
-                  '|---|---|---|---|---|---|---|'];
+    const rows = [`| dataset | client | first group ms (median, fastest) | end of frame ms (median, fastest) | client CPU s | server CPU s | bytes | triangles | page / view, end of frame |`,
+                  '|---|---|---|---|---|---|---|---|---|'];
     for (const [name, r] of Object.entries(results)) {
         for (const who of ['page', 'view']) {
             const s = r[who];
             rows.push(`| ${name} (iso ${r.iso}) | ${who === 'page' ? 'browser page' : 'isowall view'} | ` +
                 `${s.first_ms.toFixed(1)}, ${s.first_min_ms.toFixed(1)} | ${s.frame_ms.toFixed(1)}, ` +
-                `${s.frame_min_ms.toFixed(1)} | ${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
+                `${s.frame_min_ms.toFixed(1)} | ${s.client_cpu_s.toFixed(2)} | ${s.server_cpu_s.toFixed(2)} | ${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
                 `${who === 'page' ? (s.frame_ms / r.view.frame_ms).toFixed(2) : ''} |`);
         }
     }

@@ -37,7 +37,10 @@ export function decodeMesh(m) {
 }
 
 export function emptyStats() {
-  return { bytes: 0, groups: 0, named: 0, triangles: 0, first_group_ms: null, frame_ms: null };
+  // Where a frame's time goes: main-thread time decoding groups and issuing GL calls, and waiting
+  // in finish() for the GL to draw what was issued (at the first group and the end of the frame).
+  return { bytes: 0, groups: 0, named: 0, triangles: 0, first_group_ms: null, frame_ms: null,
+           decode_ms: 0, draw_ms: 0, gl_wait_ms: 0 };
 }
 
 export class ClientFrames {
@@ -88,17 +91,21 @@ export class ClientFrames {
     if (level < this.drawLevel && this.drewAny) this.renderer.clearDepth();
     this.drawLevel = level;
     this.drewCoarse = this.drewCoarse || level > 0;
+    const t0 = this.now();
     this.renderer.draw(mesh, this.viewM, this.projM);
     this.drewAny = true;
     if (level === 0) this.finals.push(mesh);
     this.stats.triangles += triangleCount(mesh);
-    if (this.stats.first_group_ms === null) this.stats.first_group_ms = this.now() - this.startMs;
+    this.stats.draw_ms += this.now() - t0;
+    if (this.stats.first_group_ms === null) this.stats.first_group_ms = this.finish();
   }
 
   handleGroup(g, wireBytes) {
     const current = this.active && g.request_id === this.request.request_id;
     if (!current && g.cache_gen === 0) return;
+    const t0 = this.now();
     const mesh = this.decode(g);
+    this.stats.decode_ms += this.now() - t0;
     if (g.cache_gen !== 0) {
       if (g.cache_gen !== this.cacheGen) {
         this.cache = [];
@@ -153,13 +160,23 @@ export class ClientFrames {
     return false;  // ready, hello, request, bye: not part of a frame
   }
 
+  // Waits for the GL to draw what was issued (a time taken before would be a time the pixels are
+  // only queued), then gives the time since the request.
+  finish() {
+    const t0 = this.now();
+    this.renderer.finish?.();
+    const t1 = this.now();
+    this.stats.gl_wait_ms += t1 - t0;
+    return t1 - this.startMs;
+  }
+
   finishFrame(end) {
     if (this.drewCoarse) {
       // The full-resolution groups alone: no coarse surface outside the fine one stays.
       this.renderer.clear();
       for (const mesh of this.finals) this.renderer.draw(mesh, this.viewM, this.projM);
     }
-    this.stats.frame_ms = this.now() - this.startMs;
+    this.stats.frame_ms = this.finish();
     this.active = false;
     this.lastEnd = end;
   }

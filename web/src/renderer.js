@@ -70,6 +70,25 @@ export class Renderer {
     this.uploaded = new Set();  // meshes with GL buffers
     this.width = canvas.width;
     this.height = canvas.height;
+    this.warmUp();
+  }
+
+  // The GL compiles its shader variants on the first draw (SwiftShader and Mesa both do, tens of
+  // ms): one triangle now, cleared away, so no frame pays it (the engine's warm_up does the same).
+  warmUp() {
+    const one = { positions: new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]),
+                  normals: new Float32Array([0, 0, 1, 0, 0, 1, 0, 0, 1]), indices: new Uint32Array([0, 1, 2]) };
+    const identity = new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+    this.draw(one, identity, identity);
+    this.finish();
+    this.collect(new Set());
+    this.clear();
+  }
+
+  // Waits until every GL command so far has run: WebGL draws are queued for another process, so
+  // a time taken after finish() is a time the pixels exist (the page's first group and end of frame).
+  finish() {
+    this.gl.finish();
   }
 
   compile(type, source) {
