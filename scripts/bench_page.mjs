@@ -10,11 +10,13 @@
 //                               [--head ../shared/data/vhp_ct_head.nhdr] [--out out/bench-page]
 //
 // Prints a table of medians (and the fastest run) and writes bench.json and bench.md to --out.
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+
+import { startServe } from '../web/test/serve.mjs';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const requireWeb = createRequire(path.join(root, 'web', 'package.json'));
@@ -60,33 +62,10 @@ function parseArgs(argv) {
     return o;
 }
 
-// `isowall serve --port 0 --http 0`: resolves with the TCP port and the page's URL.
 function startServer(o, datasets) {
-    const args = ['serve', '--port', '0', '--http', '0', '--quiet'];
-    for (const d of datasets) if (d.path) args.push('--dataset', `${d.name}=${d.path}`);
-    const proc = spawn(o.isowall, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    let seen = '';
-    return new Promise((resolve, reject) => {
-        const timer = setTimeout(() => {
-            proc.kill('SIGKILL');
-            reject(new Error(`isowall serve: no page line within 120 s: ${seen.slice(-300)}`));
-        }, 120000);
-        const onData = (chunk) => {
-            seen += chunk.toString();
-            const tcp = /listening on [^:\s]+:(\d+)/.exec(seen);
-            const page = /page at (http:\/\/\S+?)\/? /.exec(seen);
-            if (tcp && page) {
-                clearTimeout(timer);
-                resolve({ proc, port: Number(tcp[1]), url: page[1] });
-            }
-        };
-        proc.stdout.on('data', onData);
-        proc.stderr.on('data', onData);
-        proc.on('exit', (code) => {
-            clearTimeout(timer);
-            reject(new Error(`isowall serve exited (${code}): ${seen.trim().split('\n').pop()}`));
-        });
-    });
+    const extra = ['--quiet'];
+    for (const d of datasets) if (d.path) extra.push('--dataset', `${d.name}=${d.path}`);
+    return startServe(o.isowall, extra, { timeoutS: 120 });
 }
 
 async function pageRun(browser, server, d, o) {
@@ -98,7 +77,7 @@ async function pageRun(browser, server, d, o) {
     const page = await browser.newPage({ viewport: { width: w + 400, height: h + 200 } });
     try {
         const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1`;
-        await page.goto(`${url}/${q}`);
+        await page.goto(new URL(q, url).href);
         await page.waitForFunction(
             () => window.isowall && (window.isowall.state === 'done' || window.isowall.state === 'error'),
             null, { timeout: o.timeoutS * 1000 });

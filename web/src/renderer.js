@@ -5,7 +5,7 @@
 // it; collect() frees the buffers of meshes no longer held.
 import { normalMatrix } from './camera.js';
 
-const kVertexShader = `#version 300 es
+export const kVertexShader = `#version 300 es
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 uniform mat4 model_view;
@@ -21,7 +21,7 @@ void main() {
 }
 `;
 
-const kFragmentShader = `#version 300 es
+export const kFragmentShader = `#version 300 es
 precision highp float;
 in vec3 view_position;
 in vec3 view_normal;

@@ -1,17 +1,18 @@
 // Starts `isowall serve --port 0 --http 0` (and any extra arguments) for the browser checks and
 // resolves with { proc, url, port } once it prints its page line; rejects when it exits first or
-// says nothing for 60 s. The caller stops it with proc.kill('SIGINT').
+// says nothing for `timeoutS` seconds (a large dataset's octree may take longer than the default
+// 60). The caller stops it with proc.kill('SIGINT').
 import { spawn } from 'node:child_process';
 
-export function startServe(bin, extra = [], { log = null } = {}) {
+export function startServe(bin, extra = [], { log = null, timeoutS = 60 } = {}) {
   const proc = spawn(bin, ['serve', '--port', '0', '--http', '0', ...extra],
     { stdio: ['ignore', 'pipe', 'pipe'] });
   let text = '';
   return new Promise((resolve, reject) => {
     const timer = setTimeout(() => {
       proc.kill('SIGKILL');
-      reject(new Error(`isowall serve: no page line within 60 s: ${text.slice(-300)}`));
-    }, 60000);
+      reject(new Error(`isowall serve: no page line within ${timeoutS} s: ${text.slice(-300)}`));
+    }, timeoutS * 1000);
     const take = (d) => {
       text += d;
       if (log) log(String(d));
