@@ -114,6 +114,7 @@ def plot(meta, results, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     x = [r["voxels"] for r in results]
     series = [("C = 90%", lambda r: r["progressive"]["c90"], "-o"),
@@ -132,7 +133,9 @@ def plot(meta, results, path):
     ax.set_yscale("log")
     ax.set_xticks(x)
     ax.set_xticklabels([f"{label(r)}\n{count(r['voxels'])}" for r in results], fontsize=8)
-    ax.minorticks_off()
+    ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     ax.set_xlabel("volume (voxels)")
     ax.set_ylabel("seconds")
     ax.set_title(f"iso {meta['iso']:g}, {meta['size']}: time against voxels (load avg {meta['load_average'][0]:g})")
