@@ -11,9 +11,10 @@ Usage: /usr/bin/python3 scripts/bench_scaling.py [--scales 1,2] [--size 1600x120
 
 Scale 1 is the volume itself; any other scale is a trilinear copy made once by
 scripts/resample_volume.py into BUILD/data and kept there (outside git). For the shared CT head:
-scale 2 is 1024x1024x468 (491 M voxels, 491 MB, about a minute to make); scale 4 is
-2048x2048x936 (3.9 G voxels, 3.9 GB of disk, several minutes to make, about 4 GB of memory in
-each program while it loads, and a few minutes per run). Scales 1,2 take a few minutes in all.
+scale 2 is 1024x1024x468 (491 M voxels, 491 MB, 3 minutes to make on a loaded 2-core machine);
+scale 4 is 2048x2048x936 (3.9 G voxels, 3.9 GB of disk, 12 minutes to make there, about 4 GB of
+memory in each program while it loads, and a few minutes per run). Scales 1,2 take about two
+minutes once the copy is made.
 
 Every figure is wall-clock seconds measured inside the programs (loading and the octree are
 outside them); with --runs N each measure is run N times and the fastest run is kept (all of them
