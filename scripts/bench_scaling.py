@@ -12,8 +12,8 @@ Usage: /usr/bin/python3 scripts/bench_scaling.py [--scales 1,2] [--size 1600x120
 Scale 1 is the volume itself; any other scale is a trilinear copy made once by
 scripts/resample_volume.py into BUILD/data and kept there (outside git). For the shared CT head:
 scale 2 is 1024x1024x468 (491 M voxels, 491 MB, 3 minutes to make on a loaded 2-core machine);
-scale 4 is 2048x2048x936 (3.9 G voxels, 3.9 GB of disk, 12 minutes to make there, about 4 GB of
-memory in each program while it loads, and a few minutes per run). Scales 1,2 take about two
+scale 4 is 2048x2048x936 (3.9 G voxels, 3.9 GB of disk, 12 minutes to make there; each program
+holds the 3.9 GB of voxels and a run peaked at 8.4 GB in one process; 4-5 minutes per run). Scales 1,2 take about two
 minutes once the copy is made.
 
 Every figure is wall-clock seconds measured inside the programs (loading and the octree are
