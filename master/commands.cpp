@@ -18,6 +18,14 @@
 namespace isowall {
 namespace {
 
+// Pixels the surface covers (depth nearer than the background); scripts compare this count with
+// other renderers' hit pixels (scripts/bench_scaling.py).
+std::size_t covered_pixels(const Image& image) {
+    std::size_t covered = 0;
+    for (float d : image.depth) covered += d < 1.0f;
+    return covered;
+}
+
 // One line per stage, then a summary line that scripts can grep for.
 struct Timings {
     double load = 0, octree = 0, extract = 0, render = 0, write = 0;
@@ -243,6 +251,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     std::printf(
         "stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
         last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+    std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
 
     Stopwatch sw;
     write_image(batch, o.out, fr.final_image);
@@ -341,11 +350,10 @@ int run_render(const RenderOptions& o) {
     renderer->draw(mesh, cam.view(), fv.frustum.matrix());
     renderer->read_back(image);
     t.render = sw.seconds();
-    std::size_t covered = 0;
-    for (float d : image.depth) covered += d < 1.0f;
-    std::printf("render: %s %dx%d, %.1f%% of pixels covered (%.3f s)\n",
+    const std::size_t covered = covered_pixels(image);
+    std::printf("render: %s %dx%d, %.1f%% of pixels covered, %zu px (%.3f s)\n",
                 std::string(renderer->name()).c_str(), size->x, size->y,
-                100.0 * double(covered) / double(image.pixel_count()), t.render);
+                100.0 * double(covered) / double(image.pixel_count()), covered, t.render);
     sw.restart();
     write_image(batch, o.out, image);
     if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);

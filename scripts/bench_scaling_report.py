@@ -1,0 +1,148 @@
+"""The targets, tables and plot of scripts/bench_scaling.py (issue 10), from its measured results:
+one dict per scale with "progressive", "full" and "peer" (see bench_scaling.py)."""
+
+# Time to C = 99% at most 1/N of FE + Embree, by scale (512, 1024, 2048 a side for the head).
+PEER_LIMITS = {1: 1 / 4, 2: 1 / 10, 4: 1 / 40}
+FULL_LIMIT = 1 / 3         # C = 99% against our --full, from scale 2 up
+GROWTH_LIMIT = 2.0         # C = 99% from scale 1 to scale 4
+TRIS_PER_PX_LIMIT = 2.0    # triangles drawn by C = 99% per covered pixel, every scale
+EVERY_RAY_LIMIT = 1.5      # every ray against our --full, every scale
+AGREE_FRACTION = 0.005     # the peer's hit pixels against --full's covered pixels
+
+
+def label(r):
+    return "x".join(str(s) for s in r["sizes"])
+
+
+def check(checks, target, r, figure, limit, note=""):
+    holds = None if figure is None else figure <= limit
+    checks.append({"target": target, "volume": label(r) if r else "", "figure": figure,
+                   "limit": limit, "holds": holds, "note": note})
+
+
+def targets(results):
+    """Every target of the issue that these scales can test, each with its figure and verdict."""
+    checks = []
+    by_scale = {r["scale"]: r for r in results}
+    for r in results:
+        c99 = r["progressive"]["c99"]
+        peer = r["peer"].get("total_s")
+        if r["scale"] in PEER_LIMITS and peer:
+            check(checks, "C=99% / FE + Embree", r, c99 / peer if c99 else None, PEER_LIMITS[r["scale"]])
+        if r["scale"] >= 2:
+            check(checks, "C=99% / our --full", r, c99 / r["full"]["full_s"] if c99 else None, FULL_LIMIT)
+        tris = r["progressive"]["triangles_c99"]
+        covered = r["full"]["covered_px"]
+        check(checks, "triangles by C=99% per covered pixel", r,
+              tris / covered if tris is not None and covered else None, TRIS_PER_PX_LIMIT)
+        check(checks, "every ray / our --full", r, r["progressive"]["every_ray_s"] / r["full"]["full_s"],
+              EVERY_RAY_LIMIT)
+    if 1 in by_scale and 4 in by_scale:
+        a, b = by_scale[1]["progressive"]["c99"], by_scale[4]["progressive"]["c99"]
+        check(checks, "growth of C=99%, scale 1 -> 4", by_scale[4], b / a if a and b else None, GROWTH_LIMIT)
+    elif len(results) >= 2:
+        lo, hi = results[0], results[-1]
+        a, b = lo["progressive"]["c99"], hi["progressive"]["c99"]
+        checks.append({"target": "growth of C=99%, scale 1 -> 4", "volume": f"{label(lo)} -> {label(hi)}",
+                       "figure": b / a if a and b else None, "limit": GROWTH_LIMIT, "holds": None,
+                       "note": "not tested: needs --scales with 1 and 4; figure over the scales run"})
+    return checks
+
+
+def fmt(x, digits=3):
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
+def count(n):
+    if n is None:
+        return "-"
+    for div, unit in ((1e9, "G"), (1e6, "M"), (1e3, "K")):
+        if n >= div:
+            return f"{n / div:.3g} {unit}"
+    return str(n)
+
+
+def verdict(c):
+    if c["holds"] is None:
+        return "n/a" if c["figure"] is not None and c["note"] else "not reached"
+    return "holds" if c["holds"] else "MISSED"
+
+
+def times_table(results):
+    lines = ["| volume | voxels | C=90% | C=99% | C=99.9% | C=100% | triangles by C=99% | per covered px "
+             "| every ray | full (extract + draw) | FE + Embree (FE + BVH + rays) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        p, f, q = r["progressive"], r["full"], r["peer"]
+        per_px = p["triangles_c99"] / f["covered_px"] if p["triangles_c99"] and f["covered_px"] else None
+        peer = (f"{fmt(q['total_s'])} ({fmt(q['fe_s'])} + {fmt(q['bvh_s'])} + {fmt(q['rays_s'])})"
+                if "total_s" in q else f"skipped: {q['skipped']}")
+        lines.append(f"| {label(r)} | {count(r['voxels'])} | {fmt(p['c90'])} | {fmt(p['c99'])} | {fmt(p['c999'])} "
+                     f"| {fmt(p['c100'])} | {count(p['triangles_c99'])} | {fmt(per_px, 2)} | {fmt(p['every_ray_s'])} "
+                     f"| {fmt(f['full_s'])} ({fmt(f['extract_s'])} + {fmt(f['draw_s'])}) | {peer} |")
+    return lines
+
+
+def pixels_table(results):
+    lines = ["| volume | progressive final image | --full | peer hit pixels | peer vs --full |",
+             "|---|---|---|---|---|"]
+    for r in results:
+        full_px, hit = r["full"]["covered_px"], r["peer"].get("hit_px")
+        diff = "-" if hit is None else f"{100 * (hit - full_px) / max(full_px, 1):+.3f}%" + (
+            "" if abs(hit - full_px) <= AGREE_FRACTION * full_px else " (over 0.5%: check the views)")
+        lines.append(f"| {label(r)} | {r['progressive']['covered_px']} | {full_px} | "
+                     f"{'-' if hit is None else hit} | {diff} |")
+    return lines
+
+
+def report(meta, results, checks):
+    load = ", ".join(f"{x:g}" for x in meta["load_average"])
+    lines = [f"# Scaling (issue 10): {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
+             f"Measured {meta['date']} on {meta['cores']} cores (load average {load} over 1, 5, 15 min "
+             f"at the end); fastest of {meta['runs']} run(s) each; seconds. C is the share of final "
+             f"pixels; the peer uses {meta['threads']} threads.", "", *times_table(results), "",
+             "Covered pixels (the same view in each):", "", *pixels_table(results), "",
+             "Targets:", "", "| target | volume | figure | limit | verdict |", "|---|---|---|---|---|"]
+    for c in checks:
+        note = f" ({c['note']})" if c["note"] else ""
+        lines.append(f"| {c['target']} | {c['volume']} | {fmt(c['figure'], 3)} | {c['limit']:.3g} "
+                     f"| {verdict(c)}{note} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(meta, results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    x = [r["voxels"] for r in results]
+    series = [("C = 90%", lambda r: r["progressive"]["c90"], "-o"),
+              ("C = 99%", lambda r: r["progressive"]["c99"], "-o"),
+              ("C = 99.9%", lambda r: r["progressive"]["c999"], "-o"),
+              ("every ray", lambda r: r["progressive"]["every_ray_s"], "-s"),
+              ("our --full", lambda r: r["full"]["full_s"], "--^"),
+              ("FE + Embree", lambda r: r["peer"].get("total_s"), "--v"),
+              ("FE alone", lambda r: r["peer"].get("fe_s"), ":v")]
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for name, get, style in series:
+        pts = [(xi, get(r)) for xi, r in zip(x, results) if get(r)]
+        if pts:
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{label(r)}\n{count(r['voxels'])}" for r in results], fontsize=8)
+    ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+    # Seconds as numbers at 1, 2, 5 per decade: readable without crowding.
+    ax.yaxis.set_major_locator(matplotlib.ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel("volume (voxels)")
+    ax.set_ylabel("seconds")
+    ax.set_title(f"iso {meta['iso']:g}, {meta['size']}: time against voxels (load avg {meta['load_average'][0]:g})")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

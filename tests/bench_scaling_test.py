@@ -1,0 +1,89 @@
+#!/usr/bin/python3
+"""Tests of scripts/bench_scaling.py: a quick run on the shared tooth (half and full size, a small
+screen) writes its table, JSON and plot, with the peer's hit pixels agreeing with our covered
+pixels; bad options give one line and status 1. Skips (status 77) without ../shared/data.
+
+Run: /usr/bin/python3 tests/bench_scaling_test.py BUILD_DIR   (CTest passes the path)
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "bench_scaling.py")
+DATA = os.environ.get("ISOWALL_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+TOOTH = os.path.join(DATA, "tooth.nhdr")
+BUILD = None
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def bench(*args):
+    return subprocess.run([sys.executable, SCRIPT, "--build", BUILD, *args],
+                          capture_output=True, text=True, timeout=600)
+
+
+class BenchScaling(unittest.TestCase):
+    def test_quick_run_writes_table_json_and_plot(self):
+        with tempfile.TemporaryDirectory() as out:
+            p = bench("--volume", TOOTH, "--iso", "620", "--scales", "0.5,1", "--size", "320x240",
+                      "--out", out)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(out, "scaling.json")) as f:
+                res = json.load(f)
+            scales = res["scales"]
+            self.assertEqual([s["scale"] for s in scales], [0.5, 1])
+            self.assertEqual(scales[1]["sizes"], [103, 94, 161])
+            self.assertEqual(scales[0]["sizes"], [52, 47, 80])
+            for s in scales:
+                prog, full = s["progressive"], s["full"]
+                times = [prog[k] for k in ("c90", "c99", "c999", "c100")]
+                self.assertTrue(all(t is not None for t in times), s)
+                self.assertEqual(times, sorted(times), s)
+                self.assertLessEqual(prog["c100"], prog["every_ray_s"] + 1e-9)
+                self.assertGreater(full["covered_px"], 1000)
+                self.assertGreater(prog["triangles_c99"], 0)
+                # The progressive final image is the full surface's (the engine's own thresholds).
+                self.assertLess(abs(prog["covered_px"] - full["covered_px"]), 0.01 * full["covered_px"])
+                if "skipped" not in s["peer"]:
+                    # Same view, same surface: hit pixels within a fraction of a percent.
+                    self.assertLess(abs(s["peer"]["hit_px"] - full["covered_px"]), 0.005 * full["covered_px"])
+                    self.assertEqual(s["peer"]["triangles"], full["triangles"])
+            names = {c["target"] for c in res["targets"]}
+            self.assertIn("triangles by C=99% per covered pixel", names)
+            self.assertIn("every ray / our --full", names)
+            self.assertIn("growth of C=99%, scale 1 -> 4", names)
+            with open(os.path.join(out, "scaling.md")) as f:
+                md = f.read()
+            self.assertIn("| 103x94x161 | 1.56 M |", md)
+            self.assertIn("| 52x47x80 |", md)
+            self.assertIn("Targets:", md)
+            self.assertTrue("holds" in md or "MISSED" in md)
+            self.assertIn(md.splitlines()[0], p.stdout)
+            with open(os.path.join(out, "scaling.png"), "rb") as f:
+                self.assertEqual(f.read(8), PNG_MAGIC)
+
+    def test_bad_options_give_one_line_and_status_1(self):
+        with tempfile.TemporaryDirectory() as out:
+            for args, field in [(["--scales", "0"], "--scales"), (["--scales", "1,x"], "--scales"),
+                                (["--size", "320"], "--size"), (["--runs", "0"], "--runs"),
+                                (["--iso", "nan"], "--iso"), (["--runs", "x"], "--runs"),
+                                (["--volume", "/nonexistent.nhdr"], "--volume"),
+                                (["--build", "/nonexistent"], "--build")]:
+                p = subprocess.run([sys.executable, SCRIPT, "--out", out, *(["--build", BUILD] if "--build" not in args else []), *args],
+                                   capture_output=True, text=True, timeout=60)
+                self.assertEqual(p.returncode, 1, args)
+                lines = p.stderr.strip().splitlines()
+                self.assertEqual(len(lines), 1, p.stderr)
+                self.assertIn(field, lines[0])
+            self.assertEqual(os.listdir(out), [])
+
+
+if __name__ == "__main__":
+    BUILD = sys.argv.pop(1)
+    if not os.path.exists(TOOTH):
+        print(f"bench_scaling_test: skipped: {TOOTH} not found (../shared/data or $ISOWALL_SHARED_DATA)")
+        sys.exit(77)
+    unittest.main()
