@@ -6,7 +6,7 @@
 // waits for the new view's frame, saving it too. Writes views.json: the views to draw with
 // `isowall render` (web/test/compare_images.py compares them). Exits 1 on any failed check.
 import { chromium } from 'playwright-core';
-import { mkdirSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const base = process.env.ISOWALL_PAGE_URL;
@@ -32,7 +32,7 @@ const browser = await chromium.launch({
   headless: true,
   args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
 });
-const page = await browser.newPage({ viewport: { width: 1100, height: 800 }, deviceScaleFactor: 1 });
+const page = await browser.newPage({ viewport: { width: 1100, height: 800 }, deviceScaleFactor: 1, acceptDownloads: true });
 const logs = [];
 page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
 page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
@@ -87,6 +87,15 @@ try {
     `front view stats ${JSON.stringify(s.stats)}`);
   check(s.requests.length === 1 && s.requests[0].iso === iso, `one request (lod ${s.requests[0].lod}, cache ${s.requests[0].cache})`);
   const front = { ...s.view, stats: s.stats, png: await savePng('front.png'), mid_png: mid };
+
+  // The snapshot button downloads the canvas as a PNG of the canvas's size.
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.locator('#snapshot').click()]);
+  const shot = join(out, 'snapshot_button.png');
+  await download.saveAs(shot);
+  const head = readFileSync(shot);
+  const pngSize = head.length >= 24 && head.readUInt32BE(0) === 0x89504e47 ? [head.readUInt32BE(16), head.readUInt32BE(20)] : null;
+  check(pngSize && pngSize[0] === 800 && pngSize[1] === 600 && /\.png$/.test(download.suggestedFilename()),
+    `snapshot button: ${download.suggestedFilename()}, PNG ${pngSize ? pngSize.join('x') : 'not a PNG'}`);
 
   // The slider: a real input event on the range input.
   const before = s.request_id;
