@@ -1,6 +1,7 @@
 #include "common/progressive/screen_mask.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "common/core/ray.h"
 
@@ -15,47 +16,50 @@ PixelRect clip(const PixelRect& a, const PixelRect& b) {
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
-// How many of the rectangles cover each pixel of `area` (row-major, area-local): +1 at each
-// rectangle's top-left, -1 past its right and bottom edges, +1 past both, then prefix sums.
-std::vector<int> cover_counts(std::span<const PixelRect> rects, const PixelRect& area) {
-    const std::size_t w = std::size_t(area.width) + 1, h = std::size_t(area.height) + 1;
-    std::vector<int> d(w * h, 0);
+PixelRect bounding(std::span<const PixelRect> rects) {
+    int x0 = rects.front().x, y0 = rects.front().y;
+    int x1 = x0 + rects.front().width, y1 = y0 + rects.front().height;
     for (const PixelRect& r : rects) {
-        const std::size_t x0 = std::size_t(r.x - area.x), y0 = std::size_t(r.y - area.y);
-        const std::size_t x1 = x0 + std::size_t(r.width), y1 = y0 + std::size_t(r.height);
-        ++d[y0 * w + x0];
-        --d[y0 * w + x1];
-        --d[y1 * w + x0];
-        ++d[y1 * w + x1];
+        x0 = std::min(x0, r.x), y0 = std::min(y0, r.y);
+        x1 = std::max(x1, r.x + r.width), y1 = std::max(y1, r.y + r.height);
     }
-    for (std::size_t y = 0; y < h; ++y)
-        for (std::size_t x = 1; x < w; ++x) d[y * w + x] += d[y * w + x - 1];
-    for (std::size_t y = 1; y < h; ++y)
-        for (std::size_t x = 0; x < w; ++x) d[y * w + x] += d[(y - 1) * w + x];
-    return d;  // row stride w; the last row and column are zero
+    return {x0, y0, x1 - x0, y1 - y0};
 }
 
-// The pixels of `area` with a count above zero, cropped to their bounding box.
-ScreenMask crop(const std::vector<int>& counts, const PixelRect& area) {
-    const int stride = area.width + 1;
-    int x0 = area.width, y0 = area.height, x1 = -1, y1 = -1;
-    for (int y = 0; y < area.height; ++y)
-        for (int x = 0; x < area.width; ++x)
-            if (counts[std::size_t(y) * std::size_t(stride) + std::size_t(x)] > 0) {
-                x0 = std::min(x0, x), x1 = std::max(x1, x);
-                y0 = std::min(y0, y), y1 = std::max(y1, y);
-            }
+// The union of `rects` (non-empty, inside their bounding box `area`) as a mask of `area`. A sweep
+// down the rows keeps one row of differences, +1 at the left edge and -1 past the right edge of
+// each rectangle the row is inside, and a prefix sum along the row gives the cover count: one
+// pass over the area and two events per rectangle, with a row of ints as the only scratch (a
+// screen-sized difference array cost more in first-touch page faults than in arithmetic).
+ScreenMask sweep(std::vector<PixelRect> starts, const PixelRect& area) {
+    std::vector<PixelRect> ends = starts;
+    std::sort(starts.begin(), starts.end(), [](auto& a, auto& b) { return a.y < b.y; });
+    std::sort(ends.begin(), ends.end(),
+              [](auto& a, auto& b) { return a.y + a.height < b.y + b.height; });
     ScreenMask m;
-    if (x1 < 0) return m;
-    m.rect = {area.x + x0, area.y + y0, x1 - x0 + 1, y1 - y0 + 1};
-    m.cast.resize(std::size_t(m.rect.width) * std::size_t(m.rect.height));
-    for (int y = 0; y < m.rect.height; ++y)
-        for (int x = 0; x < m.rect.width; ++x) {
-            const bool on =
-                counts[std::size_t(y0 + y) * std::size_t(stride) + std::size_t(x0 + x)] > 0;
-            m.cast[std::size_t(y) * std::size_t(m.rect.width) + std::size_t(x)] = on ? 1 : 0;
-            m.count += on ? 1 : 0;
+    m.rect = area;
+    const std::size_t w = std::size_t(area.width);
+    m.cast.assign(w * std::size_t(area.height), 0);
+    std::vector<int> row(w + 1, 0);
+    const auto edge = [&](const PixelRect& r, int sign) {
+        row[std::size_t(r.x - area.x)] += sign;
+        row[std::size_t(r.x - area.x + r.width)] -= sign;
+    };
+    std::size_t next_start = 0, next_end = 0, open = 0;
+    for (int y = area.y; y < area.y + area.height; ++y) {
+        for (; next_end < ends.size() && ends[next_end].y + ends[next_end].height == y; ++next_end)
+            edge(ends[next_end], -1), --open;
+        for (; next_start < starts.size() && starts[next_start].y == y; ++next_start)
+            edge(starts[next_start], +1), ++open;
+        if (open == 0) continue;
+        std::uint8_t* out = m.cast.data() + std::size_t(y - area.y) * w;
+        int cover = 0;
+        for (std::size_t x = 0; x < w; ++x) {
+            cover += row[x];
+            out[x] = cover > 0 ? 1 : 0;
+            m.count += cover > 0 ? 1 : 0;
         }
+    }
     return m;
 }
 
@@ -73,7 +77,8 @@ ScreenMask screen_mask(std::span<const Box3> boxes, const glm::mat4& view, const
         if (r.width > 0) rects.push_back(r);
     }
     if (rects.empty()) return {};
-    return crop(cover_counts(rects, area), area);
+    const PixelRect box = bounding(rects);
+    return sweep(std::move(rects), box);
 }
 
 }  // namespace isowall

@@ -24,8 +24,9 @@ struct ScreenMask {
 };
 
 // The mask of `region` (clipped to the width x height screen) for `boxes` (object space) seen
-// through `view` (object -> view space) and `frustum`. Rasterised as a 2D difference array, so it
-// costs one pass over the boxes plus two over the region, however large the rectangles are.
+// through `view` (object -> view space) and `frustum`. Rasterised by a sweep over the rows of the
+// rectangles' bounding box, so it costs one pass over the boxes plus one over that box, however
+// large or overlapping the rectangles are.
 ScreenMask screen_mask(std::span<const Box3> boxes, const glm::mat4& view, const Frustum& frustum,
                        int width, int height, PixelRect region);
 
