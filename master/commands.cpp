@@ -252,6 +252,9 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         "stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
         last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
+    if (fr.mask_level >= 0)
+        std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",
+                    fr.mask_nodes, fr.mask_level, fr.screen_pixels);
 
     Stopwatch sw;
     write_image(batch, o.out, fr.final_image);

@@ -36,7 +36,11 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_flag("--no-interpolant-cache", e.no_interpolant_cache,
                  "Do not share vertices between cells of a group");
     app.add_flag("--no-screen-box", e.no_screen_box,
-                 "Cast rays over the whole screen, not only the volume's projected box");
+                 "Cast rays over the whole screen, not only the volume's projected box (turns "
+                 "the screen mask off too: it lies within the box)");
+    app.add_flag("--no-screen-mask", e.no_screen_mask,
+                 "Cast every ray of the volume's projected box, also where no active octree node "
+                 "projects (the box alone, to measure what the mask saves)");
     app.add_flag("--adaptive", e.adaptive,
                  "Adaptive resolution: extract regions whose cells project below a pixel as "
                  "meta-cells of 2^i cells per side");
@@ -68,6 +72,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.propagation.foldback_rad = glm::radians(c.foldback_deg);
     e.propagation.interpolant_cache = !c.no_interpolant_cache;
     e.screen_box = !c.no_screen_box;
+    e.screen_mask = !c.no_screen_mask;
     e.adaptive = c.adaptive;
     e.adaptive_max_level = c.adaptive_max_level;
     return e;

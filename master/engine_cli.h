@@ -17,6 +17,7 @@ struct EngineCli {
     float foldback_deg = 0.5f;
     bool no_interpolant_cache = false;
     bool no_screen_box = false;
+    bool no_screen_mask = false;
     bool adaptive = false;
     int adaptive_max_level = 3;
 };

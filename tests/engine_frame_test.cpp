@@ -32,7 +32,9 @@ TEST(EngineFrame, ACoarseBandThenTheRestCastEveryPixelOnceWithLimitedPropagation
     sink.begin(fv);
     EngineFrame frame(engine, fv, stop);
     RegionCursor c = frame.cursor(fv, fv.screen());
-    const std::size_t area = std::size_t(c.rect.width) * c.rect.height;
+    const std::size_t area = c.pixels;  // the screen mask's pixels in the region
+    ASSERT_GT(area, 0u);
+    ASSERT_LE(area, std::size_t(c.rect.width) * c.rect.height);
     ASSERT_TRUE(frame.cast(fv, c, sink, area / 16));  // the coarse band
     EXPECT_FALSE(c.done);
     EXPECT_GE(c.rays, area / 16);

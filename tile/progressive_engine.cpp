@@ -8,12 +8,18 @@
 #include <glm/matrix.hpp>
 
 #include "common/core/ray.h"
+#include "common/progressive/screen_mask.h"
 
 namespace isowall {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kRefreshS = 1.0 / 60.0;
+// The screen mask's node budget: the finest octree level with at most this many active nodes.
+// A few thousand boxes project in well under a millisecond (8 corners each), while the mask's
+// cost per region is its pixels; on the 512^2 CT head's skin this is the level of 16^3 cells,
+// whose boxes hug the surface to within about 16 voxels on screen.
+constexpr std::size_t kMaskNodes = 4096;
 
 double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -44,12 +50,21 @@ class FrameRun {
 
     RegionCursor cursor(const FrameView& view, const PixelRect& region) const {
         RegionCursor c;
-        const PixelRect clipped = intersect(region, view.screen());
-        c.rect = opt_.screen_box
-                     ? intersect(clipped, screen_box(ex_.volume().bounds(), view.camera.view(),
-                                                     view.frustum, view.width, view.height))
-                     : clipped;
-        c.done = c.rect.width <= 0 || c.rect.height <= 0;
+        c.rect = intersect(region, view.screen());
+        if (opt_.screen_box)
+            c.rect = intersect(c.rect, screen_box(ex_.volume().bounds(), view.camera.view(),
+                                                  view.frustum, view.width, view.height));
+        if (masked()) {
+            ScreenMask m = screen_mask(active_.boxes, view.camera.view(), view.frustum, view.width,
+                                       view.height, c.rect);
+            c.rect = m.rect;
+            c.mask = std::move(m.cast);
+            c.pixels = m.count;
+        } else {
+            c.pixels =
+                std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height));
+        }
+        c.done = c.pixels == 0;
         return c;
     }
 
@@ -69,7 +84,7 @@ class FrameRun {
             // a region's coverage is then its own pixels, not a copy of the whole screen.
             if (!c.order)
                 c.order = make_ray_order(opt_.order, c.rect.width, c.rect.height,
-                                         PixelRect{0, 0, c.rect.width, c.rect.height});
+                                         PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
             const std::size_t before = now_.rays;
             const bool level = c.order->next_level(pixels_);
             if (level && !cast_level(*c.order, c.pass == 1)) {
@@ -108,6 +123,7 @@ class FrameRun {
         if (opt_.trace) opt_.trace->switch_to(s);
     }
     bool stopped() const { return stop_.load(std::memory_order_relaxed); }
+    bool masked() const { return opt_.screen_box && opt_.screen_mask; }
 
     // The clip of `rect` of `view`: its own frustum, from the volume's voxel space.
     ScreenClip region_clip(const FrameView& view, const PixelRect& rect) const {
@@ -136,6 +152,15 @@ class FrameRun {
             levels.refine = opt_.adaptive_refine;
         }
         if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
+        if (masked()) {
+            // Meta-cells of level i are 2^i cells at multiples of 2^i, so a node of level
+            // i - kLeafLog2 or above holds each one whole: an active meta-cell then lies inside an
+            // active node (its corners are in the node's range), and the mask stays conservative.
+            const int finest = std::max(0, levels.max_level - OctreeShape::kLeafLog2);
+            active_ = ex_.active_boxes(view.iso, kMaskNodes, finest);
+            frame_.mask_level = active_.level;
+            frame_.mask_nodes = active_.boxes.size();
+        }
         frame_.group_count = 0;
         extra_ = opt_.sample_at_rays;
         std::sort(extra_.begin(), extra_.end());
@@ -264,6 +289,7 @@ class FrameRun {
     TimelineSample now_;
     Clock::time_point start_;
     glm::mat4 view_inv_{1.0f};
+    ActiveBoxes active_;              // the screen mask's nodes at this frame's isovalue
     PixelRect rect_;                  // the region being cast
     RegionCursor* cursor_ = nullptr;  // its cursor
     PropagationParams params_;        // the options, with the clip of the region being cast
@@ -304,6 +330,7 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& regio
     result.rays_screen =
         static_cast<std::size_t>(region.width) * static_cast<std::size_t>(region.height);
     result.screen_rect = c.rect;
+    result.screen_pixels = c.pixels;
     return result;
 }
 

@@ -31,6 +31,9 @@ struct EngineOptions {
     IntersectMode intersect = IntersectMode::exact;
     PropagationParams propagation;
     bool screen_box = true;  // cast no ray outside the volume's projected bounding box
+    // Within the box, cast no ray whose pixel no active node of a coarse octree level covers
+    // (common/progressive/screen_mask.h): such a ray cannot meet the surface. Needs screen_box.
+    bool screen_mask = true;
     // Propagation enters only cells that may project into the region being cast (ScreenClip):
     // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
     // whole surface within their limits, as in the text.
@@ -75,6 +78,10 @@ struct FrameResult {
     Image final_image;  // colour and depth after the last ray (the convenience run() only; empty
                         // when interrupted)
     PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
+    std::size_t screen_pixels = 0;  // of them, the pixels to cast (the screen mask's, if on)
+    // The screen mask's octree level and active nodes (-1 and 0 without the mask).
+    int mask_level = -1;
+    std::size_t mask_nodes = 0;
 };
 
 // Mesa compiles its shader variants on the first draw (about 25 ms in llvmpipe). An interactive
@@ -85,12 +92,16 @@ void warm_up(Renderer& renderer);
 // A region's place in its progressive ray order, kept between the calls that cast it (the coarse
 // and the fine band of a wall job).
 struct RegionCursor {
-    PixelRect rect;  // the pixels to cast: the region clipped to the screen and the screen box
+    // The pixels to cast: the region clipped to the screen and the screen box, or with the screen
+    // mask, to the bounding box of the mask's pixels in it.
+    PixelRect rect;
+    std::vector<std::uint8_t> mask;   // rect-local; 0: never cast. Empty: every pixel of rect
+    std::size_t pixels = 0;           // pixels of rect to cast (the mask's count, or rect's area)
     std::unique_ptr<RayOrder> order;  // null before the first level and between passes
     int pass = 0;                     // 1: the exact second pass of approximate mode
     std::size_t rays = 0;             // cast so far
     std::size_t hits = 0;             // of them, rays that met the surface
-    bool done = false;                // every pixel of rect has had its ray
+    bool done = false;                // every pixel to cast has had its ray
 };
 
 class FrameRun;
@@ -142,7 +153,8 @@ class EngineFrame {
     EngineFrame(const EngineFrame&) = delete;
     EngineFrame& operator=(const EngineFrame&) = delete;
 
-    // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box.
+    // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box, and
+    // masked by the frame's screen mask (EngineOptions::screen_mask).
     RegionCursor cursor(const FrameView& view, const PixelRect& region) const;
     // Casts whole levels of `c` into `sink` until it has cast `ray_limit` more rays or is done;
     // `view` must be the one the cursor was made for. False when stopped (c stays where it was).

@@ -130,10 +130,9 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     }
     JobSink sink(*this, own ? nullptr : &help_sink_);
     in_own_job_ = own;
-    const std::size_t area = static_cast<std::size_t>(std::max(0, cursor.rect.width)) *
-                             static_cast<std::size_t>(std::max(0, cursor.rect.height));
+    // The coarse band is a share of the rays the region will cast (its masked pixels).
     const std::size_t limit =
-        job.band == Band::coarse ? std::max<std::size_t>(1, area / 16) : SIZE_MAX;
+        job.band == Band::coarse ? std::max<std::size_t>(1, cursor.pixels / 16) : SIZE_MAX;
     const TimelineSample before = frame_->now();
     out.completed = frame_->cast(view, cursor, sink, limit);
     in_own_job_ = false;

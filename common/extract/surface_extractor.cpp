@@ -31,6 +31,10 @@ class TypedExtractor final : public SurfaceExtractor {
     const OctreeShape& octree_shape() const override { return data_.octree.shape(); }
     std::size_t octree_bytes() const override { return data_.octree.bytes(); }
     int threads() const override { return static_cast<int>(workers_.size()); }
+    ActiveBoxes active_boxes(double iso, std::size_t max_boxes, int finest_level) const override {
+        const ActiveNodes a = active_nodes(data_.octree, iso, max_boxes, finest_level);
+        return to_boxes(data_.octree.shape(), a, data_.view.spacing);
+    }
 
     using SurfaceExtractor::begin_frame;
     void begin_frame(double iso, const ResolutionLevels& levels) override {

@@ -15,6 +15,7 @@
 #include "common/extract/group.h"
 #include "common/extract/propagator.h"
 #include "common/extract/raycaster.h"
+#include "common/volume/active_nodes.h"
 #include "common/volume/volume.h"
 
 namespace isowall {
@@ -31,6 +32,9 @@ class SurfaceExtractor {
     virtual std::size_t octree_bytes() const = 0;
     // The workers this extractor holds: its thread budget. The calls below run on the first.
     virtual int threads() const = 0;
+    // The active octree nodes at `iso` of the finest level, not below `finest_level`, that has at
+    // most `max_boxes` of them (active_nodes.h), as object-space boxes: where the surface may be.
+    virtual ActiveBoxes active_boxes(double iso, std::size_t max_boxes, int finest_level) const = 0;
 
     // Starts a frame at `iso` at full resolution: forgets every visited cell.
     void begin_frame(double iso) { begin_frame(iso, ResolutionLevels{}); }

@@ -41,6 +41,13 @@ PixelRect clip_to_screen(PixelRect r, int screen_width, int screen_height) {
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
+void check_mask_size(std::span<const std::uint8_t> mask, std::size_t expected) {
+    if (mask.size() != expected)
+        throw std::invalid_argument("ray order: mask: expected " + std::to_string(expected) +
+                                    " pixels (the whole screen), got " +
+                                    std::to_string(mask.size()));
+}
+
 void check_coverage_size(std::span<const std::uint8_t> covered, std::size_t expected) {
     if (covered.size() != expected)
         throw std::invalid_argument("ray order: coverage: expected " + std::to_string(expected) +
@@ -87,6 +94,21 @@ class ProgressiveOrder : public RayOrder {
           cast_(area_, false),
           max_side_(std::max(rect.width, rect.height)),
           last_refining_(area_ == 0 ? -1 : last_refining_level(max_side_)) {}
+
+    // Masked-out pixels are cast already: no level hands them out, and done() counts them.
+    void drop_masked(std::span<const std::uint8_t> mask) {
+        if (mask.empty()) return;
+        check_mask_size(mask, std::size_t(screen_width_) * std::size_t(screen_height_));
+        for (int ly = 0; ly < rect_.height; ++ly)
+            for (int lx = 0; lx < rect_.width; ++lx) {
+                const std::size_t s = std::size_t(rect_.y + ly) * std::size_t(screen_width_) +
+                                      std::size_t(rect_.x + lx);
+                const std::size_t i = std::size_t(ly) * std::size_t(rect_.width) + std::size_t(lx);
+                if (mask[s] != 0 || cast_[i]) continue;
+                cast_[i] = true;
+                ++cast_count_;
+            }
+    }
 
     bool next_level(std::vector<glm::ivec2>& out) override {
         out.clear();
@@ -209,11 +231,13 @@ class ProgressiveOrder : public RayOrder {
 }  // namespace
 
 std::unique_ptr<RayOrder> make_ray_order(RayOrderKind kind, int screen_width, int screen_height,
-                                         PixelRect rect) {
+                                         PixelRect rect, std::span<const std::uint8_t> mask) {
     screen_width = std::max(screen_width, 0);
     screen_height = std::max(screen_height, 0);
-    return std::make_unique<ProgressiveOrder>(kind, screen_width, screen_height,
-                                              clip_to_screen(rect, screen_width, screen_height));
+    auto order = std::make_unique<ProgressiveOrder>(
+        kind, screen_width, screen_height, clip_to_screen(rect, screen_width, screen_height));
+    order->drop_masked(mask);
+    return order;
 }
 
 double surface_piece_size(std::span<const std::uint8_t> covered, int screen_width, PixelRect rect) {

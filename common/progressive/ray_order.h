@@ -43,8 +43,12 @@ class RayOrder {
 
 // `rect` is the part of the screen worth casting (the volume's screen bounding box); it is
 // clipped to the screen, and no pixel outside it is ever handed out. An empty rect gives no level.
+// `mask` (optional; screen_width * screen_height, row-major) narrows it further: a pixel where it
+// is 0 is never handed out and counts as cast from the start (the screen mask: its ray cannot
+// meet the surface), so the levels are those of the whole rect with such pixels dropped, and a
+// rect masked out entirely gives no level.
 std::unique_ptr<RayOrder> make_ray_order(RayOrderKind kind, int screen_width, int screen_height,
-                                         PixelRect rect);
+                                         PixelRect rect, std::span<const std::uint8_t> mask = {});
 
 // The size in pixels of the first surface piece the dynamic grid sizes its grid from: sqrt of the
 // area of the 4-connected covered region (inside `rect`) holding the first covered pixel in
