@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
 
+#include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
 #include "common/progressive/screen_mask.h"
 
@@ -23,13 +24,6 @@ constexpr std::size_t kMaskNodes = 4096;
 
 double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-PixelRect intersect(const PixelRect& a, const PixelRect& b) {
-    const int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
-    const int x1 = std::min(a.x + a.width, b.x + b.width),
-              y1 = std::min(a.y + a.height, b.y + b.height);
-    return {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
 }
 
 }  // namespace

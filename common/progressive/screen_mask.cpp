@@ -3,18 +3,11 @@
 #include <algorithm>
 #include <utility>
 
+#include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
 
 namespace isowall {
 namespace {
-
-PixelRect clip(const PixelRect& a, const PixelRect& b) {
-    const int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
-    const int x1 = std::min(a.x + a.width, b.x + b.width);
-    const int y1 = std::min(a.y + a.height, b.y + b.height);
-    if (x1 <= x0 || y1 <= y0) return {};
-    return {x0, y0, x1 - x0, y1 - y0};
-}
 
 PixelRect bounding(std::span<const PixelRect> rects) {
     int x0 = rects.front().x, y0 = rects.front().y;
@@ -67,14 +60,14 @@ ScreenMask sweep(std::vector<PixelRect> starts, const PixelRect& area) {
 
 ScreenMask screen_mask(std::span<const Box3> boxes, const glm::mat4& view, const Frustum& frustum,
                        int width, int height, PixelRect region) {
-    const PixelRect area = clip(region, {0, 0, std::max(width, 0), std::max(height, 0)});
-    if (area.width == 0) return {};
+    const PixelRect area = intersect(region, {0, 0, std::max(width, 0), std::max(height, 0)});
+    if (is_empty(area)) return {};
     std::vector<PixelRect> rects;
     rects.reserve(boxes.size());
     for (const Box3& b : boxes) {
         if (b.empty()) continue;
-        const PixelRect r = clip(screen_box(b, view, frustum, width, height), area);
-        if (r.width > 0) rects.push_back(r);
+        const PixelRect r = intersect(screen_box(b, view, frustum, width, height), area);
+        if (!is_empty(r)) rects.push_back(r);
     }
     if (rects.empty()) return {};
     const PixelRect box = bounding(rects);
