@@ -205,6 +205,25 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 }
 
 // The snapshots due at replayed sample `s`, staged in `batch`.
+// The progressive frame's final image against the full surface drawn in the same view (outside
+// the timings): 1 and 100% at full resolution, up to the renderers' ties; below that, what
+// adaptive resolution's meta-cells change on screen.
+void print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                        const Image& final_image) {
+    Stopwatch sw;
+    const Mesh mesh = ex.extract_full(fv.iso);
+    Image full;
+    renderer.resize(fv.width, fv.height);
+    renderer.clear();
+    renderer.draw(mesh, fv.camera.view(), fv.frustum.matrix());
+    renderer.read_back(full);
+    const Correctness c = measure_correctness(final_image, full);
+    std::printf(
+        "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%% (%.3f s, "
+        "not part of the timings)\n",
+        mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels, sw.seconds());
+}
+
 void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Image& img,
                      std::vector<bool>& c_done, std::vector<bool>& r_done, OutputFiles& batch) {
     for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
@@ -255,6 +274,8 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     if (fr.mask_level >= 0)
         std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",
                     fr.mask_nodes, fr.mask_level, fr.screen_pixels);
+
+    if (o.against_full) print_against_full(ex, renderer, fv, fr.final_image);
 
     Stopwatch sw;
     write_image(batch, o.out, fr.final_image);

@@ -37,6 +37,7 @@ struct RenderOptions {
     std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)
     std::vector<std::size_t> snapshot_rays;
     bool no_measure = false;
+    bool against_full = false;  // also measure the final image against the full surface's
     bool quiet = false;
 };
 

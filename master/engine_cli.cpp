@@ -48,6 +48,15 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
                    "Largest meta-cell level i with --adaptive")
         ->transform(number_in({1, double(kMaxMetaLevel), false, true}))
         ->capture_default_str();
+    app.add_option("--adaptive-pixels", e.adaptive_pixels,
+                   "With --adaptive: take a meta-cell where it projects below this many pixels "
+                   "(1: the text's rule; 2: triangles of about a pixel, for volumes finer than "
+                   "the screen)")
+        ->transform(number_in(limits::kMetaCellPixels))
+        ->capture_default_str();
+    app.add_flag("--no-adaptive-refine", e.no_adaptive_refine,
+                 "With --adaptive: never draw a meta-cell again at full resolution where a ray "
+                 "sees the fine surface its triangles miss (the text's distance rule alone)");
 }
 
 EngineOptions to_engine_options(const EngineCli& c) {
@@ -75,6 +84,8 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.screen_mask = !c.no_screen_mask;
     e.adaptive = c.adaptive;
     e.adaptive_max_level = c.adaptive_max_level;
+    e.adaptive_pixels = c.adaptive_pixels;
+    e.adaptive_refine = !c.no_adaptive_refine;
     return e;
 }
 

@@ -20,6 +20,8 @@ struct EngineCli {
     bool no_screen_mask = false;
     bool adaptive = false;
     int adaptive_max_level = 3;
+    float adaptive_pixels = 1.0f;
+    bool no_adaptive_refine = false;
 };
 
 void add_engine_options(CLI::App& app, EngineCli& e);

@@ -61,6 +61,10 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
         ->transform(number_in(limits::kRayCount));
     re_cmd->add_flag("--no-measure", re.no_measure,
                      "Skip the replay that measures correctness against the final image");
+    re_cmd->add_flag("--against-full", re.against_full,
+                     "After the progressive frame, extract and draw the full surface (not timed) "
+                     "and print both correctness measures of the final image against it: what "
+                     "adaptive resolution and other shortcuts cost in the image");
     re_cmd->add_flag("--quiet,-q", re.quiet, "No progress lines while casting");
 
     return re_cmd;

@@ -141,8 +141,9 @@ class FrameRun {
         } else if (opt_.adaptive) {
             // D[] depends on the eye, the frustum and the pixel size only: once per frame (every
             // tile of a wall has the same pixel size, so one frame serves all of them).
-            levels = resolution_levels(view.camera, view.frustum, view.height,
-                                       ex_.volume().spacing(), opt_.adaptive_max_level);
+            levels =
+                resolution_levels(view.camera, view.frustum, view.height, ex_.volume().spacing(),
+                                  opt_.adaptive_max_level, opt_.adaptive_pixels);
             levels.refine = opt_.adaptive_refine;
         }
         if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);

@@ -46,6 +46,9 @@ struct EngineOptions {
     bool adaptive = false;
     int adaptive_max_level = kMaxMetaLevel;
     bool adaptive_refine = true;
+    // The projected size, in pixels, below which a meta-cell is taken (resolution_levels): 1 is
+    // the text's rule; 2 keeps triangles about a pixel on volumes finer than the screen.
+    float adaptive_pixels = 1.0f;
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;

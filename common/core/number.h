@@ -35,6 +35,9 @@ inline constexpr NumberRange kRayCount{0, 9007199254740992.0, false, true};  // 
 inline constexpr NumberRange kCutoffDeg{0, 180, true};
 inline constexpr NumberRange kFoldbackDeg{0, 180};
 inline constexpr NumberRange kCellCount{1, 2147483647.0, false, true};
+// --adaptive-pixels: a meta-cell's projected size target; past 64 px a meta-cell of 8 cells
+// would stand for a region the size of an icon.
+inline constexpr NumberRange kMetaCellPixels{0, 64, true};
 }  // namespace limits
 
 // The finite number `text` spells, all of it (decimal or exponent form, an optional sign), or

@@ -6,13 +6,14 @@
 namespace isowall {
 
 ResolutionLevels resolution_levels(const Camera& camera, const Frustum& frustum, int height_px,
-                                   glm::vec3 spacing, int max_level) {
+                                   glm::vec3 spacing, int max_level, float pixels) {
     ResolutionLevels r;
     r.eye = camera.eye;
     r.max_level = std::clamp(max_level, 0, kMaxMetaLevel);
-    if (height_px <= 0 || !(frustum.height() > 0)) return r;  // no pixels: nothing to coarsen
+    if (height_px <= 0 || !(frustum.height() > 0) || !(pixels > 0))
+        return r;  // no pixels: nothing to coarsen
     const float s_max = std::max({spacing.x, spacing.y, spacing.z});
-    const float px = frustum.height() / static_cast<float>(height_px);
+    const float px = pixels * frustum.height() / static_cast<float>(height_px);
     for (int i = 0; i <= kMaxMetaLevel; ++i) {
         const float size = std::ldexp(s_max, i);
         float& d = r.d[static_cast<std::size_t>(i)];

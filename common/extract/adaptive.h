@@ -80,8 +80,13 @@ struct ResolutionLevels {
 //   orthographic: one pixel is frustum height / height_px object units at every distance, so D[i]
 //                 is 0 when 2^i * s_max is less than that, else +inf.
 // A tile's sub-frustum with the tile's height gives the same pixel size as the full screen.
+// `pixels` is the projected size below which a meta-cell is taken: 1 is the text's rule (a
+// meta-cell smaller than a pixel, so its triangles are smaller still); 2 lets a meta-cell reach
+// two pixels, so that its triangles are about a pixel and a volume with more voxels than the
+// screen has pixels draws about as many triangles as one matched to the screen (issue 10).
 ResolutionLevels resolution_levels(const Camera& camera, const Frustum& frustum, int height_px,
-                                   glm::vec3 spacing, int max_level = kMaxMetaLevel);
+                                   glm::vec3 spacing, int max_level = kMaxMetaLevel,
+                                   float pixels = 1.0f);
 
 std::ostream& operator<<(std::ostream& os, const ResolutionLevels& r);
 

@@ -12,10 +12,11 @@
 //                      g_stats); they are merged where they are read.
 //
 // The race, where it will happen: today one worker runs at a time. Two workers propagating at
-// once could both take one cell, since VisitedCells::insert reads and then writes a word of the
-// bitset, and both could refine one meta-cell through FrameState::claim_refinement. Before a
-// second worker runs, both must become atomic claims (a fetch_or on the word, a concurrent set),
-// or the volume be split between workers so that their passes never meet.
+// once could both take one cell, since VisitedCells::insert reads and then writes a slot of a
+// page (and may add the page), and both could refine one meta-cell through
+// FrameState::claim_refinement. Before a second worker runs, both must become atomic claims (a
+// fetch_or on the word, a concurrent set), or the volume be split between workers so that their
+// passes never meet.
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -64,6 +65,8 @@ struct ExtractionData {
     }
 };
 
+static_assert(VisitedCells::kLevels == kMaxMetaLevel + 1);
+
 struct FrameState {
     explicit FrameState(glm::ivec3 cell_dims) : visited(cell_dims) {}
 
@@ -78,6 +81,15 @@ struct FrameState {
     // now on it is.
     bool claim_refinement(glm::ivec3 unit) {
         return refined.find_or_insert(visited.index(unit)).second;
+    }
+    // Whether the unit (cell or meta-cell) that holds `cell` this frame was taken, and by whom.
+    bool unit_taken(glm::ivec3 cell) const {
+        const int level = resolution.level_of(cell);
+        return visited.contains(cell & ~((1 << level) - 1), level);
+    }
+    std::uint32_t unit_group(glm::ivec3 cell) const {
+        const int level = resolution.level_of(cell);
+        return visited.group_of(cell & ~((1 << level) - 1), level);
     }
 
     double iso = 0;

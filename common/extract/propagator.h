@@ -11,9 +11,9 @@
 // With a ResolutionMap (chapter 2.1.3) a pass runs at the level of its seed's unit: over meta-cells
 // of that level (face neighbours at stride 2^level, active by their corner signs), and it stops at
 // the resolution boundary: a neighbour that belongs to a unit of another level is not entered.
-// Every cell a meta-cell covers is marked visited with the pass's group id, so no ray seeds inside
-// it again and every visited cell is in exactly one group (units are disjoint, so a unit is either
-// wholly visited or not at all, and testing its first cell is enough).
+// A unit is marked visited at its first cell with the pass's group id: units are disjoint, so a
+// unit is either wholly visited or not at all, a ray's hit names the unit's first cell, and a
+// neighbour that is not the first cell of a unit of the pass's level is not entered anyway.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -107,6 +107,8 @@ class Propagator {
         };
         queue_.clear();
         queue_.push_back({seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed) : 0.0f});
+        double timed_s = 0;
+        std::size_t timed_units = 0;
         int taken = 1;
         const glm::ivec3 cells = visited.dims();
         while (!queue_.empty()) {
@@ -114,10 +116,17 @@ class Propagator {
             queue_.pop_front();
             g.cells.push_back(item.cell);
             if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
-            const auto t0 = std::chrono::steady_clock::now();
+            // Two clock reads cost about as much as a small cell's triangulation, so only one
+            // unit in kTimedEvery is timed and the pass's extraction time is scaled from them.
+            const bool timed = (g.cells.size() - 1) % kTimedEvery == 0;
+            const auto t0 =
+                timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
             const int cs = triangulate(item.cell, level, iso, p, g.mesh);
-            extract_s_ +=
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (timed) {
+                timed_s +=
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                ++timed_units;
+            }
             for (int f = 0; f < 6; ++f) {
                 const int axis = f >> 1, side = f & 1;
                 // The face's four corners: those with bit `axis` equal to `side`.
@@ -128,7 +137,7 @@ class Propagator {
                 glm::ivec3 nb = item.cell;
                 nb[axis] += side ? stride : -stride;
                 if (nb[axis] < 0 || nb[axis] >= cells[axis]) continue;
-                if (visited.contains(nb)) continue;
+                if (visited.contains(nb, level)) continue;
                 if (resolution_.max_level() > 0 && resolution_.level_of(nb) != level)
                     continue;  // the resolution boundary
                 if (p.clip.active && !p.clip.may_touch(glm::vec3(nb) + half, stride)) continue;
@@ -147,6 +156,9 @@ class Propagator {
                 queue_.push_back({nb, max_angle});
             }
         }
+        if (timed_units > 0)
+            extract_s_ =
+                timed_s * static_cast<double>(g.cells.size()) / static_cast<double>(timed_units);
         return g;
     }
 
@@ -171,18 +183,14 @@ class Propagator {
         return g;
     }
 
-    // Marks every cell of the unit of `level` at `base`; false when it was taken already.
+    // Marks the unit of `level` at `base` (its first cell); false when it was taken already.
     static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
-        if (!visited.insert(base, group_id)) return false;
-        const int s = 1 << level;
-        for (int z = 0; z < s; ++z)
-            for (int y = 0; y < s; ++y)
-                for (int x = 0; x < s; ++x)
-                    if (x | y | z) visited.insert(base + glm::ivec3(x, y, z), group_id);
-        return true;
+        return visited.insert(base, group_id, level);
     }
 
   private:
+    static constexpr std::size_t kTimedEvery = 16;
+
     // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
     int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
         double corner[8];

@@ -47,8 +47,8 @@ class TypedExtractor final : public SurfaceExtractor {
     RayHit cast(const Ray& ray, IntersectMode mode, float t_max) override {
         return worker().cast(frame_, ray, mode, t_max);
     }
-    bool visited(glm::ivec3 cell) const override { return frame_.visited.contains(cell); }
-    std::uint32_t group_of(glm::ivec3 cell) override { return frame_.visited.group_of(cell); }
+    bool visited(glm::ivec3 cell) const override { return frame_.unit_taken(cell); }
+    std::uint32_t group_of(glm::ivec3 cell) override { return frame_.unit_group(cell); }
     std::size_t visited_count() const override { return frame_.visited.size(); }
 
     Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,

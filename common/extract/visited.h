@@ -1,57 +1,131 @@
 #pragma once
-// Cells taken by propagation in the current frame, with the id of the group that took each:
-// a bitset for the hot "visited?" test (one bit per cell: 7.6 MB for 512x512x234), and a hash map
-// only for the ids of the visited cells, which are few.
+// Units (cells, or meta-cells of adaptive resolution) taken by propagation in the current frame,
+// with the id of the group that took each. A unit of level L (2^L cells a side, its first cell a
+// multiple of 2^L) is recorded once, in the grid of level L at its first cell >> L: units
+// partition the volume (common/extract/adaptive.h), so whoever asks about a unit asks about its
+// first cell and level, and marking a meta-cell of 4^3 cells costs one write, not 64.
+//
+// Each level's grid is paged by bricks of 8^3 units: a table with one page number per brick
+// (4 bytes per 512 units: 31 MB for the cells of 2048x2048x936, an eighth of that per level up),
+// made on the level's first use, and a page of 512 group ids for each brick that holds a taken
+// unit. A lookup is two loads and no hash. Pages come from a pool kept across frames, and a new
+// frame forgets only the bricks the last one touched, where a bit per cell would clear 490 MB at
+// 2048^2 x 936 and a hash would cost a probe per cell.
+#include <array>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
-
-#include "common/extract/edge_cache.h"
 
 namespace isowall {
 
 class VisitedCells {
   public:
+    // Never a group id: the mark of a free slot.
+    static constexpr std::uint32_t kFree = ~std::uint32_t{0};
+    static constexpr int kLevels = 4;  // 0 .. kMaxMetaLevel (adaptive.h)
+
     explicit VisitedCells(glm::ivec3 cell_dims = glm::ivec3(0)) { reset(cell_dims); }
 
+    // Forgets every unit; `cell_dims` may differ from the last frame's.
     void reset(glm::ivec3 cell_dims) {
-        dims_ = cell_dims;
-        const std::size_t n = static_cast<std::size_t>(cell_dims.x) * cell_dims.y * cell_dims.z;
-        bits_.assign((n + 63) / 64, 0);
-        groups_.reset(1024);
+        if (cell_dims != dims_) {
+            dims_ = cell_dims;
+            for (int l = 0; l < kLevels; ++l) grids_[static_cast<std::size_t>(l)] = Grid{};
+        } else {
+            for (Grid& g : grids_) {
+                for (const std::size_t b : g.touched) g.pages[b] = kFree;
+                g.touched.clear();
+            }
+        }
+        used_ = 0;
         count_ = 0;
     }
+    // A cell's index in x-fastest order (a key for per-cell sets).
     std::uint64_t index(glm::ivec3 c) const {
         return (static_cast<std::uint64_t>(c.z) * static_cast<std::uint64_t>(dims_.y) +
                 static_cast<std::uint64_t>(c.y)) *
                    static_cast<std::uint64_t>(dims_.x) +
                static_cast<std::uint64_t>(c.x);
     }
-    bool contains(glm::ivec3 c) const {
-        const auto i = index(c);
-        return (bits_[i >> 6] >> (i & 63)) & 1;
-    }
-    // Marks c as taken by `group`; false when it was already taken.
-    bool insert(glm::ivec3 c, std::uint32_t group) {
-        const auto i = index(c);
-        std::uint64_t& word = bits_[i >> 6];
-        const std::uint64_t bit = std::uint64_t{1} << (i & 63);
-        if (word & bit) return false;
-        word |= bit;
-        *groups_.find_or_insert(i).first = group;
-        ++count_;
+    // Whether the unit of `level` whose first cell is `c` was taken.
+    bool contains(glm::ivec3 c, int level = 0) const { return slot(c, level) != kFree; }
+    // Marks the unit of `level` whose first cell is c as taken by `group` (not kFree); false when
+    // it was taken already.
+    bool insert(glm::ivec3 c, std::uint32_t group, int level = 0) {
+        Grid& g = grid(level);
+        if (g.pages.empty()) make(g, level);
+        const glm::ivec3 u = c >> level;
+        const std::size_t b = g.brick(u);
+        std::uint32_t& page = g.pages[b];
+        if (page == kFree) {
+            page = take_page();
+            g.touched.push_back(b);
+        }
+        std::uint32_t& id = (*pool_[page])[local(u)];
+        if (id != kFree) return false;
+        id = group;
+        count_ += std::size_t{1} << (3 * level);
         return true;
     }
-    // The group that took c (c must be visited).
-    std::uint32_t group_of(glm::ivec3 c) { return *groups_.find_or_insert(index(c)).first; }
+    // The group that took the unit of `level` whose first cell is c (it must be taken).
+    std::uint32_t group_of(glm::ivec3 c, int level = 0) const { return slot(c, level); }
+    // Cells covered by the taken units (a meta-cell counts all of its cells).
     std::size_t size() const { return count_; }
     glm::ivec3 dims() const { return dims_; }
 
   private:
-    glm::ivec3 dims_{0};
-    std::vector<std::uint64_t> bits_;
-    EdgeVertexCache groups_;
+    static constexpr int kLog2 = 3;
+    static constexpr int kSide = 1 << kLog2;
+    static constexpr std::size_t kPage = std::size_t{1} << (3 * kLog2);
+    using Page = std::array<std::uint32_t, kPage>;
+
+    struct Grid {
+        glm::ivec3 bricks{0};
+        std::vector<std::uint32_t> pages;  // per brick: its page in the pool, or kFree
+        std::vector<std::size_t> touched;  // bricks with a page, to forget at reset
+        std::size_t brick(glm::ivec3 u) const {
+            const glm::ivec3 b = u >> kLog2;
+            return (static_cast<std::size_t>(b.z) * static_cast<std::size_t>(bricks.y) +
+                    static_cast<std::size_t>(b.y)) *
+                       static_cast<std::size_t>(bricks.x) +
+                   static_cast<std::size_t>(b.x);
+        }
+    };
+
+    Grid& grid(int level) { return grids_[static_cast<std::size_t>(level)]; }
+    const Grid& grid(int level) const { return grids_[static_cast<std::size_t>(level)]; }
+    void make(Grid& g, int level) const {
+        const int side = kSide << level;  // cells a brick of this level spans
+        g.bricks = (glm::max(dims_, glm::ivec3(0)) + side - 1) / side;
+        g.pages.assign(static_cast<std::size_t>(g.bricks.x) * static_cast<std::size_t>(g.bricks.y) *
+                           static_cast<std::size_t>(g.bricks.z),
+                       kFree);
+    }
+    std::uint32_t take_page() {
+        if (used_ == pool_.size()) pool_.push_back(std::make_unique<Page>());
+        Page& p = *pool_[used_];
+        p.fill(kFree);
+        return static_cast<std::uint32_t>(used_++);
+    }
+    static std::size_t local(glm::ivec3 u) {
+        const glm::ivec3 l = u & (kSide - 1);
+        return static_cast<std::size_t>((l.z << (2 * kLog2)) | (l.y << kLog2) | l.x);
+    }
+    std::uint32_t slot(glm::ivec3 c, int level) const {
+        const Grid& g = grid(level);
+        if (g.pages.empty()) return kFree;
+        const glm::ivec3 u = c >> level;
+        const std::uint32_t page = g.pages[g.brick(u)];
+        return page == kFree ? kFree : (*pool_[page])[local(u)];
+    }
+
+    glm::ivec3 dims_{-1};
+    std::array<Grid, kLevels> grids_;
+    std::vector<std::unique_ptr<Page>> pool_;  // pages, kept across frames
+    std::size_t used_ = 0;                     // pages handed out this frame
     std::size_t count_ = 0;
 };
 

@@ -12,7 +12,7 @@
 
 namespace isowall {
 
-MappedFile::MappedFile(const std::filesystem::path& path) {
+MappedFile::MappedFile(const std::filesystem::path& path, bool populate) {
     // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever.
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) throw std::runtime_error(path.string() + ": cannot open: " + std::strerror(errno));
@@ -28,7 +28,12 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
     }
     size_ = static_cast<std::size_t>(st.st_size);
     if (size_ > 0) {
-        void* p = ::mmap(nullptr, size_, PROT_READ, MAP_SHARED, fd, 0);
+        const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+        const bool fits =
+            pages > 0 && page > 0 &&
+            size_ / static_cast<std::size_t>(page) <= static_cast<std::size_t>(pages) / 2;
+        const int flags = MAP_SHARED | (populate && fits ? MAP_POPULATE : 0);
+        void* p = ::mmap(nullptr, size_, PROT_READ, flags, fd, 0);
         if (p == MAP_FAILED) {
             const int err = errno;
             ::close(fd);

@@ -185,7 +185,7 @@ Volume load_nrrd(const fs::path& path) {
     if (text.data_file) {
         data_path = data_path_of(path, *text.data_file);
         check_regular_file(data_path, where, "data file");
-        data_file = MappedFile(data_path);
+        data_file = MappedFile(data_path, true);
     } else {
         if (!text.data_offset)
             throw InputError(where, "header",

@@ -277,7 +277,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
         std::error_code ec;
         if (std::filesystem::exists(file, ec)) {
             try {
-                auto mapped = std::make_shared<MappedFile>(file);
+                auto mapped = std::make_shared<MappedFile>(file, true);
                 const OctreeShape shape = OctreeShape::for_cells(v.cell_dims());
                 const std::size_t count = 2 * shape.node_count;
                 if (auto hit =

@@ -142,7 +142,7 @@ Volume load_raw(const fs::path& path, const RawSpec& spec) {
         if (!(spec.spacing[i] > 0) || !std::isfinite(spec.spacing[i]))
             throw InputError(where, "--spacing", "expected three positive numbers");
     const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
-    MappedFile file(path);
+    MappedFile file(path, true);
     check_size(where, file.size(), spec.header_bytes, need);
     Volume volume;
     if (spec.endian == host_endian() || voxel_size(spec.type) == 1) {
