@@ -35,6 +35,9 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
         ->capture_default_str();
     app.add_flag("--no-interpolant-cache", e.no_interpolant_cache,
                  "Do not share vertices between cells of a group");
+    app.add_flag("--facing-only", e.facing_only,
+                 "Visible-surface rule: a propagation pass does not go on from a cell where the "
+                 "surface faces away from the eye (later rays seed what it leaves out)");
     app.add_flag("--no-screen-box", e.no_screen_box,
                  "Cast rays over the whole screen, not only the volume's projected box (turns "
                  "the screen mask off too: it lies within the box)");
@@ -80,6 +83,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.propagation.cutoff_rad = glm::radians(c.cutoff_deg);
     e.propagation.foldback_rad = glm::radians(c.foldback_deg);
     e.propagation.interpolant_cache = !c.no_interpolant_cache;
+    e.propagation.facing_only = c.facing_only;
     e.screen_box = !c.no_screen_box;
     e.screen_mask = !c.no_screen_mask;
     e.adaptive = c.adaptive;

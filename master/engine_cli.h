@@ -22,6 +22,7 @@ struct EngineCli {
     int adaptive_max_level = 3;
     float adaptive_pixels = 1.0f;
     bool no_adaptive_refine = false;
+    bool facing_only = false;
 };
 
 void add_engine_options(CLI::App& app, EngineCli& e);

@@ -114,6 +114,28 @@ TEST_F(Cli, ExtractWritesThePhantomSurface) {
         << info.out;
 }
 
+// --against-full: the final image's C and final pixels against the full surface, printed after
+// the frame; full resolution matches it, a coarse level of detail does not quite.
+TEST_F(Cli, AgainstFullPrintsBothMeasures) {
+    auto c_of = [](const std::string& out) {
+        const auto at = out.find("against the full surface (");
+        if (at == std::string::npos) return -1.0;
+        const auto c = out.find("C = ", at);
+        return c == std::string::npos ? -1.0 : std::stod(out.substr(c + 4));
+    };
+    auto full =
+        run_isowall(dir_, "render --size 160x120 -q --no-measure --against-full --out a.png");
+    ASSERT_EQ(full.exit_code, 0) << full.err;
+    EXPECT_GE(c_of(full.out), 0.999) << full.out;
+    auto coarse = run_isowall(dir_,
+                              "render --size 160x120 -q --no-measure --against-full --adaptive "
+                              "--adaptive-pixels 8 --no-adaptive-refine --out b.png");
+    ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
+    const double c = c_of(coarse.out);
+    EXPECT_GT(c, 0.8) << coarse.out;
+    EXPECT_LT(c, c_of(full.out)) << coarse.out;
+}
+
 TEST_F(Cli, HelpListsTheSubcommands) {
     auto r = run_isowall(dir_, "--help");
     EXPECT_EQ(r.exit_code, 0);

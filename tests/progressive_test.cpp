@@ -30,12 +30,13 @@ std::string combo_name(const Combo& c) {
 class FinalImage : public ::testing::TestWithParam<Combo> {};
 
 void expect_final_matches_full(const Volume& volume, double iso, const Combo& combo, int w, int h,
-                               float yaw = 0) {
+                               float yaw = 0, bool facing_only = false) {
     auto ex = make_surface_extractor(volume);
     auto renderer = make_renderer("osmesa");
     EngineOptions opt;
     std::tie(opt.order, opt.intersect, opt.propagation.mode) = combo;
     opt.propagation.max_count = 2000;
+    opt.propagation.facing_only = facing_only;
     const FrameView fv = make_view(volume, w, h, iso, yaw, 10);
     ProgressiveEngine engine(*ex, *renderer, opt);
     FrameResult fr = engine.run(fv);
@@ -79,6 +80,51 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(PropagationMode::max_count,
                                          PropagationMode::cutoff_angle)),
     [](const auto& info) { return combo_name(info.param); });
+
+// The visible-surface rule (passes stop where the surface faces away) leaves the image alone:
+// what a pass leaves out is seeded by a later ray.
+TEST(FacingOnly, FinalImageMatchesTheFullSurface) {
+    const Volume p = make_phantom();
+    const auto data = test::shared_data_dir();
+    for (const IntersectMode mode : {IntersectMode::exact, IntersectMode::approximate})
+        for (const PropagationMode prop :
+             {PropagationMode::max_count, PropagationMode::cutoff_angle}) {
+            const Combo combo{RayOrderKind::dynamic_grid, mode, prop};
+            for (double iso : {kPhantomSkinIso, kPhantomBoneIso})
+                expect_final_matches_full(p, iso, combo, 240, 180, 25, true);
+            if (data)
+                expect_final_matches_full(load_nrrd(*data / "cthead.nhdr"), 600, combo, 200, 150, 0,
+                                          true);
+        }
+}
+
+TEST(FacingOnly, PassesTakeNoMoreCellsThanWithout) {
+    // From one seed, the rule can only leave cells out: the pass with it takes a subset.
+    const Volume p = make_phantom();
+    const FrameView fv = make_view(p, 240, 180, kPhantomSkinIso, 25, 10);
+    const Ray ray = pixel_ray(glm::inverse(fv.camera.view()), fv.frustum, fv.width, fv.height,
+                              {fv.width / 2, fv.height / 2});
+    std::vector<std::size_t> sizes;
+    std::vector<std::set<std::tuple<int, int, int>>> cells;
+    for (const bool facing : {false, true}) {
+        auto ex = make_surface_extractor(p);
+        ex->begin_frame(fv.iso);
+        const RayHit hit = ex->cast(ray, IntersectMode::exact);
+        ASSERT_TRUE(hit.found);
+        PropagationParams params;
+        params.max_count = 1 << 30;  // the whole connected surface, less what the rule stops
+        params.facing_only = facing;
+        const Group g = ex->propagate(hit.cell, 0, params, ray);
+        sizes.push_back(g.cells.size());
+        cells.emplace_back();
+        for (const glm::ivec3 c : g.cells) cells.back().insert({c.x, c.y, c.z});
+    }
+    std::cout << "one pass over the phantom's skin: " << sizes[0] << " cells, facing only "
+              << sizes[1] << "\n";
+    EXPECT_LT(sizes[1], sizes[0]);
+    EXPECT_GT(sizes[1] * 4, sizes[0]);  // the front of the surface is a good part of it
+    for (const auto& c : cells[1]) EXPECT_TRUE(cells[0].count(c));
+}
 
 TEST(Engine, FarViewMatchesTheFullSurface) {
     // Far from the eye the ray parameter is large: a walk that nudges t by a fixed amount stops

@@ -60,8 +60,24 @@ struct PropagationParams {
     float cutoff_rad = 0.0349f;  // 2 degrees
     float foldback_rad = 0.0087f;  // 0.5 degree
     bool interpolant_cache = true;
+    // Visible-surface rule (issue 10): a unit where the surface faces away from the eye (the
+    // gradient of its corners, against the direction to the eye, has the opposite sign to the
+    // seed's, which the seed ray saw from the front) is drawn but not propagated from. A pass
+    // then stops one unit past a silhouette instead of running on over the back of the surface;
+    // what it leaves out stays unvisited, so a later ray that sees it seeds it then.
+    bool facing_only = false;
     ScreenClip clip;  // inactive: no limit on screen
 };
+
+// The value gradient of a unit from its eight corners (differences across the unit, voxel space
+// per unit side): the direction the surface's normal takes, up to sign.
+inline glm::vec3 corner_gradient(const double corner[8]) {
+    double g[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < 8; ++k)
+        for (std::size_t a = 0; a < 3; ++a)
+            g[a] += mc::kCornerOffset[k][a] ? corner[k] : -corner[k];
+    return {static_cast<float>(g[0]), static_cast<float>(g[1]), static_cast<float>(g[2])};
+}
 
 // Without the interpolant cache every triangle gets its own three vertices (the "caching off"
 // row of Table 3.4).
@@ -109,6 +125,7 @@ class Propagator {
         queue_.push_back({seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed) : 0.0f});
         double timed_s = 0;
         std::size_t timed_units = 0;
+        float seed_facing = 0;  // the seed's side, for facing_only; 0 until the seed is seen
         int taken = 1;
         const glm::ivec3 cells = visited.dims();
         while (!queue_.empty()) {
@@ -121,11 +138,18 @@ class Propagator {
             const bool timed = (g.cells.size() - 1) % kTimedEvery == 0;
             const auto t0 =
                 timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
-            const int cs = triangulate(item.cell, level, iso, p, g.mesh);
+            double corner[8];
+            const int cs = triangulate(item.cell, level, iso, p, g.mesh, corner);
             if (timed) {
                 timed_s +=
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 ++timed_units;
+            }
+            if (p.facing_only) {
+                const glm::vec3 to_eye = eye - (glm::vec3(item.cell) + half);
+                const float facing = glm::dot(corner_gradient(corner), to_eye);
+                if (seed_facing == 0) seed_facing = facing;
+                if (facing * seed_facing < 0) continue;  // folds away: no neighbours from here
             }
             for (int f = 0; f < 6; ++f) {
                 const int axis = f >> 1, side = f & 1;
@@ -175,10 +199,11 @@ class Propagator {
         g.refinement = true;
         cache_.clear();
         const int s = 1 << level;
+        double corner[8];
         for (int z = 0; z < s; ++z)
             for (int y = 0; y < s; ++y)
                 for (int x = 0; x < s; ++x)
-                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh);
+                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh, corner);
         extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return g;
     }
@@ -192,8 +217,8 @@ class Propagator {
     static constexpr std::size_t kTimedEvery = 16;
 
     // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
-    int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh) {
-        double corner[8];
+    int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh,
+                    double corner[8]) {
         meta_cell_corners(v_, c, level, corner);
         const int cs = cell_case(corner, iso);
         if (p.interpolant_cache) {

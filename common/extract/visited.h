@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 namespace isowall {
