@@ -354,56 +354,6 @@ TEST(Adaptive, ApproximateSeedsAndAngleCutoffKeepTheImage) {
     EXPECT_GE(f.correctness.c, 0.98) << f;
 }
 
-TEST(Adaptive, APixelTargetScalesTheDistances) {
-    // D[i] is where a meta-cell projects to `pixels` pixels: twice the target, half the distance.
-    const Volume p = make_phantom();
-    const FrameView fv = front_view(p, 320, 240, 1.0f);
-    const ResolutionLevels one = resolution_levels(fv.camera, fv.frustum, fv.height, p.spacing());
-    const ResolutionLevels two =
-        resolution_levels(fv.camera, fv.frustum, fv.height, p.spacing(), kMaxMetaLevel, 2.0f);
-    for (std::size_t i = 0; i < one.d.size(); ++i)
-        EXPECT_NEAR(two.d[i], one.d[i] / 2, 1e-4f * one.d[i]) << "level " << i;
-    // No target (0 or below) is full resolution, as no pixels are.
-    for (const float d :
-         resolution_levels(fv.camera, fv.frustum, fv.height, p.spacing(), kMaxMetaLevel, 0.0f).d)
-        EXPECT_EQ(d, std::numeric_limits<float>::infinity());
-    // Orthographic: one pixel is frustum height / height units, the same for every distance.
-    Camera ortho = fv.camera;
-    ortho.projection = Projection::orthographic;
-    const Frustum f = ortho.frustum(4.0f / 3.0f);
-    const float px = f.height() / 240.0f;
-    const glm::vec3 unit(px * 0.9f);  // a cell is 0.9 px: level 1 is 1.8 px, level 2 is 3.6 px
-    const ResolutionLevels o2 = resolution_levels(ortho, f, 240, unit, kMaxMetaLevel, 2.0f);
-    EXPECT_EQ(o2.level_at(1.0f), 1) << o2;
-    const ResolutionLevels o4 = resolution_levels(ortho, f, 240, unit, kMaxMetaLevel, 4.0f);
-    EXPECT_EQ(o4.level_at(1.0f), 2) << o4;
-}
-
-TEST(Adaptive, ALargerPixelTargetTakesCoarserUnitsAndKeepsTheImage) {
-    // The front view at 240 x 180 is full resolution under the text's rule (see above). With a
-    // target of 2.5 px the phantom's cells (about 1.2 px) are taken two by two by two: a quarter
-    // of the triangles, the image within the far view's bound, with and without refinement.
-    const Volume p = make_phantom();
-    const FrameView fv = front_view(p, 240, 180, 1.0f);
-    const Figures one = run_frame(p, fv, adaptive_options());
-    EngineOptions opt = adaptive_options();
-    opt.adaptive_pixels = 2.5f;
-    const Figures refined = run_frame(p, fv, opt);
-    opt.adaptive_refine = false;
-    const Figures unrefined = run_frame(p, fv, opt);
-    std::cout << "front view 240x180, 2.5 px: "
-              << resolution_levels(fv.camera, fv.frustum, fv.height, p.spacing(), kMaxMetaLevel,
-                                   2.5f)
-              << "\n  refined:   " << refined << "\n  unrefined: " << unrefined
-              << "\n  1 px:      " << one << "\n";
-    EXPECT_EQ(one.coarse_groups(), 0u) << one;
-    EXPECT_GT(refined.coarse_groups(), 0u) << refined;
-    EXPECT_LT(unrefined.triangles * 2, one.triangles) << unrefined;
-    EXPECT_EQ(unrefined.refinements, 0u) << unrefined;
-    EXPECT_GE(refined.correctness.c, 0.95) << refined;
-    EXPECT_GE(unrefined.correctness.c, 0.95) << unrefined;
-}
-
 TEST(Adaptive, MaxLevelZeroIsFullResolution) {
     const Volume p = make_phantom();
     const FrameView fv = front_view(p, 160, 120, 0.5f);
