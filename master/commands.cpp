@@ -45,13 +45,14 @@ struct Timings {
     }
 };
 
-std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t) {
+std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
+                                          ThreadBudget budget = ThreadBudget::hardware()) {
     OctreeSource src;
     if (ov.file) src.volume_path = *ov.file;
     src.cache_dir = ov.cache_dir;
     OctreeStats st;
     Stopwatch sw;
-    auto ex = make_surface_extractor(ov.volume, src, &st);
+    auto ex = make_surface_extractor(ov.volume, src, &st, budget);
     t.octree = sw.seconds();
     const double share = double(ex->octree_bytes()) / double(ov.volume.bytes().size());
     if (st.from_cache) {
@@ -150,9 +151,14 @@ Camera render_camera(const RenderOptions& o, const Box3& bounds, float aspect) {
     return fit_depth_range(cam, bounds);
 }
 
+ThreadBudget render_threads(const RenderOptions& o) {
+    return o.threads > 0 ? ThreadBudget{o.threads} : ThreadBudget::hardware();
+}
+
 EngineOptions engine_options(const RenderOptions& o) {
     EngineOptions e = to_engine_options(o.engine);
     e.sample_at_rays = o.snapshot_rays;
+    e.threads = render_threads(o).usable();
     return e;
 }
 
@@ -259,16 +265,19 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     const TimelineSample& last = fr.timeline.back();
     t.frame = fr.elapsed_s;
     std::printf(
-        "progressive: %s order, %s intersection, %s: %zu rays (%.2f%% of the screen; box %dx%d) "
-        "in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
+        "progressive: %s order, %s intersection, %s, %d thread%s: %zu rays (%.2f%% of the screen; "
+        "box %dx%d) in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
         std::string(to_string(engine.options().order)).c_str(), o.engine.intersect.c_str(),
         o.engine.propagation == "angle"
             ? "cut-off angle"
             : ("max count " + std::to_string(o.engine.max_count)).c_str(),
-        fr.rays_cast, 100.0 * double(fr.rays_cast) / double(fr.rays_screen), fr.screen_rect.width,
+        std::min(engine.options().threads, ex.threads()),
+        std::min(engine.options().threads, ex.threads()) == 1 ? "" : "s", fr.rays_cast,
+        100.0 * double(fr.rays_cast) / double(fr.rays_screen), fr.screen_rect.width,
         fr.screen_rect.height, fr.elapsed_s, fr.groups.size(), last.triangles, last.cells_visited);
     std::printf(
-        "stages: intersection %.3f s | propagation %.3f s | extraction %.3f s | rendering %.3f s\n",
+        "stages (summed over threads): intersection %.3f s | propagation %.3f s | extraction "
+        "%.3f s | rendering %.3f s\n",
         last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
     if (fr.mask_level >= 0)
@@ -348,7 +357,7 @@ int run_render(const RenderOptions& o) {
     auto renderer = make_renderer(o.gl);
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
-    auto ex = prepare(ov, t);
+    auto ex = prepare(ov, t, render_threads(o));
     const double iso = checked_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);

@@ -61,6 +61,12 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
         ->transform(number_in(limits::kRayCount));
     re_cmd->add_flag("--no-measure", re.no_measure,
                      "Skip the replay that measures correctness against the final image");
+    re_cmd
+        ->add_option("--threads", re.threads,
+                     "Threads casting rays and propagating side by side (and building the "
+                     "octree); 0: every core of the machine")
+        ->transform(number_in({0, 1024, false, true}))
+        ->capture_default_str();
     re_cmd->add_flag("--against-full", re.against_full,
                      "After the progressive frame, extract and draw the full surface (not timed) "
                      "and print both correctness measures of the final image against it: what "

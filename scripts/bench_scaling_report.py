@@ -83,6 +83,20 @@ def times_table(results):
     return lines
 
 
+def engines_table(meta, results):
+    lines = ["| volume | engine | C=90% | C=99% | C=99.9% | every ray | triangles by C=99% | per covered px "
+             "| C of the final image against the full surface | its final px |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        for name, p in r.get("engines", {}).items():
+            per_px = p["triangles_c99"] / r["full"]["covered_px"] if p["triangles_c99"] and r["full"]["covered_px"] else None
+            lines.append(f"| {label(r)} | {name} | {fmt(p['c90'])} | {fmt(p['c99'])} | {fmt(p['c999'])} "
+                         f"| {fmt(p['every_ray_s'])} | {count(p['triangles_c99'])} | {fmt(per_px, 2)} "
+                         f"| {fmt(p.get('c_vs_full'), 4)} | {fmt(100 * p['final_px_vs_full'] if p.get('final_px_vs_full') is not None else None, 1)}% |")
+    names = "; ".join(f"{k}: `{v}`" for k, v in meta.get("engines", {}).items())
+    return [f"Engines ({names}):", "", *lines]
+
+
 def pixels_table(results):
     lines = ["| volume | progressive final image | --full | peer hit pixels | peer vs --full |",
              "|---|---|---|---|---|"]
@@ -100,7 +114,9 @@ def report(meta, results, checks):
     lines = [f"# Scaling (issue 10): {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
              f"Measured {meta['date']} on {meta['cores']} cores (load average {load} over 1, 5, 15 min "
              f"at the end); fastest of {meta['runs']} run(s) each; seconds. C is the share of final "
-             f"pixels; the peer uses {meta['threads']} threads.", "", *times_table(results), "",
+             f"pixels; the peer uses {meta['threads']} threads. The progressive columns and the "
+             f"targets are the first engine's ({next(iter(meta.get('engines', {'': ''})))}).", "",
+             *times_table(results), "", *engines_table(meta, results), "",
              "Covered pixels (the same view in each):", "", *pixels_table(results), "",
              "Targets:", "", "| target | volume | figure | limit | verdict |", "|---|---|---|---|---|"]
     for c in checks:
@@ -117,13 +133,15 @@ def plot(meta, results, path):
     import matplotlib.ticker
 
     x = [r["voxels"] for r in results]
+    extra = [(f"C = 99%, {name}", (lambda n: lambda r: r["engines"][n]["c99"])(name), ":.")
+             for name in list(meta.get("engines", {}))[1:]]
     series = [("C = 90%", lambda r: r["progressive"]["c90"], "-o"),
               ("C = 99%", lambda r: r["progressive"]["c99"], "-o"),
               ("C = 99.9%", lambda r: r["progressive"]["c999"], "-o"),
               ("every ray", lambda r: r["progressive"]["every_ray_s"], "-s"),
               ("our --full", lambda r: r["full"]["full_s"], "--^"),
               ("FE + Embree", lambda r: r["peer"].get("total_s"), "--v"),
-              ("FE alone", lambda r: r["peer"].get("fe_s"), ":v")]
+              ("FE alone", lambda r: r["peer"].get("fe_s"), ":v")] + extra
     fig, ax = plt.subplots(figsize=(7.5, 5))
     for name, get, style in series:
         pts = [(xi, get(r)) for xi, r in zip(x, results) if get(r)]
@@ -140,7 +158,9 @@ def plot(meta, results, path):
     ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel("volume (voxels)")
     ax.set_ylabel("seconds")
-    ax.set_title(f"iso {meta['iso']:g}, {meta['size']}: time against voxels (load avg {meta['load_average'][0]:g})")
+    first = next(iter(meta.get("engines", {"progressive": ""})))
+    ax.set_title(f"iso {meta['iso']:g}, {meta['size']}, C from {first}: time against voxels "
+                 f"(load avg {meta['load_average'][0]:g})", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

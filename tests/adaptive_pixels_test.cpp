@@ -63,8 +63,8 @@ FrameFigures run_frame(const Volume& volume, const FrameView& fv, float pixels, 
     }
     r.c = measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv)).c;
     std::cout << "  " << pixels << " px" << (refine ? "" : ", unrefined") << ": C " << r.c << ", "
-              << r.triangles << " triangles, " << r.coarse_units << " meta-cells, "
-              << r.refinements << " refinements\n";
+              << r.triangles << " triangles, " << r.coarse_units << " meta-cells, " << r.refinements
+              << " refinements\n";
     return r;
 }
 

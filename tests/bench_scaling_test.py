@@ -51,6 +51,12 @@ class BenchScaling(unittest.TestCase):
                     # Same view, same surface: hit pixels within a fraction of a percent.
                     self.assertLess(abs(s["peer"]["hit_px"] - full["covered_px"]), 0.005 * full["covered_px"])
                     self.assertEqual(s["peer"]["triangles"], full["triangles"])
+                # Every configuration ran, and each final image was measured against the full surface.
+                self.assertEqual(list(s["engines"]), ["lod-facing", "full-res", "facing", "lod", "lod-refine"])
+                self.assertEqual(prog, s["engines"]["lod-facing"])
+                self.assertGreater(s["engines"]["full-res"]["c_vs_full"], 0.99, s)
+                for e in s["engines"].values():
+                    self.assertGreater(e["c_vs_full"], 0.9, e)
             names = {c["target"] for c in res["targets"]}
             self.assertIn("triangles by C=99% per covered pixel", names)
             self.assertIn("every ray / our --full", names)
@@ -60,6 +66,7 @@ class BenchScaling(unittest.TestCase):
             self.assertIn("| 103x94x161 | 1.56 M |", md)
             self.assertIn("| 52x47x80 |", md)
             self.assertIn("Targets:", md)
+            self.assertIn("| 103x94x161 | lod-refine |", md)
             self.assertTrue("holds" in md or "MISSED" in md)
             self.assertIn(md.splitlines()[0], p.stdout)
             with open(os.path.join(out, "scaling.png"), "rb") as f:
@@ -70,6 +77,7 @@ class BenchScaling(unittest.TestCase):
             for args, field in [(["--scales", "0"], "--scales"), (["--scales", "1,x"], "--scales"),
                                 (["--size", "320"], "--size"), (["--runs", "0"], "--runs"),
                                 (["--iso", "nan"], "--iso"), (["--runs", "x"], "--runs"),
+                                (["--engines", "lod,fast"], "--engines"), (["--engines", "lod,lod"], "--engines"),
                                 (["--volume", "/nonexistent.nhdr"], "--volume"),
                                 (["--build", "/nonexistent"], "--build")]:
                 p = subprocess.run([sys.executable, SCRIPT, "--out", out, *(["--build", BUILD] if "--build" not in args else []), *args],

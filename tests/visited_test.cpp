@@ -2,13 +2,17 @@
 // a new frame that forgets exactly what the last one took.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <thread>
+#include <vector>
+
 #include "common/extract/visited.h"
 
 namespace isowall {
 namespace {
 
 TEST(Visited, UnitsOfEachLevelAreTakenOnceAndCountTheirCells) {
-    VisitedCells v({100, 60, 37});
+    VisitedCells v({100, 60, 37}, 3);
     EXPECT_FALSE(v.contains({0, 0, 0}));
     EXPECT_TRUE(v.insert({3, 4, 5}, 7));
     EXPECT_FALSE(v.insert({3, 4, 5}, 8));  // taken already: the first group keeps it
@@ -28,7 +32,7 @@ TEST(Visited, UnitsOfEachLevelAreTakenOnceAndCountTheirCells) {
 }
 
 TEST(Visited, ResetForgetsEveryUnitAndPagesAreReused) {
-    VisitedCells v({64, 64, 64});
+    VisitedCells v({64, 64, 64}, 3);
     for (int round = 0; round < 3; ++round) {
         // Different units each round; nothing of the last round may show through.
         for (int i = 0; i < 64; ++i) {
@@ -39,7 +43,7 @@ TEST(Visited, ResetForgetsEveryUnitAndPagesAreReused) {
         }
         EXPECT_TRUE(v.insert({8 * round, 0, 0}, 5, 3));
         EXPECT_EQ(v.size(), 64u + 512u);
-        v.reset({64, 64, 64});
+        v.reset({64, 64, 64}, 3);
         EXPECT_EQ(v.size(), 0u);
         for (int i = 0; i < 64; ++i)
             EXPECT_FALSE(v.contains({i, (i * 7 + round) % 64, (i * 13 + 3 * round) % 64}));
@@ -51,6 +55,36 @@ TEST(Visited, ResetForgetsEveryUnitAndPagesAreReused) {
     EXPECT_TRUE(v.insert({8, 8, 8}, 1));
     EXPECT_TRUE(v.contains({8, 8, 8}));
     EXPECT_EQ(v.index({8, 8, 8}), 8u * 81u + 8u * 9u + 8u);
+}
+
+TEST(Visited, ThreadsClaimEachUnitExactlyOnce) {
+    // Four threads claim every unit of levels 0 and 1 of a 40^3 grid, each in its own order:
+    // every unit goes to exactly one of them, and the count is the cells.
+    const glm::ivec3 dims(40, 40, 40);
+    VisitedCells v(dims, 1);
+    constexpr int kThreads = 4;
+    std::vector<std::size_t> won(kThreads, 0);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            for (int level = 0; level <= 1; ++level) {
+                const int n = 40 >> level;
+                for (int k = 0; k < n * n * n; ++k) {
+                    const int i = (t % 2 == 0) ? k : n * n * n - 1 - k;  // two orders meet midway
+                    const glm::ivec3 u(i % n, (i / n) % n, i / (n * n));
+                    // Level 1 units sit in the other half of the volume in z, clear of level 0's.
+                    if (level == 1 && u.z < 10) continue;
+                    if (level == 0 && u.z >= 20) continue;
+                    won[std::size_t(t)] += v.insert(u << level, std::uint32_t(t), level);
+                }
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    std::size_t total = 0;
+    for (const std::size_t w : won) total += w;
+    EXPECT_EQ(total, 40u * 40u * 20u + 20u * 20u * 10u);
+    EXPECT_EQ(v.size(), 40u * 40u * 20u + 20u * 20u * 10u * 8u);
+    for (int z = 0; z < 20; ++z) EXPECT_LT(v.group_of({3, 5, z}), std::uint32_t(kThreads));
 }
 
 }  // namespace

@@ -1,8 +1,15 @@
 #include "tile/progressive_engine.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <limits>
+#include <map>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
@@ -162,13 +169,24 @@ class FrameRun {
         stage(Stage::intersection);
     }
 
+    int workers() const {
+        const int have = ex_.threads();
+        const int want = opt_.threads <= 0 ? have : std::min(opt_.threads, have);
+        return sink_->wants_seen() ? 1 : std::max(1, want);
+    }
+
     bool cast_level(RayOrder& order, bool second_pass) {
         const IntersectMode mode = second_pass ? IntersectMode::exact : opt_.intersect;
         now_.level = order.level();
-        for (const glm::ivec2 px : pixels_) {
-            if (stopped()) return false;
-            if (!cast_ray(px + glm::ivec2(rect_.x, rect_.y), mode, second_pass)) return false;
-            record(false);
+        const int n = workers();
+        if (n > 1 && pixels_.size() > 1) {
+            if (!cast_level_parallel(n, mode, second_pass)) return false;
+        } else {
+            for (const glm::ivec2 px : pixels_) {
+                if (stopped()) return false;
+                if (!cast_ray(px + glm::ivec2(rect_.x, rect_.y), mode, second_pass)) return false;
+                record(false);
+            }
         }
         if (order.wants_coverage()) give_coverage(order);
         record(true);
@@ -194,10 +212,141 @@ class FrameRun {
         return seed(hit, ray);
     }
 
+    // A group found by a worker of a parallel level, waiting for the drawing thread.
+    struct Found {
+        Group group;
+        double pass_s = 0, extract_s = 0;
+    };
+    // What one worker of a parallel level did, merged when the level ends.
+    struct WorkerTally {
+        std::size_t rays = 0, hits = 0;
+        double intersect_s = 0;
+    };
+    // One level over `n` threads: each takes the next pixel of the level, casts its ray and
+    // propagates from an unvisited hit (the units' claims keep passes apart); this thread is
+    // worker 0 and, between its own rays, draws the groups found so far in the order of their
+    // ids. False when the frame was stopped.
+    bool cast_level_parallel(int n, IntersectMode mode, bool second_pass) {
+        std::atomic<std::size_t> next_pixel{0}, rays{0};
+        std::atomic<std::uint32_t> next_id{opt_.first_group_id + ids_used_};
+        std::uint32_t next_drawn = next_id.load();
+        std::mutex lock;
+        std::condition_variable wake;
+        std::map<std::uint32_t, Found> ready;
+        int running = n - 1;
+        std::exception_ptr failure;
+        std::vector<WorkerTally> tally(static_cast<std::size_t>(n));
+        const std::size_t rays_before = now_.rays;
+        const glm::ivec2 origin(rect_.x, rect_.y);
+
+        // Casts the next pixel's ray (and propagates); false when the level has no more.
+        auto step = [&](int w) {
+            const std::size_t i = next_pixel.fetch_add(1, std::memory_order_relaxed);
+            if (i >= pixels_.size() || stopped()) return false;
+            WorkerTally& t = tally[static_cast<std::size_t>(w)];
+            const Ray ray = pixel_ray(view_inv_, view_->frustum, view_->width, view_->height,
+                                      pixels_[i] + origin);
+            const auto t0 = Clock::now();
+            const RayHit hit = ex_.cast_on(w, ray, mode, std::numeric_limits<float>::max());
+            t.intersect_s += since(t0);
+            ++t.rays;
+            rays.fetch_add(1, std::memory_order_relaxed);
+            if (!hit.found) return true;
+            ++t.hits;
+            if (!hit.refine && ex_.visited(hit.cell)) return true;
+            const std::uint32_t id = next_id.fetch_add(1, std::memory_order_relaxed);
+            Found f;
+            const auto t1 = Clock::now();
+            f.group = hit.refine ? ex_.refine_on(w, hit.cell, hit.level, id, opt_.propagation)
+                                 : ex_.propagate_on(w, hit.cell, id, params_, ray, interrupted_);
+            f.pass_s = since(t1);
+            f.extract_s = ex_.last_extract_s_on(w);
+            {
+                const std::lock_guard<std::mutex> hold(lock);
+                ready.emplace(id, std::move(f));
+            }
+            wake.notify_all();
+            return true;
+        };
+        // Draws the groups whose turn has come; with `all`, waits for the other workers first.
+        auto draw_ready = [&](bool all) {
+            std::unique_lock<std::mutex> hold(lock);
+            if (all) wake.wait(hold, [&] { return running == 0; });
+            while (!ready.empty() && (ready.begin()->first == next_drawn || all)) {
+                Found f = std::move(ready.begin()->second);
+                next_drawn = ready.begin()->first + 1;
+                ready.erase(ready.begin());
+                hold.unlock();
+                add_found(f);
+                hold.lock();
+            }
+        };
+
+        std::vector<std::thread> others;
+        others.reserve(static_cast<std::size_t>(n - 1));
+        for (int w = 1; w < n; ++w)
+            others.emplace_back([&, w] {
+                try {
+                    while (step(w)) {
+                    }
+                } catch (...) {
+                    const std::lock_guard<std::mutex> hold(lock);
+                    if (!failure) failure = std::current_exception();
+                    next_pixel.store(pixels_.size());  // the others stop too
+                }
+                {
+                    const std::lock_guard<std::mutex> hold(lock);
+                    --running;
+                }
+                wake.notify_all();
+            });
+        try {
+            for (;;) {
+                const bool more = step(0);
+                draw_ready(false);
+                now_.rays = rays_before + rays.load(std::memory_order_relaxed);
+                if (!more) break;
+                record(false);
+            }
+        } catch (...) {
+            const std::lock_guard<std::mutex> hold(lock);
+            if (!failure) failure = std::current_exception();
+            next_pixel.store(pixels_.size());
+        }
+        for (std::thread& t : others) t.join();
+        draw_ready(true);
+        if (failure) std::rethrow_exception(failure);
+        ids_used_ = next_id.load() - opt_.first_group_id;
+        for (const WorkerTally& t : tally) {
+            now_.t_intersect_s += t.intersect_s;
+            cursor_->hits += t.hits;
+            if (second_pass) frame_.rays_second_pass += t.rays;
+        }
+        now_.rays = rays_before + rays.load();
+        return !stopped();
+    }
+
+    // Hands a worker's group to the sink; a pass whose seed another worker took first found no
+    // cell, and a refinement done already has no triangle: neither is a group.
+    void add_found(const Found& f) {
+        const Group& g = f.group;
+        now_.t_extract_s += f.extract_s;
+        now_.t_propagate_s += f.pass_s - f.extract_s;
+        if (g.refinement ? g.mesh.indices.empty() : g.cells.empty()) return;
+        stage(Stage::render);
+        const auto t1 = Clock::now();
+        sink_->add(g);
+        now_.t_render_s += since(t1);
+        dirty_ = true;
+        now_.triangles += g.mesh.triangle_count();
+        ++frame_.group_count;
+        stage(Stage::intersection);
+    }
+
     bool seed(const RayHit& hit, const Ray& ray) {
         stage(Stage::propagation);
         const auto t0 = Clock::now();
-        const auto id = opt_.first_group_id + static_cast<std::uint32_t>(frame_.group_count);
+        const auto id = opt_.first_group_id + ids_used_;
         Group g = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
                              : ex_.propagate(hit.cell, id, params_, ray, interrupted_);
         const double pass_s = since(t0);
@@ -213,6 +362,7 @@ class FrameRun {
             dirty_ = true;
             now_.triangles += g.mesh.triangle_count();
             ++frame_.group_count;
+            ++ids_used_;
         }
         stage(Stage::intersection);
         return true;
@@ -294,6 +444,9 @@ class FrameRun {
     double last_sample_s_ = 0, last_progress_s_ = -1e9;
     double last_present_cpu_s_ = thread_cpu_seconds();
     bool dirty_ = false;  // groups added since the last present()
+    // Group ids handed out this frame, from opt_.first_group_id: the groups added, and with
+    // several threads also the passes dropped because another took their seed first.
+    std::uint32_t ids_used_ = 0;
     std::vector<glm::ivec2> pixels_;
     std::vector<std::uint8_t> covered_;
 };

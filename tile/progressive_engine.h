@@ -49,6 +49,13 @@ struct EngineOptions {
     // The projected size, in pixels, below which a meta-cell is taken (resolution_levels): 1 is
     // the text's rule; 2 keeps triangles about a pixel on volumes finer than the screen.
     float adaptive_pixels = 1.0f;
+    // Threads casting rays and propagating side by side over each ray-order level: at most the
+    // extractor's workers (its thread budget); 0: all of them. The calling thread is one of them
+    // and alone draws (the renderer's context is its own), taking the groups in the order of
+    // their ids. A sink that wants seen() gets one thread. With more than one, group ids may skip
+    // a number where two threads met one seed at once (the later pass finds it taken and is
+    // dropped), and the groups found differ from run to run; the final image does not.
+    int threads = 1;
     // Timeline sampling: after ray counts growing by this factor, and at least this often.
     double sample_ray_factor = 1.25;
     double sample_interval_s = 0.1;

@@ -11,15 +11,13 @@
 //                      Never shared, so its statistics need no lock either (Embree's per-thread
 //                      g_stats); they are merged where they are read.
 //
-// The race, where it will happen: today one worker runs at a time. Two workers propagating at
-// once could both take one cell, since VisitedCells::insert reads and then writes a slot of a
-// page (and may add the page), and both could refine one meta-cell through
-// FrameState::claim_refinement. Before a second worker runs, both must become atomic claims (a
-// fetch_or on the word, a concurrent set), or the volume be split between workers so that their
-// passes never meet.
+// Workers of one frame run side by side (the engine's --threads): each unit is claimed by a
+// compare-and-swap in VisitedCells::insert, so exactly one pass takes it, and a meta-cell's
+// refinement is claimed under FrameState's lock. Everything else a worker writes is its own.
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <mutex>
 
 #include "common/core/error.h"
 #include "common/core/ray.h"
@@ -74,12 +72,13 @@ struct FrameState {
     void begin(double frame_iso, const ResolutionMap& map, glm::ivec3 cell_dims) {
         iso = frame_iso;
         resolution = map;
-        visited.reset(cell_dims);
+        visited.reset(cell_dims, resolution.max_level());
         refined.reset(64);
     }
     // True when the meta-cell whose first cell is `unit` was not refined yet this frame; from
     // now on it is.
     bool claim_refinement(glm::ivec3 unit) {
+        const std::lock_guard<std::mutex> lock(refined_lock);
         return refined.find_or_insert(visited.index(unit)).second;
     }
     // Whether the unit (cell or meta-cell) that holds `cell` this frame was taken, and by whom.
@@ -96,6 +95,7 @@ struct FrameState {
     ResolutionMap resolution;  // default-constructed: full resolution
     VisitedCells visited;
     EdgeVertexCache refined{64};  // first cells of the meta-cells refined this frame
+    std::mutex refined_lock;      // workers claim refinements side by side
 };
 
 template <class T>

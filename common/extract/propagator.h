@@ -175,7 +175,8 @@ class Propagator {
                     if (a < item.max_angle - p.foldback_rad) continue;  // folds back
                     max_angle = std::max(max_angle, a);
                 }
-                insert(visited, nb, level, group_id);
+                // Another thread's pass may have taken it since contains(): the claim decides.
+                if (!insert(visited, nb, level, group_id)) continue;
                 ++taken;
                 queue_.push_back({nb, max_angle});
             }

@@ -44,24 +44,26 @@ class TypedExtractor final : public SurfaceExtractor {
     }
     double iso() const override { return frame_.iso; }
 
-    RayHit cast(const Ray& ray, IntersectMode mode, float t_max) override {
-        return worker().cast(frame_, ray, mode, t_max);
+    RayHit cast_on(int w, const Ray& ray, IntersectMode mode, float t_max) override {
+        return worker(w).cast(frame_, ray, mode, t_max);
     }
     bool visited(glm::ivec3 cell) const override { return frame_.unit_taken(cell); }
     std::uint32_t group_of(glm::ivec3 cell) override { return frame_.unit_group(cell); }
     std::size_t visited_count() const override { return frame_.visited.size(); }
 
-    Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
-                    const Ray& ray, const std::function<bool()>& interrupted) override {
-        return worker().propagate(frame_, seed, group_id, p, ray, interrupted);
+    Group propagate_on(int w, glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
+                       const Ray& ray, const std::function<bool()>& interrupted) override {
+        return worker(w).propagate(frame_, seed, group_id, p, ray, interrupted);
     }
 
-    Group refine(glm::ivec3 unit, int level, std::uint32_t group_id,
-                 const PropagationParams& p) override {
-        return worker().refine(frame_, unit, level, group_id, p);
+    Group refine_on(int w, glm::ivec3 unit, int level, std::uint32_t group_id,
+                    const PropagationParams& p) override {
+        return worker(w).refine(frame_, unit, level, group_id, p);
     }
 
-    double last_extract_s() const override { return workers_.front().last_extract_s(); }
+    double last_extract_s_on(int w) const override {
+        return workers_.at(static_cast<std::size_t>(w)).last_extract_s();
+    }
 
     Mesh extract_full(double iso, ExtractStats* stats) const override {
         return isowall::extract_full(data_.view, data_.octree, iso, stats);
@@ -76,7 +78,7 @@ class TypedExtractor final : public SurfaceExtractor {
     }
 
   private:
-    ExtractWorker<T>& worker() { return workers_.front(); }
+    ExtractWorker<T>& worker(int w) { return workers_.at(static_cast<std::size_t>(w)); }
 
     std::shared_ptr<const ExtractionData<T>> data_holder_;
     const ExtractionData<T>& data_;

@@ -30,7 +30,9 @@ class SurfaceExtractor {
     virtual double value_max() const = 0;
     virtual const OctreeShape& octree_shape() const = 0;
     virtual std::size_t octree_bytes() const = 0;
-    // The workers this extractor holds: its thread budget. The calls below run on the first.
+    // The workers this extractor holds: its thread budget. The calls below run on the first;
+    // their *_on forms run on worker `w` in [0, threads()), and different workers may run them
+    // at once within one frame (never begin_frame, mark_taken or share).
     virtual int threads() const = 0;
     // The active octree nodes at `iso` of the finest level, not below `finest_level`, that has at
     // most `max_boxes` of them (active_nodes.h), as object-space boxes: where the surface may be.
@@ -44,20 +46,32 @@ class SurfaceExtractor {
     virtual double iso() const = 0;
 
     // `ray` in object space; t is returned in the ray's own parameter.
-    virtual RayHit cast(const Ray& ray, IntersectMode mode,
-                        float t_max = std::numeric_limits<float>::max()) = 0;
+    RayHit cast(const Ray& ray, IntersectMode mode,
+                float t_max = std::numeric_limits<float>::max()) {
+        return cast_on(0, ray, mode, t_max);
+    }
+    virtual RayHit cast_on(int w, const Ray& ray, IntersectMode mode, float t_max) = 0;
     virtual bool visited(glm::ivec3 cell) const = 0;
     virtual std::uint32_t group_of(glm::ivec3 cell) = 0;
     virtual std::size_t visited_count() const = 0;
     // A propagation pass from `seed` (must be active) for the seed ray `ray` (object space).
-    virtual Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
-                            const Ray& ray, const std::function<bool()>& interrupted = {}) = 0;
+    Group propagate(glm::ivec3 seed, std::uint32_t group_id, const PropagationParams& p,
+                    const Ray& ray, const std::function<bool()>& interrupted = {}) {
+        return propagate_on(0, seed, group_id, p, ray, interrupted);
+    }
+    virtual Group propagate_on(int w, glm::ivec3 seed, std::uint32_t group_id,
+                               const PropagationParams& p, const Ray& ray,
+                               const std::function<bool()>& interrupted) = 0;
     // The refinement group of the meta-cell of `level` at `unit` (a RayHit with refine set), or an
     // empty group (no triangles) when this frame refined it already.
-    virtual Group refine(glm::ivec3 unit, int level, std::uint32_t group_id,
-                         const PropagationParams& p) = 0;
+    Group refine(glm::ivec3 unit, int level, std::uint32_t group_id, const PropagationParams& p) {
+        return refine_on(0, unit, level, group_id, p);
+    }
+    virtual Group refine_on(int w, glm::ivec3 unit, int level, std::uint32_t group_id,
+                            const PropagationParams& p) = 0;
     // Seconds of the last propagate() or refine() spent in marching cubes (the "extraction" stage).
-    virtual double last_extract_s() const = 0;
+    double last_extract_s() const { return last_extract_s_on(0); }
+    virtual double last_extract_s_on(int w) const = 0;
     // Every triangle of the surface at `iso` (the oracle; does not touch visited cells).
     virtual Mesh extract_full(double iso, ExtractStats* stats = nullptr) const = 0;
 

@@ -7,14 +7,21 @@
 //
 // Each level's grid is paged by bricks of 8^3 units: a table with one page number per brick
 // (4 bytes per 512 units: 31 MB for the cells of 2048x2048x936, an eighth of that per level up),
-// made on the level's first use, and a page of 512 group ids for each brick that holds a taken
-// unit. A lookup is two loads and no hash. Pages come from a pool kept across frames, and a new
-// frame forgets only the bricks the last one touched, where a bit per cell would clear 490 MB at
-// 2048^2 x 936 and a hash would cost a probe per cell.
+// made when a frame first uses the level, and a page of 512 group ids for each brick that holds a
+// taken unit. A lookup is two loads and no hash. Pages come from a pool kept across frames, and a
+// new frame forgets only the bricks the last one touched, where a bit per cell would clear 490 MB
+// at 2048^2 x 936 and a hash would cost a probe per cell.
+//
+// Threads: insert(), contains() and group_of() may run on any number of threads at once (the
+// workers of one frame). A unit is claimed by a compare-and-swap of its slot, so exactly one
+// insert of it returns true; a brick's page is added under a lock (once per brick), published by
+// a release store of its number that readers acquire. reset() runs alone, between frames.
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <glm/common.hpp>
@@ -28,21 +35,26 @@ class VisitedCells {
     static constexpr std::uint32_t kFree = ~std::uint32_t{0};
     static constexpr int kLevels = 4;  // 0 .. kMaxMetaLevel (adaptive.h)
 
-    explicit VisitedCells(glm::ivec3 cell_dims = glm::ivec3(0)) { reset(cell_dims); }
+    explicit VisitedCells(glm::ivec3 cell_dims = glm::ivec3(0), int max_level = 0) {
+        reset(cell_dims, max_level);
+    }
 
-    // Forgets every unit; `cell_dims` may differ from the last frame's.
-    void reset(glm::ivec3 cell_dims) {
+    // Forgets every unit; `cell_dims` may differ from the last frame's. Units of levels up to
+    // `max_level` may be inserted until the next reset.
+    void reset(glm::ivec3 cell_dims, int max_level = 0) {
         if (cell_dims != dims_) {
             dims_ = cell_dims;
-            for (int l = 0; l < kLevels; ++l) grids_[static_cast<std::size_t>(l)] = Grid{};
+            for (Grid& g : grids_) g = Grid{};
         } else {
             for (Grid& g : grids_) {
                 for (const std::size_t b : g.touched) g.pages[b] = kFree;
                 g.touched.clear();
             }
         }
+        for (int l = 0; l <= max_level && l < kLevels; ++l)
+            if (grid(l).pages.empty()) make(grid(l), l);
         used_ = 0;
-        count_ = 0;
+        count_.store(0, std::memory_order_relaxed);
     }
     // A cell's index in x-fastest order (a key for per-cell sets).
     std::uint64_t index(glm::ivec3 c) const {
@@ -53,28 +65,33 @@ class VisitedCells {
     }
     // Whether the unit of `level` whose first cell is `c` was taken.
     bool contains(glm::ivec3 c, int level = 0) const { return slot(c, level) != kFree; }
-    // Marks the unit of `level` whose first cell is c as taken by `group` (not kFree); false when
-    // it was taken already.
+    // Marks the unit of `level` (at most the last reset's max_level) whose first cell is c as
+    // taken by `group` (not kFree); false when it was taken already.
     bool insert(glm::ivec3 c, std::uint32_t group, int level = 0) {
         Grid& g = grid(level);
-        if (g.pages.empty()) make(g, level);
         const glm::ivec3 u = c >> level;
         const std::size_t b = g.brick(u);
-        std::uint32_t& page = g.pages[b];
+        std::atomic_ref<std::uint32_t> page_ref(g.pages[b]);
+        std::uint32_t page = page_ref.load(std::memory_order_acquire);
         if (page == kFree) {
-            page = take_page();
-            g.touched.push_back(b);
+            const std::lock_guard<std::mutex> lock(grow_);
+            page = page_ref.load(std::memory_order_relaxed);
+            if (page == kFree) {
+                page = take_page();
+                g.touched.push_back(b);
+                page_ref.store(page, std::memory_order_release);
+            }
         }
-        std::uint32_t& id = (*pool_[page])[local(u)];
-        if (id != kFree) return false;
-        id = group;
-        count_ += std::size_t{1} << (3 * level);
+        std::atomic_ref<std::uint32_t> id(page_at(page)[local(u)]);
+        std::uint32_t expected = kFree;
+        if (!id.compare_exchange_strong(expected, group, std::memory_order_acq_rel)) return false;
+        count_.fetch_add(std::size_t{1} << (3 * level), std::memory_order_relaxed);
         return true;
     }
-    // The group that took the unit of `level` whose first cell is c (it must be taken).
+    // The group that took the unit of `level` whose first cell is c, or kFree.
     std::uint32_t group_of(glm::ivec3 c, int level = 0) const { return slot(c, level); }
     // Cells covered by the taken units (a meta-cell counts all of its cells).
-    std::size_t size() const { return count_; }
+    std::size_t size() const { return count_.load(std::memory_order_relaxed); }
     glm::ivec3 dims() const { return dims_; }
 
   private:
@@ -82,6 +99,10 @@ class VisitedCells {
     static constexpr int kSide = 1 << kLog2;
     static constexpr std::size_t kPage = std::size_t{1} << (3 * kLog2);
     using Page = std::array<std::uint32_t, kPage>;
+    // The pool: chunks of pages that never move once made, found through a fixed directory
+    // (16 M pages at most: 32 GB of ids, more than any frame takes).
+    static constexpr std::size_t kChunkPages = 1024;
+    static constexpr std::size_t kChunks = 16384;
 
     struct Grid {
         glm::ivec3 bricks{0};
@@ -105,11 +126,16 @@ class VisitedCells {
                            static_cast<std::size_t>(g.bricks.z),
                        kFree);
     }
+    Page& page_at(std::uint32_t page) const {
+        return chunks_[page / kChunkPages][page % kChunkPages];
+    }
+    // Under grow_.
     std::uint32_t take_page() {
-        if (used_ == pool_.size()) pool_.push_back(std::make_unique<Page>());
-        Page& p = *pool_[used_];
-        p.fill(kFree);
-        return static_cast<std::uint32_t>(used_++);
+        const std::size_t chunk = used_ / kChunkPages;
+        if (!chunks_[chunk]) chunks_[chunk] = std::make_unique<Page[]>(kChunkPages);
+        const auto page = static_cast<std::uint32_t>(used_++);
+        page_at(page).fill(kFree);
+        return page;
     }
     static std::size_t local(glm::ivec3 u) {
         const glm::ivec3 l = u & (kSide - 1);
@@ -119,15 +145,22 @@ class VisitedCells {
         const Grid& g = grid(level);
         if (g.pages.empty()) return kFree;
         const glm::ivec3 u = c >> level;
-        const std::uint32_t page = g.pages[g.brick(u)];
-        return page == kFree ? kFree : (*pool_[page])[local(u)];
+        // atomic_ref needs a non-const object; the load does not write.
+        auto& entry = const_cast<std::uint32_t&>(g.pages[g.brick(u)]);
+        const std::uint32_t page =
+            std::atomic_ref<std::uint32_t>(entry).load(std::memory_order_acquire);
+        if (page == kFree) return kFree;
+        return std::atomic_ref<std::uint32_t>(page_at(page)[local(u)])
+            .load(std::memory_order_acquire);
     }
 
     glm::ivec3 dims_{-1};
     std::array<Grid, kLevels> grids_;
-    std::vector<std::unique_ptr<Page>> pool_;  // pages, kept across frames
-    std::size_t used_ = 0;                     // pages handed out this frame
-    std::size_t count_ = 0;
+    std::unique_ptr<std::unique_ptr<Page[]>[]> chunks_ =
+        std::make_unique<std::unique_ptr<Page[]>[]>(kChunks);
+    std::size_t used_ = 0;  // pages handed out this frame (under grow_)
+    std::atomic<std::size_t> count_{0};
+    std::mutex grow_;
 };
 
 }  // namespace isowall

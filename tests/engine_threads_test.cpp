@@ -1,0 +1,121 @@
+// The engine on several threads (EngineOptions::threads): the final image is the full surface's
+// for every rule, the same from run to run, and every visited unit is in exactly one group.
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <set>
+#include <string>
+#include <tuple>
+
+#include "common/volume/phantom.h"
+#include "common/volume/volume.h"
+#include "tests/engine_util.h"
+#include "tests/image_compare.h"
+#include "tests/test_util.h"
+#include "tile/progressive_engine.h"
+
+namespace isowall {
+namespace {
+
+struct Rule {
+    std::string name;
+    EngineOptions options;
+};
+
+std::vector<Rule> rules() {
+    std::vector<Rule> r;
+    r.push_back({"exact_count", {}});
+    EngineOptions approx;
+    approx.intersect = IntersectMode::approximate;
+    approx.propagation.mode = PropagationMode::cutoff_angle;
+    r.push_back({"approximate_angle", approx});
+    EngineOptions facing;
+    facing.propagation.facing_only = true;
+    facing.propagation.max_count = 300;  // many passes, so that threads meet often
+    r.push_back({"facing_only_small_passes", facing});
+    return r;
+}
+
+FrameResult run(const Volume& volume, const FrameView& fv, EngineOptions opt, int threads) {
+    auto ex = make_surface_extractor(volume, {}, nullptr, ThreadBudget{threads});
+    auto renderer = make_renderer("osmesa");
+    opt.threads = threads;
+    FrameResult fr = ProgressiveEngine(*ex, *renderer, opt).run(fv);
+    EXPECT_TRUE(fr.completed);
+    // Every group's units are distinct from every other group's.
+    std::set<std::tuple<int, int, int, int>> units;
+    std::size_t repeated = 0;
+    for (const Group& g : fr.groups) {
+        if (g.refinement) continue;
+        for (const glm::ivec3 c : g.cells) repeated += !units.insert({c.x, c.y, c.z, g.level}).second;
+    }
+    EXPECT_EQ(repeated, 0u) << threads << " threads";
+    return fr;
+}
+
+TEST(Threads, FinalImageMatchesTheFullSurfaceAndRepeats) {
+    const Volume p = make_phantom();
+    for (const Rule& rule : rules())
+        for (const double iso : {kPhantomSkinIso, kPhantomBoneIso}) {
+            const FrameView fv = test::make_view(p, 240, 180, iso, 25, 10);
+            auto ex = make_surface_extractor(p);
+            auto renderer = make_renderer("osmesa");
+            const Image full = test::full_surface_image(*ex, *renderer, fv);
+            const FrameResult one = run(p, fv, rule.options, 1);
+            for (const int threads : {2, 3}) {
+                const FrameResult a = run(p, fv, rule.options, threads);
+                const FrameResult b = run(p, fv, rule.options, threads);
+                const test::ImageComparison vs_full = test::compare_images(a.final_image, full);
+                const test::ImageComparison again = test::compare_images(a.final_image, b.final_image);
+                const test::ImageComparison vs_one =
+                    test::compare_images(a.final_image, one.final_image);
+                std::cout << rule.name << " iso " << iso << ", " << threads << " threads: "
+                          << a.groups.size() << " groups (1 thread: " << one.groups.size()
+                          << "), against full IoU " << vs_full.mask_iou << " equal "
+                          << vs_full.equal_share << "; run to run " << again.differing_pixels
+                          << " px differ; against 1 thread " << vs_one.differing_pixels
+                          << " px\n";
+                EXPECT_GE(vs_full.mask_iou, 0.999) << rule.name;
+                EXPECT_GE(vs_full.equal_share, 0.999) << rule.name;
+                EXPECT_GE(again.equal_share, 0.9999) << rule.name;
+                EXPECT_GE(vs_one.equal_share, 0.9999) << rule.name;
+                EXPECT_EQ(a.rays_cast, one.rays_cast) << rule.name;
+            }
+        }
+}
+
+TEST(Threads, AdaptiveResolutionRepeatsAcrossThreads) {
+    // Meta-cells and refinements (claimed under a lock) on three threads: the image of one thread.
+    const Volume p = make_phantom();
+    const FrameView fv = test::make_view(p, 240, 180, kPhantomSkinIso, 0, 0, 1.0f);
+    for (const bool refine : {true, false}) {
+        EngineOptions opt;
+        opt.adaptive = true;
+        opt.adaptive_pixels = 2.5f;
+        opt.adaptive_refine = refine;
+        const FrameResult one = run(p, fv, opt, 1);
+        const FrameResult three = run(p, fv, opt, 3);
+        const test::ImageComparison m = test::compare_images(three.final_image, one.final_image);
+        std::cout << "adaptive 2.5 px" << (refine ? "" : ", unrefined") << ": "
+                  << m.differing_pixels << " px differ from 1 thread, IoU " << m.mask_iou << "\n";
+        EXPECT_GE(m.mask_iou, 0.999);
+        EXPECT_GE(m.equal_share, 0.999);
+    }
+}
+
+TEST(Threads, AStopEndsEveryThread) {
+    // A frame stopped before it starts ends at once, on every thread, with nothing drawn.
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p, {}, nullptr, ThreadBudget{3});
+    auto renderer = make_renderer("osmesa");
+    EngineOptions opt;
+    opt.threads = 3;
+    const std::atomic<bool> stop{true};
+    const FrameResult fr =
+        ProgressiveEngine(*ex, *renderer, opt).run(test::make_view(p, 160, 120, kPhantomSkinIso), &stop);
+    EXPECT_FALSE(fr.completed);
+    EXPECT_EQ(fr.group_count, 0u);
+}
+
+}  // namespace
+}  // namespace isowall
