@@ -350,8 +350,7 @@ int run_render(const RenderOptions& o) {
             "--size", "value",
             "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
     check_render_outputs(o);
-    const EngineOptions checked = engine_options(o);  // fails early on a bad --order
-    (void)checked;
+    (void)engine_options(o);  // fails early on a bad --order
     Timings t;
     // Create the GL context first: a missing driver should fail before the volume is read.
     auto renderer = make_renderer(o.gl);

@@ -47,7 +47,8 @@ FrameResult run(const Volume& volume, const FrameView& fv, EngineOptions opt, in
     std::size_t repeated = 0;
     for (const Group& g : fr.groups) {
         if (g.refinement) continue;
-        for (const glm::ivec3 c : g.cells) repeated += !units.insert({c.x, c.y, c.z, g.level}).second;
+        for (const glm::ivec3 c : g.cells)
+            repeated += !units.insert({c.x, c.y, c.z, g.level}).second;
     }
     EXPECT_EQ(repeated, 0u) << threads << " threads";
     return fr;
@@ -66,15 +67,16 @@ TEST(Threads, FinalImageMatchesTheFullSurfaceAndRepeats) {
                 const FrameResult a = run(p, fv, rule.options, threads);
                 const FrameResult b = run(p, fv, rule.options, threads);
                 const test::ImageComparison vs_full = test::compare_images(a.final_image, full);
-                const test::ImageComparison again = test::compare_images(a.final_image, b.final_image);
+                const test::ImageComparison again =
+                    test::compare_images(a.final_image, b.final_image);
                 const test::ImageComparison vs_one =
                     test::compare_images(a.final_image, one.final_image);
-                std::cout << rule.name << " iso " << iso << ", " << threads << " threads: "
-                          << a.groups.size() << " groups (1 thread: " << one.groups.size()
-                          << "), against full IoU " << vs_full.mask_iou << " equal "
-                          << vs_full.equal_share << "; run to run " << again.differing_pixels
-                          << " px differ; against 1 thread " << vs_one.differing_pixels
-                          << " px\n";
+                std::cout << rule.name << " iso " << iso << ", " << threads
+                          << " threads: " << a.groups.size()
+                          << " groups (1 thread: " << one.groups.size() << "), against full IoU "
+                          << vs_full.mask_iou << " equal " << vs_full.equal_share << "; run to run "
+                          << again.differing_pixels << " px differ; against 1 thread "
+                          << vs_one.differing_pixels << " px\n";
                 EXPECT_GE(vs_full.mask_iou, 0.999) << rule.name;
                 EXPECT_GE(vs_full.equal_share, 0.999) << rule.name;
                 EXPECT_GE(again.equal_share, 0.9999) << rule.name;
@@ -111,8 +113,8 @@ TEST(Threads, AStopEndsEveryThread) {
     EngineOptions opt;
     opt.threads = 3;
     const std::atomic<bool> stop{true};
-    const FrameResult fr =
-        ProgressiveEngine(*ex, *renderer, opt).run(test::make_view(p, 160, 120, kPhantomSkinIso), &stop);
+    const FrameResult fr = ProgressiveEngine(*ex, *renderer, opt)
+                               .run(test::make_view(p, 160, 120, kPhantomSkinIso), &stop);
     EXPECT_FALSE(fr.completed);
     EXPECT_EQ(fr.group_count, 0u);
 }

@@ -1,15 +1,8 @@
 #include "tile/progressive_engine.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <exception>
-#include <limits>
-#include <map>
 #include <memory>
-#include <mutex>
-#include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
@@ -17,6 +10,7 @@
 #include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
 #include "common/progressive/screen_mask.h"
+#include "tile/parallel_level.h"
 
 namespace isowall {
 namespace {
@@ -212,127 +206,34 @@ class FrameRun {
         return seed(hit, ray);
     }
 
-    // A group found by a worker of a parallel level, waiting for the drawing thread.
-    struct Found {
-        Group group;
-        double pass_s = 0, extract_s = 0;
-    };
-    // What one worker of a parallel level did, merged when the level ends.
-    struct WorkerTally {
-        std::size_t rays = 0, hits = 0;
-        double intersect_s = 0;
-    };
-    // One level over `n` threads: each takes the next pixel of the level, casts its ray and
-    // propagates from an unvisited hit (the units' claims keep passes apart); this thread is
-    // worker 0 and, between its own rays, draws the groups found so far in the order of their
-    // ids. False when the frame was stopped.
+    // One level over `n` threads (tile/parallel_level.h); false when the frame was stopped.
     bool cast_level_parallel(int n, IntersectMode mode, bool second_pass) {
-        std::atomic<std::size_t> next_pixel{0}, rays{0};
-        std::atomic<std::uint32_t> next_id{opt_.first_group_id + ids_used_};
-        std::uint32_t next_drawn = next_id.load();
-        std::mutex lock;
-        std::condition_variable wake;
-        std::map<std::uint32_t, Found> ready;
-        int running = n - 1;
-        std::exception_ptr failure;
-        std::vector<WorkerTally> tally(static_cast<std::size_t>(n));
         const std::size_t rays_before = now_.rays;
-        const glm::ivec2 origin(rect_.x, rect_.y);
-
-        // Casts the next pixel's ray (and propagates); false when the level has no more.
-        auto step = [&](int w) {
-            const std::size_t i = next_pixel.fetch_add(1, std::memory_order_relaxed);
-            if (i >= pixels_.size() || stopped()) return false;
-            WorkerTally& t = tally[static_cast<std::size_t>(w)];
-            const Ray ray = pixel_ray(view_inv_, view_->frustum, view_->width, view_->height,
-                                      pixels_[i] + origin);
-            const auto t0 = Clock::now();
-            const RayHit hit = ex_.cast_on(w, ray, mode, std::numeric_limits<float>::max());
-            t.intersect_s += since(t0);
-            ++t.rays;
-            rays.fetch_add(1, std::memory_order_relaxed);
-            if (!hit.found) return true;
-            ++t.hits;
-            if (!hit.refine && ex_.visited(hit.cell)) return true;
-            const std::uint32_t id = next_id.fetch_add(1, std::memory_order_relaxed);
-            Found f;
-            const auto t1 = Clock::now();
-            f.group = hit.refine ? ex_.refine_on(w, hit.cell, hit.level, id, opt_.propagation)
-                                 : ex_.propagate_on(w, hit.cell, id, params_, ray, interrupted_);
-            f.pass_s = since(t1);
-            f.extract_s = ex_.last_extract_s_on(w);
-            {
-                const std::lock_guard<std::mutex> hold(lock);
-                ready.emplace(id, std::move(f));
-            }
-            wake.notify_all();
-            return true;
-        };
-        // Draws the groups whose turn has come; with `all`, waits for the other workers first.
-        auto draw_ready = [&](bool all) {
-            std::unique_lock<std::mutex> hold(lock);
-            if (all) wake.wait(hold, [&] { return running == 0; });
-            while (!ready.empty() && (ready.begin()->first == next_drawn || all)) {
-                Found f = std::move(ready.begin()->second);
-                next_drawn = ready.begin()->first + 1;
-                ready.erase(ready.begin());
-                hold.unlock();
-                add_found(f);
-                hold.lock();
-            }
-        };
-
-        std::vector<std::thread> others;
-        others.reserve(static_cast<std::size_t>(n - 1));
-        for (int w = 1; w < n; ++w)
-            others.emplace_back([&, w] {
-                try {
-                    while (step(w)) {
-                    }
-                } catch (...) {
-                    const std::lock_guard<std::mutex> hold(lock);
-                    if (!failure) failure = std::current_exception();
-                    next_pixel.store(pixels_.size());  // the others stop too
-                }
-                {
-                    const std::lock_guard<std::mutex> hold(lock);
-                    --running;
-                }
-                wake.notify_all();
-            });
-        try {
-            for (;;) {
-                const bool more = step(0);
-                draw_ready(false);
-                now_.rays = rays_before + rays.load(std::memory_order_relaxed);
-                if (!more) break;
+        const LevelJob job{
+            ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
+            mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_};
+        const LevelTally t = isowall::cast_level_parallel(
+            job, n, [this](FoundGroup& f) { add_found(f); },
+            [this, rays_before](std::size_t rays) {
+                now_.rays = rays_before + rays;
                 record(false);
-            }
-        } catch (...) {
-            const std::lock_guard<std::mutex> hold(lock);
-            if (!failure) failure = std::current_exception();
-            next_pixel.store(pixels_.size());
-        }
-        for (std::thread& t : others) t.join();
-        draw_ready(true);
-        if (failure) std::rethrow_exception(failure);
-        ids_used_ = next_id.load() - opt_.first_group_id;
-        for (const WorkerTally& t : tally) {
-            now_.t_intersect_s += t.intersect_s;
-            cursor_->hits += t.hits;
-            if (second_pass) frame_.rays_second_pass += t.rays;
-        }
-        now_.rays = rays_before + rays.load();
+            });
+        ids_used_ = t.next_id - opt_.first_group_id;
+        now_.t_intersect_s += t.intersect_s;
+        cursor_->hits += t.hits;
+        if (second_pass) frame_.rays_second_pass += t.rays;
+        now_.rays = rays_before + t.rays;
         return !stopped();
     }
 
-    // Hands a worker's group to the sink; a pass whose seed another worker took first found no
-    // cell, and a refinement done already has no triangle: neither is a group.
-    void add_found(const Found& f) {
+    // Hands a group to the sink, charging its pass to the stages; true when it was one. A pass
+    // whose seed another worker took first found no cell, and a refinement done already has no
+    // triangle: neither is a group.
+    bool add_found(const FoundGroup& f) {
         const Group& g = f.group;
         now_.t_extract_s += f.extract_s;
         now_.t_propagate_s += f.pass_s - f.extract_s;
-        if (g.refinement ? g.mesh.indices.empty() : g.cells.empty()) return;
+        if (g.refinement ? g.mesh.indices.empty() : g.cells.empty()) return false;
         stage(Stage::render);
         const auto t1 = Clock::now();
         sink_->add(g);
@@ -341,29 +242,24 @@ class FrameRun {
         now_.triangles += g.mesh.triangle_count();
         ++frame_.group_count;
         stage(Stage::intersection);
+        return true;
     }
 
     bool seed(const RayHit& hit, const Ray& ray) {
         stage(Stage::propagation);
         const auto t0 = Clock::now();
         const auto id = opt_.first_group_id + ids_used_;
-        Group g = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
+        FoundGroup f;
+        f.group = hit.refine ? ex_.refine(hit.cell, hit.level, id, opt_.propagation)
                              : ex_.propagate(hit.cell, id, params_, ray, interrupted_);
-        const double pass_s = since(t0);
-        const double extract_s = ex_.last_extract_s();
-        now_.t_extract_s += extract_s;
-        now_.t_propagate_s += pass_s - extract_s;
-        if (stopped()) return false;
-        if (!g.mesh.indices.empty() || !g.refinement) {
-            stage(Stage::render);
-            const auto t1 = Clock::now();
-            sink_->add(g);
-            now_.t_render_s += since(t1);
-            dirty_ = true;
-            now_.triangles += g.mesh.triangle_count();
-            ++frame_.group_count;
-            ++ids_used_;
+        f.pass_s = since(t0);
+        f.extract_s = ex_.last_extract_s();
+        if (stopped()) {
+            now_.t_extract_s += f.extract_s;
+            now_.t_propagate_s += f.pass_s - f.extract_s;
+            return false;
         }
+        ids_used_ += add_found(f) ? 1 : 0;
         stage(Stage::intersection);
         return true;
     }
@@ -451,17 +347,6 @@ class FrameRun {
     std::vector<std::uint8_t> covered_;
 };
 
-void warm_up(Renderer& renderer) {
-    Mesh tiny;
-    tiny.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    tiny.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
-    tiny.indices = {0, 1, 2};
-    renderer.resize(16, 16);
-    renderer.clear();
-    renderer.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
-    renderer.finish();
-}
-
 ProgressiveEngine::ProgressiveEngine(SurfaceExtractor& extractor, Renderer& renderer,
                                      EngineOptions options)
     : extractor_(extractor), renderer_(renderer), options_(options) {
@@ -503,34 +388,6 @@ FrameResult EngineFrame::finish(bool completed) {
 
 const TimelineSample& EngineFrame::now() const {
     return run_->now();
-}
-
-FrameResult ProgressiveEngine::run(const FrameView& view, const std::atomic<bool>* stop,
-                                   const Progress& progress) {
-    static const std::atomic<bool> never{false};
-    RendererSink draw(renderer_);
-    RecordingSink record;
-    TeeSink both({&draw, &record});
-    FrameResult frame = run(view, view.screen(), both, stop ? *stop : never, progress);
-    frame.groups = std::move(record.groups);
-    if (frame.completed) draw.read_back(frame.final_image);
-    return frame;
-}
-
-void ProgressiveEngine::measure(
-    FrameResult& frame, const FrameView& view,
-    const std::function<void(const TimelineSample&, const Image&)>& on_image) {
-    if (frame.final_image.pixel_count() == 0) return;
-    RendererSink replay(renderer_);
-    replay.begin(view);
-    std::size_t drawn = 0;
-    Image image;
-    for (TimelineSample& s : frame.timeline) {
-        for (; drawn < s.groups; ++drawn) replay.add(frame.groups[drawn]);
-        replay.read_back(image);
-        s.correctness = measure_correctness(image, frame.final_image);
-        if (on_image) on_image(s, image);
-    }
 }
 
 }  // namespace isowall

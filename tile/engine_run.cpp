@@ -1,0 +1,48 @@
+// The engine's conveniences around a frame: the warm-up draw, the whole-screen run that keeps
+// every group and the final image, and the replay that measures correctness.
+#include <atomic>
+
+#include "tile/progressive_engine.h"
+
+namespace isowall {
+
+void warm_up(Renderer& renderer) {
+    Mesh tiny;
+    tiny.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    tiny.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    tiny.indices = {0, 1, 2};
+    renderer.resize(16, 16);
+    renderer.clear();
+    renderer.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
+    renderer.finish();
+}
+
+FrameResult ProgressiveEngine::run(const FrameView& view, const std::atomic<bool>* stop,
+                                   const Progress& progress) {
+    static const std::atomic<bool> never{false};
+    RendererSink draw(renderer_);
+    RecordingSink record;
+    TeeSink both({&draw, &record});
+    FrameResult frame = run(view, view.screen(), both, stop ? *stop : never, progress);
+    frame.groups = std::move(record.groups);
+    if (frame.completed) draw.read_back(frame.final_image);
+    return frame;
+}
+
+void ProgressiveEngine::measure(
+    FrameResult& frame, const FrameView& view,
+    const std::function<void(const TimelineSample&, const Image&)>& on_image) {
+    if (frame.final_image.pixel_count() == 0) return;
+    RendererSink replay(renderer_);
+    replay.begin(view);
+    std::size_t drawn = 0;
+    Image image;
+    for (TimelineSample& s : frame.timeline) {
+        for (; drawn < s.groups; ++drawn) replay.add(frame.groups[drawn]);
+        replay.read_back(image);
+        s.correctness = measure_correctness(image, frame.final_image);
+        if (on_image) on_image(s, image);
+    }
+}
+
+}  // namespace isowall

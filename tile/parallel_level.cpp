@@ -1,0 +1,150 @@
+#include "tile/parallel_level.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "common/core/ray.h"
+
+namespace isowall {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The state the threads of one level share.
+class Level {
+  public:
+    Level(const LevelJob& job, int threads)
+        : job_(job), next_id_(job.first_id), next_drawn_(job.first_id), running_(threads - 1),
+          tally_(static_cast<std::size_t>(threads)) {}
+
+    // Casts the next pixel's ray on worker w (and propagates); false when the level has no more.
+    bool step(int w) {
+        const std::size_t i = next_pixel_.fetch_add(1, std::memory_order_relaxed);
+        if (i >= job_.pixels.size() || job_.stopped()) return false;
+        LevelTally& t = tally_[static_cast<std::size_t>(w)];
+        const Ray ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
+                                  job_.view.height, job_.pixels[i] + job_.origin);
+        const auto t0 = Clock::now();
+        const RayHit hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
+        t.intersect_s += since(t0);
+        ++t.rays;
+        rays_.fetch_add(1, std::memory_order_relaxed);
+        if (!hit.found) return true;
+        ++t.hits;
+        if (!hit.refine && job_.ex.visited(hit.cell)) return true;
+        const std::uint32_t id = next_id_.fetch_add(1, std::memory_order_relaxed);
+        FoundGroup f;
+        const auto t1 = Clock::now();
+        f.group = hit.refine
+                      ? job_.ex.refine_on(w, hit.cell, hit.level, id, job_.refine_params)
+                      : job_.ex.propagate_on(w, hit.cell, id, job_.params, ray, job_.stopped);
+        f.pass_s = since(t1);
+        f.extract_s = job_.ex.last_extract_s_on(w);
+        {
+            const std::lock_guard<std::mutex> hold(lock_);
+            ready_.emplace(id, std::move(f));
+        }
+        wake_.notify_all();
+        return true;
+    }
+
+    // Draws the groups whose turn has come; with `all`, waits for the other workers first and
+    // draws everything left.
+    void draw_ready(const std::function<void(FoundGroup&)>& draw, bool all) {
+        std::unique_lock<std::mutex> hold(lock_);
+        if (all) wake_.wait(hold, [&] { return running_ == 0; });
+        while (!ready_.empty() && (all || ready_.begin()->first == next_drawn_)) {
+            FoundGroup f = std::move(ready_.begin()->second);
+            next_drawn_ = ready_.begin()->first + 1;
+            ready_.erase(ready_.begin());
+            hold.unlock();
+            draw(f);
+            hold.lock();
+        }
+    }
+
+    void fail(std::exception_ptr e) {
+        const std::lock_guard<std::mutex> hold(lock_);
+        if (!failure_) failure_ = e;
+        next_pixel_.store(job_.pixels.size());  // the others stop at their next pixel
+    }
+
+    void worker_done() {
+        {
+            const std::lock_guard<std::mutex> hold(lock_);
+            --running_;
+        }
+        wake_.notify_all();
+    }
+
+    std::size_t rays() const { return rays_.load(std::memory_order_relaxed); }
+
+    LevelTally finish() {
+        if (failure_) std::rethrow_exception(failure_);
+        LevelTally sum;
+        for (const LevelTally& t : tally_) {
+            sum.rays += t.rays;
+            sum.hits += t.hits;
+            sum.intersect_s += t.intersect_s;
+        }
+        sum.next_id = next_id_.load();
+        return sum;
+    }
+
+  private:
+    const LevelJob& job_;
+    std::atomic<std::size_t> next_pixel_{0}, rays_{0};
+    std::atomic<std::uint32_t> next_id_;
+    std::uint32_t next_drawn_;  // under lock_
+    std::mutex lock_;
+    std::condition_variable wake_;
+    std::map<std::uint32_t, FoundGroup> ready_;  // by id, under lock_
+    int running_;                                // other threads still casting, under lock_
+    std::exception_ptr failure_;                 // under lock_
+    std::vector<LevelTally> tally_;              // one per thread, each written by its own
+};
+
+}  // namespace
+
+LevelTally cast_level_parallel(const LevelJob& job, int threads,
+                               const std::function<void(FoundGroup&)>& draw,
+                               const std::function<void(std::size_t)>& after_ray) {
+    Level level(job, threads);
+    std::vector<std::thread> others;
+    others.reserve(static_cast<std::size_t>(threads - 1));
+    for (int w = 1; w < threads; ++w)
+        others.emplace_back([&level, w] {
+            try {
+                while (level.step(w)) {
+                }
+            } catch (...) {
+                level.fail(std::current_exception());
+            }
+            level.worker_done();
+        });
+    try {
+        for (;;) {
+            const bool more = level.step(0);
+            level.draw_ready(draw, false);
+            if (!more) break;
+            after_ray(level.rays());
+        }
+    } catch (...) {
+        level.fail(std::current_exception());
+    }
+    for (std::thread& t : others) t.join();
+    level.draw_ready(draw, true);
+    return level.finish();
+}
+
+}  // namespace isowall
