@@ -45,13 +45,17 @@ THRESHOLDS = [("c90", 0.90), ("c99", 0.99), ("c999", 0.999), ("c100", 1.0)]
 
 # The progressive engine's configurations (`isowall render` options). "lod": adaptive resolution
 # whose level follows the projected size (meta-cells up to 2.5 px, so triangles stay about a
-# pixel as the volume grows), without refinement; "facing": the visible-surface rule.
+# pixel as the volume grows), without refinement; "facing": the visible-surface rule; "-2t": on
+# two threads (every other configuration on one).
 ENGINES = {
-    "full-res": [],
-    "facing": ["--facing-only"],
-    "lod": ["--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine"],
-    "lod-refine": ["--adaptive", "--adaptive-pixels", "2.5"],
-    "lod-facing": ["--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine", "--facing-only"],
+    "full-res": ["--threads", "1"],
+    "facing": ["--threads", "1", "--facing-only"],
+    "lod": ["--threads", "1", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine"],
+    "lod-refine": ["--threads", "1", "--adaptive", "--adaptive-pixels", "2.5"],
+    "lod-facing": ["--threads", "1", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine",
+                   "--facing-only"],
+    "lod-facing-2t": ["--threads", "2", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine",
+                      "--facing-only"],
 }
 
 
@@ -87,7 +91,7 @@ def parse_args(argv):
                     help="shared data folder (default: ../shared/data)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-scaling"), help="output folder")
     ap.add_argument("--threads", type=int, default=2, help="the peer's threads (default %(default)s)")
-    ap.add_argument("--engines", default="lod-facing,full-res,facing,lod,lod-refine",
+    ap.add_argument("--engines", default="lod-facing-2t,lod-facing,full-res,facing,lod,lod-refine",
                     help="progressive configurations, comma-separated, of " + ", ".join(ENGINES) +
                     "; the first is the one the targets judge (default %(default)s)")
     a = ap.parse_args(argv)

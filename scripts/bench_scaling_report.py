@@ -7,6 +7,7 @@ FULL_LIMIT = 1 / 3         # C = 99% against our --full, from scale 2 up
 GROWTH_LIMIT = 2.0         # C = 99% from scale 1 to scale 4
 TRIS_PER_PX_LIMIT = 2.0    # triangles drawn by C = 99% per covered pixel, every scale
 EVERY_RAY_LIMIT = 1.5      # every ray against our --full, every scale
+THREADS_LIMIT = 1 / 1.7     # two threads' time over one thread's, C=99% and every ray
 AGREE_FRACTION = 0.005     # the peer's hit pixels against --full's covered pixels
 
 
@@ -37,6 +38,15 @@ def targets(results):
               tris / covered if tris is not None and covered else None, TRIS_PER_PX_LIMIT)
         check(checks, "every ray / our --full", r, r["progressive"]["every_ray_s"] / r["full"]["full_s"],
               EVERY_RAY_LIMIT)
+    for r in results:
+        e = r.get("engines", {})
+        if "lod-facing" in e and "lod-facing-2t" in e:
+            one, two = e["lod-facing"], e["lod-facing-2t"]
+            for key, what in (("c99", "C=99%"), ("every_ray_s", "every ray")):
+                if one.get(key) and two.get(key):
+                    # A speed-up of at least 1.7 is a time ratio (2 threads / 1) of at most 1/1.7.
+                    check(checks, f"2 threads / 1 thread on {what} (lod-facing)", r,
+                          two[key] / one[key], THREADS_LIMIT)
     if 1 in by_scale and 4 in by_scale:
         a, b = by_scale[1]["progressive"]["c99"], by_scale[4]["progressive"]["c99"]
         check(checks, "growth of C=99%, scale 1 -> 4", by_scale[4], b / a if a and b else None, GROWTH_LIMIT)

@@ -52,14 +52,16 @@ class BenchScaling(unittest.TestCase):
                     self.assertLess(abs(s["peer"]["hit_px"] - full["covered_px"]), 0.005 * full["covered_px"])
                     self.assertEqual(s["peer"]["triangles"], full["triangles"])
                 # Every configuration ran, and each final image was measured against the full surface.
-                self.assertEqual(list(s["engines"]), ["lod-facing", "full-res", "facing", "lod", "lod-refine"])
-                self.assertEqual(prog, s["engines"]["lod-facing"])
+                self.assertEqual(list(s["engines"]), ["lod-facing-2t", "lod-facing", "full-res", "facing", "lod",
+                                                      "lod-refine"])
+                self.assertEqual(prog, s["engines"]["lod-facing-2t"])
                 self.assertGreater(s["engines"]["full-res"]["c_vs_full"], 0.99, s)
                 for e in s["engines"].values():
                     self.assertGreater(e["c_vs_full"], 0.9, e)
             names = {c["target"] for c in res["targets"]}
             self.assertIn("triangles by C=99% per covered pixel", names)
             self.assertIn("every ray / our --full", names)
+            self.assertIn("2 threads / 1 thread on C=99% (lod-facing)", names)
             self.assertIn("growth of C=99%, scale 1 -> 4", names)
             with open(os.path.join(out, "scaling.md")) as f:
                 md = f.read()

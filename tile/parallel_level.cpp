@@ -24,7 +24,10 @@ double since(Clock::time_point t0) {
 class Level {
   public:
     Level(const LevelJob& job, int threads)
-        : job_(job), next_id_(job.first_id), next_drawn_(job.first_id), running_(threads - 1),
+        : job_(job),
+          next_id_(job.first_id),
+          next_drawn_(job.first_id),
+          running_(threads - 1),
           tally_(static_cast<std::size_t>(threads)) {}
 
     // Casts the next pixel's ray on worker w (and propagates); false when the level has no more.

@@ -40,7 +40,7 @@ struct FoundGroup {
 
 struct LevelTally {
     std::size_t rays = 0, hits = 0;
-    double intersect_s = 0;   // summed over the threads
+    double intersect_s = 0;     // summed over the threads
     std::uint32_t next_id = 0;  // the first id not handed out
 };
 
