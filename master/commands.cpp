@@ -210,7 +210,6 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
     }
 }
 
-// The snapshots due at replayed sample `s`, staged in `batch`.
 // The progressive frame's final image against the full surface drawn in the same view (outside
 // the timings): 1 and 100% at full resolution, up to the renderers' ties; below that, what
 // adaptive resolution's meta-cells change on screen.
@@ -218,18 +217,14 @@ void print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const Fr
                         const Image& final_image) {
     Stopwatch sw;
     const Mesh mesh = ex.extract_full(fv.iso);
-    Image full;
-    renderer.resize(fv.width, fv.height);
-    renderer.clear();
-    renderer.draw(mesh, fv.camera.view(), fv.frustum.matrix());
-    renderer.read_back(full);
-    const Correctness c = measure_correctness(final_image, full);
+    const Correctness c = measure_correctness(final_image, draw_alone(renderer, mesh, fv));
     std::printf(
         "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%% (%.3f s, "
         "not part of the timings)\n",
         mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels, sw.seconds());
 }
 
+// The snapshots due at replayed sample `s`, staged in `batch`.
 void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Image& img,
                      std::vector<bool>& c_done, std::vector<bool>& r_done, OutputFiles& batch) {
     for (std::size_t k = 0; k < o.snapshots.size(); ++k) {

@@ -23,13 +23,7 @@ inline FrameView make_view(const Volume& v, int w, int h, double iso, float yaw 
 
 // Every triangle of the surface drawn in one go: what the progressive image must end up as.
 inline Image full_surface_image(SurfaceExtractor& ex, Renderer& r, const FrameView& fv) {
-    const Mesh m = ex.extract_full(fv.iso);
-    Image img;
-    r.resize(fv.width, fv.height);
-    r.clear();
-    r.draw(m, fv.camera.view(), fv.frustum.matrix());
-    r.read_back(img);
-    return img;
+    return draw_alone(r, ex.extract_full(fv.iso), fv);
 }
 
 }  // namespace isowall::test

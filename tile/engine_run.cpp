@@ -17,6 +17,15 @@ void warm_up(Renderer& renderer) {
     renderer.finish();
 }
 
+Image draw_alone(Renderer& renderer, const Mesh& mesh, const FrameView& view) {
+    Image image;
+    renderer.resize(view.width, view.height);
+    renderer.clear();
+    renderer.draw(mesh, view.camera.view(), view.frustum.matrix());
+    renderer.read_back(image);
+    return image;
+}
+
 FrameResult ProgressiveEngine::run(const FrameView& view, const std::atomic<bool>* stop,
                                    const Progress& progress) {
     static const std::atomic<bool> never{false};

@@ -99,6 +99,10 @@ struct FrameResult {
 // frame is timed (the engine does it for its renderer; scripts/vtk_reference.py warms VTK alike).
 void warm_up(Renderer& renderer);
 
+// `mesh` drawn alone into `renderer` at `view`'s size and read back: the full surface's image,
+// which a progressive frame's final image is measured against.
+Image draw_alone(Renderer& renderer, const Mesh& mesh, const FrameView& view);
+
 // A region's place in its progressive ray order, kept between the calls that cast it (the coarse
 // and the fine band of a wall job).
 struct RegionCursor {
