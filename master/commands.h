@@ -38,6 +38,7 @@ struct RenderOptions {
     std::vector<std::size_t> snapshot_rays;
     bool no_measure = false;
     bool against_full = false;  // also measure the final image against the full surface's
+    bool warm_up = false;       // one untimed frame first (a running wall's steady state)
     int threads = 0;            // the engine's threads (and the octree build's); 0: every core
     bool quiet = false;
 };

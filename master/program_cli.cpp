@@ -71,6 +71,11 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
                      "After the progressive frame, extract and draw the full surface (not timed) "
                      "and print both correctness measures of the final image against it: what "
                      "adaptive resolution and other shortcuts cost in the image");
+    re_cmd->add_flag("--warm-up", re.warm_up,
+                     "First draw one untimed frame (of the view turned 30 degrees; with --full, "
+                     "the same full surface), so the timed frame finds the process warm as a "
+                     "running wall's frames do: without it, the timings include a fresh "
+                     "process's first touch of its memory");
     re_cmd->add_flag("--quiet,-q", re.quiet, "No progress lines while casting");
 
     return re_cmd;

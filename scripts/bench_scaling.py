@@ -7,7 +7,7 @@ scales, all in one run, with the issue's targets marked holds or MISSED.
 
 Usage: /usr/bin/python3 scripts/bench_scaling.py [--scales 1,2] [--size 1600x1200] [--iso 40]
            [--runs 1] [--volume vhp_ct_head] [--build build] [--data ../shared/data]
-           [--out out/bench-scaling] [--threads 2] [--engines lod,full-res,...]
+           [--out out/bench-scaling] [--threads 2] [--engines lod,full-res,...] [--cold]
 
 Scale 1 is the volume itself; any other scale is a trilinear copy made once by
 scripts/resample_volume.py into BUILD/data and kept there (outside git). For the shared CT head:
@@ -15,6 +15,13 @@ scale 2 is 1024x1024x468 (491 M voxels, 491 MB, 3 minutes to make on a loaded 2-
 scale 4 is 2048x2048x936 (3.9 G voxels, 3.9 GB of disk, 12 minutes to make there; each program
 holds the 3.9 GB of voxels and a run peaked at 8.4 GB in one process; 4-5 minutes per run). Scales 1,2 take about two
 minutes once the copy is made.
+
+Every program measures its steady state by default: `isowall render --warm-up` draws one untimed
+frame of the view turned 30 degrees before the timed one (`--full` extracts and draws the surface
+once first), and the peer runs flying edges, the BVH build and the rays twice in its processes and
+times the second run. A wall's ranks draw frame after frame, so this is what a viewer waits for
+after moving the camera. --cold times every program's first run in a fresh process instead (the
+memory it touches then is new to it: page faults, the renderer's first buffers and bins).
 
 Each progressive configuration (--engines; the first is the one the targets judge) also prints
 its final image's C against the full surface (`render --against-full`, outside the clock).
@@ -94,7 +101,11 @@ def parse_args(argv):
     ap.add_argument("--engines", default="lod-facing-2t,lod-facing,full-res,facing,lod,lod-refine",
                     help="progressive configurations, comma-separated, of " + ", ".join(ENGINES) +
                     "; the first is the one the targets judge (default %(default)s)")
+    ap.add_argument("--cold", action="store_true",
+                    help="time each program's first run in a fresh process (default: the run after a warm-up)")
     a = ap.parse_args(argv)
+    a.warm = [] if a.cold else ["--warm-up"]
+    a.repeat = "1" if a.cold else "2"
     a.engines = [e for e in a.engines.split(",") if e]
     bad = [e for e in a.engines if e not in ENGINES]
     if not a.engines or bad or len(set(a.engines)) != len(a.engines):
@@ -169,7 +180,7 @@ def progressive(a, volume, tmp, engine):
     csv_path = os.path.join(tmp, "timeline.csv")
     out = run([a.isowall, "render", "-v", volume, "--iso", f"{a.iso:g}", "--size", a.size, "-q",
                "--out", os.path.join(tmp, "progressive.png"), "--timeline", csv_path, "--against-full",
-               *ENGINES[engine]], f"isowall render --timeline ({engine})")
+               *ENGINES[engine], *a.warm], f"isowall render --timeline ({engine})")
     with open(csv_path) as f:
         rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
     res = {}
@@ -189,7 +200,7 @@ def progressive(a, volume, tmp, engine):
 
 def full(a, volume, tmp):
     out = run([a.isowall, "render", "-v", volume, "--iso", f"{a.iso:g}", "--size", a.size, "--full",
-               "--out", os.path.join(tmp, "full.png")], "isowall render --full")
+               "--out", os.path.join(tmp, "full.png"), *a.warm], "isowall render --full")
     ext = float(re.search(r"^extract: .*\(([\d.]+) s\)$", out, re.M).group(1))
     m = re.search(r"^render: .*, (\d+) px \(([\d.]+) s\)$", out, re.M)
     tris = int(re.search(r"^extract: iso \S+: (\d+) triangles", out, re.M).group(1))
@@ -209,11 +220,13 @@ def peer_missing(a):
 def peer(a, volume, tmp):
     mesh = os.path.join(tmp, "peer.mesh")
     fe = key_values(run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "fe_mesh.py"), volume,
-                         f"{a.iso:g}", mesh, "--threads", str(a.threads)], "fe_mesh.py"))
-    rays = key_values(run([a.peer, mesh, "--size", a.size, "--threads", str(a.threads)], "isowall-peer"))
+                         f"{a.iso:g}", mesh, "--threads", str(a.threads), "--repeat", a.repeat], "fe_mesh.py"))
+    rays = key_values(run([a.peer, mesh, "--size", a.size, "--threads", str(a.threads), "--repeat", a.repeat],
+                          "isowall-peer"))
     os.remove(mesh)
     return {"fe_s": fe["fe_s"], "bvh_s": rays["bvh_s"], "rays_s": rays["rays_s"],
             "total_s": fe["fe_s"] + rays["bvh_s"] + rays["rays_s"],
+            "first_total_s": fe["fe_first_s"] + rays["bvh_first_s"] + rays["rays_first_s"],
             "triangles": int(fe["triangles"]), "hit_px": int(rays["hit_pixels"])}
 
 
@@ -255,6 +268,7 @@ def main(argv):
         shutil.rmtree(tmp, ignore_errors=True)
     checks = targets(results)
     meta = {"volume": a.source, "iso": a.iso, "size": a.size, "runs": a.runs, "threads": a.threads,
+            "frame": "cold" if a.cold else "warm",
             "engines": {e: " ".join(ENGINES[e]) or "(defaults)" for e in a.engines},
             "date": time.strftime("%Y-%m-%d %H:%M"), "cores": os.cpu_count(),
             "load_average": [round(x, 2) for x in os.getloadavg()]}

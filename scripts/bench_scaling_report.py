@@ -119,11 +119,18 @@ def pixels_table(results):
     return lines
 
 
+def frame_words(meta):
+    if meta.get("frame", "cold") == "cold":
+        return "each program's first run in a fresh process (cold)"
+    return ("each program's run after an untimed one in the same process (warm: the progressive frame "
+            "after one of the view turned 30 degrees, the peer's second flying edges, BVH and rays)")
+
+
 def report(meta, results, checks):
     load = ", ".join(f"{x:g}" for x in meta["load_average"])
     lines = [f"# Scaling (issue 10): {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
              f"Measured {meta['date']} on {meta['cores']} cores (load average {load} over 1, 5, 15 min "
-             f"at the end); fastest of {meta['runs']} run(s) each; seconds. C is the share of final "
+             f"at the end); fastest of {meta['runs']} run(s) each; seconds; {frame_words(meta)}. C is the share of final "
              f"pixels; the peer uses {meta['threads']} threads. The progressive columns and the "
              f"targets are the first engine's ({next(iter(meta.get('engines', {'': ''})))}).", "",
              *times_table(results), "", *engines_table(meta, results), "",
@@ -169,8 +176,8 @@ def plot(meta, results, path):
     ax.set_xlabel("volume (voxels)")
     ax.set_ylabel("seconds")
     first = next(iter(meta.get("engines", {"progressive": ""})))
-    ax.set_title(f"iso {meta['iso']:g}, {meta['size']}, C from {first}: time against voxels "
-                 f"(load avg {meta['load_average'][0]:g})", fontsize=9)
+    ax.set_title(f"iso {meta['iso']:g}, {meta['size']}, C from {first}, {meta.get('frame', 'cold')} frames: "
+                 f"time against voxels (load avg {meta['load_average'][0]:g})", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -34,6 +34,7 @@ class BenchScaling(unittest.TestCase):
             with open(os.path.join(out, "scaling.json")) as f:
                 res = json.load(f)
             scales = res["scales"]
+            self.assertEqual(res["meta"]["frame"], "warm")  # every program timed after a warm-up
             self.assertEqual([s["scale"] for s in scales], [0.5, 1])
             self.assertEqual(scales[1]["sizes"], [103, 94, 161])
             self.assertEqual(scales[0]["sizes"], [52, 47, 80])
@@ -51,6 +52,7 @@ class BenchScaling(unittest.TestCase):
                     # Same view, same surface: hit pixels within a fraction of a percent.
                     self.assertLess(abs(s["peer"]["hit_px"] - full["covered_px"]), 0.005 * full["covered_px"])
                     self.assertEqual(s["peer"]["triangles"], full["triangles"])
+                    self.assertGreater(s["peer"]["first_total_s"], 0)  # the peer ran twice
                 # Every configuration ran, and each final image was measured against the full surface.
                 self.assertEqual(list(s["engines"]), ["lod-facing-2t", "lod-facing", "full-res", "facing", "lod",
                                                       "lod-refine"])

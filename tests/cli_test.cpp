@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/io/image_io.h"
 #include "common/io/ply.h"
 #include "tests/cli_util.h"
 #include "tests/test_util.h"
@@ -134,6 +135,27 @@ TEST_F(Cli, AgainstFullPrintsBothMeasures) {
     const double c = c_of(coarse.out);
     EXPECT_GT(c, 0.8) << coarse.out;
     EXPECT_LT(c, c_of(full.out)) << coarse.out;
+}
+
+// The warm-up frame (another view, untimed) leaves nothing that changes the timed frame: the same
+// image, progressive or full.
+TEST_F(Cli, WarmUpFrameLeavesTheTimedFrameAlone) {
+    for (const std::string mode : {"", " --full"}) {
+        auto cold = run_isowall(dir_, "render --size 160x120 -q --threads 1 --out cold.png" + mode);
+        ASSERT_EQ(cold.exit_code, 0) << cold.err;
+        EXPECT_EQ(cold.out.find("warm-up"), std::string::npos) << cold.out;
+        auto warm = run_isowall(
+            dir_, "render --size 160x120 -q --threads 1 --warm-up --out warm.png" + mode);
+        ASSERT_EQ(warm.exit_code, 0) << warm.err;
+        EXPECT_NE(warm.out.find(mode.empty() ? "warm-up: an untimed frame of the view turned 30"
+                                             : "warm-up: the full surface extracted and drawn"),
+                  std::string::npos)
+            << warm.out;
+        const Image a = read_image(dir_ / "cold.png"), b = read_image(dir_ / "warm.png");
+        ASSERT_EQ(a.rgba.size(), 160u * 120u * 4u);
+        EXPECT_TRUE(a.rgba == b.rgba) << "warm-up changed the image" << mode;
+        EXPECT_GT(std::count(a.rgba.begin(), a.rgba.end(), 0), 0);
+    }
 }
 
 TEST_F(Cli, HelpListsTheSubcommands) {
