@@ -30,6 +30,7 @@ void print_error(std::string_view message, const char* tail = "") {
 int main(int argc, char** argv) {
     using namespace isowall;
     install_output_cleanup();  // a SIGINT or SIGTERM leaves no temporary file behind
+    keep_freed_memory();       // frames reuse what the frame before freed
     ProgramCli cli;
     CLI::App& app = cli.app;
     try {

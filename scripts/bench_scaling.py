@@ -21,7 +21,9 @@ frame of the view turned 30 degrees before the timed one (`--full` extracts and 
 once first), and the peer runs flying edges, the BVH build and the rays twice in its processes and
 times the second run. A wall's ranks draw frame after frame, so this is what a viewer waits for
 after moving the camera. --cold times every program's first run in a fresh process instead (the
-memory it touches then is new to it: page faults, the renderer's first buffers and bins).
+memory it touches then is new to it: page faults, the renderer's first buffers and bins). isowall
+keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the peer's processes
+run with the same C library settings (MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_).
 
 Each progressive configuration (--engines; the first is the one the targets judge) also prints
 its final image's C against the full surface (`render --against-full`, outside the clock).
@@ -136,10 +138,10 @@ def parse_args(argv):
     return a
 
 
-def run(cmd, what):
+def run(cmd, what, env=None):
     """stdout of `cmd`; a failure is one BenchError line naming `what` and the last stderr line."""
     try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=3600)
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=3600, env=env)
     except subprocess.TimeoutExpired:
         raise BenchError(f"{what}: no answer within an hour: {' '.join(cmd)}")
     if proc.returncode != 0:
@@ -217,12 +219,17 @@ def peer_missing(a):
     return None
 
 
+# isowall keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the
+# peer's processes get the same C library settings through its environment.
+PEER_ENV = dict(os.environ, MALLOC_TRIM_THRESHOLD_=str(1 << 30), MALLOC_MMAP_THRESHOLD_=str(32 << 20))
+
+
 def peer(a, volume, tmp):
     mesh = os.path.join(tmp, "peer.mesh")
     fe = key_values(run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "fe_mesh.py"), volume,
-                         f"{a.iso:g}", mesh, "--threads", str(a.threads), "--repeat", a.repeat], "fe_mesh.py"))
+                         f"{a.iso:g}", mesh, "--threads", str(a.threads), "--repeat", a.repeat], "fe_mesh.py", PEER_ENV))
     rays = key_values(run([a.peer, mesh, "--size", a.size, "--threads", str(a.threads), "--repeat", a.repeat],
-                          "isowall-peer"))
+                          "isowall-peer", PEER_ENV))
     os.remove(mesh)
     return {"fe_s": fe["fe_s"], "bvh_s": rays["bvh_s"], "rays_s": rays["rays_s"],
             "total_s": fe["fe_s"] + rays["bvh_s"] + rays["rays_s"],

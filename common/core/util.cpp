@@ -1,5 +1,6 @@
 #include "common/core/util.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <csignal>
@@ -8,6 +9,13 @@
 #include <fstream>
 
 namespace isowall {
+
+void keep_freed_memory() {
+    // Trimming the top of a heap is what gives freed pages back; blocks of 32 MiB and more (the
+    // largest threshold glibc takes) are still mapped and unmapped on their own.
+    mallopt(M_TRIM_THRESHOLD, static_cast<int>(kKeepFreedBytes));
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+}
 
 double peak_rss_mib() {
     rusage ru{};
