@@ -1,5 +1,6 @@
 #include "tile/parallel_level.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -52,7 +53,7 @@ class Level {
                       ? job_.ex.refine_on(w, hit.cell, hit.level, id, job_.refine_params)
                       : job_.ex.propagate_on(w, hit.cell, id, job_.params, ray, job_.stopped);
         f.pass_s = since(t1);
-        f.extract_s = job_.ex.last_extract_s_on(w);
+        f.extract_s = std::min(job_.ex.last_extract_s_on(w), f.pass_s);  // sampled: see engine
         {
             const std::lock_guard<std::mutex> hold(lock_);
             ready_.emplace(id, std::move(f));
