@@ -320,11 +320,7 @@ int run_render(const RenderOptions& o) {
     }
     Mesh mesh = extract_timed(*ex, iso, t);
     Stopwatch sw;
-    Image image;
-    renderer->resize(size->x, size->y);
-    renderer->clear();
-    renderer->draw(mesh, cam.view(), fv.frustum.matrix());
-    renderer->read_back(image);
+    const Image image = draw_alone(*renderer, mesh, fv);
     t.render = sw.seconds();
     const std::size_t covered = covered_pixels(image);
     std::printf("render: %s %dx%d, %.1f%% of pixels covered, %zu px (%.3f s)\n",

@@ -10,7 +10,8 @@ reads them; `spacings:` is honoured, 1 1 1 without it), placed as isowall places
 (i, j, k) at (i, j, k) * spacing. The voxels are read into memory before the clock starts, as
 isowall loads a volume before it extracts. With --repeat N the filter runs N times in the
 process and fe_s is the last run's (fe_first_s the first's): the steady state `isowall render
---warm-up` measures. Prints "key value" lines: fe_s, fe_first_s, triangles, vertices, threads. Errors: one line naming the file or option, exit 1.
+--warm-up` measures. Prints "key value" lines: fe_s, fe_first_s, triangles, vertices,
+threads. Errors: one line naming the file or option, exit 1.
 """
 import argparse
 import os

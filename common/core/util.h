@@ -26,7 +26,7 @@ class Stopwatch {
 // a frame's meshes, the renderer's buffers and its queued triangles are freed at the end of one
 // frame and needed again in the next, and pages given back are faulted in again, zeroed, one by
 // one (on this machine a 2048^3 frame on two threads took 20,000 such faults and half its time to
-// C = 99%; with this, under 2,000). Programs that draw frame after frame call it first in main().
+// C = 99%; with this, 1,000-3,500). Programs that draw frame after frame call it first in main().
 // Freed memory up to kKeepFreedBytes stays in the process.
 inline constexpr std::size_t kKeepFreedBytes = std::size_t(1) << 30;
 void keep_freed_memory();
