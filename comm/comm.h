@@ -44,6 +44,8 @@ class Comm {
     virtual int size() const = 0;
     bool is_master() const { return rank() == kMasterRank; }
     virtual std::string host() const = 0;
+    // How many ranks of the job run on this rank's host (they share its cores).
+    virtual int ranks_on_host() const = 0;
     // Hands the bytes over and returns without waiting for the peer to take them (they are
     // copied); messages to one peer arrive in the order sent.
     virtual void send(int dest, Tag tag, std::span<const std::byte> bytes) = 0;

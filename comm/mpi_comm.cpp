@@ -111,6 +111,10 @@ class MpiComm final : public Comm {
         ISOWALL_MPI_CALL(MPI_Comm_dup(MPI_COMM_WORLD, &comm_));
         ISOWALL_MPI_CALL(MPI_Comm_rank(comm_, &rank_));
         ISOWALL_MPI_CALL(MPI_Comm_size(comm_, &size_));
+        MPI_Comm node = MPI_COMM_NULL;
+        ISOWALL_MPI_CALL(MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+        ISOWALL_MPI_CALL(MPI_Comm_size(node, &on_host_));
+        MPI_Comm_free(&node);
     }
     ~MpiComm() override {
         Watchdog watchdog(watchdog_limit(limits_.end_s, rank_),
@@ -135,6 +139,7 @@ class MpiComm final : public Comm {
     }
     int rank() const override { return rank_; }
     int size() const override { return size_; }
+    int ranks_on_host() const override { return on_host_; }
     std::string host() const override {
         char name[MPI_MAX_PROCESSOR_NAME];
         int len = 0;
@@ -239,6 +244,7 @@ class MpiComm final : public Comm {
     MPI_Comm comm_ = MPI_COMM_NULL;
     int rank_ = 0;
     int size_ = 1;
+    int on_host_ = 1;  // ranks sharing this host (MPI_COMM_TYPE_SHARED)
 };
 
 }  // namespace

@@ -18,9 +18,10 @@ WallFigures wall_figures(const std::vector<TileResultMsg>& results) {
 
 void print_rank_table(std::FILE* out, const WallSpec& spec,
                       const std::vector<TileResultMsg>& results) {
-    std::fprintf(out,
-                 "per rank (CPU seconds of each tile's frame thread, all frames; makespan = the "
-                 "largest):\n");
+    std::fprintf(
+        out,
+        "per rank (CPU seconds of each tile's frame thread, plus what its engine workers ran "
+        "past it; all frames; makespan = the largest):\n");
     std::fprintf(out, "  %4s %-12s %4s %8s %8s %7s %6s %10s %7s %10s %8s %5s %6s %8s\n", "rank",
                  "host", "tile", "cpu s", "frame s", "frames", "intr", "rays", "groups",
                  "triangles", "RSS MiB", "jobs", "helped", "MB sent");
@@ -101,9 +102,10 @@ void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard
 
 void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results) {
-    std::fprintf(
-        out, "CPU seconds by stage (thread CPU time; propagation includes marching cubes):\n  %4s",
-        "rank");
+    std::fprintf(out,
+                 "CPU seconds by stage (thread CPU time, engine workers' included; propagation "
+                 "includes marching cubes):\n  %4s",
+                 "rank");
     for (const char* name : kTraceStages) std::fprintf(out, " %12s", name);
     std::fprintf(out, "\n");
     auto row = [&](std::size_t rank, const std::vector<TraceSpan>& spans) {

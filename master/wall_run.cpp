@@ -37,6 +37,13 @@ std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadB
     return make_surface_extractor(ov.volume, src, nullptr, budget);
 }
 
+// The rank's thread budget: --threads, or its share of the node's cores (common/core/
+// thread_budget.h), so that ranks emulating a wall on one machine do not oversubscribe it.
+ThreadBudget rank_budget(const WallOptions& o, const Comm& comm) {
+    if (o.threads > 0) return ThreadBudget{o.threads};
+    return node_share(cores_allowed(), ThreadBudget::hardware().threads, comm.ranks_on_host());
+}
+
 // What the master checks before any frame starts: a bad volume, isovalue, output folder, engine
 // option or script line stops the job here, with one line naming the source and the field.
 struct MasterInput {
@@ -46,11 +53,11 @@ struct MasterInput {
     std::vector<ScriptLine> script;
 };
 
-MasterInput check_master_input(const WallOptions& o) {
+MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
     in.volume.emplace(open_volume(o.volume));
     const OpenedVolume& ov = *in.volume;
-    in.extractor = open_extractor(ov, ThreadBudget{o.threads});
+    in.extractor = open_extractor(ov, budget);
     in.iso = o.iso.value_or(kPhantomSkinIso);
     if (!o.iso && ov.file)
         throw InputError(ov.file->string(), "--iso",
@@ -117,12 +124,18 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
 
 int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
     const OpenedVolume ov = open_volume(o.volume, /*quiet=*/true);
-    auto extractor = open_extractor(ov, ThreadBudget{o.threads});
+    const ThreadBudget budget = rank_budget(o, comm);
+    auto extractor = open_extractor(ov, budget);
+    // llvmpipe rasterises in the drawing thread (unless the user says otherwise): its work is then
+    // within the rank's budget and in the frame thread's CPU clock, which the trace and the
+    // emulated time read. A vendor driver ignores the variable.
+    setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     auto renderer = make_renderer(o.gl);
     auto help_renderer = make_renderer(o.gl);
     TileSetup setup{*extractor, *renderer, *help_renderer, to_engine_options(o.engine),
                     {},         o.measure};
     setup.engine.region_clip = o.region_clip;
+    setup.engine.threads = budget.usable();
     if (o.fault_rank == comm.rank()) setup.fault.kind = o.fault_kind;
     const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
     setup.timeout_s = o.timeout_s;
@@ -233,7 +246,7 @@ int run_wall(const WallOptions& o, Comm& comm) {
         if (o.fault_rank == kMasterRank) raise_test_signal(o.fault_kind, "load");
         std::optional<MasterInput> input;
         try {
-            input.emplace(check_master_input(o));
+            input.emplace(check_master_input(o, rank_budget(o, comm)));
         } catch (const InputError& e) {
             fail(comm, spec, e, true);
         }

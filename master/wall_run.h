@@ -37,9 +37,10 @@ struct WallOptions {
     bool measure = false;           // emulated wall-wide correctness curves
     bool windows = false;           // each tile shows its frame in a window on its display
     bool region_clip = true;        // propagation stays within each job's region
-    // Threads each rank may use (the octree build and extraction workers): ranks share nodes,
-    // so this is the rank's budget, not the machine's core count.
-    int threads = 1;
+    // Threads each rank may use (the octree build, and the engine's threads casting and
+    // propagating side by side): ranks share nodes, so this is the rank's budget, not the
+    // machine's core count. 0: the rank's share of its node (rank_budget in wall_run.cpp).
+    int threads = 0;
     // Test hook (ISOWALL_TEST_FAULT=KIND:RANK): the rank named fails in the way named (tile:
     // hang, exit, throw; master: throw).
     std::string fault_kind;

@@ -39,7 +39,7 @@ const std::vector<Slot> kSlots = {
     {"wall --wall w.toml --pan {} 0", "--pan", {"1001", "-1e300"}},
     {"wall --wall w.toml --timeout {}", "--timeout", kTimeouts},
     {"wall --wall w.toml --startup-timeout {}", "--startup-timeout", kTimeouts},
-    {"wall --wall w.toml --threads {}", "--threads", {"0", "-5", "1025", "2.5"}},
+    {"wall --wall w.toml --threads {}", "--threads", {"-5", "1025", "2.5"}},
 };
 
 std::string fill(const std::string& slot, const std::string& value) {

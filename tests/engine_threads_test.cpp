@@ -105,6 +105,21 @@ TEST(Threads, AdaptiveResolutionRepeatsAcrossThreads) {
     }
 }
 
+TEST(Threads, TheWorkersCpuIsCounted) {
+    // The CPU of the threads beside the caller is in the frame's figures (a wall rank's trace and
+    // emulated clock add it); one thread has none.
+    const Volume p = make_phantom();
+    const FrameView fv = test::make_view(p, 240, 180, kPhantomSkinIso);
+    const FrameResult one = run(p, fv, {}, 1);
+    const FrameResult two = run(p, fv, {}, 2);
+    std::cout << "workers' CPU: 1 thread " << one.workers.sum_s << " s, 2 threads "
+              << two.workers.sum_s << " s (beyond the caller " << two.workers.beyond_s << " s)\n";
+    EXPECT_EQ(one.workers.sum_s, 0.0);
+    EXPECT_EQ(one.workers.beyond_s, 0.0);
+    EXPECT_GT(two.workers.sum_s, 0.0);
+    EXPECT_LE(two.workers.beyond_s, two.workers.sum_s);
+}
+
 TEST(Threads, AStopEndsEveryThread) {
     // A frame stopped before it starts ends at once, on every thread, with nothing drawn.
     const Volume p = make_phantom();

@@ -58,6 +58,18 @@ TEST(ThreadBudget, ZeroIsReadAsOneAndSetsTheWorkers) {
     EXPECT_EQ(make_surface_extractor(p, {}, nullptr, ThreadBudget{0})->threads(), 1);
 }
 
+TEST(ThreadBudget, ARankTakesItsShareOfTheNode) {
+    // A wall emulated on 2 cores: 5 ranks, 1 each (never 0).
+    EXPECT_EQ(node_share(2, 2, 5), ThreadBudget{1});
+    // One rank per 16-core display node: every core; two ranks: half each.
+    EXPECT_EQ(node_share(16, 16, 1), ThreadBudget{16});
+    EXPECT_EQ(node_share(16, 16, 2), ThreadBudget{8});
+    // mpirun bound the rank to 4 cores: no more than those.
+    EXPECT_EQ(node_share(4, 16, 1), ThreadBudget{4});
+    // Nonsense counts still give one thread.
+    EXPECT_EQ(node_share(0, 0, 0), ThreadBudget{1});
+}
+
 TEST(ThreadBudget, OctreeIsTheSameOnAnyNumberOfThreads) {
     const Volume p = make_phantom();
     const auto v = p.view<std::uint8_t>();

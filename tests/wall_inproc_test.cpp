@@ -253,6 +253,37 @@ TEST(WallBalance, BalancedAndStaticMosaicsAreEqual) {
     }
 }
 
+// Each rank on two engine threads (--threads 2; the in-process default is one per rank, five
+// ranks sharing one machine): the mosaic of one thread per rank, with and without migration, and
+// the ranks' traces carry the workers' CPU.
+TEST(WallBalance, TwoThreadsPerRankGiveTheSameMosaic) {
+    for (const bool balance : {false, true}) {
+        SCOPED_TRACE(balance ? "balanced" : "static");
+        const std::string name = balance ? "on" : "off";
+        const WallOptions one =
+            balance_wall(test::scratch_dir("threads_one_" + name), balance, false);
+        WallOptions two = balance_wall(test::scratch_dir("threads_two_" + name), balance, false);
+        two.threads = 2;
+        const WallRun r1 = run_wall_in_process(one);
+        const WallRun r2 = run_wall_in_process(two);
+        for (int code : r1.codes) ASSERT_EQ(code, 0) << r1.err;
+        for (int code : r2.codes) ASSERT_EQ(code, 0) << r2.err;
+        const test::ImageComparison m = expect_same_view(two.out, one.out);
+        EXPECT_GT(m.covered_both, 1000u) << m;
+        double rays1 = 0, rays2 = 0;
+        for (int rank = 1; rank <= 4; ++rank) {
+            rays1 += static_cast<double>(r1.results[static_cast<std::size_t>(rank)].rays);
+            rays2 += static_cast<double>(r2.results[static_cast<std::size_t>(rank)].rays);
+        }
+        // Static regions cast the same pixels on any number of threads (with migration, which
+        // rank casts a region's band, and so which rays, depends on timing).
+        if (!balance) {
+            EXPECT_EQ(rays1, rays2);
+        }
+        std::printf("%s: %s\n", name.c_str(), testing::PrintToString(m).c_str());
+    }
+}
+
 // A new view while helpers hold regions of the old one: their results, arriving late, are
 // dropped, never composited into the new frame.
 TEST(WallBalance, AnInterruptWhileJobsMigrateLeavesNothingOfTheOldView) {

@@ -1,10 +1,25 @@
-// The engine's conveniences around a frame: the warm-up draw, the whole-screen run that keeps
-// every group and the final image, and the replay that measures correctness.
+// The engine's conveniences around a frame: one region into a sink, the warm-up draw, the
+// whole-screen run that keeps every group and the final image, and the replay that measures
+// correctness.
 #include <atomic>
 
 #include "tile/progressive_engine.h"
 
 namespace isowall {
+
+FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& region, GroupSink& sink,
+                                   const std::atomic<bool>& stop, const Progress& progress) {
+    EngineFrame frame(*this, view, stop, progress);
+    sink.begin(view);
+    RegionCursor c = frame.cursor(view, region);
+    const bool done = frame.cast(view, c, sink);
+    FrameResult result = frame.finish(done);
+    result.rays_screen =
+        static_cast<std::size_t>(region.width) * static_cast<std::size_t>(region.height);
+    result.screen_rect = c.rect;
+    result.screen_pixels = c.pixels;
+    return result;
+}
 
 void warm_up(Renderer& renderer) {
     Mesh tiny;

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "common/core/ray.h"
+#include "common/progressive/trace.h"
 
 namespace isowall {
 namespace {
@@ -20,6 +21,12 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+
+// One thread's share of a level, written by that thread only.
+struct WorkerTally {
+    std::size_t rays = 0, hits = 0;
+    double intersect_s = 0, cpu_s = 0;
+};
 
 // The state the threads of one level share.
 class Level {
@@ -35,7 +42,7 @@ class Level {
     bool step(int w) {
         const std::size_t i = next_pixel_.fetch_add(1, std::memory_order_relaxed);
         if (i >= job_.pixels.size() || job_.stopped()) return false;
-        LevelTally& t = tally_[static_cast<std::size_t>(w)];
+        WorkerTally& t = tally_[static_cast<std::size_t>(w)];
         const Ray ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
                                   job_.view.height, job_.pixels[i] + job_.origin);
         const auto t0 = Clock::now();
@@ -83,7 +90,8 @@ class Level {
         next_pixel_.store(job_.pixels.size());  // the others stop at their next pixel
     }
 
-    void worker_done() {
+    void worker_done(int w, double cpu_s) {
+        tally_[static_cast<std::size_t>(w)].cpu_s = cpu_s;
         {
             const std::lock_guard<std::mutex> hold(lock_);
             --running_;
@@ -96,10 +104,12 @@ class Level {
     LevelTally finish() {
         if (failure_) std::rethrow_exception(failure_);
         LevelTally sum;
-        for (const LevelTally& t : tally_) {
+        for (const WorkerTally& t : tally_) {
             sum.rays += t.rays;
             sum.hits += t.hits;
             sum.intersect_s += t.intersect_s;
+            sum.workers_cpu_s += t.cpu_s;
+            sum.busiest_worker_cpu_s = std::max(sum.busiest_worker_cpu_s, t.cpu_s);
         }
         sum.next_id = next_id_.load();
         return sum;
@@ -115,7 +125,7 @@ class Level {
     std::map<std::uint32_t, FoundGroup> ready_;  // by id, under lock_
     int running_;                                // other threads still casting, under lock_
     std::exception_ptr failure_;                 // under lock_
-    std::vector<LevelTally> tally_;              // one per thread, each written by its own
+    std::vector<WorkerTally> tally_;             // one per thread, each written by its own
 };
 
 }  // namespace
@@ -128,13 +138,14 @@ LevelTally cast_level_parallel(const LevelJob& job, int threads,
     others.reserve(static_cast<std::size_t>(threads - 1));
     for (int w = 1; w < threads; ++w)
         others.emplace_back([&level, w] {
+            const double c0 = thread_cpu_seconds();
             try {
                 while (level.step(w)) {
                 }
             } catch (...) {
                 level.fail(std::current_exception());
             }
-            level.worker_done();
+            level.worker_done(w, thread_cpu_seconds() - c0);
         });
     try {
         for (;;) {

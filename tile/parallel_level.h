@@ -40,7 +40,10 @@ struct FoundGroup {
 
 struct LevelTally {
     std::size_t rays = 0, hits = 0;
-    double intersect_s = 0;     // summed over the threads
+    double intersect_s = 0;  // summed over the threads
+    // CPU seconds (CLOCK_THREAD_CPUTIME_ID) of the threads other than the caller, each from its
+    // start to its end, summed; and the largest one (the caller's own CPU is its thread clock).
+    double workers_cpu_s = 0, busiest_worker_cpu_s = 0;
     std::uint32_t next_id = 0;  // the first id not handed out
 };
 

@@ -112,6 +112,7 @@ class FrameRun {
     }
 
     const TimelineSample& now() const { return now_; }
+    const WorkersCpu& workers_cpu() const { return frame_.workers; }
 
   private:
     void stage(Stage s) {
@@ -212,12 +213,17 @@ class FrameRun {
         const LevelJob job{
             ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
             mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_};
+        const double own0 = thread_cpu_seconds();
         const LevelTally t = isowall::cast_level_parallel(
             job, n, [this](FoundGroup& f) { add_found(f); },
             [this, rays_before](std::size_t rays) {
                 now_.rays = rays_before + rays;
                 record(false);
             });
+        frame_.workers.sum_s += t.workers_cpu_s;
+        frame_.workers.beyond_s +=
+            std::max(0.0, t.busiest_worker_cpu_s - (thread_cpu_seconds() - own0));
+        if (opt_.trace) opt_.trace->add_cpu(t.workers_cpu_s);
         ids_used_ = t.next_id - opt_.first_group_id;
         now_.t_intersect_s += t.intersect_s;
         cursor_->hits += t.hits;
@@ -354,20 +360,6 @@ ProgressiveEngine::ProgressiveEngine(SurfaceExtractor& extractor, Renderer& rend
     warm_up(renderer_);
 }
 
-FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& region, GroupSink& sink,
-                                   const std::atomic<bool>& stop, const Progress& progress) {
-    EngineFrame frame(*this, view, stop, progress);
-    sink.begin(view);
-    RegionCursor c = frame.cursor(view, region);
-    const bool done = frame.cast(view, c, sink);
-    FrameResult result = frame.finish(done);
-    result.rays_screen =
-        static_cast<std::size_t>(region.width) * static_cast<std::size_t>(region.height);
-    result.screen_rect = c.rect;
-    result.screen_pixels = c.pixels;
-    return result;
-}
-
 EngineFrame::EngineFrame(ProgressiveEngine& engine, const FrameView& view,
                          const std::atomic<bool>& stop, const ProgressiveEngine::Progress& progress)
     : run_(std::make_unique<FrameRun>(engine.extractor_, engine.options_, view, stop, progress)) {}
@@ -389,6 +381,10 @@ FrameResult EngineFrame::finish(bool completed) {
 
 const TimelineSample& EngineFrame::now() const {
     return run_->now();
+}
+
+const WorkersCpu& EngineFrame::workers() const {
+    return run_->workers_cpu();
 }
 
 }  // namespace isowall

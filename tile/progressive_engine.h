@@ -76,6 +76,14 @@ struct EngineOptions {
     std::uint32_t first_group_id = 0;
 };
 
+// The CPU of the engine's threads other than the caller's (EngineOptions::threads > 1), summed
+// over the frame's levels: their CPU seconds, and by how much each level's busiest worker
+// outlasted the caller. The caller's thread CPU plus beyond_s is the frame's time on cores of its
+// own (each level ends when its last thread does); plus sum_s, the CPU it used on all of them.
+struct WorkersCpu {
+    double sum_s = 0, beyond_s = 0;
+};
+
 struct FrameResult {
     bool completed = false;  // false: interrupted before the last ray
     std::size_t rays_cast = 0;
@@ -92,6 +100,7 @@ struct FrameResult {
     // The screen mask's octree level and active nodes (-1 and 0 without the mask).
     int mask_level = -1;
     std::size_t mask_nodes = 0;
+    WorkersCpu workers;
 };
 
 // Mesa compiles its shader variants on the first draw (about 25 ms in llvmpipe). An interactive
@@ -178,6 +187,8 @@ class EngineFrame {
     FrameResult finish(bool completed);
     // The latest sample: rays, groups, triangles of the frame so far.
     const TimelineSample& now() const;
+    // The workers' CPU so far (threads > 1).
+    const WorkersCpu& workers() const;
 
   private:
     std::unique_ptr<FrameRun> run_;

@@ -90,13 +90,17 @@ void TileJobs::measure_point() {
     // its next refresh anyway); only the copy of the region is the measurement's own cost.
     tile_sink_.present();
     const double now = thread_cpu_seconds();
-    const double busy_now = busy_cpu_s_ + (now - job_c0_ - job_measure_cpu_);
+    const double busy_now = busy_cpu_s_ + job_cpu_s(now);
     if (busy_now - last_shot_s_ < kShotIntervalS) return;
     Image img;
     tile_sink_.read_back(img, job_rect_);
     shots_.push_back({busy_now, job_rect_, std::move(img), true});
     last_shot_s_ = busy_now;
     job_measure_cpu_ += thread_cpu_seconds() - now;
+}
+
+double TileJobs::job_cpu_s(double now) const {
+    return now - job_c0_ - job_measure_cpu_ + (frame_->workers().beyond_s - job_beyond0_);
 }
 
 // Every group found earlier in the frame that may show in `view`: the engine casts no new pass
@@ -111,6 +115,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const double c0 = thread_cpu_seconds();
     job_c0_ = c0;
     job_measure_cpu_ = 0;
+    job_beyond0_ = frame_->workers().beyond_s;
     job_rect_ = job.rect;
     Outcome out;
     out.done.generation = job.generation;
@@ -152,7 +157,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
         out.result = std::move(r);
     }
     // The emulated clock of a rank is its busy CPU: what it would have spent on a core of its own.
-    out.done.cpu_s = thread_cpu_seconds() - c0 - job_measure_cpu_;
+    out.done.cpu_s = job_cpu_s(thread_cpu_seconds());
     busy_cpu_s_ += out.done.cpu_s;
     out.done.cpu_end_s = busy_cpu_s_;
     if (out.result) out.result->cpu_end_s = busy_cpu_s_;

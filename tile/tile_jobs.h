@@ -60,12 +60,15 @@ class TileJobs {
     // What the tile shows now: its own drawing with every landed result over it.
     Image image();
     // CPU seconds the frame thread spent in this frame's jobs and landings (and what the caller
-    // adds: sending results): a rank's emulated clock, as if it had a core of its own.
+    // adds: sending results): a rank's emulated clock, as if it had a core of its own. With
+    // several engine threads, each level counts until its last thread ends (WorkersCpu).
     double busy_cpu_s() const { return busy_cpu_s_; }
     void add_busy(double cpu_s) { busy_cpu_s_ += cpu_s; }
     // Wall seconds from the frame's start to its last job's end.
     double frame_wall_s() const { return wall_end_ - wall0_; }
     const TimelineSample& now() const { return frame_->now(); }
+    // By how much the engine's workers outlasted the frame thread in this frame's levels.
+    double workers_beyond_s() const { return frame_ ? frame_->workers().beyond_s : 0.0; }
 
     // The correctness of what the tile showed against its final image (image()) at each job end,
     // in emulated time (each rank's CPU clock from the frame's start). Needs `measure`.
@@ -96,7 +99,9 @@ class TileJobs {
     double last_draw_s_ = 0;  // emulated time of this rank's last job: its own image is final
     bool in_own_job_ = false;
     PixelRect job_rect_;
-    double job_c0_ = 0, job_measure_cpu_ = 0, last_shot_s_ = -1;
+    double job_c0_ = 0, job_measure_cpu_ = 0, job_beyond0_ = 0, last_shot_s_ = -1;
+    // The job's busy CPU up to `now` (the frame thread's clock).
+    double job_cpu_s(double now) const;
     struct Shot {
         double emulated_s;
         PixelRect rect;

@@ -163,7 +163,8 @@ class TileRank {
             last_progress_s_ = s.time_s;
             const Stage left = trace_.switch_to(Stage::comm);
             send_message(comm_, kMasterRank,
-                         ProgressMsg{jobs_.generation(), s.rays, thread_cpu_seconds() - cpu0_});
+                         ProgressMsg{jobs_.generation(), s.rays,
+                                     thread_cpu_seconds() - cpu0_ + jobs_.workers_beyond_s()});
             answer_snapshots();
             trace_.switch_to(left);
         });

@@ -19,6 +19,14 @@ struct ThreadBudget {
     int usable() const { return std::max(1, threads); }
 };
 
+// A rank's share of its node: the cores it may run on (its CPU affinity, which mpirun's binding
+// may narrow), but no more than the node's cores divided among the ranks on it, and at least one.
+// Five ranks of a wall emulated on 2 cores get 1 each; one rank per 16-core display node, 16.
+inline ThreadBudget node_share(int allowed_cores, int node_cores, int ranks_on_node) {
+    const int split = std::max(1, node_cores) / std::max(1, ranks_on_node);
+    return {std::max(1, std::min(std::max(1, allowed_cores), split))};
+}
+
 inline bool operator==(ThreadBudget a, ThreadBudget b) {
     return a.threads == b.threads;
 }

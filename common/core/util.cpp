@@ -1,10 +1,12 @@
 #include "common/core/util.h"
 
 #include <malloc.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <csignal>
 
+#include <algorithm>
 #include <charconv>
 #include <fstream>
 
@@ -15,6 +17,13 @@ void keep_freed_memory() {
     // largest threshold glibc takes) are still mapped and unmapped on their own.
     mallopt(M_TRIM_THRESHOLD, static_cast<int>(kKeepFreedBytes));
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
+}
+
+int cores_allowed() {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
+    return std::max(1, CPU_COUNT(&set));
 }
 
 double peak_rss_mib() {

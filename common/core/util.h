@@ -31,6 +31,9 @@ class Stopwatch {
 inline constexpr std::size_t kKeepFreedBytes = std::size_t(1) << 30;
 void keep_freed_memory();
 
+// The cores this process may run on (its CPU affinity mask; mpirun's binding may narrow it).
+int cores_allowed();
+
 // Peak resident set size of this process, in MiB (getrusage).
 double peak_rss_mib();
 // Current resident set size of this process, in MiB (/proc/self/statm).

@@ -46,6 +46,11 @@ class TraceRecorder {
     Stage switch_to(Stage stage);
     // Ends the current span (the recorder can go on with switch_to).
     void close();
+    // Charges CPU seconds of the rank's other threads (the engine's workers) to the open span, so
+    // that a span's cpu_s is the CPU the rank spent in it, on every thread.
+    void add_cpu(double cpu_s) {
+        if (open_) cpu0_ -= cpu_s;
+    }
     const std::vector<TraceSpan>& spans() const { return spans_; }
     // CPU seconds per stage, summed over the spans.
     std::vector<double> cpu_by_stage() const;
