@@ -123,10 +123,8 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->capture_default_str();
     wall_cmd
         ->add_option("--threads", wall.threads,
-                     "Threads each rank may use (octree build; rays and propagation side by "
-                     "side). 0: the cores the rank may run on, shared among the ranks on its "
-                     "node (1 each when a wall is emulated on one machine; every core of a "
-                     "display node that runs one rank)")
+                     "Threads each rank may use (octree build; rays and propagation). 0: its "
+                     "share of its node's cores (1 each when emulating a wall on one machine)")
         ->transform(number_in({0, 1024, false, true}))
         ->capture_default_str();
     wall_cmd->add_option("--trace", wall.trace,
