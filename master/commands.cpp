@@ -198,7 +198,9 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
             "%.3f s\n",
             kWarmUpYawDeg, w.timeline.back().triangles, w.elapsed_s);
     }
+    const double cpu0 = thread_cpu_seconds();
     FrameResult fr = engine.run(fv, nullptr, progress);
+    const double caller_cpu = thread_cpu_seconds() - cpu0;
     const TimelineSample& last = fr.timeline.back();
     t.frame = fr.elapsed_s;
     std::printf(
@@ -216,6 +218,11 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         "stages (summed over threads): intersection %.3f s | propagation %.3f s | extraction "
         "%.3f s | rendering %.3f s\n",
         last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+    if (fr.workers.sum_s > 0)
+        std::printf(
+            "CPU: the drawing thread %.3f s, the other threads %.3f s (the busiest ran %.3f s "
+            "past the drawing thread's levels)\n",
+            caller_cpu, fr.workers.sum_s, fr.workers.beyond_s);
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
     if (fr.mask_level >= 0)
         std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",

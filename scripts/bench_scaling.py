@@ -25,6 +25,12 @@ memory it touches then is new to it: page faults, the renderer's first buffers a
 keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the peer's processes
 run with the same C library settings (MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_).
 
+Two threads against one: the targets compare lod-facing on 1 and 2 threads. Beside them the
+run prints, for each scale, the peer's own 2-thread gain (flying edges, BVH and rays on 1 thread,
+one run) and what the machine's two cores gave two threads of plain work at that time
+(bench/cores' isowall-cores: arithmetic, and random reads over 256 MiB; 2.0 is perfect), since on
+a shared machine that moves from hour to hour.
+
 Each progressive configuration (--engines; the first is the one the targets judge) also prints
 its final image's C against the full surface (`render --against-full`, outside the clock).
 Every figure is wall-clock seconds measured inside the programs (loading and the octree are
@@ -125,8 +131,10 @@ def parse_args(argv):
         raise BenchError(f"--threads: expected an integer in [1, 64], got {a.threads}")
     a.isowall = os.path.join(a.build, "master", "isowall")
     a.peer = os.path.join(a.build, "bench", "peer", "isowall-peer")
-    if not os.path.exists(a.isowall):
-        raise BenchError(f"--build: {a.isowall} not found; build first (bash scripts/setup.sh)")
+    a.cores = os.path.join(a.build, "bench", "cores", "isowall-cores")
+    for program in (a.isowall, a.cores):
+        if not os.path.exists(program):
+            raise BenchError(f"--build: {program} not found; build first (bash scripts/setup.sh)")
     if os.sep in a.volume or a.volume.endswith(".nhdr"):
         a.source = a.volume
         if not os.path.exists(a.source):
@@ -224,11 +232,12 @@ def peer_missing(a):
 PEER_ENV = dict(os.environ, MALLOC_TRIM_THRESHOLD_=str(1 << 30), MALLOC_MMAP_THRESHOLD_=str(32 << 20))
 
 
-def peer(a, volume, tmp):
+def peer(a, volume, tmp, threads=None):
+    threads = str(threads or a.threads)
     mesh = os.path.join(tmp, "peer.mesh")
     fe = key_values(run(["/usr/bin/python3", os.path.join(ROOT, "scripts", "fe_mesh.py"), volume,
-                         f"{a.iso:g}", mesh, "--threads", str(a.threads), "--repeat", a.repeat], "fe_mesh.py", PEER_ENV))
-    rays = key_values(run([a.peer, mesh, "--size", a.size, "--threads", str(a.threads), "--repeat", a.repeat],
+                         f"{a.iso:g}", mesh, "--threads", threads, "--repeat", a.repeat], "fe_mesh.py", PEER_ENV))
+    rays = key_values(run([a.peer, mesh, "--size", a.size, "--threads", threads, "--repeat", a.repeat],
                           "isowall-peer", PEER_ENV))
     os.remove(mesh)
     return {"fe_s": fe["fe_s"], "bvh_s": rays["bvh_s"], "rays_s": rays["rays_s"],
@@ -255,6 +264,11 @@ def measure_scale(a, scale, skip_peer, tmp):
         res["peer"] = {"skipped": skip_peer}
     else:
         res["peer"] = fastest([peer(a, volume, tmp) for _ in range(a.runs)], "total_s")
+        # The peer on one thread (one run): how much its two threads gain on this machine.
+        if a.threads == 2:
+            res["peer_1t"] = peer(a, volume, tmp, 1)
+    # What the machine's two cores gave two threads around this scale's runs (bench/cores).
+    res["cores"] = key_values(run([a.cores, "--reps", "3"], "isowall-cores"))
     return res
 
 

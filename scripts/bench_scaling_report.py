@@ -119,6 +119,31 @@ def pixels_table(results):
     return lines
 
 
+def two_threads_table(results):
+    """Speed-ups of two threads over one (one thread's time / two threads'): ours, the peer's, and
+    what the machine's cores gave plain work at the time (bench/cores)."""
+    lines = ["Two threads against one (speed-up: one thread's time / two threads'; 1.7 is the target, "
+             "2 is perfect):", "",
+             "| volume | ours, C=99% | ours, every ray | peer FE | peer BVH + rays | peer total | "
+             "machine: arithmetic | machine: random reads |", "|---|---|---|---|---|---|---|---|"]
+
+    def gain(one, two):
+        return fmt(one / two, 2) if one and two else "-"
+
+    for r in results:
+        e = r.get("engines", {})
+        one, two = e.get("lod-facing", {}), e.get("lod-facing-2t", {})
+        p1, p2 = r.get("peer_1t", {}), r.get("peer", {})
+        cores = r.get("cores", {})
+        lines.append(
+            f"| {label(r)} | {gain(one.get('c99'), two.get('c99'))} | "
+            f"{gain(one.get('every_ray_s'), two.get('every_ray_s'))} | {gain(p1.get('fe_s'), p2.get('fe_s'))} | "
+            f"{gain(p1.get('bvh_s', 0) + p1.get('rays_s', 0), p2.get('bvh_s', 0) + p2.get('rays_s', 0))} | "
+            f"{gain(p1.get('total_s'), p2.get('total_s'))} | {fmt(cores.get('alu_speedup'), 2)} | "
+            f"{fmt(cores.get('memory_speedup'), 2)} |")
+    return lines
+
+
 def frame_words(meta):
     if meta.get("frame", "cold") == "cold":
         return "each program's first run in a fresh process (cold)"
@@ -134,6 +159,7 @@ def report(meta, results, checks):
              f"pixels; the peer uses {meta['threads']} threads. The progressive columns and the "
              f"targets are the first engine's ({next(iter(meta.get('engines', {'': ''})))}).", "",
              *times_table(results), "", *engines_table(meta, results), "",
+             *two_threads_table(results), "",
              "Covered pixels (the same view in each):", "", *pixels_table(results), "",
              "Targets:", "", "| target | volume | figure | limit | verdict |", "|---|---|---|---|---|"]
     for c in checks:

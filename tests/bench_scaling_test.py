@@ -53,6 +53,13 @@ class BenchScaling(unittest.TestCase):
                     self.assertLess(abs(s["peer"]["hit_px"] - full["covered_px"]), 0.005 * full["covered_px"])
                     self.assertEqual(s["peer"]["triangles"], full["triangles"])
                     self.assertGreater(s["peer"]["first_total_s"], 0)  # the peer ran twice
+                    # ... and once on one thread, for its own two-thread gain.
+                    self.assertEqual(s["peer_1t"]["triangles"], s["peer"]["triangles"])
+                    self.assertGreater(s["peer_1t"]["total_s"], 0)
+                # What the machine's cores gave two threads of plain work at the time.
+                for key in ("alu_speedup", "memory_speedup"):
+                    self.assertGreater(s["cores"][key], 0.5, s["cores"])
+                    self.assertLess(s["cores"][key], 2.5, s["cores"])
                 # Every configuration ran, and each final image was measured against the full surface.
                 self.assertEqual(list(s["engines"]), ["lod-facing-2t", "lod-facing", "full-res", "facing", "lod",
                                                       "lod-refine"])
@@ -70,6 +77,7 @@ class BenchScaling(unittest.TestCase):
             self.assertIn("| 103x94x161 | 1.56 M |", md)
             self.assertIn("| 52x47x80 |", md)
             self.assertIn("Targets:", md)
+            self.assertIn("Two threads against one", md)
             self.assertIn("| 103x94x161 | lod-refine |", md)
             self.assertTrue("holds" in md or "MISSED" in md)
             self.assertIn(md.splitlines()[0], p.stdout)
