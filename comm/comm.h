@@ -46,6 +46,9 @@ class Comm {
     virtual std::string host() const = 0;
     // How many ranks of the job run on this rank's host (they share its cores).
     virtual int ranks_on_host() const = 0;
+    // Whether this rank has its process to itself (MPI), so that it may change the process's
+    // environment; false where ranks are threads of one process (in-process transport).
+    virtual bool owns_process() const = 0;
     // Hands the bytes over and returns without waiting for the peer to take them (they are
     // copied); messages to one peer arrive in the order sent.
     virtual void send(int dest, Tag tag, std::span<const std::byte> bytes) = 0;

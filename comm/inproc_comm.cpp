@@ -13,6 +13,7 @@ class InProcComm final : public Comm {
     int size() const override { return world_.size(); }
     std::string host() const override { return "inproc"; }
     int ranks_on_host() const override { return world_.size(); }  // one process, one machine
+    bool owns_process() const override { return false; }
     void send(int dest, Tag tag, std::span<const std::byte> bytes) override {
         world_.post(dest, Envelope{rank_, tag, std::vector<std::byte>(bytes.begin(), bytes.end())});
     }

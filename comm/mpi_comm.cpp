@@ -140,6 +140,7 @@ class MpiComm final : public Comm {
     int rank() const override { return rank_; }
     int size() const override { return size_; }
     int ranks_on_host() const override { return on_host_; }
+    bool owns_process() const override { return true; }
     std::string host() const override {
         char name[MPI_MAX_PROCESSOR_NAME];
         int len = 0;

@@ -131,8 +131,9 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
     // thread's CPU clock, which the trace and the emulated time read. With more, llvmpipe keeps
     // its raster threads (groups of 2,000 triangles draw 2.3x faster with one than with none,
     // isowall_bench_render at 1024x768), and their CPU is not in the trace. A vendor driver
-    // ignores the variable.
-    if (budget.usable() == 1) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+    // ignores the variable. Ranks that are threads of one process (tests) leave the shared
+    // environment alone: another rank's thread may be reading it.
+    if (budget.usable() == 1 && comm.owns_process()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     auto renderer = make_renderer(o.gl);
     auto help_renderer = make_renderer(o.gl);
     TileSetup setup{*extractor, *renderer, *help_renderer, to_engine_options(o.engine),
