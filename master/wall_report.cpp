@@ -94,7 +94,7 @@ void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard
         return std::string(buf);
     };
     std::fprintf(out,
-                 "emulated time (each rank on its own core, CPU-derived) to wall-wide C = "
+                 "emulated time (each rank on cores of its own, CPU-derived) to wall-wide C = "
                  "90/99/100%%: %s / %s / %s s; final pixels 90/99/100%%: %s / %s / %s s\n",
                  at(0.90, false).c_str(), at(0.99, false).c_str(), at(1.0, false).c_str(),
                  at(0.90, true).c_str(), at(0.99, true).c_str(), at(1.0, true).c_str());
