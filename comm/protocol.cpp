@@ -50,6 +50,7 @@ TraceSpan get_trace_span(MessageReader& r) {
 std::vector<std::byte> encode(const HelloMsg& m) {
     MessageWriter w(HelloMsg::kVersion);
     w.put_string(m.host);
+    w.put(m.threads);
     w.put(static_cast<std::uint8_t>(m.loaded));
     return w.take();
 }
@@ -58,6 +59,10 @@ static HelloMsg decode_hello(std::span<const std::byte> bytes) {
     MessageReader r(bytes, HelloMsg::kVersion, "hello message");
     HelloMsg m;
     m.host = r.get_string();
+    m.threads = r.get<std::uint32_t>();
+    if (m.threads < 1 || m.threads > 1024)
+        throw WireError("hello message: threads: expected 1 to 1024, got " +
+                        std::to_string(m.threads));
     m.loaded = r.get_bool();
     r.finish();
     return m;

@@ -44,8 +44,9 @@ inline constexpr int kMaxImageSide = 32768;
 // heard from when a stage of the start-up runs past --startup-timeout.
 struct HelloMsg {
     static constexpr Tag kTag = Tag::hello;
-    static constexpr std::uint8_t kVersion = 2;
+    static constexpr std::uint8_t kVersion = 3;
     std::string host;
+    std::uint32_t threads = 1;  // the rank's engine threads (its thread budget)
     bool loaded = false;
 };
 

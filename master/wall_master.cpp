@@ -51,6 +51,7 @@ void WallMaster::handle(const Envelope& e) {
     t.heard.restart();
     if (auto* h = std::get_if<HelloMsg>(&m)) {
         t.host = h->host;
+        t.threads = h->threads;
         (h->loaded ? t.hello : t.joined) = true;
     } else if (std::holds_alternative<AliveMsg>(m)) {
         // its message loop runs: heard is all it tells
@@ -181,10 +182,12 @@ void WallMaster::print_map() const {
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         const PixelRect r = tile_rect(spec_, tile);
+        const TileState& t = tiles_[static_cast<std::size_t>(rank)];
         std::printf(
-            "  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d\n", rank,
-            tiles_[static_cast<std::size_t>(rank)].host.c_str(), tile, tile % spec_.columns,
-            tile / spec_.columns, r.x, r.y, r.width, r.height);
+            "  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d, %u "
+            "thread%s\n",
+            rank, t.host.c_str(), tile, tile % spec_.columns, tile / spec_.columns, r.x, r.y,
+            r.width, r.height, t.threads, t.threads == 1 ? "" : "s");
     }
     std::fflush(stdout);
 }

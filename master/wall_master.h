@@ -75,11 +75,12 @@ class WallMaster {
   private:
     struct TileState {
         std::string host;
-        bool joined = false;     // said hello before loading
-        bool hello = false;      // said hello after loading: takes views, sends alive messages
-        Stopwatch heard;         // since its last message of any kind
-        std::uint64_t rays = 0;  // of the current generation
-        FrameView view;          // of the current generation
+        std::uint32_t threads = 1;  // its engine threads (from its hello after loading)
+        bool joined = false;        // said hello before loading
+        bool hello = false;         // said hello after loading: takes views, sends alive messages
+        Stopwatch heard;            // since its last message of any kind
+        std::uint64_t rays = 0;     // of the current generation
+        FrameView view;             // of the current generation
         std::optional<ImageMsg> image;  // the answer to the pending image request
         std::optional<TileResultMsg> result;
     };

@@ -242,7 +242,7 @@ int run_wall(const WallOptions& o, Comm& comm) {
         // The master loads first and writes the octree cache; the tile ranks then map the same
         // files, so the machine holds one copy of the volume and the octree.
         if (!comm.is_master()) {
-            send_message(comm, kMasterRank, HelloMsg{comm.host(), false});
+            send_message(comm, kMasterRank, HelloMsg{comm.host(), 1, false});
             await_start(comm, o.startup_timeout_s);
             if (o.fault_rank == comm.rank()) raise_test_signal(o.fault_kind, "load");
             return run_tile_rank(o, comm, spec);

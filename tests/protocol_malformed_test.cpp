@@ -91,6 +91,14 @@ TEST(ProtocolMalformed, HelloWithAHugeLengthThrowsWithoutAllocating) {
     }
 }
 
+TEST(ProtocolMalformed, HelloWithNoThreadsOrTooManyThrows) {
+    for (const std::uint32_t threads : {0u, 1025u}) {
+        HelloMsg h = sample_hello();
+        h.threads = threads;
+        expect_wire_error(Tag::hello, encode(h), "threads: expected 1 to 1024");
+    }
+}
+
 TEST(ProtocolMalformed, HelloWithABadBoolThrows) {
     Bytes bytes = encode(sample_hello());
     bytes.back() = std::byte{2};  // `loaded` is the last byte

@@ -48,7 +48,7 @@ inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
            a.cpu_s == b.cpu_s;
 }
 inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
-    return a.host == b.host && a.loaded == b.loaded;
+    return a.host == b.host && a.threads == b.threads && a.loaded == b.loaded;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
     return a.generation == b.generation && a.view == b.view;
@@ -113,7 +113,8 @@ inline std::ostream& operator<<(std::ostream& os, const TraceSpan& s) {
               << s.wall_s << ", cpu " << s.cpu_s << "}";
 }
 inline void PrintTo(const HelloMsg& m, std::ostream* os) {
-    *os << "HelloMsg{" << m.host << (m.loaded ? ", loaded}" : "}");
+    *os << "HelloMsg{" << m.host << ", " << m.threads << " threads"
+        << (m.loaded ? ", loaded}" : "}");
 }
 inline void PrintTo(const ViewMsg& m, std::ostream* os) {
     *os << "ViewMsg{generation " << m.generation << ", " << m.view << "}";
@@ -188,7 +189,7 @@ inline std::string hex(std::span<const std::byte> bytes) {
 
 inline HelloMsg sample_hello() {
     using namespace std::string_literals;
-    return {"rank\0host-\xc3\xa9"s, true};  // an inner NUL and UTF-8: the length is on the wire
+    return {"rank\0host-\xc3\xa9"s, 24, true};  // an inner NUL and UTF-8: the length is on the wire
 }
 
 inline ViewMsg sample_view() {

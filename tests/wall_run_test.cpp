@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/core/thread_budget.h"
+#include "common/core/util.h"
 #include "common/io/image_io.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
@@ -51,6 +53,12 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
         const std::string log = slurp(dir / "wall.log");
         EXPECT_NE(log.find("rank  4 on "), std::string::npos) << log;
         EXPECT_NE(log.find("-> tile  3 (column 1, row 1)"), std::string::npos) << log;
+        // --threads 0 (the default): each of the 5 ranks takes its share of this machine.
+        const int share = node_share(cores_allowed(), ThreadBudget::hardware().threads, 5).threads;
+        EXPECT_EQ(test::count_of(log, ", " + std::to_string(share) +
+                                          (share == 1 ? " thread\n" : " threads\n")),
+                  4u)
+            << log;
         EXPECT_NE(log.find("makespan"), std::string::npos) << log;
     }
 }

@@ -102,7 +102,10 @@ class TileRank {
 
     int run() {
         if (setup_.tile_width > 0) jobs_.prepare(setup_.tile_width, setup_.tile_height);
-        send_message(comm_, kMasterRank, HelloMsg{comm_.host(), true});
+        send_message(
+            comm_, kMasterRank,
+            HelloMsg{comm_.host(), static_cast<std::uint32_t>(std::max(1, setup_.engine.threads)),
+                     true});
         Receiver receiver(comm_, inbox_, setup_.timeout_s);
         bool quit = false;
         for (;;) {
