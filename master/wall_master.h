@@ -75,7 +75,7 @@ class WallMaster {
   private:
     struct TileState {
         std::string host;
-        std::uint32_t threads = 1;  // its engine threads (from its hello after loading)
+        std::uint32_t threads = 1;  // its engine threads (its thread budget, from its hellos)
         bool joined = false;        // said hello before loading
         bool hello = false;         // said hello after loading: takes views, sends alive messages
         Stopwatch heard;            // since its last message of any kind

@@ -122,9 +122,8 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     return master.finish();
 }
 
-int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec) {
+int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
     const OpenedVolume ov = open_volume(o.volume, /*quiet=*/true);
-    const ThreadBudget budget = rank_budget(o, comm);
     auto extractor = open_extractor(ov, budget);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
     // thread, unless the user says otherwise: the work then stays on its core and in the frame
@@ -242,10 +241,12 @@ int run_wall(const WallOptions& o, Comm& comm) {
         // The master loads first and writes the octree cache; the tile ranks then map the same
         // files, so the machine holds one copy of the volume and the octree.
         if (!comm.is_master()) {
-            send_message(comm, kMasterRank, HelloMsg{comm.host(), 1, false});
+            const ThreadBudget budget = rank_budget(o, comm);
+            send_message(comm, kMasterRank,
+                         HelloMsg{comm.host(), static_cast<std::uint32_t>(budget.usable()), false});
             await_start(comm, o.startup_timeout_s);
             if (o.fault_rank == comm.rank()) raise_test_signal(o.fault_kind, "load");
-            return run_tile_rank(o, comm, spec);
+            return run_tile_rank(o, comm, spec, budget);
         }
         if (o.fault_rank == kMasterRank) raise_test_signal(o.fault_kind, "load");
         std::optional<MasterInput> input;
