@@ -165,7 +165,7 @@ class Level {
 
 LevelTally cast_level_parallel(const LevelJob& job, int threads,
                                const std::function<void(FoundGroup&)>& draw,
-                               const std::function<void(std::size_t)>& after_ray) {
+                               const std::function<void(std::size_t)>& between_rays) {
     Level level(job, threads);
     std::vector<std::thread> others;
     others.reserve(static_cast<std::size_t>(threads - 1));
@@ -181,11 +181,12 @@ LevelTally cast_level_parallel(const LevelJob& job, int threads,
             level.worker_done(w, thread_cpu_seconds() - c0);
         });
     try {
+        between_rays(level.rays());
         for (;;) {
             const bool more = level.step(0);
             level.draw_ready(draw, false);
             if (!more) break;
-            after_ray(level.rays());
+            between_rays(level.rays());
         }
     } catch (...) {
         level.fail(std::current_exception());

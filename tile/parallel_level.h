@@ -48,10 +48,12 @@ struct LevelTally {
 };
 
 // Casts every pixel of `job` on `threads` threads (at most the extractor's workers). `draw` and
-// `after_ray` (given the rays cast so far, all threads) run on the calling thread only. An
-// exception on any thread stops the others and is rethrown here once all have ended.
+// `between_rays` (given the rays cast so far, all threads) run on the calling thread only:
+// between_rays once as soon as the other threads have started (the caller may then present what
+// the level before drew, while they cast) and after each of the caller's own rays. An exception
+// on any thread stops the others and is rethrown here once all have ended.
 LevelTally cast_level_parallel(const LevelJob& job, int threads,
                                const std::function<void(FoundGroup&)>& draw,
-                               const std::function<void(std::size_t)>& after_ray);
+                               const std::function<void(std::size_t)>& between_rays);
 
 }  // namespace isowall

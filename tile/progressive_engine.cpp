@@ -97,9 +97,11 @@ class FrameRun {
             else
                 c.done = true;
         }
-        // A sample at every job's end, but no present: groups show at the next refresh (a
-        // present flushes the renderer, which llvmpipe pays per call, not per triangle).
-        record(true, false);
+        // A sample at every job's end, but no present (groups show at the next refresh: a
+        // present flushes the renderer, which llvmpipe pays per call, not per triangle), unless
+        // the last level's present was put off (see cast_level).
+        record(true, present_due_);
+        present_due_ = false;
         return true;
     }
 
@@ -174,9 +176,12 @@ class FrameRun {
         const IntersectMode mode = second_pass ? IntersectMode::exact : opt_.intersect;
         now_.level = order.level();
         const int n = workers();
-        if (n > 1 && pixels_.size() > 1) {
+        const bool parallel = n > 1 && pixels_.size() > 1;
+        if (parallel) {
             if (!cast_level_parallel(n, mode, second_pass)) return false;
         } else {
+            record(present_due_);
+            present_due_ = false;
             for (const glm::ivec2 px : pixels_) {
                 if (stopped()) return false;
                 if (!cast_ray(px + glm::ivec2(rect_.x, rect_.y), mode, second_pass)) return false;
@@ -184,7 +189,11 @@ class FrameRun {
             }
         }
         if (order.wants_coverage()) give_coverage(order);
-        record(true);
+        // After a level on several threads, its sample and present wait until the next level's
+        // other threads cast (or the job ends): a present waits for the rasteriser, and would
+        // leave them idle between levels. A coverage read-back has waited for it already.
+        present_due_ = parallel && !order.wants_coverage();
+        if (!present_due_) record(true);
         return true;
     }
 
@@ -218,7 +227,8 @@ class FrameRun {
             job, n, [this](FoundGroup& f) { add_found(f); },
             [this, rays_before](std::size_t rays) {
                 now_.rays = rays_before + rays;
-                record(false);
+                record(present_due_);
+                present_due_ = false;
             });
         frame_.workers.sum_s += t.workers_cpu_s;
         frame_.workers.beyond_s +=
@@ -347,6 +357,9 @@ class FrameRun {
     double last_sample_s_ = 0, last_progress_s_ = -1e9;
     double last_present_cpu_s_ = thread_cpu_seconds();
     bool dirty_ = false;  // groups added since the last present()
+    // A level on several threads ended: its sample (with a present) is taken once the next
+    // level's other threads run, or at the job's end.
+    bool present_due_ = false;
     // Group ids handed out this frame, from opt_.first_group_id: the groups added, and with
     // several threads also the passes dropped because another took their seed first.
     std::uint32_t ids_used_ = 0;
