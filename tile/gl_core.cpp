@@ -300,12 +300,36 @@ void GlCore::finish() {
     check("glFinish");
 }
 
-void GlCore::read_back(Image& out, const PixelRect& rect) {
-    require_size("read_back");
+void GlCore::bind_rect(std::string_view call, const PixelRect& rect) {
+    require_size(call);
     if (rect.x < 0 || rect.y < 0 || rect.width < 0 || rect.height < 0 ||
         rect.x + rect.width > width_ || rect.y + rect.height > height_)
-        fail("read_back", "the rect lies outside the frame");
+        fail(call, "the rect lies outside the frame");
     bind_frame();
+}
+
+void GlCore::read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {
+    bind_rect("read_coverage", rect);
+    const auto w = static_cast<std::size_t>(rect.width);
+    const auto h = static_cast<std::size_t>(rect.height);
+    covered.resize(w * h);
+    depth_scratch_.resize(w * h);
+    if (covered.empty()) return;
+    // The depth alone, as integers: the cleared depth 1 reads as the largest value (a colour
+    // read and a float conversion of the depth took 4.7 ms for the 861x574 box of the head).
+    gl_->PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl_->ReadPixels(rect.x, height_ - rect.y - rect.height, rect.width, rect.height,
+                    GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, depth_scratch_.data());
+    check("glReadPixels(GL_DEPTH_COMPONENT)");
+    for (std::size_t y = 0; y < h; ++y) {  // GL's rows from the bottom
+        const std::uint32_t* from = depth_scratch_.data() + (h - 1 - y) * w;
+        std::uint8_t* to = covered.data() + y * w;
+        for (std::size_t x = 0; x < w; ++x) to[x] = from[x] != 0xFFFFFFFFu;
+    }
+}
+
+void GlCore::read_back(Image& out, const PixelRect& rect) {
+    bind_rect("read_back", rect);
     if (out.width != rect.width || out.height != rect.height ||
         out.pixel_count() != out.depth.size() || out.pixel_count() * 4 != out.rgba.size()) {
         out.resize(rect.width, rect.height);

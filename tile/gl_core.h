@@ -3,9 +3,11 @@
 // 24-bit depth renderbuffers), the headlight shader, mesh upload, drawing and read-back. A back
 // end creates the context, makes it current and then forwards every call here; GlCore itself
 // never switches contexts.
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 
@@ -36,6 +38,8 @@ class GlCore {
     void clear_depth();
     void draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& projection);
     void read_back(Image& out, const PixelRect& rect);
+    // The depth of `rect` alone, as Renderer::read_coverage gives it.
+    void read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect);
     void finish();
 
   private:
@@ -43,6 +47,8 @@ class GlCore {
     // Throws naming `call` when GL has recorded an error since the last check.
     void check(std::string_view call) const;
     void require_size(std::string_view call) const;
+    // Binds the frame and checks that `rect` lies inside it.
+    void bind_rect(std::string_view call, const PixelRect& rect);
     unsigned compile_shader(unsigned type, const char* source);
     void bind_frame();
 
@@ -63,6 +69,7 @@ class GlCore {
     int projection_location_ = -1;
     int normal_matrix_location_ = -1;
     int orthographic_location_ = -1;
+    std::vector<std::uint32_t> depth_scratch_;  // read_coverage's rows, as GL gives them
 };
 
 // The Renderer calls every GL back end shares: make the back end's context current, then let
@@ -92,6 +99,10 @@ class GlRenderer : public Renderer {
     void read_back(Image& out, const PixelRect& rect) override {
         make_current();
         core_->read_back(out, rect);
+    }
+    void read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
+        make_current();
+        core_->read_coverage(covered, rect);
     }
     void finish() override {
         make_current();

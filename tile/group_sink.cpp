@@ -22,9 +22,7 @@ double RendererSink::present() {
 }
 
 bool RendererSink::coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {
-    renderer_.read_back(scratch_, rect);
-    covered.resize(scratch_.depth.size());
-    for (std::size_t i = 0; i < covered.size(); ++i) covered[i] = scratch_.depth[i] < 1.0f;
+    renderer_.read_coverage(covered, rect);
     return true;
 }
 

@@ -52,7 +52,6 @@ class RendererSink final : public GroupSink {
   private:
     Renderer& renderer_;
     glm::mat4 view_m_{1.0f}, proj_m_{1.0f};
-    Image scratch_;
 };
 
 // Keeps every group, in order: the replay that measures correctness redraws them.

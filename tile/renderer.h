@@ -1,9 +1,11 @@
 #pragma once
 // The tile renderer: draws meshes into an off-screen frame and reads it back as an Image. Back
 // ends (OSMesa, EGL) hide behind this interface, so no caller ever sees a GL or EGL header.
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string_view>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 
@@ -39,6 +41,10 @@ class Renderer {
     // The same for `rect` of the frame only (x, y from the top-left; inside the frame), so a
     // caller that needs a region does not copy the whole frame.
     virtual void read_back(Image& out, const PixelRect& rect) = 0;
+    // Sizes `covered` to `rect` and writes covered[y * rect.width + x] = 1 where something is
+    // drawn at pixel (rect.x + x, rect.y + y) (depth below 1), else 0: what a ray order needs,
+    // without the colour. This default reads both back; a back end may read the depth alone.
+    virtual void read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect);
     // Waits until everything drawn so far is in the frame (for honest stage timings).
     virtual void finish() = 0;
     virtual std::string_view name() const = 0;
