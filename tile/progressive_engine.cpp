@@ -189,11 +189,10 @@ class FrameRun {
             }
         }
         if (order.wants_coverage()) give_coverage(order);
-        // After a level on several threads, its sample and present wait until the next level's
-        // other threads cast (or the job ends): a present waits for the rasteriser, and would
-        // leave them idle between levels. A coverage read-back has waited for it already.
-        present_due_ = parallel && !order.wants_coverage();
-        if (!present_due_) record(true);
+        // After a level on several threads, its sample (and present, which waits for the
+        // rasteriser) waits until the next level's other threads cast, or the job's end.
+        present_due_ = parallel;
+        if (!parallel) record(true);
         return true;
     }
 
@@ -356,10 +355,8 @@ class FrameRun {
     // The first progress report comes at the first ray: a wall master then knows the frame began.
     double last_sample_s_ = 0, last_progress_s_ = -1e9;
     double last_present_cpu_s_ = thread_cpu_seconds();
-    bool dirty_ = false;  // groups added since the last present()
-    // A level on several threads ended: its sample (with a present) is taken once the next
-    // level's other threads run, or at the job's end.
-    bool present_due_ = false;
+    bool dirty_ = false;        // groups added since the last present()
+    bool present_due_ = false;  // a level's sample and present put off (see cast_level)
     // Group ids handed out this frame, from opt_.first_group_id: the groups added, and with
     // several threads also the passes dropped because another took their seed first.
     std::uint32_t ids_used_ = 0;
