@@ -31,6 +31,23 @@ TEST(Visited, UnitsOfEachLevelAreTakenOnceAndCountTheirCells) {
     EXPECT_EQ(v.group_of({2, 4, 5}), VisitedCells::kFree);
 }
 
+// A propagation pass claims units without counting them and adds its cells once at its end: the
+// units are taken at once, the count follows add_count.
+TEST(Visited, ClaimTakesAUnitAndTheCountFollowsAddCount) {
+    VisitedCells v({64, 64, 64}, 1);
+    EXPECT_TRUE(v.claim({5, 6, 7}, 3));
+    EXPECT_TRUE(v.claim({8, 8, 8}, 3, 1));
+    EXPECT_FALSE(v.claim({5, 6, 7}, 4));      // taken already
+    EXPECT_FALSE(v.insert({8, 8, 8}, 4, 1));  // insert and claim take from one set of units
+    EXPECT_TRUE(v.contains({5, 6, 7}));
+    EXPECT_EQ(v.group_of({8, 8, 8}, 1), 3u);
+    EXPECT_EQ(v.size(), 0u);
+    v.add_count(1 + 8);
+    EXPECT_EQ(v.size(), 9u);
+    EXPECT_TRUE(v.insert({0, 0, 0}, 5));  // insert counts its own unit
+    EXPECT_EQ(v.size(), 10u);
+}
+
 TEST(Visited, ResetForgetsEveryUnitAndPagesAreReused) {
     VisitedCells v({64, 64, 64}, 3);
     for (int round = 0; round < 3; ++round) {

@@ -112,7 +112,7 @@ class Propagator {
         g.seed = seed;
         g.level = level;
         g.iso = iso;
-        if (!insert(visited, seed, level, group_id)) return g;
+        if (!visited.claim(seed, group_id, level)) return g;
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
         const float cos_cutoff = std::cos(p.cutoff_rad);
@@ -176,11 +176,12 @@ class Propagator {
                     max_angle = std::max(max_angle, a);
                 }
                 // Another thread's pass may have taken it since contains(): the claim decides.
-                if (!insert(visited, nb, level, group_id)) continue;
+                if (!visited.claim(nb, group_id, level)) continue;
                 ++taken;
                 queue_.push_back({nb, max_angle});
             }
         }
+        visited.add_count(static_cast<std::size_t>(taken) << (3 * level));
         if (timed_units > 0)
             extract_s_ =
                 timed_s * static_cast<double>(g.cells.size()) / static_cast<double>(timed_units);

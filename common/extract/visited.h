@@ -66,8 +66,16 @@ class VisitedCells {
     // Whether the unit of `level` whose first cell is `c` was taken.
     bool contains(glm::ivec3 c, int level = 0) const { return slot(c, level) != kFree; }
     // Marks the unit of `level` (at most the last reset's max_level) whose first cell is c as
-    // taken by `group` (not kFree); false when it was taken already.
+    // taken by `group` (not kFree) and counts it; false when it was taken already.
     bool insert(glm::ivec3 c, std::uint32_t group, int level = 0) {
+        if (!claim(c, group, level)) return false;
+        add_count(std::size_t{1} << (3 * level));
+        return true;
+    }
+    // insert() without the count, for a caller that claims many units (a propagation pass) and
+    // adds its count once with add_count(): one counter bumped by every thread at every unit
+    // would move its cache line between the cores each time.
+    bool claim(glm::ivec3 c, std::uint32_t group, int level = 0) {
         Grid& g = grid(level);
         const glm::ivec3 u = c >> level;
         const std::size_t b = g.brick(u);
@@ -84,13 +92,13 @@ class VisitedCells {
         }
         std::atomic_ref<std::uint32_t> id(page_at(page)[local(u)]);
         std::uint32_t expected = kFree;
-        if (!id.compare_exchange_strong(expected, group, std::memory_order_acq_rel)) return false;
-        count_.fetch_add(std::size_t{1} << (3 * level), std::memory_order_relaxed);
-        return true;
+        return id.compare_exchange_strong(expected, group, std::memory_order_acq_rel);
     }
+    // Adds `cells` to size(): the cells of units that claim() took.
+    void add_count(std::size_t cells) { count_.fetch_add(cells, std::memory_order_relaxed); }
     // The group that took the unit of `level` whose first cell is c, or kFree.
     std::uint32_t group_of(glm::ivec3 c, int level = 0) const { return slot(c, level); }
-    // Cells covered by the taken units (a meta-cell counts all of its cells).
+    // Cells covered by the taken units (a meta-cell counts all of its cells), as counted so far.
     std::size_t size() const { return count_.load(std::memory_order_relaxed); }
     glm::ivec3 dims() const { return dims_; }
 
