@@ -243,6 +243,10 @@ void GlCore::clear() {
     gl_->ClearDepth(1.0);
     gl_->DepthMask(GL_TRUE);
     gl_->Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    // Started at once: a software rasteriser (llvmpipe) clears the frame's tiles on its own
+    // threads while the caller works on, instead of at the frame's first flush (about 2 ms at
+    // 1600x1200, when the engine waits for its first coverage).
+    gl_->Flush();
     check("glClear");
 }
 

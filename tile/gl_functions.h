@@ -21,6 +21,7 @@ namespace isowall {
     X(PFNGLCLEARDEPTHPROC, ClearDepth)                           \
     X(PFNGLCLEARPROC, Clear)                                     \
     X(PFNGLFINISHPROC, Finish)                                   \
+    X(PFNGLFLUSHPROC, Flush)                                     \
     X(PFNGLENABLEPROC, Enable)                                   \
     X(PFNGLDISABLEPROC, Disable)                                 \
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                             \
