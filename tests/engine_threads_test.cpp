@@ -2,7 +2,9 @@
 // for every rule, the same from run to run, and every visited unit is in exactly one group.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
+#include <map>
 #include <set>
 #include <string>
 #include <tuple>
@@ -118,6 +120,31 @@ TEST(Threads, TheWorkersCpuIsCounted) {
     EXPECT_EQ(one.workers.beyond_s, 0.0);
     EXPECT_GT(two.workers.sum_s, 0.0);
     EXPECT_LE(two.workers.beyond_s, two.workers.sum_s);
+}
+
+TEST(Threads, EveryLevelEndsWithASampleOfItsOwn) {
+    // On several threads a level's closing sample (and present) waits until the next level's
+    // threads run: it still carries its own level's number, the levels and rays never go back,
+    // and each level has a sample with at least the rays one thread had cast by its end.
+    const Volume p = make_phantom();
+    const FrameView fv = test::make_view(p, 240, 180, kPhantomSkinIso, 25, 10);
+    const FrameResult one = run(p, fv, {}, 1);
+    const FrameResult two = run(p, fv, {}, 2);
+    std::map<int, std::size_t> end_one, end_two;  // level -> most rays of a sample of it
+    for (const auto& [frame, ends] : {std::tie(one, end_one), std::tie(two, end_two)}) {
+        for (std::size_t i = 1; i < frame.timeline.size(); ++i) {
+            EXPECT_GE(frame.timeline[i].level, frame.timeline[i - 1].level) << i;
+            EXPECT_GE(frame.timeline[i].rays, frame.timeline[i - 1].rays) << i;
+        }
+        for (const TimelineSample& s : frame.timeline)
+            ends[s.level] = std::max(ends[s.level], s.rays);
+    }
+    ASSERT_GE(end_one.size(), 3u);
+    ASSERT_EQ(end_two.size(), end_one.size());
+    for (const auto& [level, rays] : end_one) {
+        ASSERT_TRUE(end_two.count(level)) << "level " << level;
+        EXPECT_GE(end_two[level], rays) << "level " << level;
+    }
 }
 
 TEST(Threads, AStopEndsEveryThread) {

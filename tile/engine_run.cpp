@@ -1,7 +1,12 @@
-// The engine's conveniences around a frame: one region into a sink, the warm-up draw, the
-// whole-screen run that keeps every group and the final image, and the replay that measures
-// correctness.
+// The engine's conveniences around a frame: one region into a sink, a region's clip, the warm-up
+// draw, the whole-screen run that keeps every group and the final image, and the replay that
+// measures correctness.
+#include <algorithm>
 #include <atomic>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "tile/progressive_engine.h"
 
@@ -19,6 +24,17 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& regio
     result.screen_rect = c.rect;
     result.screen_pixels = c.pixels;
     return result;
+}
+
+ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {
+    ScreenClip clip;
+    if (rect.width <= 0 || rect.height <= 0) return clip;
+    const glm::mat4 proj = sub_frustum(view.frustum, view.width, view.height, rect).matrix();
+    clip.active = true;
+    clip.clip_from_voxel = proj * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
+    clip.ndc_per_unit = std::max(std::abs(proj[0][0]), std::abs(proj[1][1]));
+    clip.half_diagonal = 0.5f * glm::length(spacing);
+    return clip;
 }
 
 void warm_up(Renderer& renderer) {

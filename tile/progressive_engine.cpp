@@ -4,7 +4,6 @@
 #include <chrono>
 #include <memory>
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <glm/matrix.hpp>
 
 #include "common/core/pixel_rect_ops.h"
@@ -70,7 +69,7 @@ class FrameRun {
         rect_ = c.rect;
         cursor_ = &c;
         params_ = opt_.propagation;
-        if (opt_.region_clip) params_.clip = region_clip(view, c.rect);
+        if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
         // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
         // c.rays, so a region's second band would cast nothing.
         const std::size_t limit = ray_limit > SIZE_MAX - c.rays ? SIZE_MAX : c.rays + ray_limit;
@@ -123,19 +122,6 @@ class FrameRun {
     bool stopped() const { return stop_.load(std::memory_order_relaxed); }
     bool masked() const { return opt_.screen_box && opt_.screen_mask; }
 
-    // The clip of `rect` of `view`: its own frustum, from the volume's voxel space.
-    ScreenClip region_clip(const FrameView& view, const PixelRect& rect) const {
-        ScreenClip clip;
-        if (rect.width <= 0 || rect.height <= 0) return clip;
-        const glm::mat4 proj = sub_frustum(view.frustum, view.width, view.height, rect).matrix();
-        const glm::vec3 spacing = ex_.volume().spacing();
-        clip.active = true;
-        clip.clip_from_voxel = proj * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
-        clip.ndc_per_unit = std::max(std::abs(proj[0][0]), std::abs(proj[1][1]));
-        clip.half_diagonal = 0.5f * glm::length(spacing);
-        return clip;
-    }
-
     void begin(const FrameView& view) {
         stage(Stage::setup);
         start_ = Clock::now();
@@ -174,14 +160,12 @@ class FrameRun {
 
     bool cast_level(RayOrder& order, bool second_pass) {
         const IntersectMode mode = second_pass ? IntersectMode::exact : opt_.intersect;
-        now_.level = order.level();
         const int n = workers();
         const bool parallel = n > 1 && pixels_.size() > 1;
         if (parallel) {
-            if (!cast_level_parallel(n, mode, second_pass)) return false;
+            if (!cast_level_parallel(n, mode, second_pass, order.level())) return false;
         } else {
-            record(present_due_);
-            present_due_ = false;
+            begin_level(order.level());
             for (const glm::ivec2 px : pixels_) {
                 if (stopped()) return false;
                 if (!cast_ray(px + glm::ivec2(rect_.x, rect_.y), mode, second_pass)) return false;
@@ -216,18 +200,27 @@ class FrameRun {
     }
 
     // One level over `n` threads (tile/parallel_level.h); false when the frame was stopped.
-    bool cast_level_parallel(int n, IntersectMode mode, bool second_pass) {
+    // The put-off sample of the level before (see cast_level), then the new level's number.
+    void begin_level(int level) {
+        if (present_due_) record(true);
+        present_due_ = false;
+        now_.level = level;
+    }
+
+    bool cast_level_parallel(int n, IntersectMode mode, bool second_pass, int level) {
         const std::size_t rays_before = now_.rays;
+        bool begun = false;
         const LevelJob job{
             ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
             mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_};
         const double own0 = thread_cpu_seconds();
         const LevelTally t = isowall::cast_level_parallel(
             job, n, [this](FoundGroup& f) { add_found(f); },
-            [this, rays_before](std::size_t rays) {
+            [this, rays_before, level, &begun](std::size_t rays) {
                 now_.rays = rays_before + rays;
-                record(present_due_);
-                present_due_ = false;
+                if (!begun) begin_level(level);
+                begun = true;
+                record(false);
             });
         frame_.workers.sum_s += t.workers_cpu_s;
         frame_.workers.beyond_s +=

@@ -112,6 +112,10 @@ void warm_up(Renderer& renderer);
 // which a progressive frame's final image is measured against.
 Image draw_alone(Renderer& renderer, const Mesh& mesh, const FrameView& view);
 
+// The clip of `rect` of `view` for propagation (EngineOptions::region_clip): the region's own
+// frustum, from the voxel space of a volume of `spacing`; inactive for an empty rect.
+ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing);
+
 // A region's place in its progressive ray order, kept between the calls that cast it (the coarse
 // and the fine band of a wall job).
 struct RegionCursor {
