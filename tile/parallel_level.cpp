@@ -22,13 +22,15 @@ double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// One thread's share of a level, written by that thread only; a cache line of its own, so one
+// One thread's share of a level, written by that thread only; cache lines of its own, so one
 // thread's counts do not evict the other's at every ray.
 struct alignas(64) WorkerTally {
-    std::atomic<std::size_t> rays{0};  // stored by its thread only; the caller reads it for samples
-    std::size_t hits = 0;
+    std::size_t rays = 0, hits = 0;
     double intersect_s = 0, cpu_s = 0;
     std::size_t next = 0, end = 0;  // the pixels claimed and not cast yet
+    // `rays` as of the thread's last claim, for the caller's samples: a line the caller reads at
+    // every one of its rays, which this thread writes once per claim, not once per ray.
+    alignas(64) std::atomic<std::size_t> published{0};
 };
 
 // The most pixels a thread claims at once. Claiming one pixel per ray bounced one counter's cache
@@ -50,7 +52,10 @@ class Level {
     // Casts the next pixel's ray on worker w (and propagates); false when the level has no more.
     bool step(int w) {
         WorkerTally& t = tally_[static_cast<std::size_t>(w)];
-        if (t.next == t.end && !claim(t)) return false;
+        if (t.next == t.end) {
+            t.published.store(t.rays, std::memory_order_relaxed);
+            if (!claim(t)) return false;
+        }
         if (failed_.load(std::memory_order_relaxed) || job_.stopped()) return false;
         const std::size_t i = t.next++;
         const Ray ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
@@ -58,7 +63,7 @@ class Level {
         const auto t0 = Clock::now();
         const RayHit hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
         t.intersect_s += since(t0);
-        t.rays.store(t.rays.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+        ++t.rays;
         if (!hit.found) return true;
         ++t.hits;
         if (!hit.refine && job_.ex.visited(hit.cell)) return true;
@@ -74,6 +79,7 @@ class Level {
             const std::lock_guard<std::mutex> hold(lock_);
             ready_.emplace(id, std::move(f));
         }
+        found_.fetch_add(1, std::memory_order_release);
         wake_.notify_all();
         return true;
     }
@@ -81,6 +87,11 @@ class Level {
     // Draws the groups whose turn has come; with `all`, waits for the other workers first and
     // draws everything left.
     void draw_ready(const std::function<void(FoundGroup&)>& draw, bool all) {
+        // Only an arrival makes a group drawable: with none since the last look, the caller (at
+        // every one of its rays) takes no lock.
+        const std::size_t found = found_.load(std::memory_order_acquire);
+        if (!all && found == looked_) return;
+        looked_ = found;
         std::unique_lock<std::mutex> hold(lock_);
         if (all) wake_.wait(hold, [&] { return running_ == 0; });
         while (!ready_.empty() && (all || ready_.begin()->first == next_drawn_)) {
@@ -108,10 +119,12 @@ class Level {
         wake_.notify_all();
     }
 
-    // The rays cast so far by all threads (the others' counts may lag by a ray).
+    // The rays cast so far: the caller's own, and the others' as of their last claims (at most
+    // kMaxClaim each behind). Called on the caller's thread only.
     std::size_t rays() const {
-        std::size_t n = 0;
-        for (const WorkerTally& t : tally_) n += t.rays.load(std::memory_order_relaxed);
+        std::size_t n = tally_[0].rays;
+        for (std::size_t w = 1; w < tally_.size(); ++w)
+            n += tally_[w].published.load(std::memory_order_relaxed);
         return n;
     }
 
@@ -147,12 +160,17 @@ class Level {
         }
     }
 
+    // Read at every ray: a cache line that no thread writes while the level goes well.
     const LevelJob& job_;
     const std::size_t threads_;
-    std::atomic<std::size_t> next_pixel_{0};
     std::atomic<bool> failed_{false};
-    std::atomic<std::uint32_t> next_id_;
-    std::uint32_t next_drawn_;  // under lock_
+    // Written once per claim.
+    alignas(64) std::atomic<std::size_t> next_pixel_{0};
+    // Written once per pass: ids handed out and groups found; looked_ is the caller's.
+    alignas(64) std::atomic<std::uint32_t> next_id_;
+    std::atomic<std::size_t> found_{0};
+    std::size_t looked_ = 0;
+    alignas(64) std::uint32_t next_drawn_;  // under lock_
     std::mutex lock_;
     std::condition_variable wake_;
     std::map<std::uint32_t, FoundGroup> ready_;  // by id, under lock_

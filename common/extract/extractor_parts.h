@@ -99,7 +99,7 @@ struct FrameState {
 };
 
 template <class T>
-class ExtractWorker {
+class alignas(64) ExtractWorker {  // cache lines of its own: a worker's state is hot per ray
   public:
     explicit ExtractWorker(const ExtractionData<T>& data)
         : data_(data), caster_(data.view, data.octree), propagator_(data.view) {}
