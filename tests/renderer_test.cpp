@@ -272,38 +272,37 @@ TEST(Renderer, ReadBackPutsTheTopRowFirst) {
 }
 
 // The coverage a ray order reads (the depth alone) is the read-back's depth below 1, row for
-// row, for the whole frame, for rects in it and for an empty rect.
+// row, for the whole frame, for rects in it (one across the torus's hole) and for an empty rect.
 TEST(Renderer, CoverageIsTheDepthBelowOne) {
-    constexpr int kWidth = 64, kHeight = 48;
-    const Mesh sphere = uv_sphere(glm::vec3(0.6f, 0.5f, 0.0f), 0.3f, 32, 64);
-    Box3 bounds = sphere.bounds();
-    bounds.merge(glm::vec3(0));
-    const Camera camera = looking_down_z(5.0f, Projection::perspective, bounds);
-    for (const char* backend : kBackends) {
-        SCOPED_TRACE(backend);
-        auto renderer = make_renderer(backend);
-        const Image image = render(*renderer, sphere, camera, kWidth, kHeight);
-        ASSERT_GT(covered_count(image), 20u);
-        for (const PixelRect rect : {PixelRect{0, 0, kWidth, kHeight}, PixelRect{30, 5, 21, 17},
-                                     PixelRect{3, 40, 10, 8}, PixelRect{5, 5, 0, 0}}) {
+    constexpr int kW = 80, kH = 60;
+    const Mesh ring = torus(glm::vec3(0), 1.0f, 0.3f, 48, 24);
+    const Camera eye = looking_down_z(4.0f, Projection::perspective, ring.bounds());
+    for (const char* name : kBackends) {
+        SCOPED_TRACE(name);
+        const auto r = make_renderer(name);
+        const Image frame = render(*r, ring, eye, kW, kH);
+        ASSERT_GT(covered_count(frame), 100u);
+        ASSERT_FALSE(frame.covered(kW / 2, kH / 2)) << "the hole";
+        for (const PixelRect rect : {PixelRect{0, 0, kW, kH}, PixelRect{30, 20, 21, 17},
+                                     PixelRect{3, 50, 10, 8}, PixelRect{5, 5, 0, 0}}) {
             std::vector<std::uint8_t> covered(7, 9);
-            renderer->read_coverage(covered, rect);
+            r->read_coverage(covered, rect);
             ASSERT_EQ(covered.size(), std::size_t(rect.width) * std::size_t(rect.height));
             std::size_t differ = 0, count = 0;
             for (int y = 0; y < rect.height; ++y)
                 for (int x = 0; x < rect.width; ++x) {
                     const std::uint8_t c = covered[std::size_t(y * rect.width + x)];
-                    differ += c != (image.covered(rect.x + x, rect.y + y) ? 1 : 0);
+                    differ += c != (frame.covered(rect.x + x, rect.y + y) ? 1 : 0);
                     count += c;
                 }
             EXPECT_EQ(differ, 0u) << rect.x << "," << rect.y << " " << rect.width << "x"
                                   << rect.height;
-            if (rect.width == kWidth) {
-                EXPECT_EQ(count, covered_count(image));
+            if (rect.width == kW) {
+                EXPECT_EQ(count, covered_count(frame));
             }
         }
         std::vector<std::uint8_t> covered;
-        EXPECT_THROW(renderer->read_coverage(covered, PixelRect{60, 0, 10, 10}), RendererError);
+        EXPECT_THROW(r->read_coverage(covered, PixelRect{75, 0, 10, 10}), RendererError);
     }
 }
 
