@@ -34,9 +34,10 @@ a shared machine that moves from hour to hour.
 Each progressive configuration (--engines; the first is the one the targets judge) also prints
 its final image's C against the full surface (`render --against-full`, outside the clock).
 Every figure is wall-clock seconds measured inside the programs (loading and the octree are
-outside them); with --runs N each measure is run N times and the fastest run is kept (all of them
-are in the JSON); the engines' runs take turns, round by round. The peer's mesh goes from Python to C++ through a file in a temp folder, outside
-the clock. Writes OUT/scaling.md, OUT/scaling.json and OUT/scaling.png (time against voxels,
+outside them); with --runs N each measure is run N times and the fastest run is kept (of each
+engine, the run with the fastest C = 99%; all of them are in the JSON), the engines' runs taking
+turns round by round. The peer's mesh goes from Python to C++ through a file in a temp folder,
+outside the clock. Writes OUT/scaling.md, OUT/scaling.json and OUT/scaling.png (time against voxels,
 log-log). Errors: one line naming the option, exit 1.
 """
 import argparse

@@ -319,8 +319,8 @@ void GlCore::read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& 
     covered.resize(w * h);
     depth_scratch_.resize(w * h);
     if (covered.empty()) return;
-    // The depth alone, as integers: the cleared depth 1 reads as the largest value (a colour
-    // read and a float conversion of the depth took 4.7 ms for the 861x574 box of the head).
+    // The depth alone, as integers: the cleared depth 1 reads as the largest value (for the
+    // head's 861x574 box in llvmpipe, 0.7-0.9 ms against 1.0-1.2 ms for colour and float depth).
     gl_->PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl_->ReadPixels(rect.x, height_ - rect.y - rect.height, rect.width, rect.height,
                     GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, depth_scratch_.data());

@@ -199,7 +199,6 @@ class FrameRun {
         return seed(hit, ray);
     }
 
-    // One level over `n` threads (tile/parallel_level.h); false when the frame was stopped.
     // The put-off sample of the level before (see cast_level), then the new level's number.
     void begin_level(int level) {
         if (present_due_) record(true);
@@ -207,6 +206,7 @@ class FrameRun {
         now_.level = level;
     }
 
+    // One level over `n` threads (tile/parallel_level.h); false when the frame was stopped.
     bool cast_level_parallel(int n, IntersectMode mode, bool second_pass, int level) {
         const std::size_t rays_before = now_.rays;
         bool begun = false;
