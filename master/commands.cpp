@@ -259,7 +259,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
 int run_info(const InfoOptions& o) {
     Timings t;
-    OpenedVolume ov = open_volume(o.volume);
+    OpenedVolume ov = open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false});
     t.load = ov.load_s;
     prepare(ov, t);
     const Box3 b = ov.volume.bounds();

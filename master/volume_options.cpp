@@ -30,6 +30,11 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "Octree cache folder (default $ISOWALL_CACHE_DIR, else ~/.cache/isowall)");
     app.add_flag("--no-cache", o.no_cache,
                  "Always build the octree; never read or write the cache");
+    app.add_option("--huge-pages", o.huge_pages,
+                   "Copy the volume into transparent huge pages for the engine's random reads: "
+                   "auto (from 256 MiB, when every rank's copy fits in half the available "
+                   "memory), on, off (keep the shared memory map). Default: auto")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
 }
 
 namespace {
@@ -58,7 +63,7 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
 
 }  // namespace
 
-OpenedVolume open_volume(const VolumeOptions& o, bool quiet) {
+OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     OpenedVolume out;
     Stopwatch sw;
     if (o.path.empty()) {
@@ -69,6 +74,21 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet) {
         out.volume = load_volume(o.path, raw_spec(o));
         out.file = std::filesystem::path(o.path);
     }
+    std::string huge_note;
+    if (use.casts) {
+        const auto mode = parse_huge_pages(o.huge_pages);
+        if (!mode)
+            throw InputError("--huge-pages", "value",
+                             "expected auto, on or off, got " + quote(o.huge_pages));
+        const HugePagesChoice choice = choose_huge_pages(
+            *mode, out.volume.bytes().size(), use.copies_on_host, thp_mode(), mem_available());
+        if (choice.copy) {
+            out.volume.copy_to_huge_pages();
+            huge_note = " (" + choice.why + ")";
+        } else {
+            huge_note = " (huge pages: no, " + choice.why + ")";
+        }
+    }
     out.load_s = sw.seconds();
     if (out.file && !o.no_cache)
         out.cache_dir =
@@ -77,10 +97,13 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet) {
     const Volume& v = out.volume;
     const glm::ivec3 d = v.dims();
     const glm::vec3 s = v.spacing();
-    std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s  (%.2f s)\n",
+    const char* where = v.in_huge_pages() ? "in huge pages"
+                        : v.mapped()      ? "memory-mapped"
+                                          : "in memory";
+    std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s%s  (%.2f s)\n",
                 v.source().c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
                 double(s.x), double(s.y), double(s.z), double(v.bytes().size()) / (1024.0 * 1024.0),
-                v.mapped() ? "memory-mapped" : "in memory", out.load_s);
+                where, huge_note.c_str(), out.load_s);
     return out;
 }
 

@@ -20,6 +20,7 @@ struct VolumeOptions {
     std::size_t header_bytes = 0;
     std::string cache_dir;
     bool no_cache = false;
+    std::string huge_pages = "auto";  // auto, on, off (common/volume/huge_pages.h)
 };
 
 void add_volume_options(CLI::App& app, VolumeOptions& opts);
@@ -31,7 +32,16 @@ struct OpenedVolume {
     double load_s = 0;
 };
 
-// Loads the file (or generates the phantom) and prints one line about it.
-OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false);
+// Who holds the volume: `casts` when this process runs the engine over it (the master of a wall
+// and `info` only read its size and octree, so it stays mapped); `copies_on_host` is how many
+// processes on this machine would each copy it into huge pages (a wall's tile ranks).
+struct VolumeUse {
+    bool casts = true;
+    int copies_on_host = 1;
+};
+
+// Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,
+// and prints one line about it.
+OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false, VolumeUse use = {});
 
 }  // namespace isowall

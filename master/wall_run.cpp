@@ -55,7 +55,8 @@ struct MasterInput {
 
 MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
-    in.volume.emplace(open_volume(o.volume));
+    // The master casts no ray: its volume stays in the shared map.
+    in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
     in.iso = o.iso.value_or(kPhantomSkinIso);
@@ -123,7 +124,8 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
 }
 
 int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
-    const OpenedVolume ov = open_volume(o.volume, /*quiet=*/true);
+    const OpenedVolume ov =
+        open_volume(o.volume, /*quiet=*/true, VolumeUse{.copies_on_host = comm.ranks_on_host()});
     auto extractor = open_extractor(ov, budget);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
     // thread, unless the user says otherwise: the work then stays on its core and in the frame

@@ -62,7 +62,9 @@ THRESHOLDS = [("c90", 0.90), ("c99", 0.99), ("c999", 0.999), ("c100", 1.0)]
 # The progressive engine's configurations (`isowall render` options). "lod": adaptive resolution
 # whose level follows the projected size (meta-cells up to 2.5 px, so triangles stay about a
 # pixel as the volume grows), without refinement; "facing": the visible-surface rule; "-2t": on
-# two threads (every other configuration on one).
+# two threads (every other configuration on one); "-mapped": the volume read from its shared memory
+# map instead of the copy in huge pages that `--huge-pages auto` makes from 256 MiB up (not run by
+# default; they show what the copy gains, in the same run).
 ENGINES = {
     "full-res": ["--threads", "1"],
     "facing": ["--threads", "1", "--facing-only"],
@@ -73,6 +75,8 @@ ENGINES = {
     "lod-facing-2t": ["--threads", "2", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine",
                       "--facing-only"],
 }
+ENGINES["lod-facing-mapped"] = ENGINES["lod-facing"] + ["--huge-pages", "off"]
+ENGINES["lod-facing-2t-mapped"] = ENGINES["lod-facing-2t"] + ["--huge-pages", "off"]
 
 
 class BenchError(Exception):

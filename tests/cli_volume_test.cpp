@@ -82,6 +82,8 @@ TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
         {"info -v zero.nhdr", {"zero.nhdr", "data file", "/dev/zero", "character device"}},
         {"extract -v nan.raw --dims 4 4 4 --type float32 --iso 0 --out s.ply",
          {"nan.raw", "data", "no finite voxel"}},
+        {"render --huge-pages maybe --out s.png", {"--huge-pages", "maybe"}},
+        {"render --huge-pages --out s.png", {"--huge-pages"}},
     };
     for (const CliCase& c : cases) {
         SCOPED_TRACE(c.args);
@@ -95,6 +97,30 @@ TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
             EXPECT_NE(r.err.find(m), std::string::npos) << "missing \"" << m << "\" in: " << r.err;
     }
     EXPECT_FALSE(std::filesystem::exists(dir / "s.ply"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "s.png"));
+}
+
+// --huge-pages on copies the phantom (any size) and says so; the picture is the mapped one's.
+TEST(CliVolume, HugePagesOnGivesTheSameImage) {
+    const auto dir = test::scratch_dir("cli_huge_pages");
+    const auto render = [&](const std::string& mode) {
+        std::string cmd = "cd '";
+        cmd += dir.string();
+        cmd += "' && '";
+        cmd += ISOWALL_BINARY;
+        cmd += "' render --size 160x120 --huge-pages ";
+        cmd += mode + " --out " + mode + ".png > " + mode + ".txt";
+        return std::system(cmd.c_str());
+    };
+    ASSERT_EQ(render("off"), 0);
+    const int status = render("on");
+    const std::string on = slurp(dir / "on.txt"), off = slurp(dir / "off.txt");
+    if (on.empty() && WIFEXITED(status) && WEXITSTATUS(status) != 0)
+        GTEST_SKIP() << "this kernel grants no transparent huge pages";
+    ASSERT_EQ(status, 0);
+    EXPECT_NE(on.find("in huge pages (--huge-pages on)"), std::string::npos) << on;
+    EXPECT_NE(off.find("in memory (huge pages: no, --huge-pages off)"), std::string::npos) << off;
+    EXPECT_EQ(slurp(dir / "on.png"), slurp(dir / "off.png"));
 }
 
 }  // namespace

@@ -88,6 +88,15 @@ Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile fi
     bytes_ = file_.bytes().subspan(offset, voxel_count() * voxel_size(type));
 }
 
+void Volume::copy_to_huge_pages() {
+    HugePageBuffer buffer(bytes_.size());
+    std::copy(bytes_.begin(), bytes_.end(), buffer.bytes().begin());
+    huge_ = std::move(buffer);
+    bytes_ = huge_.bytes();
+    file_ = MappedFile();
+    owned_ = std::vector<std::byte>();
+}
+
 Box3 Volume::bounds() const {
     Box3 b;
     b.merge(glm::vec3(0));

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "common/core/box.h"
+#include "common/volume/huge_pages.h"
 #include "common/volume/mapped_file.h"
 
 namespace isowall {
@@ -71,6 +72,10 @@ class Volume {
     void set_files(std::vector<std::filesystem::path> files) { files_ = std::move(files); }
     std::span<const std::byte> bytes() const { return bytes_; }
     bool mapped() const { return file_.size() > 0; }
+    bool in_huge_pages() const { return huge_.size() > 0; }
+    // Moves the voxels into a HugePageBuffer (common/volume/huge_pages.h says why) and lets go of
+    // the file's map or the owned bytes. The voxels and everything else stay as they were.
+    void copy_to_huge_pages();
     std::size_t voxel_count() const {
         return static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
     }
@@ -89,6 +94,7 @@ class Volume {
     std::vector<std::filesystem::path> files_;
     MappedFile file_;
     std::vector<std::byte> owned_;
+    HugePageBuffer huge_;
     std::span<const std::byte> bytes_;
 };
 
