@@ -95,12 +95,12 @@ HugePageBuffer::HugePageBuffer(std::size_t size) {
     if (size == 0) return;
     // One extra huge page of slack so that an aligned start always exists inside the mapping.
     map_size_ = (size + kAlign - 1) / kAlign * kAlign + kAlign;
-    void* p = ::mmap(nullptr, map_size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1,
-                     0);
+    void* p =
+        ::mmap(nullptr, map_size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) {
         map_size_ = 0;
-        throw std::runtime_error("cannot map " + mib(size) + " for huge pages: " +
-                                 std::strerror(errno));
+        throw std::runtime_error("cannot map " + mib(size) +
+                                 " for huge pages: " + std::strerror(errno));
     }
     map_ = p;
     const auto start = reinterpret_cast<std::uintptr_t>(p);
