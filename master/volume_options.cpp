@@ -82,11 +82,17 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
                              "expected auto, on or off, got " + quote(o.huge_pages));
         const HugePagesChoice choice = choose_huge_pages(
             *mode, out.volume.bytes().size(), use.copies_on_host, thp_mode(), mem_available());
+        huge_note = " (huge pages: no, " + choice.why + ")";
         if (choice.copy) {
-            out.volume.copy_to_huge_pages();
-            huge_note = " (" + choice.why + ")";
-        } else {
-            huge_note = " (huge pages: no, " + choice.why + ")";
+            try {
+                out.volume.copy_to_huge_pages();
+                huge_note = " (" + choice.why + ")";
+            } catch (const std::runtime_error& e) {
+                // The mapping failed (no address space or memory): asked for, that is the error;
+                // under auto the volume stays in its map, which works, only slower.
+                if (*mode == HugePages::on) throw InputError("--huge-pages", "on", e.what());
+                huge_note = std::string(" (huge pages: no, ") + e.what() + ")";
+            }
         }
     }
     out.load_s = sw.seconds();

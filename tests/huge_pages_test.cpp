@@ -141,6 +141,15 @@ TEST(HugePages, BufferIsAlignedWritableAdvisedAndMoves) {
     c = std::move(b);
     EXPECT_EQ(c.bytes().data(), data);
     EXPECT_EQ(c.size(), size);
+
+    // No machine maps 4 EiB: an error naming the size, which open_volume turns into keeping
+    // the map (auto) or an error naming --huge-pages (on).
+    try {
+        HugePageBuffer huge(std::size_t{1} << 62);
+        ADD_FAILURE() << "mapped 4 EiB";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot map"), std::string::npos) << e.what();
+    }
 }
 
 template <class T>
