@@ -52,8 +52,10 @@ struct OctreeShape {
     }
     // First cell and one-past-last cell of node n at `level`, clipped to the volume.
     glm::ivec3 cell_begin(int level, glm::ivec3 n) const { return n << (level + kLeafLog2); }
+    // Written out rather than glm::min: GCC 12 kept glm's out of line in the ray walk.
     glm::ivec3 cell_end(int level, glm::ivec3 n) const {
-        return glm::min((n + 1) << (level + kLeafLog2), cell_dims);
+        const glm::ivec3 e = (n + 1) << (level + kLeafLog2);
+        return {std::min(e.x, cell_dims.x), std::min(e.y, cell_dims.y), std::min(e.z, cell_dims.z)};
     }
     // ceil(log2 D) + 1 for the longest side D in cells: the depth of the full octree.
     int depth() const { return static_cast<int>(levels.size()) + kLeafLog2; }
