@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "common/core/camera.h"
@@ -296,6 +297,10 @@ int run_render(const RenderOptions& o) {
     check_render_outputs(o);
     (void)engine_options(o);  // fails early on a bad --order
     Timings t;
+    // One thread is one core, as on a wall rank with one (master/wall_run.cpp): llvmpipe then
+    // rasterises in the drawing thread instead of its own threads on the other cores. The
+    // variable must be set before the first context; a vendor driver ignores it.
+    if (render_threads(o).usable() == 1) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     // Create the GL context first: a missing driver should fail before the volume is read.
     auto renderer = make_renderer(o.gl);
     OpenedVolume ov = open_volume(o.volume);

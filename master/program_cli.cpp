@@ -64,7 +64,8 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     re_cmd
         ->add_option("--threads", re.threads,
                      "Threads casting rays and propagating side by side (and building the "
-                     "octree); 0: every core of the machine")
+                     "octree); 0: every core of the machine. With 1, llvmpipe rasterises in the "
+                     "drawing thread too (LP_NUM_THREADS=0 unless set), so the frame uses one core")
         ->transform(number_in({0, 1024, false, true}))
         ->capture_default_str();
     re_cmd->add_flag("--against-full", re.against_full,

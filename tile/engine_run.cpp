@@ -1,6 +1,6 @@
-// The engine's conveniences around a frame: one region into a sink, a region's clip, the warm-up
-// draw, the whole-screen run that keeps every group and the final image, and the replay that
-// measures correctness.
+// The engine's conveniences around a frame: one region into a sink, a region's cursor and clip,
+// the warm-up draw, the whole-screen run that keeps every group and the final image, and the
+// replay that measures correctness.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -8,6 +8,9 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/core/pixel_rect_ops.h"
+#include "common/core/ray.h"
+#include "common/progressive/screen_mask.h"
 #include "tile/progressive_engine.h"
 
 namespace isowall {
@@ -24,6 +27,39 @@ FrameResult ProgressiveEngine::run(const FrameView& view, const PixelRect& regio
     result.screen_rect = c.rect;
     result.screen_pixels = c.pixels;
     return result;
+}
+
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing) {
+    ResolutionLevels levels;
+    if (opt.uniform_level > 0) return uniform_levels(opt.uniform_level);
+    if (!opt.adaptive) return levels;
+    // D[] depends on the eye, the frustum and the pixel size only: once per frame (every tile of
+    // a wall has the same pixel size, so one frame serves all of them).
+    levels = resolution_levels(view.camera, view.frustum, view.height, spacing,
+                               opt.adaptive_max_level, opt.adaptive_pixels);
+    levels.refine = opt.adaptive_refine;
+    return levels;
+}
+
+RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
+                           const std::optional<Box3>& volume_box,
+                           const std::vector<Box3>* mask_boxes) {
+    RegionCursor c;
+    c.rect = intersect(region, view.screen());
+    if (volume_box)
+        c.rect = intersect(c.rect, screen_box(*volume_box, view.camera.view(), view.frustum,
+                                              view.width, view.height));
+    if (mask_boxes) {
+        ScreenMask m = screen_mask(*mask_boxes, view.camera.view(), view.frustum, view.width,
+                                   view.height, c.rect);
+        c.rect = m.rect;
+        c.mask = std::move(m.cast);
+        c.pixels = m.count;
+    } else {
+        c.pixels = std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height));
+    }
+    c.done = c.pixels == 0;
+    return c;
 }
 
 ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {

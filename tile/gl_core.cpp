@@ -148,6 +148,7 @@ GlCore::GlCore(std::string_view backend, GlLoader loader)
 }
 
 GlCore::~GlCore() {
+    if (fence_) gl_->DeleteSync(static_cast<GLsync>(fence_));
     gl_->DeleteFramebuffers(1, &framebuffer_);
     gl_->DeleteRenderbuffers(1, &colour_buffer_);
     gl_->DeleteRenderbuffers(1, &depth_buffer_);
@@ -302,6 +303,35 @@ void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& proj
 void GlCore::finish() {
     gl_->Finish();
     check("glFinish");
+    // Everything is in the frame now, the fenced commands too.
+    if (fence_) gl_->DeleteSync(static_cast<GLsync>(fence_));
+    fence_ = nullptr;
+}
+
+void GlCore::flush() {
+    if (fence_) gl_->DeleteSync(static_cast<GLsync>(fence_));
+    fence_ = gl_->FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    if (fence_ == nullptr) fail("glFenceSync", "no fence");
+    gl_->Flush();
+    check("glFlush");
+}
+
+bool GlCore::finished(bool wait) {
+    if (!fence_) return true;
+    // A second at a time, so a wait that never ends is an error rather than a hang.
+    constexpr GLuint64 kWaitNs = 1'000'000'000;
+    GLenum r = gl_->ClientWaitSync(static_cast<GLsync>(fence_), 0, wait ? kWaitNs : 0);
+    for (int tries = 1; wait && r == GL_TIMEOUT_EXPIRED && tries < 60; ++tries)
+        r = gl_->ClientWaitSync(static_cast<GLsync>(fence_), 0, kWaitNs);
+    if (r == GL_WAIT_FAILED) {
+        check("glClientWaitSync");
+        fail("glClientWaitSync", "GL_WAIT_FAILED");
+    }
+    if (wait && r == GL_TIMEOUT_EXPIRED) fail("glClientWaitSync", "the fence did not pass in 60 s");
+    if (r == GL_TIMEOUT_EXPIRED) return false;
+    gl_->DeleteSync(static_cast<GLsync>(fence_));
+    fence_ = nullptr;
+    return true;
 }
 
 void GlCore::bind_rect(std::string_view call, const PixelRect& rect) {

@@ -41,6 +41,12 @@ class GlCore {
     // The depth of `rect` alone, as Renderer::read_coverage gives it.
     void read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect);
     void finish();
+    // A fence after everything drawn so far, then glFlush: the rasteriser starts on it and this
+    // returns at once (finished() tells when it is done). Replaces an earlier fence.
+    void flush();
+    // Whether the last flush()'s fence has passed (true when there is none); with `wait`, waits
+    // for it.
+    bool finished(bool wait);
 
   private:
     [[noreturn]] void fail(std::string_view call, std::string_view detail) const;
@@ -70,6 +76,7 @@ class GlCore {
     int normal_matrix_location_ = -1;
     int orthographic_location_ = -1;
     std::vector<std::uint32_t> depth_scratch_;  // read_coverage's rows, as GL gives them
+    void* fence_ = nullptr;                     // flush()'s GLsync, until it has passed
 };
 
 // The Renderer calls every GL back end shares: make the back end's context current, then let
@@ -107,6 +114,14 @@ class GlRenderer : public Renderer {
     void finish() override {
         make_current();
         core_->finish();
+    }
+    void flush() override {
+        make_current();
+        core_->flush();
+    }
+    bool finished(bool wait) override {
+        make_current();
+        return core_->finished(wait);
     }
 
   protected:

@@ -22,6 +22,9 @@ namespace isowall {
     X(PFNGLCLEARPROC, Clear)                                     \
     X(PFNGLFINISHPROC, Finish)                                   \
     X(PFNGLFLUSHPROC, Flush)                                     \
+    X(PFNGLFENCESYNCPROC, FenceSync)                             \
+    X(PFNGLCLIENTWAITSYNCPROC, ClientWaitSync)                   \
+    X(PFNGLDELETESYNCPROC, DeleteSync)                           \
     X(PFNGLENABLEPROC, Enable)                                   \
     X(PFNGLDISABLEPROC, Disable)                                 \
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                             \

@@ -21,6 +21,15 @@ double RendererSink::present() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+bool RendererSink::present_async() {
+    renderer_.flush();
+    return true;
+}
+
+bool RendererSink::presented(bool wait) {
+    return renderer_.finished(wait);
+}
+
 bool RendererSink::coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {
     renderer_.read_coverage(covered, rect);
     return true;
@@ -48,6 +57,18 @@ double TeeSink::present() {
     double seconds = 0;
     for (GroupSink* s : sinks_) seconds += s->present();
     return seconds;
+}
+
+bool TeeSink::present_async() {
+    for (GroupSink* s : sinks_)
+        if (!s->present_async()) s->present();
+    return true;
+}
+
+bool TeeSink::presented(bool wait) {
+    bool all = true;
+    for (GroupSink* s : sinks_) all = s->presented(wait) && all;
+    return all;
 }
 
 bool TeeSink::coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {

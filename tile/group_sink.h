@@ -23,6 +23,13 @@ class GroupSink {
     // Makes every group added so far visible, as a display does at its next refresh. Called at
     // most once per refresh and at the end of each ray-order level; returns the seconds it took.
     virtual double present() { return 0; }
+    // The same without waiting for the renderer: the caller goes on casting while the groups are
+    // drawn, and presented() tells when they show. False when this sink cannot; the caller then
+    // calls present().
+    virtual bool present_async() { return false; }
+    // Whether every group added before the last present_async() shows (true when none is
+    // outstanding); with `wait`, waits until they do and returns true.
+    virtual bool presented(bool /*wait*/) { return true; }
     // Sizes `covered` to `rect` and writes covered[y * rect.width + x] != 0 when pixel
     // (rect.x + x, rect.y + y) shows the surface now; false when this sink cannot tell (the
     // readback ray orders then see nothing covered).
@@ -44,6 +51,8 @@ class RendererSink final : public GroupSink {
     void begin(const FrameView& view) override;
     void add(const Group& group) override;
     double present() override;
+    bool present_async() override;
+    bool presented(bool wait) override;
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
     // The frame as drawn so far (finishes pending draws first).
     void read_back(Image& out);
@@ -62,13 +71,17 @@ class RecordingSink final : public GroupSink {
     std::vector<Group> groups;
 };
 
-// Forwards to each sink in turn; coverage comes from the first that can tell.
+// Forwards to each sink in turn; coverage comes from the first that can tell. An asynchronous
+// present presents each sink that cannot present asynchronously at once, and is presented when
+// every sink's is.
 class TeeSink final : public GroupSink {
   public:
     explicit TeeSink(std::vector<GroupSink*> sinks) : sinks_(std::move(sinks)) {}
     void begin(const FrameView& view) override;
     void add(const Group& group) override;
     double present() override;
+    bool present_async() override;
+    bool presented(bool wait) override;
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
 
   private:

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <optional>
 
 #include <glm/matrix.hpp>
 
-#include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
-#include "common/progressive/screen_mask.h"
 #include "tile/parallel_level.h"
 
 namespace isowall {
@@ -16,6 +15,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kRefreshS = 1.0 / 60.0;
+// How often a present in flight is asked whether it is done (a context switch and a fence query
+// per ask): a sample's time is late by at most this and one propagation pass.
+constexpr double kPollS = 0.25e-3;
 // The screen mask's node budget: the finest octree level with at most this many active nodes.
 // A few thousand boxes project in well under a millisecond (8 corners each), while the mask's
 // cost per region is its pixels; on the 512^2 CT head's skin this is the level of 16^3 cells,
@@ -43,26 +45,13 @@ class FrameRun {
     }
 
     RegionCursor cursor(const FrameView& view, const PixelRect& region) const {
-        RegionCursor c;
-        c.rect = intersect(region, view.screen());
-        if (opt_.screen_box)
-            c.rect = intersect(c.rect, screen_box(ex_.volume().bounds(), view.camera.view(),
-                                                  view.frustum, view.width, view.height));
-        if (masked()) {
-            ScreenMask m = screen_mask(active_.boxes, view.camera.view(), view.frustum, view.width,
-                                       view.height, c.rect);
-            c.rect = m.rect;
-            c.mask = std::move(m.cast);
-            c.pixels = m.count;
-        } else {
-            c.pixels =
-                std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height));
-        }
-        c.done = c.pixels == 0;
-        return c;
+        return region_cursor(view, region,
+                             opt_.screen_box ? std::optional(ex_.volume().bounds()) : std::nullopt,
+                             masked() ? &active_.boxes : nullptr);
     }
 
     bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink, std::size_t ray_limit) {
+        settle(true);  // a present in flight belongs to the sink of the last cast
         view_ = &view;
         sink_ = &sink;
         view_inv_ = glm::inverse(view.camera.view());
@@ -107,6 +96,7 @@ class FrameRun {
     FrameResult finish(bool completed) {
         frame_.completed = completed;
         record(true);
+        settle(true);
         frame_.rays_cast = now_.rays;
         frame_.elapsed_s = since(start_);
         return std::move(frame_);
@@ -125,17 +115,7 @@ class FrameRun {
     void begin(const FrameView& view) {
         stage(Stage::setup);
         start_ = Clock::now();
-        ResolutionLevels levels;
-        if (opt_.uniform_level > 0) {
-            levels = uniform_levels(opt_.uniform_level);
-        } else if (opt_.adaptive) {
-            // D[] depends on the eye, the frustum and the pixel size only: once per frame (every
-            // tile of a wall has the same pixel size, so one frame serves all of them).
-            levels =
-                resolution_levels(view.camera, view.frustum, view.height, ex_.volume().spacing(),
-                                  opt_.adaptive_max_level, opt_.adaptive_pixels);
-            levels.refine = opt_.adaptive_refine;
-        }
+        const ResolutionLevels levels = frame_levels(opt_, view, ex_.volume().spacing());
         if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
         if (masked()) {
             // Meta-cells of level i are 2^i cells at multiples of 2^i, so a node of level
@@ -290,23 +270,28 @@ class FrameRun {
 
     // A timeline sample, after ray counts growing by a factor and at least every interval.
     void record(bool force, bool present_now = true) {
-        now_.time_s = since(start_);
+        if (pending_ && since(start_) - last_poll_s_ >= kPollS) settle(false);
+        now_.time_s = since(start_);  // after a sample settle() kept
         while (next_extra_ < extra_.size() && extra_[next_extra_] < now_.rays) ++next_extra_;
         if (next_extra_ < extra_.size() && extra_[next_extra_] == now_.rays) force = true;
         if (!force && now_.rays < next_sample_rays_ &&
             now_.time_s - last_sample_s_ < opt_.sample_interval_s)
             return;
-        // The sample shows what is on screen: present queued groups as a display would at its
-        // next refresh. Presenting after every group would cost a full-screen flush each time
-        // (about 7 ms at 1600x1200 in llvmpipe), so between refreshes a sample may count groups
-        // still in flight: sample times are exact to one refresh (1/60 s). The refresh is paced
-        // by this thread's CPU clock, which is the wall clock of a rank with a core of its own;
-        // with many ranks per core (an emulated wall) the wall clock would present far more
-        // often than a real display node does.
+        // A sample waiting for its groups to show goes first: no later one passes it.
+        if (pending_ && !force) return;
+        if (settle(true)) now_.time_s = since(start_);
+        // The sample shows what is on screen: queued groups are presented as a display would at
+        // its next refresh (paced by this thread's CPU clock, a rank's wall clock on a core of
+        // its own), so between refreshes a sample may count groups in flight. A sink presenting
+        // without waiting (a fence) lets this thread cast on: the sample waits in pending_
+        // until its groups show, which is then its time.
         const double cpu = thread_cpu_seconds();
+        bool in_flight = false;
         if (dirty_ && sink_ && ((force && present_now) || cpu - last_present_cpu_s_ >= kRefreshS)) {
             stage(Stage::render);
-            now_.t_render_s += sink_->present();
+            const auto t0 = Clock::now();
+            in_flight = sink_->present_async();
+            now_.t_render_s += in_flight ? since(t0) : sink_->present();
             stage(Stage::intersection);
             now_.time_s = since(start_);
             last_present_cpu_s_ = thread_cpu_seconds();
@@ -314,15 +299,34 @@ class FrameRun {
         }
         now_.cells_visited = ex_.visited_count();
         now_.groups = frame_.group_count;
-        frame_.timeline.push_back(now_);
-        last_sample_s_ = now_.time_s;
+        last_sample_s_ = last_poll_s_ = now_.time_s;
         while (next_sample_rays_ <= now_.rays)
             next_sample_rays_ = std::max(
                 next_sample_rays_ + 1,
                 static_cast<std::size_t>(double(next_sample_rays_) * opt_.sample_ray_factor));
-        if (progress_ && now_.time_s - last_progress_s_ >= opt_.progress_interval_s) {
-            last_progress_s_ = now_.time_s;
-            progress_(now_);
+        if (in_flight)
+            pending_ = now_;
+        else
+            push(now_);
+    }
+
+    // The sample of a present in flight, timed and kept once its groups show (`wait`: now);
+    // true when it was kept.
+    bool settle(bool wait) {
+        if (!pending_) return false;
+        last_poll_s_ = since(start_);
+        if (!sink_->presented(wait)) return false;
+        pending_->time_s = since(start_);
+        push(*pending_);
+        pending_.reset();
+        return true;
+    }
+
+    void push(const TimelineSample& s) {
+        frame_.timeline.push_back(s);
+        if (progress_ && s.time_s - last_progress_s_ >= opt_.progress_interval_s) {
+            last_progress_s_ = s.time_s;
+            progress_(s);
         }
     }
 
@@ -350,6 +354,8 @@ class FrameRun {
     double last_present_cpu_s_ = thread_cpu_seconds();
     bool dirty_ = false;        // groups added since the last present()
     bool present_due_ = false;  // a level's sample and present put off (see cast_level)
+    std::optional<TimelineSample> pending_;  // its present in flight (GroupSink::present_async)
+    double last_poll_s_ = 0;                 // when pending_'s present was last asked about
     // Group ids handed out this frame, from opt_.first_group_id: the groups added, and with
     // several threads also the passes dropped because another took their seed first.
     std::uint32_t ids_used_ = 0;

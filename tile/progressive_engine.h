@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "common/core/camera.h"
@@ -131,6 +132,17 @@ struct RegionCursor {
     bool done = false;                // every pixel to cast has had its ray
 };
 
+// The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
+// every cell at full resolution; `spacing` is the volume's.
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing);
+
+// The cursor of `region` of `view`: the region clipped to the screen; with `volume_box`, to the
+// volume's projected box too; with `mask_boxes` (the active octree nodes of the frame's screen
+// mask, object space), to the bounding box of the pixels they cover, casting only those.
+RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
+                           const std::optional<Box3>& volume_box,
+                           const std::vector<Box3>* mask_boxes);
+
 class FrameRun;
 
 class ProgressiveEngine {
@@ -179,6 +191,11 @@ class EngineFrame {
     ~EngineFrame();
     EngineFrame(const EngineFrame&) = delete;
     EngineFrame& operator=(const EngineFrame&) = delete;
+
+    // The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
+    // every cell at full resolution; `spacing` is the volume's.
+    ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view,
+                                  glm::vec3 spacing);
 
     // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box, and
     // masked by the frame's screen mask (EngineOptions::screen_mask).

@@ -47,6 +47,13 @@ class Renderer {
     virtual void read_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect);
     // Waits until everything drawn so far is in the frame (for honest stage timings).
     virtual void finish() = 0;
+    // Starts putting everything drawn so far into the frame without waiting for it (a present
+    // that lets the caller go on extracting while the rasteriser or GPU draws): finished() then
+    // says when it is there. A back end without fences waits here, as finish() does.
+    virtual void flush() { finish(); }
+    // Whether everything drawn before the last flush() is in the frame (true when no flush() is
+    // outstanding); with `wait`, waits until it is and returns true.
+    virtual bool finished(bool /*wait*/) { return true; }
     virtual std::string_view name() const = 0;
 };
 
