@@ -29,7 +29,7 @@ TEST(PresentAsync, FlushedFrameIsTheFinishedOneOnEveryBackEnd) {
         SCOPED_TRACE(backend);
         auto r = make_renderer(backend);
         const Image finished = draw_alone(*r, surface.mesh, fv);  // finish() waits
-        EXPECT_TRUE(r->finished(false));                      // no flush outstanding
+        EXPECT_TRUE(r->finished(false));                          // no flush outstanding
 
         RendererSink sink(*r);
         sink.begin(fv);

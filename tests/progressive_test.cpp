@@ -221,13 +221,15 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     ProgressiveEngine engine(*ex, *renderer, opt);
     const FrameView first = make_view(p, 200, 150, kPhantomSkinIso);
     // The stop flag is set as a communication thread would, here from the first sample at 300 rays
-    // or more (samples grow by 1.25x, so that sample is at most 375 rays).
+    // or more (samples grow by 1.25x, so that sample is at most 375 rays). A sample that waits for
+    // its present (GroupSink::present_async) reaches the callback once the renderer has drawn its
+    // groups, while rays go on: a few dozen here, so the frame ends well before 600.
     std::atomic<bool> stop{false};
     FrameResult a = engine.run(first, &stop, [&](const TimelineSample& s) {
         if (s.rays >= 300) stop = true;
     });
     EXPECT_FALSE(a.completed);
-    EXPECT_LE(a.rays_cast, 400u);
+    EXPECT_LE(a.rays_cast, 600u);
     EXPECT_EQ(a.final_image.pixel_count(), 0u);
 
     // New view and new isovalue: nothing of the first frame may remain.

@@ -10,6 +10,7 @@
 
 #include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
+#include "common/progressive/mesh_coverage.h"
 #include "common/progressive/screen_mask.h"
 #include "tile/progressive_engine.h"
 
@@ -60,6 +61,33 @@ RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
     }
     c.done = c.pixels == 0;
     return c;
+}
+
+void begin_order(RegionCursor& c, RayOrderKind kind) {
+    c.order = make_ray_order(kind, c.rect.width, c.rect.height,
+                             PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
+    c.sizing = kind == RayOrderKind::dynamic_grid;
+    if (c.sizing)
+        c.drawn.assign(
+            std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height)), 0);
+}
+
+void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view) {
+    add_mesh_coverage(mesh, view_m, view.frustum, view.width, view.height, c.rect, c.drawn);
+}
+
+void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+                         std::vector<std::uint8_t>& scratch) {
+    if (c.sizing) {
+        order.set_coverage(c.drawn);
+        if (order.wants_coverage()) return;
+        c.sizing = false;
+        c.drawn = {};
+        return;
+    }
+    if (!sink.coverage(scratch, c.rect))
+        scratch.assign(std::size_t(c.rect.width) * std::size_t(c.rect.height), 0);
+    order.set_coverage(scratch);
 }
 
 ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {

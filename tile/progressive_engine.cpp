@@ -54,7 +54,8 @@ class FrameRun {
         settle(true);  // a present in flight belongs to the sink of the last cast
         view_ = &view;
         sink_ = &sink;
-        view_inv_ = glm::inverse(view.camera.view());
+        view_m_ = view.camera.view();
+        view_inv_ = glm::inverse(view_m_);
         rect_ = c.rect;
         cursor_ = &c;
         params_ = opt_.propagation;
@@ -63,11 +64,7 @@ class FrameRun {
         // c.rays, so a region's second band would cast nothing.
         const std::size_t limit = ray_limit > SIZE_MAX - c.rays ? SIZE_MAX : c.rays + ray_limit;
         while (!c.done && c.rays < limit) {
-            // The order sees the region as a screen of its own (pixels and coverage local to it):
-            // a region's coverage is then its own pixels, not a copy of the whole screen.
-            if (!c.order)
-                c.order = make_ray_order(opt_.order, c.rect.width, c.rect.height,
-                                         PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
+            if (!c.order) begin_order(c, opt_.order);
             const std::size_t before = now_.rays;
             const bool level = c.order->next_level(pixels_);
             if (level && !cast_level(*c.order, c.pass == 1)) {
@@ -224,6 +221,7 @@ class FrameRun {
         if (g.refinement ? g.mesh.indices.empty() : g.cells.empty()) return false;
         stage(Stage::render);
         const auto t1 = Clock::now();
+        if (cursor_->sizing) add_drawn(*cursor_, g.mesh, view_m_, *view_);
         sink_->add(g);
         now_.t_render_s += since(t1);
         dirty_ = true;
@@ -260,10 +258,7 @@ class FrameRun {
         if (cursor_->hits == 0) return;
         stage(Stage::render);
         const auto t0 = Clock::now();
-        if (!sink_->coverage(covered_, rect_))
-            covered_.assign(
-                static_cast<std::size_t>(rect_.width) * static_cast<std::size_t>(rect_.height), 0);
-        order.set_coverage(covered_);
+        give_order_coverage(order, *cursor_, *sink_, covered_);
         now_.t_render_s += since(t0);
         stage(Stage::intersection);
     }
@@ -342,7 +337,7 @@ class FrameRun {
     FrameResult frame_;
     TimelineSample now_;
     Clock::time_point start_;
-    glm::mat4 view_inv_{1.0f};
+    glm::mat4 view_m_{1.0f}, view_inv_{1.0f};
     ActiveBoxes active_;              // the screen mask's nodes at this frame's isovalue
     PixelRect rect_;                  // the region being cast
     RegionCursor* cursor_ = nullptr;  // its cursor

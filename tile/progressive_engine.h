@@ -130,6 +130,11 @@ struct RegionCursor {
     std::size_t rays = 0;             // cast so far
     std::size_t hits = 0;             // of them, rays that met the surface
     bool done = false;                // every pixel to cast has had its ray
+    // The dynamic grid before it has sized its grid: the groups this region finds add the pixels
+    // they cover to `drawn` (rect-local), which the order gets as the region's coverage, with no
+    // read-back from the renderer (common/progressive/mesh_coverage.h).
+    bool sizing = false;
+    std::vector<std::uint8_t> drawn;
 };
 
 // The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
@@ -142,6 +147,17 @@ ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, g
 RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
                            const std::optional<Box3>& volume_box,
                            const std::vector<Box3>* mask_boxes);
+
+// A new ray order for `c`'s next pass, which sees the region as a screen of its own (pixels and
+// coverage local to it); the dynamic grid starts sizing (RegionCursor::sizing).
+void begin_order(RegionCursor& c, RayOrderKind kind);
+// Adds what `mesh` covers of `c`'s region to c.drawn (`view_m`: view's camera matrix).
+void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view);
+// Gives `order` the region's coverage after a level that wants it: while sizing, c.drawn (and
+// sizing ends once the order has its size); else what `sink` shows (`scratch` holds it), or
+// nothing covered when the sink cannot tell.
+void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+                         std::vector<std::uint8_t>& scratch);
 
 class FrameRun;
 
