@@ -57,7 +57,7 @@ RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
         c.mask = std::move(m.cast);
         c.pixels = m.count;
     } else {
-        c.pixels = std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height));
+        c.pixels = pixel_count(c.rect);
     }
     c.done = c.pixels == 0;
     return c;
@@ -67,9 +67,7 @@ void begin_order(RegionCursor& c, RayOrderKind kind) {
     c.order = make_ray_order(kind, c.rect.width, c.rect.height,
                              PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
     c.sizing = kind == RayOrderKind::dynamic_grid;
-    if (c.sizing)
-        c.drawn.assign(
-            std::size_t(std::max(0, c.rect.width)) * std::size_t(std::max(0, c.rect.height)), 0);
+    if (c.sizing) c.drawn.assign(pixel_count(c.rect), 0);
 }
 
 void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view) {
@@ -80,13 +78,11 @@ void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
                          std::vector<std::uint8_t>& scratch) {
     if (c.sizing) {
         order.set_coverage(c.drawn);
-        if (order.wants_coverage()) return;
-        c.sizing = false;
-        c.drawn = {};
+        c.sizing = order.wants_coverage();  // still searching: no piece found in the region yet
+        if (!c.sizing) c.drawn = {};
         return;
     }
-    if (!sink.coverage(scratch, c.rect))
-        scratch.assign(std::size_t(c.rect.width) * std::size_t(c.rect.height), 0);
+    if (!sink.coverage(scratch, c.rect)) scratch.assign(pixel_count(c.rect), 0);
     order.set_coverage(scratch);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Pure operations on pixel rectangles, shared by the engine's regions and the screen mask.
 #include <algorithm>
+#include <cstddef>
 
 #include "common/core/camera.h"
 
@@ -9,6 +10,11 @@ namespace isowall {
 // True when the rectangle holds no pixel.
 inline bool is_empty(const PixelRect& r) {
     return r.width <= 0 || r.height <= 0;
+}
+
+// The pixels the rectangle holds (0 when it is empty).
+inline std::size_t pixel_count(const PixelRect& r) {
+    return is_empty(r) ? 0 : std::size_t(r.width) * std::size_t(r.height);
 }
 
 // The pixels both rectangles hold: at the corner where they would meet, with a width or height of

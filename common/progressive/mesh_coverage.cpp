@@ -7,6 +7,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "common/core/pixel_rect_ops.h"
+
 namespace isowall {
 namespace {
 
@@ -19,10 +21,9 @@ float edge(glm::vec2 a, glm::vec2 b, glm::vec2 p) {
 
 void add_mesh_coverage(const Mesh& mesh, const glm::mat4& view, const Frustum& frustum, int width,
                        int height, const PixelRect& rect, std::vector<std::uint8_t>& covered) {
-    if (covered.size() !=
-        std::size_t(std::max(0, rect.width)) * std::size_t(std::max(0, rect.height)))
+    if (covered.size() != pixel_count(rect))
         throw std::invalid_argument("add_mesh_coverage: covered does not match the rect");
-    if (rect.width <= 0 || rect.height <= 0) return;
+    if (is_empty(rect)) return;
     const glm::mat4 m = frustum.matrix() * view;
     // Window coordinates, y from the top; the flag marks corners the renderer would clip.
     std::vector<glm::vec2> win(mesh.positions.size());
