@@ -1,6 +1,7 @@
 #include "master/wall_master.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -309,12 +310,17 @@ bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where)
 
 void WallMaster::wait(const WaitCmd& w) {
     Stopwatch t;
+    if (w.until == WaitCmd::Until::time) {
+        // A pause: it lasts its seconds even when the frame ends first (a script holding a
+        // finished frame on the wall). The tiles are quiet then, so only their alive messages
+        // (keep_alive) tell that they still run.
+        wait_until([&] { return t.seconds() >= w.amount; }, HUGE_VAL);
+        return;
+    }
     auto done = [&] {
-        // Every wait also ends when the frame is complete on every tile.
+        // A wait for rays also ends when the frame is complete on every tile.
         if (frame_done()) return true;
-        if (w.until == WaitCmd::Until::rays) return double(total_rays()) >= w.amount;
-        if (w.until == WaitCmd::Until::time) return t.seconds() >= w.amount;
-        return false;
+        return w.until == WaitCmd::Until::rays && double(total_rays()) >= w.amount;
     };
     wait_until(done, o_.timeout_s);
 }

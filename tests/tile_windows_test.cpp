@@ -68,8 +68,10 @@ TEST(TileWindows, ShowTheFrameAsItBuildsAndThenExactlyTheTileImage) {
     if (!x.ok()) GTEST_SKIP() << "no Xvfb: " << x.why_not();
     const auto dir = test::scratch_dir("tile_windows");
     std::ofstream(dir / "wall.toml") << wall_file(x.display(), 320, 240);
-    // The frame is held on screen for 3 s after it is done, so the last captures are of it.
-    std::ofstream(dir / "show.txt") << "wait done\nwait time 3\nquit\n";
+    // The frame is held on screen for 1.5 s after it is done (`wait time` is a pause, which does
+    // not end with the frame), so the last captures are of it. It once ended with the frame, and
+    // a tile's last change, shown at its next refresh, then sometimes came after the quit.
+    std::ofstream(dir / "show.txt") << "wait done\nwait time 1.5\nquit\n";
     std::atomic<bool> running{true};
     int rc = -1;
     // --max-count 4: many small groups, so the frame takes long enough to be seen building.

@@ -2,6 +2,7 @@
 // of the whole virtual screen, and bad input ends every rank with a non-zero exit, never a hang.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -233,6 +234,29 @@ TEST(WallRun, ConsoleCommandsDriveTheWall) {
     EXPECT_NE(log.find("console:2: command: unknown command \"fly\""), std::string::npos) << log;
     EXPECT_TRUE(std::filesystem::exists(dir / "typed.png")) << log;
     EXPECT_TRUE(std::filesystem::exists(dir / "m.png")) << log;
+}
+
+// `wait time S` is a pause: it holds the finished frame on the wall for its S seconds (it once
+// ended with the frame), and the quiet tiles meanwhile are not taken for silent ones, even when
+// S is longer than --timeout.
+TEST(WallRun, WaitTimeHoldsTheFinishedFrameLongerThanTheTimeout) {
+    const auto dir = test::scratch_dir("wall_wait_time");
+    std::ofstream(dir / "1x1.toml") << "tiles = [1, 1]\ntile_size_px = [96, 72]\n";
+    std::ofstream(dir / "hold.txt") << "wait done\nsnapshot done\nwait time 2.5\nquit\n";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int rc =
+        run(mpirun(2) + "wall --timeout 1 --wall '" + (dir / "1x1.toml").string() + "' --script '" +
+                (dir / "hold.txt").string() + "' --out '" + (dir / "m.png").string() + "'",
+            dir / "hold.log");
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string log = slurp(dir / "hold.log");
+    ASSERT_EQ(rc, 0) << log;
+    EXPECT_GE(took, 2.5) << log;
+    // The frame was done before the pause: the mosaic at quit is the snapshot taken then.
+    const auto m =
+        test::compare_images(read_image(dir / "m.png"), read_image(dir / "done.png"), kFromFiles);
+    EXPECT_EQ(m.differing_pixels, 0u) << m;
 }
 
 TEST(WallRun, BadInputEndsEveryRank) {

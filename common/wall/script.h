@@ -5,7 +5,8 @@
 //   zoom F                     F > 1 moves closer
 //   pan DX DY                  move the view by DX screen widths right and DY heights up
 //   iso V                      new isovalue
-//   wait rays N | wait time S | wait done
+//   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
+//   wait time S                a pause of S seconds, whether or not the frame ends first
 //   snapshot NAME              write the mosaic as NAME.png
 //   quit
 // '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
