@@ -6,7 +6,7 @@ primary rays: scripts/fe_mesh.py and bench/peer's isowall-peer), for one volume 
 scales, all in one run, with the issue's targets marked holds or MISSED.
 
 Usage: /usr/bin/python3 scripts/bench_scaling.py [--scales 1,2] [--size 1600x1200] [--iso 40]
-           [--runs 1] [--volume vhp_ct_head] [--build build] [--data ../shared/data]
+           [--runs 1] [--pair-rounds 2] [--volume vhp_ct_head] [--build build] [--data ../shared/data]
            [--out out/bench-scaling] [--threads 2] [--engines lod,full-res,...] [--cold]
 
 Scale 1 is the volume itself; any other scale is a trilinear copy made once by
@@ -25,7 +25,10 @@ memory it touches then is new to it: page faults, the renderer's first buffers a
 keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the peer's processes
 run with the same C library settings (MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_).
 
-Two threads against one: the targets compare lod-facing on 1 and 2 threads. Beside them the
+Two threads against one: the targets compare lod-facing on 1 and 2 threads. After the --runs
+rounds of every engine, --pair-rounds more rounds run only those two (in turn one first, then
+the other), each followed by a one-pass machine check, and their runs join the others (the
+fastest is kept). A table gives every round's own speed-ups beside the machine's. Beside them the
 run prints, for each scale, the peer's own 2-thread gain (flying edges, BVH and rays on 1 thread,
 one run) and what the machine's two cores gave two threads of plain work at that time
 (bench/cores' isowall-cores: arithmetic, and random reads over 256 MiB; 2.0 is perfect), since on
@@ -75,6 +78,8 @@ ENGINES = {
     "lod-facing-2t": ["--threads", "2", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine",
                       "--facing-only"],
 }
+# The two engines the two-thread target compares: one thread, then two.
+PAIR = ("lod-facing", "lod-facing-2t")
 ENGINES["lod-facing-mapped"] = ENGINES["lod-facing"] + ["--huge-pages", "off"]
 ENGINES["lod-facing-2t-mapped"] = ENGINES["lod-facing-2t"] + ["--huge-pages", "off"]
 
@@ -105,6 +110,9 @@ def parse_args(argv):
     ap.add_argument("--size", default="1600x1200", help="screen WIDTHxHEIGHT (default %(default)s)")
     ap.add_argument("--iso", type=float, default=40.0, help="isovalue (default %(default)s: skin of the head)")
     ap.add_argument("--runs", type=int, default=1, help="runs of each measure, fastest kept (default %(default)s)")
+    ap.add_argument("--pair-rounds", type=int, default=2,
+                    help="more rounds of lod-facing and lod-facing-2t only, each with a machine check "
+                    "(default %(default)s)")
     ap.add_argument("--volume", default="vhp_ct_head", help="a name in --data or an .nhdr file (default %(default)s)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="build folder (default: build)")
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"),
@@ -132,6 +140,8 @@ def parse_args(argv):
         raise BenchError(f"--iso: expected a finite number, got {a.iso}")
     if not 1 <= a.runs <= 20:
         raise BenchError(f"--runs: expected an integer in [1, 20], got {a.runs}")
+    if not 0 <= a.pair_rounds <= 20:
+        raise BenchError(f"--pair-rounds: expected an integer in [0, 20], got {a.pair_rounds}")
     if not 1 <= a.threads <= 64:
         raise BenchError(f"--threads: expected an integer in [1, 64], got {a.threads}")
     a.isowall = os.path.join(a.build, "master", "isowall")
@@ -257,6 +267,29 @@ def fastest(runs, key):
     return dict(best, runs=runs)
 
 
+def pair_rounds(a, volume, tmp, runs):
+    """--pair-rounds more rounds of the two engines the two-thread target compares (one thread
+    first in even rounds, two threads first in odd ones, so a slow stretch of the machine does not
+    always fall on the same one), each followed by what the machine's cores gave two threads then.
+    Their runs join the engines' (the fastest is kept as for the others); returns every round in
+    which both ran, the first --runs rounds included, with its speed-ups."""
+    pair = [e for e in PAIR if e in a.engines]
+    if len(pair) < 2:
+        return []
+    machine = [None] * a.runs
+    for k in range(a.pair_rounds):
+        for e in (pair if k % 2 == 0 else pair[::-1]):
+            runs[e].append(progressive(a, volume, tmp, e))
+        machine.append(key_values(run([a.cores, "--reps", "1"], "isowall-cores")))
+    rounds = []
+    for i, (one, two) in enumerate(zip(runs[pair[0]], runs[pair[1]])):
+        def gain(key):
+            return one[key] / two[key] if one.get(key) and two.get(key) else None
+        rounds.append({"round": i + 1, "c99_speedup": gain("c99"), "every_ray_speedup": gain("every_ray_s"),
+                       "machine": machine[i]})
+    return rounds
+
+
 def measure_scale(a, scale, skip_peer, tmp):
     volume, sizes = scaled_volume(a, scale)
     run([a.isowall, "info", "-v", volume], "isowall info")  # builds the octree cache, untimed
@@ -268,6 +301,7 @@ def measure_scale(a, scale, skip_peer, tmp):
     for _ in range(a.runs):
         for e in a.engines:
             runs[e].append(progressive(a, volume, tmp, e))
+    res["pair_rounds"] = pair_rounds(a, volume, tmp, runs)
     res["engines"] = {e: fastest(runs[e], "c99") for e in a.engines}
     res["progressive"] = res["engines"][a.engines[0]]  # the one the targets judge
     res["full"] = fastest([full(a, volume, tmp) for _ in range(a.runs)], "full_s")
@@ -299,7 +333,8 @@ def main(argv):
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     checks = targets(results)
-    meta = {"volume": a.source, "iso": a.iso, "size": a.size, "runs": a.runs, "threads": a.threads,
+    meta = {"volume": a.source, "iso": a.iso, "size": a.size, "runs": a.runs, "pair_rounds": a.pair_rounds,
+            "threads": a.threads,
             "frame": "cold" if a.cold else "warm",
             "engines": {e: " ".join(ENGINES[e]) or "(defaults)" for e in a.engines},
             "date": time.strftime("%Y-%m-%d %H:%M"), "cores": os.cpu_count(),

@@ -144,6 +144,20 @@ def two_threads_table(results):
     return lines
 
 
+def rounds_table(results):
+    """Each round in which both lod-facing engines ran: its own speed-ups, and what the machine's
+    two cores gave random reads right after it (pair rounds only; bench/cores)."""
+    lines = ["Two threads against one, round by round (the runs of one round follow each other; "
+             "machine: random reads on two threads right after the round, pair rounds only):", "",
+             "| volume | round | C=99% | every ray | machine: random reads |", "|---|---|---|---|---|"]
+    for r in results:
+        for k in r.get("pair_rounds", []):
+            m = k.get("machine") or {}
+            lines.append(f"| {label(r)} | {k['round']} | {fmt(k['c99_speedup'], 2)} | "
+                         f"{fmt(k['every_ray_speedup'], 2)} | {fmt(m.get('memory_speedup'), 2)} |")
+    return lines
+
+
 def frame_words(meta):
     if meta.get("frame", "cold") == "cold":
         return "each program's first run in a fresh process (cold)"
@@ -155,11 +169,12 @@ def report(meta, results, checks):
     load = ", ".join(f"{x:g}" for x in meta["load_average"])
     lines = [f"# Scaling (issue 10): {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
              f"Measured {meta['date']} on {meta['cores']} cores (load average {load} over 1, 5, 15 min "
-             f"at the end); fastest of {meta['runs']} run(s) each; seconds; {frame_words(meta)}. C is the share of final "
+             f"at the end); fastest of {meta['runs']} run(s) each ({meta['runs'] + meta.get('pair_rounds', 0)} "
+             f"of lod-facing and lod-facing-2t); seconds; {frame_words(meta)}. C is the share of final "
              f"pixels; the peer uses {meta['threads']} threads. The progressive columns and the "
              f"targets are the first engine's ({next(iter(meta.get('engines', {'': ''})))}).", "",
              *times_table(results), "", *engines_table(meta, results), "",
-             *two_threads_table(results), "",
+             *two_threads_table(results), "", *rounds_table(results), "",
              "Covered pixels (the same view in each):", "", *pixels_table(results), "",
              "Targets:", "", "| target | volume | figure | limit | verdict |", "|---|---|---|---|---|"]
     for c in checks:

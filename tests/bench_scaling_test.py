@@ -68,6 +68,21 @@ class BenchScaling(unittest.TestCase):
                 self.assertGreater(s["engines"]["full-res"]["c_vs_full"], 0.99, s)
                 for e in s["engines"].values():
                     self.assertGreater(e["c_vs_full"], 0.9, e)
+                # The default two pair rounds: lod-facing and lod-facing-2t ran once more each
+                # time (one thread first, then two threads first), each round with a machine check.
+                self.assertEqual(len(s["engines"]["lod-facing"]["runs"]), 3)
+                self.assertEqual(len(s["engines"]["lod-facing-2t"]["runs"]), 3)
+                self.assertEqual(len(s["engines"]["lod"]["runs"]), 1)
+                rounds = s["pair_rounds"]
+                self.assertEqual([k["round"] for k in rounds], [1, 2, 3])
+                self.assertIsNone(rounds[0]["machine"])
+                for k in rounds:
+                    self.assertGreater(k["c99_speedup"], 0.1, k)
+                    self.assertGreater(k["every_ray_speedup"], 0.1, k)
+                for k in rounds[1:]:
+                    self.assertGreater(k["machine"]["memory_speedup"], 0.1, k)
+                fastest_c99 = min(r["c99"] for r in s["engines"]["lod-facing-2t"]["runs"])
+                self.assertEqual(s["engines"]["lod-facing-2t"]["c99"], fastest_c99)
             names = {c["target"] for c in res["targets"]}
             self.assertIn("triangles by C=99% per covered pixel", names)
             self.assertIn("every ray / our --full", names)
@@ -79,6 +94,8 @@ class BenchScaling(unittest.TestCase):
             self.assertIn("| 52x47x80 |", md)
             self.assertIn("Targets:", md)
             self.assertIn("Two threads against one", md)
+            self.assertIn("round by round", md)
+            self.assertIn("| 103x94x161 | 3 |", md)
             self.assertIn("| 103x94x161 | lod-refine |", md)
             self.assertTrue("holds" in md or "MISSED" in md)
             self.assertIn(md.splitlines()[0], p.stdout)
@@ -88,7 +105,7 @@ class BenchScaling(unittest.TestCase):
     def test_bad_options_give_one_line_and_status_1(self):
         with tempfile.TemporaryDirectory() as out:
             for args, field in [(["--scales", "0"], "--scales"), (["--scales", "1,x"], "--scales"),
-                                (["--size", "320"], "--size"), (["--runs", "0"], "--runs"),
+                                (["--size", "320"], "--size"), (["--runs", "0"], "--runs"), (["--pair-rounds", "-1"], "--pair-rounds"),
                                 (["--iso", "nan"], "--iso"), (["--runs", "x"], "--runs"),
                                 (["--engines", "lod,fast"], "--engines"), (["--engines", "lod,lod"], "--engines"),
                                 (["--volume", "/nonexistent.nhdr"], "--volume"),
@@ -100,6 +117,21 @@ class BenchScaling(unittest.TestCase):
                 self.assertEqual(len(lines), 1, p.stderr)
                 self.assertIn(field, lines[0])
             self.assertEqual(os.listdir(out), [])
+
+
+class Cores(unittest.TestCase):
+    """bench/cores' isowall-cores, which the benchmark runs: --help, and one line for a bad option."""
+
+    def test_help_and_bad_option(self):
+        cores = os.path.join(BUILD, "bench", "cores", "isowall-cores")
+        p = subprocess.run([cores, "--help"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("Usage: isowall-cores", p.stdout)
+        for args in (["--reps", "x"], ["--reps"], ["--fast"]):
+            p = subprocess.run([cores, *args], capture_output=True, text=True, timeout=60)
+            self.assertEqual(p.returncode, 1, args)
+            self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+            self.assertEqual(p.stdout, "")
 
 
 if __name__ == "__main__":
