@@ -95,6 +95,7 @@ class BenchScaling(unittest.TestCase):
             self.assertIn("Targets:", md)
             self.assertIn("Two threads against one", md)
             self.assertIn("round by round", md)
+            self.assertIn("median of rounds", md)
             self.assertIn("| 103x94x161 | 3 |", md)
             self.assertIn("| 103x94x161 | lod-refine |", md)
             self.assertTrue("holds" in md or "MISSED" in md)
