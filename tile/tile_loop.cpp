@@ -239,9 +239,15 @@ class TileRank {
     }
 
     // Before the frame thread waits for work: pending changes are shown when due, so the last
-    // change of a frame reaches every show even when no more work comes.
+    // change of a frame reaches every show even when no more work comes. What is due is shown
+    // before the inbox is looked at, so messages coming faster than a refresh cannot hold it.
     void show_pending() {
         for (;;) {
+            const double now = shown_clock_.seconds();
+            std::vector<FrameShow*> due;
+            for (Shown& s : shows_)
+                if (s.pacer.due(now)) due.push_back(s.show);
+            show_to(due, false);
             double wait = -1;
             for (const Shown& s : shows_)
                 if (s.pacer.pending()) {
@@ -249,11 +255,6 @@ class TileRank {
                     wait = wait < 0 ? w : std::min(wait, w);
                 }
             if (wait < 0 || inbox_.wait_for(wait)) return;
-            const double now = shown_clock_.seconds();
-            std::vector<FrameShow*> due;
-            for (Shown& s : shows_)
-                if (s.pacer.due(now)) due.push_back(s.show);
-            show_to(due, false);
         }
     }
 
