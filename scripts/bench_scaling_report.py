@@ -1,5 +1,6 @@
 """The targets, tables and plot of scripts/bench_scaling.py (issue 10), from its measured results:
 one dict per scale with "progressive", "full" and "peer" (see bench_scaling.py)."""
+import statistics
 
 # Time to C = 99% at most 1/N of FE + Embree, by scale (512, 1024, 2048 a side for the head).
 PEER_LIMITS = {1: 1 / 4, 2: 1 / 10, 4: 1 / 40}
@@ -119,17 +120,12 @@ def pixels_table(results):
     return lines
 
 
-def median(xs):
-    xs = sorted(xs)
-    n = len(xs)
-    return None if n == 0 else (xs[n // 2] if n % 2 else (xs[n // 2 - 1] + xs[n // 2]) / 2)
-
-
 def round_medians(r):
     """The median over the rounds of each round's own speed-up (rounds: see rounds_table)."""
     rounds = r.get("pair_rounds", [])
-    c99 = median([k["c99_speedup"] for k in rounds if k["c99_speedup"]])
-    every = median([k["every_ray_speedup"] for k in rounds if k["every_ray_speedup"]])
+    c99 = [k["c99_speedup"] for k in rounds if k["c99_speedup"]]
+    every = [k["every_ray_speedup"] for k in rounds if k["every_ray_speedup"]]
+    c99, every = (statistics.median(xs) if xs else None for xs in (c99, every))
     return f"{fmt(c99, 2)} / {fmt(every, 2)}"
 
 
