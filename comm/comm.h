@@ -2,8 +2,9 @@
 // The thin messaging layer between the ranks of a wall run (STYLE.md: IceT's communicator,
 // OSPRay's MPI_CALL). Two transports: MPI (comm/mpi_comm.cpp, the only file that includes mpi.h)
 // and in-process (comm/inproc_comm.h: every rank a thread, for tests). The wall logic sees only
-// this interface and the typed messages of comm/protocol.h.
+// this interface and the typed messages of protocol/protocol.h.
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -12,10 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "comm/protocol.h"
-#include "common/wall/wall.h"  // kMasterRank
-
 namespace isowall {
+
+// A message's kind on the wire (an MPI tag). Declared here without values: protocol/protocol.h
+// defines them, so this layer moves any tag it is given and never looks inside the bytes.
+enum class Tag : std::int32_t;
 
 inline constexpr double kForever = std::numeric_limits<double>::infinity();
 
@@ -42,7 +44,6 @@ class Comm {
     virtual ~Comm() = default;
     virtual int rank() const = 0;
     virtual int size() const = 0;
-    bool is_master() const { return rank() == kMasterRank; }
     virtual std::string host() const = 0;
     // How many ranks of the job run on this rank's host (they share its cores).
     virtual int ranks_on_host() const = 0;
@@ -59,11 +60,6 @@ class Comm {
     // Ends every rank of the job at once (a failing rank must not leave others waiting).
     [[noreturn]] virtual void abort(int code) = 0;
 };
-
-template <class T>
-void send_message(Comm& comm, int dest, const T& message) {
-    comm.send(dest, T::kTag, encode(message));
-}
 
 // How long MPI_Init and MPI_Finalize may take: they wait for every rank, so a stopped rank would
 // hold the others there for ever. Past the limit the process prints one line and exits (2).

@@ -1,6 +1,6 @@
 #pragma once
 // A window on an X display that images are presented to (tile windows, the control window).
-// Drawing stays off screen (tile/renderer.h); a window only shows a finished RGBA8 image, through
+// Drawing stays off screen (render/renderer.h); a window only shows a finished RGBA8 image, through
 // MIT-SHM where the server shares memory with us (same host), else XPutImage. Works on Xvfb and
 // on any X server; no GL, so it does not care which driver renders. No Xlib header leaks from
 // here: callers see only value types.

@@ -32,10 +32,10 @@ bool is_prefix(const std::vector<std::byte>& a, std::span<const std::byte> b) {
 
 void check_payload(std::span<const std::byte> data) {
     if (data.size() < 2) return;
-    const auto type = static_cast<MsgType>(std::to_integer<unsigned>(data[0]) |
-                                           std::to_integer<unsigned>(data[1]) << 8);
+    const auto type = static_cast<RemoteTag>(std::to_integer<unsigned>(data[0]) |
+                                             std::to_integer<unsigned>(data[1]) << 8);
     const auto payload = data.subspan(2);
-    const ViewMessage m = decode_payload(type, payload);
+    const RemoteMessage m = decode_payload(type, payload);
     check(type_of(m) == type, "decode gives a message of its type");
     const std::vector<std::byte> again = encode_payload(m);
     check(again.size() == payload.size() && is_prefix(again, payload),

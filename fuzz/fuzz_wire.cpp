@@ -1,7 +1,7 @@
-// Harness: the wire messages (comm/protocol.h, comm/protocol_jobs.h). The first byte is the tag
-// (any value, so unknown tags are fuzzed too), the rest the message. A message that decodes must
-// encode back to exactly its bytes (every field is read, nothing is normalised) and decode again
-// to a message of the same tag; a decoder never allocates much more than the message holds
+// Harness: the wire messages (protocol/protocol.h, protocol/protocol_jobs.h). The first byte is the
+// tag (any value, so unknown tags are fuzzed too), the rest the message. A message that decodes
+// must encode back to exactly its bytes (every field is read, nothing is normalised) and decode
+// again to a message of the same tag; a decoder never allocates much more than the message holds
 // (fuzz.sh runs this harness with a small -malloc_limit_mb).
 #include <cstddef>
 #include <cstdint>
@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "comm/protocol.h"
 #include "fuzz/fuzz_check.h"
+#include "protocol/protocol.h"
 
 namespace {
 

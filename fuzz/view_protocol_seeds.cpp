@@ -16,7 +16,7 @@ namespace {
 using namespace isowall;
 using namespace isowall::remote;
 
-std::vector<ViewMessage> samples() {
+std::vector<RemoteMessage> samples() {
     RequestMsg request;
     request.request_id = 3;
     request.view.camera.eye = {1, -40, 3};
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(dir);
     std::vector<std::byte> all{std::byte{1}, std::byte{5}};
     int n = 0;
-    for (const ViewMessage& m : samples()) {
+    for (const RemoteMessage& m : samples()) {
         const auto type = static_cast<std::uint16_t>(type_of(m));
         std::vector<std::byte> payload{std::byte{0}, std::byte(type & 0xff), std::byte(type >> 8)};
         const auto p = encode_payload(m);

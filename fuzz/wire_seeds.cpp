@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "comm/protocol.h"
+#include "protocol/protocol.h"
 
 namespace {
 
@@ -39,8 +39,8 @@ std::vector<Message> samples() {
     JobDoneMsg done{9, 4, 500, 3, 40, 0.1, 0.9, 100.5, 100.6, 96};
     RegionMsg region{9, 4, {1, 1, 2, 1}, 0.9, {1, 2, 3, 4, 5, 6, 7, 8}, {0.25f, 0.75f}};
     PreviewMsg preview{9, 2, 1, {10, 20, 30, 40, 50, 60}};
-    return {HelloMsg{"tile-1", 1, false},
-            HelloMsg{"tile-1", 16, true},
+    return {TileHelloMsg{"tile-1", 1, false},
+            TileHelloMsg{"tile-1", 16, true},
             ViewMsg{5, view},
             ProgressMsg{5, 12345, 0.5},
             SnapshotMsg{},

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <thread>
 
-#include "comm/preview.h"
 #include "common/core/error.h"
+#include "common/core/preview.h"
 #include "master/control_view.h"
 
 namespace isowall {

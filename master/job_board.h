@@ -17,10 +17,10 @@
 #include <optional>
 #include <vector>
 
-#include "comm/protocol.h"
 #include "common/core/box.h"
 #include "common/core/camera.h"
 #include "common/core/view.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 

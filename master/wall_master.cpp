@@ -50,7 +50,7 @@ void WallMaster::handle(const Envelope& e) {
         throw WireError(rank_label(spec_, e.from) + ": " + err.what());
     }
     t.heard.restart();
-    if (auto* h = std::get_if<HelloMsg>(&m)) {
+    if (auto* h = std::get_if<TileHelloMsg>(&m)) {
         t.host = h->host;
         t.threads = h->threads;
         (h->loaded ? t.hello : t.joined) = true;
@@ -75,7 +75,7 @@ void WallMaster::handle(const Envelope& e) {
             ++previews_taken_;
         }
     } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
-        raise_test_signal(o_.fault, "gather");
+        raise_test_signal(o_.fault, FaultMoment::gather);
         t.result = std::move(*res);
     } else {
         throw WireError(rank_label(spec_, e.from) + " sent a " + to_string(e.tag) +
@@ -170,8 +170,9 @@ void WallMaster::start() {
     wait_for_tiles([](const TileState& t) { return t.hello; }, o_.startup_timeout_s);
     print_map();
     send_views();
-    raise_test_signal(o_.fault, "frame");
-    if (o_.fault == "throw") throw std::runtime_error("test fault: the master throws");
+    raise_test_signal(o_.fault, FaultMoment::frame);
+    if (o_.fault.action == FaultAction::throw_error)
+        throw std::runtime_error("test fault: the master throws");
 }
 
 void WallMaster::print_map() const {
@@ -235,7 +236,7 @@ void WallMaster::fill(int rank) {
         m.view = tiles_[static_cast<std::size_t>(j.owner)].view;
         m.rect = j.rect;
         send_message(comm_, rank, m);
-        if (j.owner != rank) raise_test_signal(o_.fault, "migration");
+        if (j.owner != rank) raise_test_signal(o_.fault, FaultMoment::migration);
     }
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "common/core/test_fault.h"
 #include "common/core/util.h"
 #include "common/core/view.h"
 #include "common/progressive/trace.h"
@@ -26,7 +27,7 @@ struct MasterOptions {
     std::string trace;               // PREFIX for PREFIX.json and PREFIX.csv, or empty
     double timeout_s = 120;          // the wall silent this long ends the job
     double startup_timeout_s = 600;  // the same, while the tiles start (load, say hello)
-    std::string fault;  // test hook (ISOWALL_TEST_FAULT of the master): "throw", "stop@frame"...
+    TestFault fault;  // the fault tests' hook (common/core/test_fault.h); none by default
     // The screen-region scheduler: off, every tile casts its own screen (one job per band);
     // on, tiles are cut into regions of region_w x region_h and idle ranks take others' regions.
     // The first view: the front full view turned, zoomed and panned by these.

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "comm/protocol.h"
 #include "common/progressive/trace.h"
 #include "common/wall/wall.h"
 #include "master/job_board.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 

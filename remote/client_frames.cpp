@@ -110,7 +110,7 @@ void ClientFrames::handle_visible(const VisibleMsg& v, std::size_t wire_bytes, d
     sample(now_s, false);
 }
 
-bool ClientFrames::handle(const ViewMessage& m, std::size_t wire_bytes, double now_s) {
+bool ClientFrames::handle(const RemoteMessage& m, std::size_t wire_bytes, double now_s) {
     if (const auto* e = std::get_if<ErrorMsg>(&m)) throw RemoteError(e->code, e->text);
     if (const auto* g = std::get_if<GroupMsg>(&m)) {
         handle_group(*g, wire_bytes, now_s);

@@ -29,7 +29,7 @@
 #include "common/core/image.h"
 #include "common/progressive/correctness.h"
 #include "remote/view_protocol.h"
-#include "tile/renderer.h"
+#include "render/renderer.h"
 
 namespace isowall::remote {
 
@@ -60,7 +60,7 @@ class ClientFrames {
     // the current frame (then result() holds it). Messages of older requests only fill the cache.
     // Throws WireError for a group that does not decode or names an unknown cached group, and
     // RemoteError (below) for an ErrorMsg.
-    bool handle(const ViewMessage& m, std::size_t wire_bytes, double now_s);
+    bool handle(const RemoteMessage& m, std::size_t wire_bytes, double now_s);
     // The last frame ended; measure() first fills the correctness of its samples.
     const ClientFrameResult& result() const { return result_; }
     // Replays the frame's draw steps and measures each sample against the final image.

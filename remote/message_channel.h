@@ -21,10 +21,10 @@ class MessageChannel {
     virtual const std::string& peer() const = 0;
     // Sends one whole message; returns the bytes it took on the wire, frame header included.
     // Throws NetError or PeerClosed (also after shutdown()).
-    virtual std::size_t send(const ViewMessage& m) = 0;
+    virtual std::size_t send(const RemoteMessage& m) = 0;
     // The next whole message within `timeout_s`, or nullopt. Throws WireError when what arrived
     // does not decode, PeerClosed when the peer has gone or after shutdown().
-    virtual std::optional<ViewMessage> receive(double timeout_s) = 0;
+    virtual std::optional<RemoteMessage> receive(double timeout_s) = 0;
     // The emulated link (token bucket on every send); 0: none.
     virtual void set_rate(double bits_per_second) = 0;
     // Wakes a blocked receive and a blocked or paced send; later calls throw PeerClosed.
@@ -40,8 +40,8 @@ class TcpChannel final : public MessageChannel {
         : conn_(std::move(s), std::move(peer), max_payload_bytes) {}
 
     const std::string& peer() const override { return conn_.peer(); }
-    std::size_t send(const ViewMessage& m) override { return conn_.send(m); }
-    std::optional<ViewMessage> receive(double timeout_s) override {
+    std::size_t send(const RemoteMessage& m) override { return conn_.send(m); }
+    std::optional<RemoteMessage> receive(double timeout_s) override {
         return conn_.receive(timeout_s);
     }
     void set_rate(double bits_per_second) override { conn_.set_rate(bits_per_second); }

@@ -12,25 +12,12 @@
 namespace isowall::remote {
 namespace {
 
-// The server extracts and never draws: the engine's renderer (which it only warms up) is this.
-class NullRenderer final : public Renderer {
-  public:
-    void resize(int, int) override {}
-    void clear() override {}
-    void clear_depth() override {}
-    void draw(const Mesh&, const glm::mat4&, const glm::mat4&) override {}
-    void read_back(Image& out) override { out = Image{}; }
-    void read_back(Image& out, const PixelRect&) override { out = Image{}; }
-    void finish() override {}
-    std::string_view name() const override { return "none"; }
-};
-
 // The pixel whose centre sees `p` (object space), if it is on the screen.
 std::optional<glm::ivec2> pixel_of(const FrameView& v, glm::vec3 p) {
     const glm::vec4 clip = v.frustum.matrix() * v.camera.view() * glm::vec4(p, 1.0f);
     if (!(clip.w > 0)) return std::nullopt;
-    const float x = (clip.x / clip.w * 0.5f + 0.5f) * float(v.width);
-    const float y = (0.5f - clip.y / clip.w * 0.5f) * float(v.height);
+    const glm::vec2 w = ndc_to_window(clip.x / clip.w, clip.y / clip.w, v.width, v.height);
+    const float x = w.x, y = w.y;
     if (!(x >= 0 && y >= 0 && x < float(v.width) && y < float(v.height))) return std::nullopt;
     return glm::ivec2(int(x), int(y));
 }
@@ -38,7 +25,7 @@ std::optional<glm::ivec2> pixel_of(const FrameView& v, glm::vec3 p) {
 }  // namespace
 
 // One level of detail: its extractor (own visited cells, shared octree) and what was sent.
-struct ServerSession::Level {
+struct ServerSession::LodLevel {
     int lod = 0;
     std::unique_ptr<SurfaceExtractor> ex;
     struct Sent {
@@ -53,7 +40,7 @@ struct ServerSession::Level {
 // Sends each group as it is made, and names cached groups that rays meet.
 class ServerSession::Sink final : public GroupSink {
   public:
-    Sink(ServerSession& s, Level& lv, const RequestMsg& r, bool keep, RequestFigures& f)
+    Sink(ServerSession& s, LodLevel& lv, const RequestMsg& r, bool keep, RequestFigures& f)
         : s_(s), lv_(lv), r_(r), keep_(keep), f_(f) {}
 
     void add(const Group& g) override {
@@ -92,7 +79,7 @@ class ServerSession::Sink final : public GroupSink {
 
   private:
     ServerSession& s_;
-    Level& lv_;
+    LodLevel& lv_;
     const RequestMsg& r_;
     const bool keep_;
     RequestFigures& f_;
@@ -109,9 +96,9 @@ ServerSession::ServerSession(const SurfaceExtractor& prototype, SessionOptions o
 
 ServerSession::~ServerSession() = default;
 
-ServerSession::Level& ServerSession::level(int l) {
+ServerSession::LodLevel& ServerSession::lod_level(int l) {
     while (levels_.size() <= static_cast<std::size_t>(l)) {
-        auto lv = std::make_unique<Level>();
+        auto lv = std::make_unique<LodLevel>();
         lv->lod = static_cast<int>(levels_.size());
         lv->ex = prototype_.share();
         levels_.push_back(std::move(lv));
@@ -119,7 +106,7 @@ ServerSession::Level& ServerSession::level(int l) {
     return *levels_[static_cast<std::size_t>(l)];
 }
 
-void ServerSession::begin_cached(Level& lv, const RequestMsg& r, bool keep) {
+void ServerSession::begin_cached(LodLevel& lv, const RequestMsg& r, bool keep) {
     lv.ex->begin_frame(r.view.iso, uniform_levels(lv.lod));
     if (!keep) lv.sent.clear();
     for (std::size_t i = 0; i < lv.sent.size(); ++i)
@@ -138,8 +125,8 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
     VisibleMsg m;
     m.request_id = r.request_id;
     for (int l = top; l >= 0; --l) {
-        Level& lv = level(l);
-        for (const Level::Sent& s : lv.sent) {
+        LodLevel& lv = lod_level(l);
+        for (const LodLevel::Sent& s : lv.sent) {
             const float half = 0.5f * float(1 << s.key.level);
             const auto px = pixel_of(v, (glm::vec3(s.key.seed) + half) * spacing);
             if (!px) continue;
@@ -161,7 +148,7 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
 
 bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std::atomic<bool>& stop,
                                RequestFigures& f) {
-    Level& lv = level(l);
+    LodLevel& lv = lod_level(l);
     EngineOptions eo = options_.engine;
     eo.uniform_level = l;
     eo.adaptive = false;
@@ -169,8 +156,7 @@ bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std:
     eo.first_group_id = static_cast<std::uint32_t>(lv.sent.size());
     eo.trace = nullptr;
     eo.sample_at_rays.clear();
-    NullRenderer none;
-    ProgressiveEngine engine(*lv.ex, none, eo);
+    ProgressiveEngine engine(*lv.ex, eo);
     Sink sink(*this, lv, r, keep, f);
     EngineFrame frame(engine, r.view, stop);
     RegionCursor c = frame.cursor(r.view, r.view.screen());
@@ -200,7 +186,7 @@ RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& 
         for (auto& lv : levels_) lv->sent.clear();
     }
     const int top = r.progressive_lod ? options_.lod_levels : 0;
-    for (int l = top; l >= 0; --l) begin_cached(level(l), r, keep);
+    for (int l = top; l >= 0; --l) begin_cached(lod_level(l), r, keep);
     if (keep) name_by_seed_rays(r, f);
     for (int l = top; l >= 0; --l)
         if (stop.load() || !cast_level(l, r, keep, stop, f)) return f;

@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "common/extract/surface_extractor.h"
+#include "engine/progressive_engine.h"
 #include "remote/group_codec.h"
 #include "remote/view_protocol.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall::remote {
 
@@ -50,7 +50,7 @@ struct SessionOptions {
 };
 
 // Sends one message; returns its bytes on the wire. Throws when the connection is gone.
-using SendMessage = std::function<std::size_t(const ViewMessage&)>;
+using SendMessage = std::function<std::size_t(const RemoteMessage&)>;
 
 struct RequestFigures {
     bool completed = false;    // false: stopped by a newer request or a closed connection
@@ -75,10 +75,10 @@ class ServerSession {
     RequestFigures run(const RequestMsg& request, const std::atomic<bool>& stop);
 
   private:
-    struct Level;
+    struct LodLevel;
     class Sink;
-    Level& level(int l);
-    void begin_cached(Level& lv, const RequestMsg& r, bool keep);
+    LodLevel& lod_level(int l);
+    void begin_cached(LodLevel& lv, const RequestMsg& r, bool keep);
     void name_by_seed_rays(const RequestMsg& r, RequestFigures& f);
     bool cast_level(int l, const RequestMsg& r, bool drawn, const std::atomic<bool>& stop,
                     RequestFigures& f);
@@ -86,7 +86,7 @@ class ServerSession {
     const SurfaceExtractor& prototype_;
     SessionOptions options_;
     SendMessage send_;
-    std::vector<std::unique_ptr<Level>> levels_;  // index = level of detail (0 = full)
+    std::vector<std::unique_ptr<LodLevel>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;
     std::uint64_t cache_gen_ = 0;  // the generation groups are sent in; 0 while not caching

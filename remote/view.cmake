@@ -8,10 +8,3 @@ add_library(isowall_remote_view
 target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_view
     PUBLIC isowall_engine isowall_remote_codec isowall_remote_net PRIVATE isowall_warnings)
-
-# isowall_remote_app: `isowall serve` and `isowall view` (options, datasets, scripts, outputs).
-add_library(isowall_remote_app
-    ${CMAKE_CURRENT_LIST_DIR}/serve_command.cpp ${CMAKE_CURRENT_LIST_DIR}/view_command.cpp)
-target_link_libraries(isowall_remote_app
-    PUBLIC isowall_remote_view isowall_remote_http isowall_cli isowall_io isowall_wall_spec
-    PRIVATE isowall_warnings)

@@ -13,7 +13,7 @@ ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(rende
     hello.token = h.token;
     hello.encoding = static_cast<std::uint8_t>(h.encoding);
     conn_->send(hello);
-    std::optional<ViewMessage> m = conn_->receive(h.connect_timeout_s);
+    std::optional<RemoteMessage> m = conn_->receive(h.connect_timeout_s);
     if (!m)
         throw NetError(conn_->peer() + ": no answer to hello within " +
                        std::to_string(h.connect_timeout_s) + " s");
@@ -41,7 +41,7 @@ void ViewClient::request(const FrameView& view, bool progressive_lod, bool cache
 }
 
 bool ViewClient::receive_one(double timeout_s) {
-    std::optional<ViewMessage> m = conn_->receive(timeout_s);
+    std::optional<RemoteMessage> m = conn_->receive(timeout_s);
     if (!m) return false;
     // Its bytes on the wire: a payload that decodes encodes back to exactly its bytes.
     const std::size_t bytes = kHeaderBytes + encode_payload(*m).size();

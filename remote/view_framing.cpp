@@ -54,10 +54,10 @@ FrameHeader decode_header(std::span<const std::byte, kHeaderBytes> bytes,
         header_error("version: expected " + std::to_string(kProtocolVersion) + ", got " +
                      std::to_string(h.version));
     const std::uint16_t type = get_u16(bytes.subspan<6, 2>());
-    if (type < 1 || type > kLastMsgType)
-        header_error("type: expected 1.." + std::to_string(kLastMsgType) + ", got " +
+    if (type < 1 || type > kLastRemoteTag)
+        header_error("type: expected 1.." + std::to_string(kLastRemoteTag) + ", got " +
                      std::to_string(type));
-    h.type = static_cast<MsgType>(type);
+    h.type = static_cast<RemoteTag>(type);
     h.payload_bytes = get_u32(bytes.subspan<8, 4>());
     if (h.payload_bytes > max_payload_bytes)
         header_error("length: " + std::to_string(h.payload_bytes) + " bytes is over the limit of " +
@@ -72,7 +72,7 @@ void put_header(std::span<std::byte, kHeaderBytes> out, const FrameHeader& h) {
     put_le(out.subspan<8, 4>(), h.payload_bytes);
 }
 
-std::vector<std::byte> encode_frame(const ViewMessage& m) {
+std::vector<std::byte> encode_frame(const RemoteMessage& m) {
     const std::vector<std::byte> payload = encode_payload(m);
     if (payload.size() > std::numeric_limits<std::uint32_t>::max())
         throw WireError(std::string(to_string(type_of(m))) + " message: " +
@@ -84,7 +84,7 @@ std::vector<std::byte> encode_frame(const ViewMessage& m) {
     return out;
 }
 
-ViewMessage decode_frame(std::span<const std::byte> bytes, std::uint32_t max_payload_bytes) {
+RemoteMessage decode_frame(std::span<const std::byte> bytes, std::uint32_t max_payload_bytes) {
     if (bytes.size() < kHeaderBytes)
         header_error("truncated: " + std::to_string(bytes.size()) + " of 12 bytes");
     const FrameHeader h = decode_header(bytes.first<kHeaderBytes>(), max_payload_bytes);
@@ -102,7 +102,7 @@ void FrameParser::fail(const std::string& why) {
     throw WireError(why);
 }
 
-std::optional<ViewMessage> FrameParser::next(std::span<const std::byte>& input) {
+std::optional<RemoteMessage> FrameParser::next(std::span<const std::byte>& input) {
     if (failed_) throw WireError(*failed_);
     if (!header_) {
         const std::size_t n = std::min(input.size(), kHeaderBytes - header_filled_);
@@ -127,7 +127,7 @@ std::optional<ViewMessage> FrameParser::next(std::span<const std::byte>& input) 
     input = input.subspan(n);
     if (payload_.size() < header_->payload_bytes) return std::nullopt;
 
-    const MsgType type = header_->type;
+    const RemoteTag type = header_->type;
     header_.reset();
     header_filled_ = 0;
     std::vector<std::byte> payload;

@@ -5,7 +5,7 @@
 //   offset  size  field
 //   0       4     magic "IWVP" (0x49 0x57 0x56 0x50)
 //   4       2     protocol version, u16 little-endian (kProtocolVersion)
-//   6       2     message type, u16 little-endian (MsgType, 1..kLastMsgType)
+//   6       2     message type, u16 little-endian (RemoteTag, 1..kLastRemoteTag)
 //   8       4     payload length in bytes, u32 little-endian (at most the receiver's limit)
 //
 // A receiver checks the header as soon as it has its 12 bytes, before it holds any of the
@@ -32,7 +32,7 @@ inline constexpr std::uint32_t kDefaultMaxPayloadBytes = std::uint32_t{64} << 20
 
 struct FrameHeader {
     std::uint16_t version = kProtocolVersion;
-    MsgType type = MsgType::bye;
+    RemoteTag type = RemoteTag::bye;
     std::uint32_t payload_bytes = 0;
 };
 
@@ -44,10 +44,10 @@ void put_header(std::span<std::byte, kHeaderBytes> out, const FrameHeader& h);
 
 // Header and payload of one message, ready to send. Throws WireError when the payload is over
 // 4 GiB - 1 (the header cannot say its length); the receiver's limit is the receiver's.
-std::vector<std::byte> encode_frame(const ViewMessage& m);
+std::vector<std::byte> encode_frame(const RemoteMessage& m);
 // Exactly one whole frame: a short buffer or bytes after the payload are errors.
-ViewMessage decode_frame(std::span<const std::byte> bytes,
-                         std::uint32_t max_payload_bytes = kDefaultMaxPayloadBytes);
+RemoteMessage decode_frame(std::span<const std::byte> bytes,
+                           std::uint32_t max_payload_bytes = kDefaultMaxPayloadBytes);
 
 // Cuts a byte stream into messages, whatever the chunks it arrives in (as recv gives them):
 //
@@ -65,7 +65,7 @@ class FrameParser {
     explicit FrameParser(std::uint32_t max_payload_bytes = kDefaultMaxPayloadBytes)
         : max_payload_bytes_(max_payload_bytes) {}
 
-    std::optional<ViewMessage> next(std::span<const std::byte>& input);
+    std::optional<RemoteMessage> next(std::span<const std::byte>& input);
     // Bytes of a message begun but not complete: a stream that ends here was cut short.
     std::size_t pending_bytes() const { return header_filled_ + payload_.size(); }
     // The bytes held for the message being read (at most kHeaderBytes + the limit).

@@ -8,7 +8,7 @@
 #include <string>
 #include <type_traits>
 
-#include "comm/wire_pieces.h"
+#include "common/core/wire_pieces.h"
 #include "remote/slot_list.h"
 
 namespace isowall::remote {
@@ -268,53 +268,53 @@ ErrorMsg make_error(ErrorCode code, std::string_view text) {
     return m;
 }
 
-const char* to_string(MsgType type) {
+const char* to_string(RemoteTag type) {
     switch (type) {
-        case MsgType::hello:
+        case RemoteTag::hello:
             return "hello";
-        case MsgType::ready:
+        case RemoteTag::ready:
             return "ready";
-        case MsgType::request:
+        case RemoteTag::request:
             return "request";
-        case MsgType::group:
+        case RemoteTag::group:
             return "group";
-        case MsgType::visible:
+        case RemoteTag::visible:
             return "visible";
-        case MsgType::end_of_frame:
+        case RemoteTag::end_of_frame:
             return "end_of_frame";
-        case MsgType::error:
+        case RemoteTag::error:
             return "error";
-        case MsgType::bye:
+        case RemoteTag::bye:
             return "bye";
     }
     return "unknown";
 }
 
-std::vector<std::byte> encode_payload(const ViewMessage& m) {
+std::vector<std::byte> encode_payload(const RemoteMessage& m) {
     return std::visit([](const auto& msg) { return encode(msg); }, m);
 }
 
-MsgType type_of(const ViewMessage& m) {
-    return std::visit([](const auto& msg) { return std::decay_t<decltype(msg)>::kType; }, m);
+RemoteTag type_of(const RemoteMessage& m) {
+    return std::visit([](const auto& msg) { return std::decay_t<decltype(msg)>::kTag; }, m);
 }
 
-ViewMessage decode_payload(MsgType type, std::span<const std::byte> payload) {
+RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload) {
     switch (type) {
-        case MsgType::hello:
+        case RemoteTag::hello:
             return decode_hello(payload);
-        case MsgType::ready:
+        case RemoteTag::ready:
             return decode_ready(payload);
-        case MsgType::request:
+        case RemoteTag::request:
             return decode_request(payload);
-        case MsgType::group:
+        case RemoteTag::group:
             return decode_group(payload);
-        case MsgType::visible:
+        case RemoteTag::visible:
             return decode_visible(payload);
-        case MsgType::end_of_frame:
+        case RemoteTag::end_of_frame:
             return decode_end_of_frame(payload);
-        case MsgType::error:
+        case RemoteTag::error:
             return decode_error(payload);
-        case MsgType::bye:
+        case RemoteTag::bye:
             return decode_bye(payload);
     }
     throw WireError("view protocol: unknown message type " +

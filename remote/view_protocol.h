@@ -21,7 +21,7 @@
 namespace isowall::remote {
 
 // The type field of a frame's header. Numbers are never reused: a retired type stays retired.
-enum class MsgType : std::uint16_t {
+enum class RemoteTag : std::uint16_t {
     hello = 1,         // client -> server, first: protocol version, dataset, token, encoding
     ready = 2,         // server -> client: the dataset is loaded; its bounds and range
     request = 3,       // client -> server: a view to draw; interrupts the current one
@@ -31,8 +31,8 @@ enum class MsgType : std::uint16_t {
     error = 7,         // either way: what was wrong; the sender closes the connection after it
     bye = 8,           // either way: the sender closes the connection, nothing was wrong
 };
-inline constexpr std::uint16_t kLastMsgType = 8;
-const char* to_string(MsgType type);
+inline constexpr std::uint16_t kLastRemoteTag = 8;
+const char* to_string(RemoteTag type);
 
 // ---- limits: each is checked by the decoder before anything is sized from the bytes -----------
 inline constexpr std::size_t kMaxDatasetNameBytes = 256;  // printable ASCII, not empty
@@ -47,7 +47,7 @@ inline constexpr std::size_t kMaxVisibleKeys = std::size_t{1} << 20;
 inline constexpr int kMaxGroupLevel = 30;
 
 struct HelloMsg {
-    static constexpr MsgType kType = MsgType::hello;
+    static constexpr RemoteTag kTag = RemoteTag::hello;
     static constexpr std::uint8_t kVersion = 1;
     std::uint16_t protocol_version = 1;  // the newest the client speaks
     std::string dataset;                 // the name the server loaded the volume under
@@ -56,7 +56,7 @@ struct HelloMsg {
 };
 
 struct ReadyMsg {
-    static constexpr MsgType kType = MsgType::ready;
+    static constexpr RemoteTag kTag = RemoteTag::ready;
     static constexpr std::uint8_t kVersion = 1;
     Box3 bounds{glm::vec3(0), glm::vec3(1)};  // object space; finite, min <= max
     double value_min = 0, value_max = 0;      // finite, min <= max
@@ -65,7 +65,7 @@ struct ReadyMsg {
 };
 
 struct RequestMsg {
-    static constexpr MsgType kType = MsgType::request;
+    static constexpr RemoteTag kTag = RemoteTag::request;
     static constexpr std::uint8_t kVersion = 1;
     std::uint64_t request_id = 0;  // grows with every request of a connection
     // Camera, frustum, image size (each side 1..kMaxImageSide) and isovalue; the camera must be
@@ -76,7 +76,7 @@ struct RequestMsg {
 };
 
 struct GroupMsg {
-    static constexpr MsgType kType = MsgType::group;
+    static constexpr RemoteTag kTag = RemoteTag::group;
     static constexpr std::uint8_t kVersion = 2;
     std::uint64_t request_id = 0;
     GroupKey key;  // seed >= 0 on each axis, level 0..kMaxGroupLevel, finite iso
@@ -91,7 +91,7 @@ struct GroupMsg {
 };
 
 struct VisibleMsg {
-    static constexpr MsgType kType = MsgType::visible;
+    static constexpr RemoteTag kTag = RemoteTag::visible;
     static constexpr std::uint8_t kVersion = 2;
     std::uint64_t request_id = 0;
     // Cached groups of the client's generation, by slot: strictly ascending, each below
@@ -100,7 +100,7 @@ struct VisibleMsg {
 };
 
 struct EndOfFrameMsg {
-    static constexpr MsgType kType = MsgType::end_of_frame;
+    static constexpr RemoteTag kTag = RemoteTag::end_of_frame;
     static constexpr std::uint8_t kVersion = 1;
     std::uint64_t request_id = 0;
     std::uint64_t rays = 0, groups = 0, triangles = 0;
@@ -118,7 +118,7 @@ enum class ErrorCode : std::uint16_t {
 inline constexpr std::uint16_t kLastErrorCode = 6;
 
 struct ErrorMsg {
-    static constexpr MsgType kType = MsgType::error;
+    static constexpr RemoteTag kTag = RemoteTag::error;
     static constexpr std::uint8_t kVersion = 1;
     ErrorCode code = ErrorCode::malformed;
     std::string text;  // one printable ASCII line, <= kMaxErrorTextBytes
@@ -128,17 +128,17 @@ struct ErrorMsg {
 ErrorMsg make_error(ErrorCode code, std::string_view text);
 
 struct ByeMsg {
-    static constexpr MsgType kType = MsgType::bye;
+    static constexpr RemoteTag kTag = RemoteTag::bye;
     static constexpr std::uint8_t kVersion = 1;
 };
 
-using ViewMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
-                                 EndOfFrameMsg, ErrorMsg, ByeMsg>;
+using RemoteMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
+                                   EndOfFrameMsg, ErrorMsg, ByeMsg>;
 
 // The payload of a message (what follows the frame header).
-std::vector<std::byte> encode_payload(const ViewMessage& m);
-MsgType type_of(const ViewMessage& m);
+std::vector<std::byte> encode_payload(const RemoteMessage& m);
+RemoteTag type_of(const RemoteMessage& m);
 // Throws WireError naming the message and the field; an unknown type is an error too.
-ViewMessage decode_payload(MsgType type, std::span<const std::byte> payload);
+RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload);
 
 }  // namespace isowall::remote

@@ -72,7 +72,7 @@ class ViewServer::Client {
 
     const Dataset* hello() {
         const double timeout = server_.options_.hello_timeout_s;
-        std::optional<ViewMessage> m = conn_.receive(timeout);
+        std::optional<RemoteMessage> m = conn_.receive(timeout);
         if (!m) {
             refuse(ErrorCode::malformed, "no hello within " + std::to_string(timeout) + " s");
             return nullptr;
@@ -138,10 +138,10 @@ class ViewServer::Client {
         SessionOptions so = server_.options_.session;
         so.encoding = encoding_;
         session_ = std::make_unique<ServerSession>(
-            *d.extractor, so, [this](const ViewMessage& m) { return conn_.send(m); });
+            *d.extractor, so, [this](const RemoteMessage& m) { return conn_.send(m); });
         worker_ = std::thread([this] { work(); });
         for (;;) {
-            std::optional<ViewMessage> m = conn_.receive(0.5);
+            std::optional<RemoteMessage> m = conn_.receive(0.5);
             if (!m) continue;
             if (std::holds_alternative<ByeMsg>(*m)) return;
             const auto* r = std::get_if<RequestMsg>(&*m);

@@ -175,7 +175,7 @@ def main():
     ap.add_argument("--regions", default="256x192,128x96,64x48")
     ap.add_argument("--repeat", type=int, default=1, help="runs per configuration (median)")
     a = ap.parse_args()
-    isowall = os.path.join(a.build, "master", "isowall")
+    isowall = os.path.join(a.build, "bin", "isowall")
     if not os.access(isowall, os.X_OK):
         sys.exit(f"balance_study: {isowall} not found; build first (scripts/setup.sh)")
     volumes = a.volumes.split(",")

@@ -5,7 +5,8 @@ speed. Prints the median and minimum of each build and the ratio of medians.
 
 Usage: scripts/bench_compare_builds.py BEFORE_BUILD AFTER_BUILD [--volume PATH] [--isos 40,105]
                                        [--size 1600x1200] [--runs 7]
-A build is a folder holding master/isowall (e.g. build/, or a copy of an older build).
+A build is a folder holding bin/isowall (e.g. build/), or master/isowall (a build from before the
+folders of issue 28).
 """
 import argparse
 import csv
@@ -34,6 +35,15 @@ def times_to_thresholds(isowall, volume, iso, size, tmp):
             for th in THRESHOLDS]
 
 
+def program_in(build):
+    """bin/isowall of a build, or master/isowall of one from before issue 28."""
+    for sub in ("bin", "master"):
+        path = os.path.join(build, sub, "isowall")
+        if os.access(path, os.X_OK):
+            return path
+    return os.path.join(build, "bin", "isowall")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("before")
@@ -43,7 +53,7 @@ def main():
     ap.add_argument("--size", default="1600x1200")
     ap.add_argument("--runs", type=int, default=7)
     a = ap.parse_args()
-    builds = {"before": os.path.join(a.before, "master", "isowall"), "after": os.path.join(a.after, "master", "isowall")}
+    builds = {"before": program_in(a.before), "after": program_in(a.after)}
     for name, path in builds.items():
         if not os.access(path, os.X_OK):
             sys.exit(f"bench_compare_builds: {name}: {path} is not an executable")

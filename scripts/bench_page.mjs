@@ -6,7 +6,7 @@
 // the cache (the study's case 5, compact + zstd), so neither client starts with cached groups.
 // Runs alternate page / view, so load on this 2-core machine falls on both alike.
 //
-//   node scripts/bench_page.mjs [--isowall build/master/isowall] [--runs 5] [--size 800x600]
+//   node scripts/bench_page.mjs [--isowall build/bin/isowall] [--runs 5] [--size 800x600]
 //                               [--head ../shared/data/vhp_ct_head.nhdr] [--out out/bench-page]
 //
 // Prints a table of medians (and the fastest run) and writes bench.json and bench.md to --out.
@@ -28,7 +28,7 @@ function fail(text) {
 
 function parseArgs(argv) {
     const o = {
-        isowall: path.join(root, 'build/master/isowall'),
+        isowall: path.join(root, 'build/bin/isowall'),
         runs: 5,
         size: '800x600',
         head: path.join(root, '../shared/data/vhp_ct_head.nhdr'),

@@ -116,7 +116,7 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"))
     a = ap.parse_args()
-    isowall = os.path.join(a.build, "master", "isowall")
+    isowall = os.path.join(a.build, "bin", "isowall")
     bench_foundation = os.path.join(a.build, "tests", "isowall_bench_foundation")
     if not os.path.exists(isowall):
         sys.exit(f"bench_progressive: {isowall} not found; build first (bash scripts/setup.sh)")

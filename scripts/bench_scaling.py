@@ -144,7 +144,7 @@ def parse_args(argv):
         raise BenchError(f"--pair-rounds: expected an integer in [0, 20], got {a.pair_rounds}")
     if not 1 <= a.threads <= 64:
         raise BenchError(f"--threads: expected an integer in [1, 64], got {a.threads}")
-    a.isowall = os.path.join(a.build, "master", "isowall")
+    a.isowall = os.path.join(a.build, "bin", "isowall")
     a.peer = os.path.join(a.build, "bench", "peer", "isowall-peer")
     a.cores = os.path.join(a.build, "bench", "cores", "isowall-cores")
     for program in (a.isowall, a.cores):

@@ -12,7 +12,8 @@ from pathlib import Path
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 80
 GENERATED = {"common/extract/mc_tables.h"}
-FOLDERS = ["common", "tile", "master", "comm", "remote", "display", "fuzz", "tests", "wall", "bench"]
+FOLDERS = ["common", "comm", "render", "display", "engine", "protocol", "cli", "tile", "master",
+           "remote", "app", "fuzz", "tests", "bench"]
 
 
 def strip(text):

@@ -2,7 +2,7 @@
 """The remote-viewing study of the dissertation's section 4.2: bytes and time to C = 90, 99, 99.9
 and 100% for each test case, over links paced to 100, 10 and 1 Mbit/s.
 
-Usage: scripts/remote_study.py [--isowall build/master/isowall] [--volume PATH|phantom]
+Usage: scripts/remote_study.py [--isowall build/bin/isowall] [--volume PATH|phantom]
                                [--iso 40] [--size 800x600] [--turn 30] [--rates 100,10,1]
                                [--cases 1,2,3,4,5] [--out out/remote-study]
 
@@ -266,7 +266,7 @@ def plot(res, rates, cols, out_dir):
 
 def parse_args(argv):
     p = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n")[0])
-    p.add_argument("--isowall", default=os.path.join(ROOT, "build", "master", "isowall"))
+    p.add_argument("--isowall", default=os.path.join(ROOT, "build", "bin", "isowall"))
     p.add_argument("--volume", help="NRRD volume, or 'phantom' (default: the 256-wide head)")
     p.add_argument("--iso", type=float, default=None, help="isovalue (head: 40, phantom: 50)")
     p.add_argument("--size", default="800x600")

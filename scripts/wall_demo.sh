@@ -6,12 +6,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 WALL=${1:-walls/2x2.toml}
 shift || true
-[ -x build/master/isowall ] || bash scripts/setup.sh
+[ -x build/bin/isowall ] || bash scripts/setup.sh
 # Open MPI refuses root and more ranks than cores unless told; a one-machine emulation needs both.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-NP=$(./build/master/isowall wall --wall "$WALL" --ranks-needed)
+NP=$(./build/bin/isowall wall --wall "$WALL" --ranks-needed)
 mkdir -p out
 # llvmpipe rasterises in the calling thread, so each rank's thread CPU counts its drawing too: the
 # per-rank table then says what each rank would cost on a node of its own.
 mpirun --oversubscribe -np "$NP" -x LP_NUM_THREADS=0 \
-    ./build/master/isowall wall --wall "$WALL" --out out/mosaic.png "$@"
+    ./build/bin/isowall wall --wall "$WALL" --out out/mosaic.png "$@"

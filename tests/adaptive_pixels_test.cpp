@@ -10,8 +10,8 @@
 #include "common/progressive/correctness.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -53,7 +53,7 @@ FrameFigures run_frame(const Volume& volume, const FrameView& fv, float pixels, 
     opt.adaptive = true;
     opt.adaptive_pixels = pixels;
     opt.adaptive_refine = refine;
-    const FrameResult fr = ProgressiveEngine(*ex, *renderer, opt).run(fv);
+    const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
     EXPECT_TRUE(fr.completed);
     FrameFigures r;
     for (const Group& g : fr.groups) {

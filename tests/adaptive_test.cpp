@@ -16,7 +16,7 @@
 #include "common/progressive/correctness.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
-#include "tile/progressive_engine.h"
+#include "engine/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -245,7 +245,7 @@ void expect_groups_partition_the_visited_cells(SurfaceExtractor& ex, const Volum
 Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions& opt) {
     auto ex = make_surface_extractor(volume);
     auto renderer = make_renderer("osmesa");
-    const FrameResult fr = ProgressiveEngine(*ex, *renderer, opt).run(fv);
+    const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
     EXPECT_TRUE(fr.completed);
     Figures f;
     for (const Group& g : fr.groups) {
@@ -361,8 +361,8 @@ TEST(Adaptive, MaxLevelZeroIsFullResolution) {
     auto renderer = make_renderer("osmesa");
     EngineOptions opt = adaptive_options();
     opt.adaptive_max_level = 0;
-    const FrameResult a = ProgressiveEngine(*ex, *renderer, opt).run(fv);
-    const FrameResult b = ProgressiveEngine(*ex, *renderer, EngineOptions{}).run(fv);
+    const FrameResult a = ProgressiveEngine(*ex, opt).run(fv, *renderer);
+    const FrameResult b = ProgressiveEngine(*ex, EngineOptions{}).run(fv, *renderer);
     ASSERT_EQ(a.groups.size(), b.groups.size());
     for (std::size_t i = 0; i < a.groups.size(); ++i) {
         EXPECT_EQ(a.groups[i].level, 0);

@@ -13,7 +13,7 @@
 #include "common/core/util.h"
 #include "common/extract/extract.h"
 #include "common/volume/phantom.h"
-#include "tile/renderer.h"
+#include "render/renderer.h"
 
 namespace {
 

@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "common/core/camera.h"
-#include "tile/backends.h"
-#include "tile/renderer.h"
+#include "render/backends.h"
+#include "render/renderer.h"
 
 namespace isowall {
 

@@ -5,7 +5,7 @@
 
 #include <sstream>
 
-#include "master/program_cli.h"
+#include "app/program_cli.h"
 
 namespace isowall {
 namespace {

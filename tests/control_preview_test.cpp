@@ -2,8 +2,9 @@
 // message made from it, and nearest-neighbour scaling back into the window.
 #include <gtest/gtest.h>
 
-#include "comm/preview.h"
 #include "common/core/image_ops.h"
+#include "common/core/preview.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 namespace {
@@ -75,7 +76,7 @@ TEST(ControlPreview, AThinLineFadesInsteadOfVanishing) {
 
 TEST(ControlPreview, MakePreviewKeepsTheLargerSideWithinTheLimit) {
     const Image frame = solid(1024, 768, 10, 20, 30);
-    const PreviewMsg p = make_preview(frame, 42, 300);
+    const PreviewMsg p{make_preview(frame, 42, 300)};
     EXPECT_EQ(p.generation, 42u);
     EXPECT_EQ(p.width, 256);  // factor 4
     EXPECT_EQ(p.height, 192);
@@ -86,13 +87,13 @@ TEST(ControlPreview, MakePreviewKeepsTheLargerSideWithinTheLimit) {
     // It goes on the wire as it is.
     EXPECT_NO_THROW(decode_as<PreviewMsg>(Tag::preview, encode(p)));
     // The limit is clamped to what a message carries.
-    const PreviewMsg big = make_preview(solid(3000, 10, 0, 0, 0), 1, 1 << 20);
+    const PreviewMsg big{make_preview(solid(3000, 10, 0, 0, 0), 1, 1 << 20)};
     EXPECT_LE(big.width, kMaxPreviewSide);
     EXPECT_EQ(make_preview(solid(3, 2, 0, 0, 0), 1, 0).width, 1);  // max_side 0 counts as 1
 }
 
 TEST(ControlPreview, AnEmptyFrameGivesOneBlackPixel) {
-    const PreviewMsg p = make_preview(Image{}, 7, 256);
+    const PreviewMsg p{make_preview(Image{}, 7, 256)};
     EXPECT_EQ(p.width, 1);
     EXPECT_EQ(p.height, 1);
     EXPECT_EQ(p.rgb, (std::vector<std::uint8_t>{0, 0, 0}));

@@ -18,7 +18,7 @@
 #include <string>
 #include <thread>
 
-#include "comm/preview.h"
+#include "common/core/preview.h"
 #include "common/core/util.h"
 #include "common/io/image_io.h"
 #include "common/wall/control_layout.h"

@@ -6,9 +6,9 @@
 #include <cstdint>
 
 #include "common/volume/phantom.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -23,8 +23,8 @@ TEST(EngineFrame, ACoarseBandThenTheRestCastEveryPixelOnceWithLimitedPropagation
     // its ray shows (a band that cast nothing left most of the screen to the coarse levels).
     opt.propagation.max_count = 4;
     const FrameView fv = test::make_view(p, 200, 150, kPhantomSkinIso);
-    ProgressiveEngine engine(*ex, *renderer, opt);
-    const FrameResult whole = engine.run(fv);
+    ProgressiveEngine engine(*ex, opt);
+    const FrameResult whole = engine.run(fv, *renderer);
     ASSERT_TRUE(whole.completed);
 
     std::atomic<bool> stop{false};

@@ -11,10 +11,10 @@
 
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -42,7 +42,7 @@ FrameResult run(const Volume& volume, const FrameView& fv, EngineOptions opt, in
     auto ex = make_surface_extractor(volume, {}, nullptr, ThreadBudget{threads});
     auto renderer = make_renderer("osmesa");
     opt.threads = threads;
-    FrameResult fr = ProgressiveEngine(*ex, *renderer, opt).run(fv);
+    FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
     EXPECT_TRUE(fr.completed);
     // Every group's units are distinct from every other group's.
     std::set<std::tuple<int, int, int, int>> units;
@@ -155,8 +155,8 @@ TEST(Threads, AStopEndsEveryThread) {
     EngineOptions opt;
     opt.threads = 3;
     const std::atomic<bool> stop{true};
-    const FrameResult fr = ProgressiveEngine(*ex, *renderer, opt)
-                               .run(test::make_view(p, 160, 120, kPhantomSkinIso), &stop);
+    const FrameResult fr = ProgressiveEngine(*ex, opt).run(
+        test::make_view(p, 160, 120, kPhantomSkinIso), *renderer, &stop);
     EXPECT_FALSE(fr.completed);
     EXPECT_EQ(fr.group_count, 0u);
 }

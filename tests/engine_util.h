@@ -2,8 +2,8 @@
 // Helpers shared by the engine tests: views of a volume and the full-surface reference image.
 #include "common/extract/surface_extractor.h"
 #include "common/volume/volume.h"
-#include "tile/progressive_engine.h"
-#include "tile/renderer.h"
+#include "engine/progressive_engine.h"
+#include "render/renderer.h"
 
 namespace isowall::test {
 

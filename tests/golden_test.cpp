@@ -24,10 +24,10 @@
 #include "common/io/image_io.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -89,8 +89,8 @@ Image render(const GoldenView& g) {
     const FrameView fv = frame_view(volume, g);
     if (g.source == Source::full_surface)
         return test::full_surface_image(*extractor, *renderer, fv);
-    ProgressiveEngine engine(*extractor, *renderer);
-    FrameResult frame = engine.run(fv);
+    ProgressiveEngine engine(*extractor);
+    FrameResult frame = engine.run(fv, *renderer);
     if (!frame.completed)
         throw std::runtime_error(std::string(g.name) + ": frame did not complete");
     return std::move(frame.final_image);

@@ -11,9 +11,9 @@
 
 #include "common/progressive/mesh_coverage.h"
 #include "common/volume/phantom.h"
+#include "engine/group_sink.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
-#include "tile/group_sink.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -98,7 +98,7 @@ TEST(MeshCoverage, DynamicGridSizesWithoutARenderer) {
     auto ex = make_surface_extractor(p);
     auto r = make_renderer("osmesa");
     const FrameView fv = test::make_view(p, 200, 150, kPhantomSkinIso);
-    ProgressiveEngine engine(*ex, *r);
+    ProgressiveEngine engine(*ex);
     const std::atomic<bool> stop{false};
     EngineFrame frame(engine, fv, stop);
     RecordingSink recorded;

@@ -8,10 +8,10 @@
 
 #include "common/core/error.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -103,8 +103,8 @@ TEST(NonFinite, ProgressiveFrameMatchesTheFullSurfaceWithFiniteGroups) {
         auto ex = make_surface_extractor(volume);
         auto renderer = make_renderer("osmesa");
         const FrameView fv = test::make_view(volume, 160, 120, 0.0, 30, 20);
-        ProgressiveEngine engine(*ex, *renderer);
-        const FrameResult fr = engine.run(fv);
+        ProgressiveEngine engine(*ex);
+        const FrameResult fr = engine.run(fv, *renderer);
         ASSERT_TRUE(fr.completed);
         std::size_t triangles = 0;
         for (const Group& g : fr.groups) {

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "common/volume/phantom.h"
+#include "engine/group_sink.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
-#include "tile/group_sink.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -130,7 +130,7 @@ TEST(PresentAsync, EngineCastsOnAndKeepsEachPresentsSampleUntilItShows) {
         EngineOptions opt;
         opt.threads = threads;
         opt.propagation.max_count = 200;  // many groups, so presents come while casting
-        ProgressiveEngine engine(*ex, *r, opt);
+        ProgressiveEngine engine(*ex, opt);
         const Image full = test::full_surface_image(*ex, *r, fv);
 
         LaggingSink sink(*r, 50);

@@ -8,10 +8,10 @@
 #include "common/core/ray.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -38,8 +38,8 @@ void expect_final_matches_full(const Volume& volume, double iso, const Combo& co
     opt.propagation.max_count = 2000;
     opt.propagation.facing_only = facing_only;
     const FrameView fv = make_view(volume, w, h, iso, yaw, 10);
-    ProgressiveEngine engine(*ex, *renderer, opt);
-    FrameResult fr = engine.run(fv);
+    ProgressiveEngine engine(*ex, opt);
+    FrameResult fr = engine.run(fv, *renderer);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
     const test::ImageComparison m = test::compare_images(fr.final_image, full);
@@ -132,12 +132,12 @@ TEST(Engine, FarViewMatchesTheFullSurface) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
-    ProgressiveEngine engine(*ex, *renderer);
+    ProgressiveEngine engine(*ex);
     FrameView fv = make_view(p, 320, 240, kPhantomSkinIso);
     fv.camera = fit_depth_range(zoom(fv.camera, 0.02f), p.bounds());
     fv.frustum = fv.camera.frustum(320.0f / 240.0f);
     ASSERT_GT(fv.camera.distance(), 5000.0f);
-    FrameResult fr = engine.run(fv);
+    FrameResult fr = engine.run(fv, *renderer);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
     const test::ImageComparison m = test::compare_images(fr.final_image, full);
@@ -153,9 +153,9 @@ TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
         EngineOptions opt;
         opt.propagation.mode = mode;
         opt.propagation.max_count = 500;  // many small groups
-        ProgressiveEngine engine(*ex, *renderer, opt);
+        ProgressiveEngine engine(*ex, opt);
         const FrameView fv = make_view(p, 160, 120, kPhantomBoneIso, 30, 20);
-        FrameResult fr = engine.run(fv);
+        FrameResult fr = engine.run(fv, *renderer);
         ASSERT_TRUE(fr.completed);
         const auto view = p.view<std::uint8_t>();
         std::set<std::tuple<int, int, int>> seen;
@@ -218,14 +218,14 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     auto renderer = make_renderer("osmesa");
     EngineOptions opt;
     opt.progress_interval_s = 0;  // progress at every sample
-    ProgressiveEngine engine(*ex, *renderer, opt);
+    ProgressiveEngine engine(*ex, opt);
     const FrameView first = make_view(p, 200, 150, kPhantomSkinIso);
     // The stop flag is set as a communication thread would, here from the first sample at 300 rays
     // or more (samples grow by 1.25x, so that sample is at most 375 rays). A sample that waits for
     // its present (GroupSink::present_async) reaches the callback once the renderer has drawn its
     // groups, while rays go on: a few dozen here, so the frame ends well before 600.
     std::atomic<bool> stop{false};
-    FrameResult a = engine.run(first, &stop, [&](const TimelineSample& s) {
+    FrameResult a = engine.run(first, *renderer, &stop, [&](const TimelineSample& s) {
         if (s.rays >= 300) stop = true;
     });
     EXPECT_FALSE(a.completed);
@@ -234,7 +234,7 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
 
     // New view and new isovalue: nothing of the first frame may remain.
     const FrameView second = make_view(p, 200, 150, kPhantomBoneIso, 60, -20);
-    FrameResult b = engine.run(second);
+    FrameResult b = engine.run(second, *renderer);
     ASSERT_TRUE(b.completed);
     const Image full = full_surface_image(*ex, *renderer, second);
     const test::ImageComparison m = test::compare_images(b.final_image, full);
@@ -246,11 +246,11 @@ TEST(Engine, TimelineIsMonotoneAndReachesFullCorrectness) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
-    ProgressiveEngine engine(*ex, *renderer);
+    ProgressiveEngine engine(*ex);
     const FrameView fv = make_view(p, 240, 180, kPhantomSkinIso);
-    FrameResult fr = engine.run(fv);
+    FrameResult fr = engine.run(fv, *renderer);
     ASSERT_TRUE(fr.completed);
-    engine.measure(fr, fv);
+    engine.measure(fr, fv, *renderer);
     ASSERT_GT(fr.timeline.size(), 5u);
     for (std::size_t i = 1; i < fr.timeline.size(); ++i) {
         EXPECT_GE(fr.timeline[i].time_s, fr.timeline[i - 1].time_s);
@@ -288,10 +288,10 @@ TEST(Engine, EveryStepOfAFrameIsChargedToItsOwnStage) {
         EngineOptions opt;
         opt.adaptive = adaptive;
         opt.trace = &trace;
-        ProgressiveEngine engine(*ex, *renderer, opt);
+        ProgressiveEngine engine(*ex, opt);
         trace.switch_to(Stage::idle);  // what a tile was doing before the view arrived
         const std::size_t first = trace.spans().size();  // the idle span, once closed
-        const FrameResult fr = engine.run(test::make_view(p, 160, 120, kPhantomSkinIso));
+        const FrameResult fr = engine.run(test::make_view(p, 160, 120, kPhantomSkinIso), *renderer);
         ASSERT_TRUE(fr.completed);
         trace.close();
         const auto& spans = trace.spans();

@@ -62,7 +62,7 @@ TEST(ProtocolMalformed, DecodeAsAnotherTypeThrows) {
     } catch (const WireError& e) {
         EXPECT_STREQ(e.what(), "expected a view message, got image");
     }
-    EXPECT_THROW(decode_as<HelloMsg>(Tag::quit, encode(QuitMsg{})), WireError);
+    EXPECT_THROW(decode_as<TileHelloMsg>(Tag::quit, encode(QuitMsg{})), WireError);
     EXPECT_EQ(decode_as<ImageMsg>(Tag::image, bytes), sample_image());
 }
 
@@ -81,7 +81,7 @@ TEST(ProtocolMalformed, AllocationsAreSeen) {
 TEST(ProtocolMalformed, HelloWithAHugeLengthThrowsWithoutAllocating) {
     for (std::uint64_t length :
          {kHugeCount, std::numeric_limits<std::uint64_t>::max(), std::uint64_t{5}}) {
-        MessageWriter w(HelloMsg::kVersion);
+        MessageWriter w(TileHelloMsg::kVersion);
         w.put(length);
         w.put(std::uint32_t{0x74736f68});  // 4 bytes of a host name, fewer than the length
         const Bytes bytes = w.take();
@@ -93,7 +93,7 @@ TEST(ProtocolMalformed, HelloWithAHugeLengthThrowsWithoutAllocating) {
 
 TEST(ProtocolMalformed, HelloWithNoThreadsOrTooManyThrows) {
     for (const std::uint32_t threads : {0u, 1025u}) {
-        HelloMsg h = sample_hello();
+        TileHelloMsg h = sample_hello();
         h.threads = threads;
         expect_wire_error(Tag::hello, encode(h), "threads: expected 1 to 1024");
     }

@@ -16,7 +16,7 @@ using namespace protocol_testing;
 // ---- degenerate messages first ---------------------------------------------------------------
 
 TEST(Protocol, DegenerateMessagesRoundTrip) {
-    expect_round_trip(HelloMsg{});  // empty host
+    expect_round_trip(TileHelloMsg{});  // empty host
     expect_round_trip(SnapshotMsg{});
     expect_round_trip(QuitMsg{});
     expect_round_trip(ImageMsg{});       // 0x0, no pixels, no depth

@@ -4,7 +4,7 @@
 // in a named namespace, so a test file that uses only some of it draws no unused-function warning.
 #pragma once
 
-#include "comm/protocol.h"
+#include "protocol/protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@
 
 namespace isowall {
 
-// ---- equality and printing for the tests only (comm/protocol.h stays free of them) ----------
+// ---- equality and printing for the tests only (protocol/protocol.h stays free of them) ----------
 
 inline bool operator==(const Camera& a, const Camera& b) {
     return a.eye == b.eye && a.target == b.target && a.up == b.up && a.projection == b.projection &&
@@ -47,7 +47,7 @@ inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
     return a.stage == b.stage && a.start_s == b.start_s && a.wall_s == b.wall_s &&
            a.cpu_s == b.cpu_s;
 }
-inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
+inline bool operator==(const TileHelloMsg& a, const TileHelloMsg& b) {
     return a.host == b.host && a.threads == b.threads && a.loaded == b.loaded;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
@@ -112,8 +112,8 @@ inline std::ostream& operator<<(std::ostream& os, const TraceSpan& s) {
     return os << "TraceSpan{stage " << int{s.stage} << ", start " << s.start_s << ", wall "
               << s.wall_s << ", cpu " << s.cpu_s << "}";
 }
-inline void PrintTo(const HelloMsg& m, std::ostream* os) {
-    *os << "HelloMsg{" << m.host << ", " << m.threads << " threads"
+inline void PrintTo(const TileHelloMsg& m, std::ostream* os) {
+    *os << "TileHelloMsg{" << m.host << ", " << m.threads << " threads"
         << (m.loaded ? ", loaded}" : "}");
 }
 inline void PrintTo(const ViewMsg& m, std::ostream* os) {
@@ -187,7 +187,7 @@ inline std::string hex(std::span<const std::byte> bytes) {
 
 // ---- samples with a value other than the default in every field -----------------------------
 
-inline HelloMsg sample_hello() {
+inline TileHelloMsg sample_hello() {
     using namespace std::string_literals;
     return {"rank\0host-\xc3\xa9"s, 24, true};  // an inner NUL and UTF-8: the length is on the wire
 }

@@ -27,16 +27,16 @@ struct Pair {
         : data(phantom_dataset()),
           renderer(make_renderer("osmesa")),
           client(*renderer),
-          session(*data.extractor, options(), [this](const ViewMessage& m) { return pass(m); }) {}
+          session(*data.extractor, options(), [this](const RemoteMessage& m) { return pass(m); }) {}
 
     static SessionOptions options() {
         SessionOptions o;
         o.encoding = GroupEncoding::indexed;
         return o;
     }
-    std::size_t pass(const ViewMessage& m) {
+    std::size_t pass(const RemoteMessage& m) {
         const auto frame = encode_frame(m);
-        const ViewMessage got = decode_frame(frame);
+        const RemoteMessage got = decode_frame(frame);
         if (const auto* g = std::get_if<GroupMsg>(&got)) gens.push_back(g->cache_gen);
         if (const auto* v = std::get_if<VisibleMsg>(&got)) visible.push_back(*v);
         ended = client.handle(got, frame.size(), 0.0) || ended;

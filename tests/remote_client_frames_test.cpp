@@ -9,7 +9,7 @@
 #include "common/core/camera.h"
 #include "remote/client_frames.h"
 #include "remote/group_codec.h"
-#include "tile/renderer.h"
+#include "render/renderer.h"
 
 namespace isowall::test {
 namespace {

@@ -67,7 +67,7 @@ TEST(RemoteNet, EveryMessageRoundTripsBothWays) {
     auto server = link.server_connection();
     auto client = link.client_connection();
     std::uint64_t frame_bytes = 0;
-    for (const ViewMessage& m : samples()) {
+    for (const RemoteMessage& m : samples()) {
         SCOPED_TRACE(to_string(type_of(m)));
         const std::size_t sent = client->send(m);
         EXPECT_EQ(sent, encode_frame(m).size());
@@ -89,7 +89,7 @@ TEST(RemoteNet, EveryMessageRoundTripsBothWays) {
 TEST(RemoteNet, BytesOneAtATimeStillMakeWholeMessages) {
     Loopback link;
     auto server = link.server_connection();
-    for (const ViewMessage& m : {ViewMessage(sample_hello()), ViewMessage(sample_group())}) {
+    for (const RemoteMessage& m : {RemoteMessage(sample_hello()), RemoteMessage(sample_group())}) {
         const Bytes frame = encode_frame(m);
         for (std::size_t i = 0; i + 1 < frame.size(); ++i) {
             send_all(link.client, std::span(frame).subspan(i, 1), "test client");
@@ -122,7 +122,7 @@ TEST(RemoteNet, ALargeMessageInSmallChunksFromAnotherThread) {
     if (!got) link.client.shutdown_both();  // so that the sender cannot block forever
     sender.join();
     ASSERT_TRUE(got);
-    EXPECT_EQ(*got, ViewMessage(big));
+    EXPECT_EQ(*got, RemoteMessage(big));
 }
 
 TEST(RemoteNet, ReceiveTimesOutQuickly) {
@@ -242,21 +242,21 @@ TEST(RemoteNet, ConcurrentSendersNeverInterleaveFrames) {
     constexpr int kEach = 200;
     GroupMsg big = sample_group();
     big.encoded.assign(20000, std::byte{3});
-    const auto send_many = [&](const ViewMessage& m) {
+    const auto send_many = [&](const RemoteMessage& m) {
         try {
             for (int i = 0; i < kEach; ++i) client->send(m);
         } catch (const NetError&) {  // shut down below after a failure: reported there
         }
     };
-    std::thread a(send_many, ViewMessage(big));
-    std::thread b(send_many, ViewMessage(sample_error()));
+    std::thread a(send_many, RemoteMessage(big));
+    std::thread b(send_many, RemoteMessage(sample_error()));
     int groups = 0, errors = 0;
     try {
         for (int i = 0; i < 2 * kEach; ++i) {
             const auto m = server->receive(kTimeout_s);
             if (!m) break;
-            if (*m == ViewMessage(big)) ++groups;
-            if (*m == ViewMessage(sample_error())) ++errors;
+            if (*m == RemoteMessage(big)) ++groups;
+            if (*m == RemoteMessage(sample_error())) ++errors;
         }
     } catch (const std::exception& e) {
         ADD_FAILURE() << e.what();

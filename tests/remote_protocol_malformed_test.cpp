@@ -39,7 +39,7 @@ void expect_faults(const M& sample, std::initializer_list<Fault<M>> faults) {
     for (const Fault<M>& f : faults) {
         M m = sample;
         f.apply(m);
-        expect_view_wire_error(M::kType, encode_payload(m), f.field);
+        expect_view_wire_error(M::kTag, encode_payload(m), f.field);
     }
 }
 
@@ -47,7 +47,7 @@ TEST(RemoteProtocolMalformed, AllocationsAreSeen) {
     GroupMsg m = sample_group();
     m.encoded.assign(100000, std::byte{7});
     const Bytes bytes = encode_payload(m);
-    EXPECT_GE(largest_allocation_in([&] { decode_payload(MsgType::group, bytes); }), 100000u);
+    EXPECT_GE(largest_allocation_in([&] { decode_payload(RemoteTag::group, bytes); }), 100000u);
 }
 
 TEST(RemoteProtocolMalformed, HelloFields) {
@@ -63,7 +63,7 @@ TEST(RemoteProtocolMalformed, HelloFields) {
     HelloMsg ok = sample_hello();
     ok.token.clear();
     ok.dataset.assign(kMaxDatasetNameBytes, '~');
-    EXPECT_NO_THROW(decode_payload(MsgType::hello, encode_payload(ok)));
+    EXPECT_NO_THROW(decode_payload(RemoteTag::hello, encode_payload(ok)));
 }
 
 TEST(RemoteProtocolMalformed, ReadyFields) {
@@ -95,10 +95,10 @@ TEST(RemoteProtocolMalformed, RequestFields) {
           [](RequestMsg& m) { m.view.camera.projection = static_cast<Projection>(2); }}});
     Bytes bytes = encode_payload(sample_request());
     bytes[bytes.size() - 2] = std::byte{2};  // progressive_lod
-    expect_view_wire_error(MsgType::request, bytes, "progressive_lod: expected 0 or 1, got 2");
+    expect_view_wire_error(RemoteTag::request, bytes, "progressive_lod: expected 0 or 1, got 2");
     bytes[bytes.size() - 2] = std::byte{1};
     bytes.back() = std::byte{255};  // cached_groups
-    expect_view_wire_error(MsgType::request, bytes, "cached_groups: expected 0 or 1, got 255");
+    expect_view_wire_error(RemoteTag::request, bytes, "cached_groups: expected 0 or 1, got 255");
 }
 
 TEST(RemoteProtocolMalformed, GroupFields) {
@@ -111,13 +111,13 @@ TEST(RemoteProtocolMalformed, GroupFields) {
     Bytes bytes = encode_payload(sample_group());
     const std::size_t refinement_at = 1 + 8 + 12 + 4 + 8;
     bytes[refinement_at] = std::byte{3};
-    expect_view_wire_error(MsgType::group, bytes, "key.refinement: expected 0 or 1, got 3");
+    expect_view_wire_error(RemoteTag::group, bytes, "key.refinement: expected 0 or 1, got 3");
     bytes[refinement_at] = std::byte{0};
     bytes[refinement_at + 1] = std::byte{2};
-    expect_view_wire_error(MsgType::group, bytes, "draw_from_next_frame: expected 0 or 1, got 2");
+    expect_view_wire_error(RemoteTag::group, bytes, "draw_from_next_frame: expected 0 or 1, got 2");
     GroupMsg big = sample_group();
     big.encoded.assign(kMaxGroupBytes + 1, std::byte{1});
-    expect_view_wire_error(MsgType::group, encode_payload(big), "encoded: 33554433 bytes");
+    expect_view_wire_error(RemoteTag::group, encode_payload(big), "encoded: 33554433 bytes");
 }
 
 TEST(RemoteProtocolMalformed, GroupWithAHugeLengthThrowsWithoutAllocating) {
@@ -133,7 +133,7 @@ TEST(RemoteProtocolMalformed, GroupWithAHugeLengthThrowsWithoutAllocating) {
         w.put(std::uint32_t{0x01020304});  // 4 bytes, fewer than the length
         bytes.insert(bytes.end(), w.bytes().begin() + 1, w.bytes().end());
         const auto largest = largest_allocation_in(
-            [&] { expect_view_wire_error(MsgType::group, bytes, "longer than the message"); });
+            [&] { expect_view_wire_error(RemoteTag::group, bytes, "longer than the message"); });
         EXPECT_LT(largest, 4096u) << "length " << length;
     }
 }
@@ -151,21 +151,21 @@ TEST(RemoteProtocolMalformed, VisibleBitmapFields) {
     past.put(std::uint32_t{10});  // two bytes; bit 10 (byte 1, bit 2) is past the count
     past.put(std::uint8_t{0x01});
     past.put(std::uint8_t{0x06});
-    expect_view_wire_error(MsgType::visible, past.take(),
+    expect_view_wire_error(RemoteTag::visible, past.take(),
                            "slots: bit 10 is set, expected none at or past the bit count 10");
     MessageWriter cut = visible_head(SlotForm::bitmap);
     cut.put(std::uint32_t{17});  // three bytes of bits, two given
     cut.put(std::uint16_t{0xffff});
-    expect_view_wire_error(MsgType::visible, cut.take(),
+    expect_view_wire_error(RemoteTag::visible, cut.take(),
                            "slots: a bitmap of 17 bits takes 3 bytes, 2 left");
     MessageWriter over = visible_head(SlotForm::bitmap);
     over.put(static_cast<std::uint32_t>(kMaxVisibleKeys + 1));
-    expect_view_wire_error(MsgType::visible, over.take(),
+    expect_view_wire_error(RemoteTag::visible, over.take(),
                            "slots: bit count 1048577, expected at most 1048576");
     MessageWriter form = visible_head(SlotForm::bitmap);
     Bytes bytes = form.take();
     bytes.back() = std::byte{2};
-    expect_view_wire_error(MsgType::visible, bytes,
+    expect_view_wire_error(RemoteTag::visible, bytes,
                            "form: expected 0 (bitmap) or 1 (deltas), got 2");
 }
 
@@ -193,10 +193,10 @@ TEST(RemoteProtocolMalformed, VisibleDeltasFields) {
         {visible_deltas(2, {0xff, 0xff, 0x3f, 0x01}), "slots[1]: slot 1048576, expected less than"},
         {visible_deltas(3, {1, 2}), "slots: count 3 is larger than the 2 bytes left"},
     };
-    for (const Case& c : cases) expect_view_wire_error(MsgType::visible, c.bytes, c.field);
+    for (const Case& c : cases) expect_view_wire_error(RemoteTag::visible, c.bytes, c.field);
     // The encoder writes what it is given: a slot over the limit goes out, and is refused.
     VisibleMsg far{9, {1, static_cast<std::uint32_t>(kMaxVisibleKeys)}};
-    expect_view_wire_error(MsgType::visible, encode_payload(far),
+    expect_view_wire_error(RemoteTag::visible, encode_payload(far),
                            "slots[1]: slot 1048576, expected less than 1048576");
 }
 
@@ -206,17 +206,17 @@ TEST(RemoteProtocolMalformed, VisibleAcceptsOnlyTheEncodersBytes) {
     MessageWriter slack = visible_head(SlotForm::bitmap);
     slack.put(std::uint32_t{16});  // slot 0 only: the count should be 1
     slack.put(std::uint16_t{0x0001});
-    expect_view_wire_error(MsgType::visible, slack.take(),
+    expect_view_wire_error(RemoteTag::visible, slack.take(),
                            "slots: bit count 16 but bit 15 is clear, expected the highest slot");
-    expect_view_wire_error(MsgType::visible, visible_deltas(1, {0x81, 0x00}),
+    expect_view_wire_error(RemoteTag::visible, visible_deltas(1, {0x81, 0x00}),
                            "slots[0]: varint of 2 bytes ends in a zero byte");
-    expect_view_wire_error(MsgType::visible, visible_deltas(10, {0, 1, 1, 1, 1, 1, 1, 1, 1, 1}),
+    expect_view_wire_error(RemoteTag::visible, visible_deltas(10, {0, 1, 1, 1, 1, 1, 1, 1, 1, 1}),
                            "form: 1, but the slots take 7 bytes as a bitmap and 15 as deltas");
     MessageWriter sparse = visible_head(SlotForm::bitmap);
     sparse.put(std::uint32_t{100});  // slot 99 alone: 13 bytes of bits, where one varint does
     for (int i = 0; i < 12; ++i) sparse.put(std::uint8_t{0});
     sparse.put(std::uint8_t{0x08});
-    expect_view_wire_error(MsgType::visible, sparse.take(),
+    expect_view_wire_error(RemoteTag::visible, sparse.take(),
                            "form: 0, but the slots take 18 bytes as a bitmap and 6 as deltas");
 }
 
@@ -224,7 +224,7 @@ TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
     for (std::uint32_t count : {std::uint32_t{4}, std::uint32_t{1} << 30, UINT32_MAX}) {
         const Bytes bytes = visible_deltas(count, {1, 2, 3});
         const auto largest = largest_allocation_in([&] {
-            expect_view_wire_error(MsgType::visible, bytes, "is larger than the 3 bytes left");
+            expect_view_wire_error(RemoteTag::visible, bytes, "is larger than the 3 bytes left");
         });
         EXPECT_LT(largest, 4096u) << "count " << count;
     }
@@ -232,7 +232,7 @@ TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
     w.put(UINT32_MAX);
     const Bytes bitmap = w.take();
     const auto largest = largest_allocation_in(
-        [&] { expect_view_wire_error(MsgType::visible, bitmap, "slots: bit count 4294967295"); });
+        [&] { expect_view_wire_error(RemoteTag::visible, bitmap, "slots: bit count 4294967295"); });
     EXPECT_LT(largest, 4096u);
 }
 
@@ -246,7 +246,7 @@ TEST(RemoteProtocolMalformed, ErrorFields) {
 }
 
 TEST(RemoteProtocolMalformed, WrongLayoutVersionThrows) {
-    for (const ViewMessage& m : samples()) {
+    for (const RemoteMessage& m : samples()) {
         Bytes bytes = encode_payload(m);
         bytes[0] = std::byte{99};
         const int version = std::visit([](const auto& msg) { return int(msg.kVersion); }, m);
@@ -256,8 +256,8 @@ TEST(RemoteProtocolMalformed, WrongLayoutVersionThrows) {
 }
 
 TEST(RemoteProtocolMalformed, AnUnknownTypeThrows) {
-    EXPECT_THROW(decode_payload(static_cast<MsgType>(0), encode_payload(ByeMsg{})), WireError);
-    EXPECT_THROW(decode_payload(static_cast<MsgType>(9), encode_payload(ByeMsg{})), WireError);
+    EXPECT_THROW(decode_payload(static_cast<RemoteTag>(0), encode_payload(ByeMsg{})), WireError);
+    EXPECT_THROW(decode_payload(static_cast<RemoteTag>(9), encode_payload(ByeMsg{})), WireError);
 }
 
 }  // namespace

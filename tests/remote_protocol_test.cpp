@@ -30,9 +30,9 @@ std::string wire_error_of(F f, const std::string& expected) {
     return {};
 }
 
-Bytes stream_of(const std::vector<ViewMessage>& messages) {
+Bytes stream_of(const std::vector<RemoteMessage>& messages) {
     Bytes out;
-    for (const ViewMessage& m : messages) {
+    for (const RemoteMessage& m : messages) {
         const Bytes f = encode_frame(m);
         out.insert(out.end(), f.begin(), f.end());
     }
@@ -41,8 +41,8 @@ Bytes stream_of(const std::vector<ViewMessage>& messages) {
 
 TEST(RemoteProtocol, EveryMessageRoundTrips) {
     const auto all = samples();
-    ASSERT_EQ(all.size(), std::size_t{kLastMsgType}) << "a sample of every type";
-    for (const ViewMessage& m : all) {
+    ASSERT_EQ(all.size(), std::size_t{kLastRemoteTag}) << "a sample of every type";
+    for (const RemoteMessage& m : all) {
         SCOPED_TRACE(to_string(type_of(m)));
         EXPECT_EQ(decode_frame(encode_frame(m)), m);
         EXPECT_EQ(decode_payload(type_of(m), encode_payload(m)), m);
@@ -51,10 +51,10 @@ TEST(RemoteProtocol, EveryMessageRoundTrips) {
 
 TEST(RemoteProtocol, SamplesDifferFromDefaults) {
     // A round trip proves a field travels only when the sample sets it to something else.
-    for (const ViewMessage& m : samples()) {
-        if (type_of(m) == MsgType::bye) continue;
-        const ViewMessage blank = std::visit(
-            [](const auto& msg) -> ViewMessage { return std::decay_t<decltype(msg)>{}; }, m);
+    for (const RemoteMessage& m : samples()) {
+        if (type_of(m) == RemoteTag::bye) continue;
+        const RemoteMessage blank = std::visit(
+            [](const auto& msg) -> RemoteMessage { return std::decay_t<decltype(msg)>{}; }, m);
         EXPECT_NE(encode_payload(m), encode_payload(blank)) << to_string(type_of(m));
     }
 }
@@ -69,7 +69,7 @@ TEST(RemoteProtocol, HeaderBytesAreAsDocumented) {
 }
 
 TEST(RemoteProtocol, EveryTruncationThrows) {
-    for (const ViewMessage& m : samples()) {
+    for (const RemoteMessage& m : samples()) {
         SCOPED_TRACE(to_string(type_of(m)));
         const Bytes frame = encode_frame(m);
         for (std::size_t n = 0; n < frame.size(); ++n)
@@ -83,7 +83,7 @@ TEST(RemoteProtocol, EveryTruncationThrows) {
 }
 
 TEST(RemoteProtocol, TrailingBytesThrow) {
-    for (const ViewMessage& m : samples()) {
+    for (const RemoteMessage& m : samples()) {
         Bytes frame = encode_frame(m);
         frame.push_back(std::byte{0});
         EXPECT_NE(wire_error_of([&] { decode_frame(frame); }, "trailing").find("trailing bytes"),
@@ -135,14 +135,14 @@ TEST(RemoteProtocol, MakeErrorGivesOneBoundedPrintableLine) {
         make_error(ErrorCode::internal, "bad\nline \xc3\xa9" + std::string(600, 'x'));
     EXPECT_EQ(m.text.size(), kMaxErrorTextBytes);
     EXPECT_EQ(m.text.substr(0, 11), "bad?line ??");
-    EXPECT_EQ(decode_frame(encode_frame(m)), ViewMessage(m));
+    EXPECT_EQ(decode_frame(encode_frame(m)), RemoteMessage(m));
 }
 
 // ---- the FrameParser ----------------------------------------------------------------------------
 
-std::vector<ViewMessage> parse_in_chunks(FrameParser& parser, const Bytes& stream,
-                                         const std::vector<std::size_t>& sizes) {
-    std::vector<ViewMessage> out;
+std::vector<RemoteMessage> parse_in_chunks(FrameParser& parser, const Bytes& stream,
+                                           const std::vector<std::size_t>& sizes) {
+    std::vector<RemoteMessage> out;
     std::size_t at = 0;
     for (std::size_t i = 0; at < stream.size(); ++i) {
         const std::size_t n = std::min(sizes[i % sizes.size()], stream.size() - at);
@@ -162,8 +162,8 @@ TEST(RemoteProtocolFraming, OneByteAtATime) {
 }
 
 TEST(RemoteProtocolFraming, RandomChunkSizes) {
-    std::vector<ViewMessage> messages = samples();
-    for (const ViewMessage& m : samples()) messages.push_back(m);  // twice, back to back
+    std::vector<RemoteMessage> messages = samples();
+    for (const RemoteMessage& m : samples()) messages.push_back(m);  // twice, back to back
     const Bytes stream = stream_of(messages);
     std::mt19937 rng(12);
     for (int trial = 0; trial < 50; ++trial) {
@@ -195,7 +195,7 @@ TEST(RemoteProtocolFraming, ABadHeaderFailsTheParserForGood) {
     stream[bad_at + 4] = std::byte{9};  // the second frame's version
     FrameParser parser;
     std::span<const std::byte> chunk(stream);
-    EXPECT_EQ(parser.next(chunk), ViewMessage(sample_hello()));
+    EXPECT_EQ(parser.next(chunk), RemoteMessage(sample_hello()));
     EXPECT_NE(wire_error_of([&] { parser.next(chunk); }, "version").find("version"),
               std::string::npos);
     const Bytes good = encode_frame(ByeMsg{});
@@ -208,14 +208,14 @@ TEST(RemoteProtocolFraming, AClaimedLengthIsNotBufferedBeforeItsBytesCome) {
     FrameParser parser;  // the default limit, 64 MiB
     Bytes header(kHeaderBytes);
     put_header(std::span(header).first<kHeaderBytes>(),
-               {kProtocolVersion, MsgType::group, kDefaultMaxPayloadBytes});
+               {kProtocolVersion, RemoteTag::group, kDefaultMaxPayloadBytes});
     header.insert(header.end(), 100, std::byte{0});
     std::span<const std::byte> chunk(header);
     EXPECT_FALSE(parser.next(chunk).has_value());
     EXPECT_LE(parser.buffered_capacity(), kHeaderBytes + 200);
     Bytes over(kHeaderBytes);
     put_header(std::span(over).first<kHeaderBytes>(),
-               {kProtocolVersion, MsgType::group, kDefaultMaxPayloadBytes + 1});
+               {kProtocolVersion, RemoteTag::group, kDefaultMaxPayloadBytes + 1});
     FrameParser second;
     std::span<const std::byte> c2(over);
     EXPECT_NE(wire_error_of([&] { second.next(c2); }, "length").find("over the limit"),
@@ -233,12 +233,12 @@ TEST(RemoteProtocolFraming, TheCommittedFuzzSeedsDecode) {
     ASSERT_GT(raw.size(), 2u);
     std::span<const std::byte> chunk = std::as_bytes(std::span(raw)).subspan(2);
     FrameParser parser;
-    std::vector<MsgType> types;
+    std::vector<RemoteTag> types;
     while (!chunk.empty())
         if (auto m = parser.next(chunk)) types.push_back(type_of(*m));
-    ASSERT_EQ(types.size(), std::size_t{kLastMsgType});
-    for (std::uint16_t t = 1; t <= kLastMsgType; ++t)
-        EXPECT_EQ(types[t - 1], static_cast<MsgType>(t));
+    ASSERT_EQ(types.size(), std::size_t{kLastRemoteTag});
+    for (std::uint16_t t = 1; t <= kLastRemoteTag; ++t)
+        EXPECT_EQ(types[t - 1], static_cast<RemoteTag>(t));
 }
 
 }  // namespace

@@ -92,13 +92,13 @@ inline ErrorMsg sample_error() {
     return {ErrorCode::unknown_dataset, "no dataset named \"ct_hed\""};
 }
 
-inline std::vector<ViewMessage> samples() {
+inline std::vector<RemoteMessage> samples() {
     return {sample_hello(),   sample_ready(),        sample_request(), sample_group(),
             sample_visible(), sample_end_of_frame(), sample_error(),   ByeMsg{}};
 }
 
 // decode_payload(type, bytes) throws a WireError naming the message and `field`.
-inline void expect_view_wire_error(MsgType type, std::span<const std::byte> bytes,
+inline void expect_view_wire_error(RemoteTag type, std::span<const std::byte> bytes,
                                    const std::string& field) {
     const std::string message = std::string(to_string(type)) + " message";
     try {

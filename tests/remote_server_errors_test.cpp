@@ -17,7 +17,7 @@ namespace {
 
 using namespace remote;
 
-std::vector<std::byte> frame_of(const ViewMessage& m) {
+std::vector<std::byte> frame_of(const RemoteMessage& m) {
     return encode_frame(m);
 }
 
@@ -27,7 +27,7 @@ ErrorMsg error_after(int port, const std::vector<std::byte>& bytes, bool half_cl
     send_all(s, bytes, "server");
     if (half_close) ::shutdown(s.fd(), SHUT_WR);
     Connection conn(std::move(s), "server");
-    std::optional<ViewMessage> m = conn.receive(20);
+    std::optional<RemoteMessage> m = conn.receive(20);
     if (!m) throw std::runtime_error("no answer within 20 s");
     const auto* e = std::get_if<ErrorMsg>(&*m);
     if (!e)

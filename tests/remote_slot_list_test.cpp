@@ -49,7 +49,7 @@ TEST(RemoteSlotList, VarintsRoundTripAtEveryLength) {
 std::size_t round_trip(const std::vector<std::uint32_t>& slots) {
     const VisibleMsg m{42, slots};
     const Bytes payload = encode_payload(m);
-    const auto back = std::get<VisibleMsg>(decode_payload(MsgType::visible, payload));
+    const auto back = std::get<VisibleMsg>(decode_payload(RemoteTag::visible, payload));
     EXPECT_EQ(back.slots, slots);
     EXPECT_EQ(back.request_id, 42u);
     return payload.size();

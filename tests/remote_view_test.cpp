@@ -81,14 +81,14 @@ struct RawClient {
         r.cached_groups = cache;
         conn.send(r);
     }
-    ViewMessage next() {
+    RemoteMessage next() {
         auto m = conn.receive(kTimeout);
         if (!m) throw std::runtime_error("nothing within the timeout");
         return *m;
     }
     // Every message up to and including the end of frame of `id`.
-    std::vector<ViewMessage> until_end(std::uint64_t id) {
-        std::vector<ViewMessage> out;
+    std::vector<RemoteMessage> until_end(std::uint64_t id) {
+        std::vector<RemoteMessage> out;
         for (;;) {
             out.push_back(next());
             if (const auto* e = std::get_if<EndOfFrameMsg>(&out.back()); e && e->request_id == id)
@@ -109,7 +109,7 @@ TEST(RemoteView, CachedGroupsAreNamedFirstAfterARotationAndNoGroupIsSentTwice) {
         raw.request(id, phantom_view(kW, kH, 20.0 * double(id - 1)), true, true);
         const auto msgs = raw.until_end(id);
         bool group_seen = false;
-        for (const ViewMessage& m : msgs) {
+        for (const RemoteMessage& m : msgs) {
             if (const auto* g = std::get_if<GroupMsg>(&m)) {
                 EXPECT_TRUE(sent.insert(g->key).second) << "sent twice: " << g->key;
                 if (id > 1 && g->key.level == 0) group_seen = true;
@@ -143,7 +143,7 @@ TEST(RemoteView, ARequestInterruptsTheFrameAndTheNextFrameHoldsOnlyItsGroups) {
     raw.request(2, phantom_view(kW, kH, 90), false, false);
     const auto msgs = raw.until_end(2);
     bool second_started = false;
-    for (const ViewMessage& m : msgs) {
+    for (const RemoteMessage& m : msgs) {
         if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) {
             EXPECT_EQ(e->request_id, 2u) << "request 1 was not interrupted";
         }

@@ -8,10 +8,10 @@
 
 #include "common/core/camera.h"
 #include "common/volume/phantom.h"
+#include "engine/progressive_engine.h"
 #include "remote/view_server.h"
+#include "render/renderer.h"
 #include "tests/image_compare.h"
-#include "tile/progressive_engine.h"
-#include "tile/renderer.h"
 
 namespace isowall::test {
 
@@ -63,8 +63,8 @@ inline Image local_image(const FrameView& view) {
     const Volume v = make_phantom();
     auto ex = make_surface_extractor(v);
     auto r = make_renderer("osmesa");
-    ProgressiveEngine engine(*ex, *r);
-    return engine.run(view).final_image;
+    ProgressiveEngine engine(*ex);
+    return engine.run(view, *r).final_image;
 }
 
 // The thresholds every final-image test of the engine uses.

@@ -20,12 +20,12 @@ constexpr double kTimeoutS = 30;
 void send_frame(WsTestClient& ws, const std::vector<std::byte>& frame) {
     ws.send_binary(frame.data(), frame.size());
 }
-void send_message(WsTestClient& ws, const ViewMessage& m) {
+void send_message(WsTestClient& ws, const RemoteMessage& m) {
     send_frame(ws, encode_frame(m));
 }
 
 // The next message, decoded (each WebSocket message must be exactly one frame).
-ViewMessage receive_message(WsTestClient& ws) {
+RemoteMessage receive_message(WsTestClient& ws) {
     std::optional<WsMessage> m = ws.receive(kTimeoutS);
     if (!m) throw std::runtime_error("no message within the timeout");
     EXPECT_TRUE(m->binary) << "the server sent a text message";
@@ -52,11 +52,11 @@ RequestMsg request() {
 template <class Send, class Receive>
 EndOfFrameMsg one_frame(Send send, Receive receive, std::uint64_t& groups) {
     send(hello());
-    const ViewMessage ready = receive();
+    const RemoteMessage ready = receive();
     EXPECT_TRUE(std::holds_alternative<ReadyMsg>(ready)) << to_string(type_of(ready));
     send(request());
     for (;;) {
-        const ViewMessage m = receive();
+        const RemoteMessage m = receive();
         if (std::holds_alternative<GroupMsg>(m)) ++groups;
         if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) return *e;
         if (std::holds_alternative<ErrorMsg>(m))
@@ -65,7 +65,7 @@ EndOfFrameMsg one_frame(Send send, Receive receive, std::uint64_t& groups) {
 }
 
 ErrorMsg expect_error_then_close(WsTestClient& ws) {
-    const ViewMessage m = receive_message(ws);
+    const RemoteMessage m = receive_message(ws);
     const auto* e = std::get_if<ErrorMsg>(&m);
     EXPECT_TRUE(e) << "expected an error, got " << to_string(type_of(m));
     EXPECT_TRUE(ws.wait_closed(10)) << "the server did not close the WebSocket";
@@ -76,10 +76,10 @@ TEST(RemoteWebSocket, AFrameOverWebSocketEqualsTheSameFrameOverTcp) {
     WebTestServer server;
     std::uint64_t ws_groups = 0, tcp_groups = 0;
     WsTestClient ws(server.http_port());
-    const EndOfFrameMsg over_ws = one_frame([&](const ViewMessage& m) { send_message(ws, m); },
+    const EndOfFrameMsg over_ws = one_frame([&](const RemoteMessage& m) { send_message(ws, m); },
                                             [&] { return receive_message(ws); }, ws_groups);
     Connection tcp(connect_tcp("127.0.0.1", server.tcp_port(), 5), "server");
-    const EndOfFrameMsg over_tcp = one_frame([&](const ViewMessage& m) { tcp.send(m); },
+    const EndOfFrameMsg over_tcp = one_frame([&](const RemoteMessage& m) { tcp.send(m); },
                                              [&] {
                                                  auto m = tcp.receive(kTimeoutS);
                                                  if (!m) throw std::runtime_error("timeout");
@@ -111,7 +111,7 @@ TEST(RemoteWebSocket, AWrongTokenGetsBadToken) {
     EXPECT_EQ(expect_error_then_close(ws).code, ErrorCode::bad_token);
     WsTestClient good(server.http_port());
     send_message(good, hello("sesame"));
-    const ViewMessage m = receive_message(good);
+    const RemoteMessage m = receive_message(good);
     EXPECT_TRUE(std::holds_alternative<ReadyMsg>(m)) << to_string(type_of(m));
 }
 
@@ -167,7 +167,7 @@ TEST(RemoteWebSocket, ARequestInterruptsAPacedFrame) {
     second.request_id = 2;
     second.view = phantom_view(200, 150, 90);
     send_message(ws, first);
-    ViewMessage m = receive_message(ws);
+    RemoteMessage m = receive_message(ws);
     ASSERT_TRUE(std::holds_alternative<GroupMsg>(m)) << to_string(type_of(m));
     const auto sent = std::chrono::steady_clock::now();
     send_message(ws, second);

@@ -17,9 +17,9 @@
 #include "common/core/image.h"
 #include "common/core/mesh.h"
 #include "common/io/image_io.h"
+#include "render/renderer.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
-#include "tile/renderer.h"
 
 namespace isowall {
 namespace {

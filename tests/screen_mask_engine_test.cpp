@@ -13,9 +13,9 @@
 #include "common/core/ray.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
+#include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/test_util.h"
-#include "tile/progressive_engine.h"
 
 namespace isowall {
 namespace {
@@ -42,8 +42,8 @@ std::vector<NamedView> views(const Volume& v, int w, int h, double iso) {
 FrameResult run_engine(SurfaceExtractor& ex, Renderer& r, EngineOptions opt, const FrameView& fv,
                        bool mask) {
     opt.screen_mask = mask;
-    ProgressiveEngine engine(ex, r, opt);
-    return engine.run(fv);
+    ProgressiveEngine engine(ex, opt);
+    return engine.run(fv, r);
 }
 
 // With and without the mask: the same final colour and depth, and no more rays with it.
@@ -125,7 +125,7 @@ TEST(ScreenMaskEngine, ARegionWithNoActiveNodeCastsNoRay) {
         EngineOptions opt;
         for (bool mask : {false, true}) {
             opt.screen_mask = mask;
-            ProgressiveEngine engine(*ex, *renderer, opt);
+            ProgressiveEngine engine(*ex, opt);
             RendererSink sink(*renderer);
             const FrameResult fr = engine.run(fv, corner, sink, stop);
             EXPECT_TRUE(fr.completed);
@@ -137,7 +137,7 @@ TEST(ScreenMaskEngine, ARegionWithNoActiveNodeCastsNoRay) {
                 EXPECT_EQ(fr.rays_cast, 144u) << "the corner is inside the screen box";
             }
         }
-        ProgressiveEngine engine(*ex, *renderer);
+        ProgressiveEngine engine(*ex);
         EngineFrame frame(engine, fv, stop);
         const RegionCursor c = frame.cursor(fv, corner);
         EXPECT_TRUE(c.done);
@@ -149,8 +149,8 @@ TEST(ScreenMaskEngine, AnIsovalueAboveEveryVoxelCastsNoRay) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
-    ProgressiveEngine engine(*ex, *renderer);
-    const FrameResult fr = engine.run(test::make_view(p, 160, 120, ex->value_max() + 1));
+    ProgressiveEngine engine(*ex);
+    const FrameResult fr = engine.run(test::make_view(p, 160, 120, ex->value_max() + 1), *renderer);
     EXPECT_TRUE(fr.completed);
     EXPECT_EQ(fr.rays_cast, 0u);
     EXPECT_EQ(fr.mask_nodes, 0u);

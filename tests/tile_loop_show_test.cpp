@@ -8,10 +8,10 @@
 #include <mutex>
 
 #include "comm/inproc_comm.h"
-#include "comm/protocol.h"
 #include "common/volume/phantom.h"
+#include "protocol/protocol.h"
+#include "render/renderer.h"
 #include "tests/engine_util.h"
-#include "tile/renderer.h"
 #include "tile/tile_loop.h"
 
 namespace isowall {
@@ -67,7 +67,7 @@ TEST(TileLoopShows, TheLastChangeIsShownWhileMessagesKeepTheInboxFull) {
             setup.shows = {&show};
             return run_tile(comm, setup);
         }
-        await<HelloMsg>(comm);
+        await<TileHelloMsg>(comm);
         send_message(comm, 1, ViewMsg{1, fv});
         send_message(comm, 1,
                      JobMsg{1, 0, 1, Band::fine, fv, PixelRect{0, 0, fv.width, fv.height}});

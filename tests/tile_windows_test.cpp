@@ -16,11 +16,11 @@
 
 #include "common/io/image_io.h"
 #include "display/x_window.h"
-#include "master/tile_window.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
 #include "tests/xvfb_util.h"
+#include "tile/tile_window.h"
 
 namespace isowall {
 namespace {

@@ -9,11 +9,11 @@
 #include <fstream>
 #include <iterator>
 
+#include "app/wall_run.h"
 #include "comm/inproc_comm.h"
 #include "common/core/wire.h"
 #include "common/io/image_io.h"
 #include "master/wall_report.h"
-#include "master/wall_run.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
 
@@ -137,8 +137,7 @@ TEST(WallInProcess, ASilentTileIsNamedAfterTheTimeoutAndEveryRankEnds) {
     const auto dir = test::scratch_dir("inproc_silent");
     WallOptions o = small_wall(dir);
     o.timeout_s = 2;
-    o.fault_kind = "hang";
-    o.fault_rank = 2;
+    o.fault = {FaultAction::hang, FaultMoment::none, 2};
     const WallRun r = run_wall_in_process(o);
     for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
     EXPECT_NE(r.err.find("isowall: error: rank 0 (master): no tile rank has answered for 2 s"),
@@ -158,8 +157,7 @@ TEST(WallInProcess, ARankThatThrowsEndsEveryRankWithOneLine) {
                  {0, "isowall: error: rank 0 (master): test fault: the master throws"}};
     for (const auto& c : cases) {
         WallOptions o = small_wall(test::scratch_dir("inproc_throws_" + std::to_string(c.rank)));
-        o.fault_kind = "throw";
-        o.fault_rank = c.rank;
+        o.fault = {FaultAction::throw_error, FaultMoment::none, c.rank};
         const WallRun r = run_wall_in_process(o);
         for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
         EXPECT_EQ(test::count_of(r.err, "isowall: error:"), 1u) << r.err;
@@ -311,7 +309,7 @@ TEST(WallInProcess, AMalformedMessageToTheMasterEndsTheJobNamingTheRank) {
     testing::internal::CaptureStderr();
     const std::vector<int> codes = run_in_process(5, [&](Comm& comm) {
         if (comm.rank() != 4) return run_wall(o, comm);
-        const std::byte junk[] = {std::byte{HelloMsg::kVersion}, std::byte{9}};  // cut short
+        const std::byte junk[] = {std::byte{TileHelloMsg::kVersion}, std::byte{9}};  // cut short
         comm.send(kMasterRank, Tag::hello, junk);
         for (;;) comm.receive(-1, kForever);  // until the job ends
     });

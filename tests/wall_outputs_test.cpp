@@ -4,8 +4,8 @@
 
 #include <fstream>
 
+#include "app/wall_outputs.h"
 #include "common/core/error.h"
-#include "master/wall_outputs.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -1,6 +1,6 @@
 #pragma once
 // Where a tile shows its frame while it builds, besides the image the master gathers at quit: a
-// window on the tile's display (master/tile_window.h, through display/), a scaled-down preview
+// window on the tile's display (tile/tile_window.h, through display/), a scaled-down preview
 // for the master's control window. The tile loop calls show() with what the tile shows now, at
 // most once per interval_s(), and once more with the last change when its work runs out, so the
 // final frame is always shown. Implementations need no GL and take no locks of the tile loop.

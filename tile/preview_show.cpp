@@ -1,11 +1,12 @@
 #include "tile/preview_show.h"
 
-#include "comm/preview.h"
+#include "common/core/preview.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 
 void PreviewShow::show(const Image& tile, std::uint64_t generation) {
-    send_message(comm_, kMasterRank, make_preview(tile, generation, max_side_));
+    send_message(comm_, kMasterRank, PreviewMsg{make_preview(tile, generation, max_side_)});
 }
 
 }  // namespace isowall

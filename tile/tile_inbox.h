@@ -12,7 +12,7 @@
 #include <mutex>
 #include <optional>
 
-#include "comm/protocol.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 

@@ -54,6 +54,7 @@ bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
 
 TileJobs::TileJobs(ProgressiveEngine& engine, Renderer& tile, Renderer& help, bool measure)
     : engine_(engine), tile_sink_(tile), help_sink_(help), measure_(measure) {
+    warm_up(tile);
     warm_up(help);
 }
 

@@ -12,10 +12,10 @@
 #include <tuple>
 #include <vector>
 
-#include "comm/protocol.h"
 #include "common/core/box.h"
-#include "tile/group_sink.h"
-#include "tile/progressive_engine.h"
+#include "engine/group_sink.h"
+#include "engine/progressive_engine.h"
+#include "protocol/protocol.h"
 
 namespace isowall {
 

@@ -95,7 +95,7 @@ class TileRank {
     TileRank(Comm& comm, TileSetup& setup)
         : comm_(comm),
           setup_(setup),
-          engine_(setup.extractor, setup.renderer, options()),
+          engine_(setup.extractor, options()),
           jobs_(engine_, setup.renderer, setup.help_renderer, setup.measure) {
         for (FrameShow* f : setup.shows) shows_.push_back({f, PresentPacer(f->interval_s())});
     }
@@ -104,8 +104,8 @@ class TileRank {
         if (setup_.tile_width > 0) jobs_.prepare(setup_.tile_width, setup_.tile_height);
         send_message(
             comm_, kMasterRank,
-            HelloMsg{comm_.host(), static_cast<std::uint32_t>(std::max(1, setup_.engine.threads)),
-                     true});
+            TileHelloMsg{comm_.host(),
+                         static_cast<std::uint32_t>(std::max(1, setup_.engine.threads)), true});
         Receiver receiver(comm_, inbox_, setup_.timeout_s);
         bool quit = false;
         for (;;) {
@@ -122,7 +122,7 @@ class TileRank {
             } else if (auto* r = std::get_if<RegionMsg>(&*m)) {
                 if (!quit) land(std::move(*r));
             } else if (std::holds_alternative<QuitMsg>(*m)) {
-                raise_test_signal(setup_.fault.kind, "gather");
+                raise_test_signal(setup_.fault, FaultMoment::gather);
                 quit = true;
                 send_result();
                 send_image();
@@ -154,10 +154,11 @@ class TileRank {
     }
 
     void begin(const ViewMsg& v) {
-        if (setup_.fault.kind == "hang") inbox_.wait_closed();
-        if (setup_.fault.kind == "exit") std::_Exit(3);
-        if (setup_.fault.kind == "throw") throw std::runtime_error("test fault: a tile throws");
-        raise_test_signal(setup_.fault.kind, "frame");
+        if (setup_.fault.action == FaultAction::hang) inbox_.wait_closed();
+        if (setup_.fault.action == FaultAction::exit) std::_Exit(3);
+        if (setup_.fault.action == FaultAction::throw_error)
+            throw std::runtime_error("test fault: a tile throws");
+        raise_test_signal(setup_.fault, FaultMoment::frame);
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             jobs_.measure_point();
@@ -192,7 +193,7 @@ class TileRank {
     void job(const JobMsg& j) {
         // Jobs of an older frame are dropped: the master no longer counts on them.
         if (!jobs_.started() || j.generation != jobs_.generation()) return;
-        if (j.owner != comm_.rank()) raise_test_signal(setup_.fault.kind, "migration");
+        if (j.owner != comm_.rank()) raise_test_signal(setup_.fault, FaultMoment::migration);
         TileJobs::Outcome out = jobs_.run(j, comm_.rank());
         trace_.switch_to(Stage::comm);
         if (!out.completed) {

@@ -10,27 +10,20 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "common/core/test_fault.h"
 #include "common/extract/surface_extractor.h"
+#include "engine/progressive_engine.h"
+#include "render/renderer.h"
 #include "tile/frame_show.h"
-#include "tile/progressive_engine.h"
-#include "tile/renderer.h"
 
 namespace isowall {
-
-// Test hooks for fault handling (ISOWALL_TEST_FAULT=KIND:RANK): after its first view a tile
-// "hang"s (stops answering until the job ends), "exit"s at once (process only; never in process),
-// or "throw"s an error; "stop@MOMENT" and "kill@MOMENT" send the process SIGSTOP or SIGKILL at
-// a moment (init, load, frame, migration, gather; see raise_test_signal).
-struct TileFault {
-    std::string kind;  // empty: none
-};
 
 struct TileSetup {
     SurfaceExtractor& extractor;
     Renderer& renderer;       // the tile's own frame
     Renderer& help_renderer;  // the regions it fills for other tiles
     EngineOptions engine;
-    TileFault fault;
+    TestFault fault;         // the fault tests' hook (common/core/test_fault.h); none by default
     bool measure = false;    // keep each job's result for the emulated correctness curve
     double timeout_s = 120;  // the master silent this long (not even alive messages) ends the job
     int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "common/core/box.h"
@@ -28,6 +29,14 @@ struct Frustum {
 struct PixelRect {
     int x = 0, y = 0, width = 0, height = 0;
 };
+
+// The window position, in pixels with (0, 0) at the top-left corner of the screen's top-left
+// pixel, of a point at normalised device coordinates (x, y) on a width x height screen: the one
+// projection to a pixel (ray.cpp's screen_box, the coverage rasteriser, the remote server's seeds).
+inline glm::vec2 ndc_to_window(float x, float y, int width, int height) {
+    return {(x + 1.0f) * 0.5f * static_cast<float>(width),
+            (1.0f - y) * 0.5f * static_cast<float>(height)};
+}
 
 // The frustum of `rect` when the whole of `full` maps onto a screen of screen_w x screen_h pixels.
 Frustum sub_frustum(const Frustum& full, int screen_w, int screen_h, const PixelRect& rect);

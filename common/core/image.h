@@ -5,6 +5,11 @@
 
 namespace isowall {
 
+// Largest image side a message may carry (common/core/wire_pieces.h reads sides against it). A
+// message over 2 GiB cannot travel (MPI counts are int); a tile is far smaller (a 4K display is
+// 32 MiB of RGBA).
+inline constexpr int kMaxImageSide = 32768;
+
 struct Image {
     int width = 0;
     int height = 0;

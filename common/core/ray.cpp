@@ -69,12 +69,11 @@ PixelRect screen_box(const Box3& b, const glm::mat4& view, const Frustum& f, int
                           (k & 4) ? b.max.z : b.min.z);
         const glm::vec4 c = clip * glm::vec4(p, 1.0f);
         if (c.w <= 1e-6f) return {0, 0, width, height};  // behind the eye: no bound
-        const float px = (c.x / c.w * 0.5f + 0.5f) * static_cast<float>(width);
-        const float py = (0.5f - c.y / c.w * 0.5f) * static_cast<float>(height);
-        x0 = std::min(x0, px);
-        x1 = std::max(x1, px);
-        y0 = std::min(y0, py);
-        y1 = std::max(y1, py);
+        const glm::vec2 px = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
+        x0 = std::min(x0, px.x);
+        x1 = std::max(x1, px.x);
+        y0 = std::min(y0, px.y);
+        y1 = std::max(y1, px.y);
     }
     // Pixels whose centres may fall inside the projected box, with one pixel of margin.
     const int ix0 = std::clamp(static_cast<int>(std::floor(x0)) - 1, 0, width);

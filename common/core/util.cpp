@@ -52,12 +52,4 @@ std::optional<glm::ivec2> parse_size(std::string_view s) {
     return glm::ivec2(w, h);
 }
 
-void raise_test_signal(std::string_view kind, std::string_view moment) {
-    const auto at = kind.find('@');
-    if (at == std::string_view::npos || kind.substr(at + 1) != moment) return;
-    const std::string_view what = kind.substr(0, at);
-    if (what == "stop") ::raise(SIGSTOP);
-    if (what == "kill") ::raise(SIGKILL);
-}
-
 }  // namespace isowall

@@ -42,9 +42,4 @@ double current_rss_mib();
 // "1600x1200" -> (1600, 1200); nullopt unless two positive integers <= 32768.
 std::optional<glm::ivec2> parse_size(std::string_view s);
 
-// Test hook of the fault matrix (ISOWALL_TEST_FAULT=stop@MOMENT:RANK or kill@MOMENT:RANK): when
-// `kind` is "stop@<moment>" or "kill@<moment>", this process sends itself SIGSTOP or SIGKILL, as
-// an operator's `kill -STOP` or `kill -9` would at that moment. Anything else does nothing.
-void raise_test_signal(std::string_view kind, std::string_view moment);
-
 }  // namespace isowall

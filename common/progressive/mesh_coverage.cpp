@@ -32,8 +32,7 @@ void add_mesh_coverage(const Mesh& mesh, const glm::mat4& view, const Frustum& f
         const glm::vec4 c = m * glm::vec4(mesh.positions[i], 1.0f);
         clipped[i] = !(c.w > 0.0f) || c.z < -c.w || c.z > c.w;
         const float inv_w = clipped[i] ? 0.0f : 1.0f / c.w;
-        win[i] = {(c.x * inv_w + 1.0f) * 0.5f * float(width),
-                  (1.0f - c.y * inv_w) * 0.5f * float(height)};
+        win[i] = ndc_to_window(c.x * inv_w, c.y * inv_w, width, height);
     }
     for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
         const std::uint32_t ia = mesh.indices[t], ib = mesh.indices[t + 1],

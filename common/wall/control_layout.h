@@ -25,7 +25,7 @@ struct ControlLayout {
 ControlLayout control_layout(const WallSpec& spec, PixelSize max = kControlMaxSize);
 
 // The larger side of the largest tile in control_layout(spec, max), at least 1: the size a tile's
-// preview needs (comm/preview.h: make_preview's max_side).
+// preview needs (common/core/preview.h: make_preview's max_side).
 int preview_max_side(const WallSpec& spec, PixelSize max = kControlMaxSize);
 
 std::ostream& operator<<(std::ostream& os, const ControlLayout& layout);

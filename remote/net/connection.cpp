@@ -60,7 +60,7 @@ void Connection::pace(std::size_t bytes) {
     }
 }
 
-std::size_t Connection::send(const ViewMessage& m) {
+std::size_t Connection::send(const RemoteMessage& m) {
     const std::vector<std::byte> frame = encode_frame(m);
     std::lock_guard lock(send_mutex_);
     if (shut_down_) throw_shut_down();
@@ -83,7 +83,7 @@ std::size_t Connection::send(const ViewMessage& m) {
     return frame.size();
 }
 
-std::optional<ViewMessage> Connection::receive(double timeout_s) {
+std::optional<RemoteMessage> Connection::receive(double timeout_s) {
     if (broken_) throw WireError(*broken_);
     const bool forever = !(timeout_s >= 0) || std::isinf(timeout_s);
     const double deadline_s = forever ? 0 : steady_now_s() + timeout_s;
@@ -91,7 +91,7 @@ std::optional<ViewMessage> Connection::receive(double timeout_s) {
         if (recv_begin_ < recv_end_) {
             std::span<const std::byte> input(recv_buffer_.data() + recv_begin_,
                                              recv_end_ - recv_begin_);
-            std::optional<ViewMessage> m;
+            std::optional<RemoteMessage> m;
             try {
                 m = parser_.next(input);
             } catch (const WireError& e) {

@@ -43,7 +43,7 @@ class Connection {
     // Sends one whole message (header and payload), paced by the rate if one is set. Returns the
     // bytes sent, header included. Throws NetError, or PeerClosed (also when shutdown() ended a
     // paced wait), or WireError when the message cannot be framed.
-    std::size_t send(const ViewMessage& m);
+    std::size_t send(const RemoteMessage& m);
     // The emulated link: `bits_per_second` > 0, or 0 for none (the default). Bytes already sent
     // are forgotten: the bucket starts full.
     void set_rate(double bits_per_second, std::size_t burst_bytes = kPaceChunkBytes);
@@ -54,7 +54,7 @@ class Connection {
     // when the stream is broken (a bad header, a payload that does not decode: every later call
     // throws it again), or PeerClosed on EOF (saying so when the stream was cut short inside a
     // message) or after shutdown().
-    std::optional<ViewMessage> receive(double timeout_s);
+    std::optional<RemoteMessage> receive(double timeout_s);
 
     std::uint64_t bytes_sent() const { return bytes_sent_.load(); }
     std::uint64_t bytes_received() const { return bytes_received_.load(); }

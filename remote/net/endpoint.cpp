@@ -1,5 +1,6 @@
 #include "remote/net/endpoint.h"
 
+#include <algorithm>
 #include <string>
 
 #include "common/core/error.h"
@@ -59,6 +60,30 @@ Endpoint parse_endpoint(std::string_view text, std::string_view source, std::str
     const int port_number = parse_port(port);
     if (port_number == 0) fail("port: expected an integer 1..65535, got " + quote(port));
     return {std::string(host), port_number};
+}
+
+Endpoint parse_listen_endpoint(std::string_view text, int default_port, std::string_view source,
+                               std::string_view field) {
+    // With a port: "[IPV6]:PORT", or "HOST:PORT" with a single colon (a bare IPv6 has several).
+    const bool port_given = text.find(']') != std::string_view::npos
+                                ? text.back() != ']'
+                                : std::count(text.begin(), text.end(), ':') == 1;
+    if (!port_given) {
+        std::string_view host = text;
+        if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+            host = host.substr(1, host.size() - 2);
+        Endpoint e = parse_endpoint(host_port(host, 1), source, field);  // checks the host alone
+        e.port = default_port;
+        return e;
+    }
+    // PORT 0 asks for any free port, which a peer's endpoint never has.
+    if (text.size() > 2 && text.substr(text.size() - 2) == ":0") {
+        Endpoint e =
+            parse_endpoint(std::string(text.substr(0, text.size() - 1)) + "1", source, field);
+        e.port = 0;
+        return e;
+    }
+    return parse_endpoint(text, source, field);
 }
 
 std::string host_port(std::string_view host, int port) {

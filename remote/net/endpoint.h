@@ -15,6 +15,12 @@ struct Endpoint {
 // InputError("--connect", "endpoint", "port: expected an integer 1..65535, got \"0\"").
 Endpoint parse_endpoint(std::string_view text, std::string_view source, std::string_view field);
 
+// Where a server listens, in the same form as parse_endpoint's: "HOST:PORT" or "[IPV6]:PORT",
+// where PORT may also be 0 (any free port). The port may be left out ("HOST", "[IPV6]", or a bare
+// IPv6 address such as "::1"): it is then `default_port`. Throws InputError as parse_endpoint.
+Endpoint parse_listen_endpoint(std::string_view text, int default_port, std::string_view source,
+                               std::string_view field);
+
 // "host:port", with an IPv6 host in brackets: the name of a peer in error lines.
 std::string to_string(const Endpoint& e);
 std::string host_port(std::string_view host, int port);

@@ -73,7 +73,7 @@ void WebChannel::pace(std::size_t bytes) {
     }
 }
 
-std::size_t WebChannel::send(const ViewMessage& m) {
+std::size_t WebChannel::send(const RemoteMessage& m) {
     const std::vector<std::byte> frame = encode_frame(m);
     std::lock_guard lock(send_mutex_);
     if (shut_down_) throw_closed();
@@ -82,7 +82,7 @@ std::size_t WebChannel::send(const ViewMessage& m) {
     return frame.size();
 }
 
-ViewMessage WebChannel::decode(const WebInbox::Message& message) {
+RemoteMessage WebChannel::decode(const WebInbox::Message& message) {
     try {
         if (!message.binary)
             throw WireError("WebSocket: a text message (each message must be one binary frame)");
@@ -95,7 +95,7 @@ ViewMessage WebChannel::decode(const WebInbox::Message& message) {
     }
 }
 
-std::optional<ViewMessage> WebChannel::receive(double timeout_s) {
+std::optional<RemoteMessage> WebChannel::receive(double timeout_s) {
     if (broken_) throw WireError(*broken_);
     const bool forever = !(timeout_s >= 0) || std::isinf(timeout_s);
     const auto ready = [this] {

@@ -43,15 +43,15 @@ class WebChannel final : public MessageChannel {
     const std::string& peer() const override { return peer_; }
     // Blocks while the connection has more than a few MiB unsent (web::WebOptions), and for the
     // emulated link's tokens; both waits end at shutdown() or when the peer goes.
-    std::size_t send(const ViewMessage& m) override;
-    std::optional<ViewMessage> receive(double timeout_s) override;
+    std::size_t send(const RemoteMessage& m) override;
+    std::optional<RemoteMessage> receive(double timeout_s) override;
     void set_rate(double bits_per_second) override;
     void shutdown() override;
     // The closing handshake goes after every message already queued (the error just sent).
     void close_gracefully() override { shutdown(); }
 
   private:
-    ViewMessage decode(const WebInbox::Message& message);
+    RemoteMessage decode(const WebInbox::Message& message);
     void pace(std::size_t bytes);  // send_mutex_ held
     [[noreturn]] void throw_closed() const;
 

@@ -69,7 +69,7 @@ function getIntIn(r, field, lo, hi) {
   return v;
 }
 
-// ---- frame view (comm/wire_pieces.cpp) -------------------------------------------------------
+// ---- frame view (common/core/wire_pieces.cpp) -------------------------------------------------------
 
 function getProjection(r, field) {
   const v = r.i32();

@@ -1,4 +1,4 @@
-// WebGL2 drawing with the shaders of tile/gl_core.cpp (headlight Phong, front and back colours),
+// WebGL2 drawing with the shaders of render/gl_core.cpp (headlight Phong, front and back colours),
 // ported to GLSL ES 3.00: depth test LESS, no culling (open surfaces show both sides), black
 // background, drawing straight into the canvas (preserveDrawingBuffer keeps it between frames).
 // Each mesh is uploaded once (positions, normals, uint32 indices) and kept while the client holds

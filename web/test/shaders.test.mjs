@@ -1,4 +1,4 @@
-// The page shades as `isowall render` does: its GLSL ES 3.00 shaders are tile/gl_core.cpp's GLSL
+// The page shades as `isowall render` does: its GLSL ES 3.00 shaders are render/gl_core.cpp's GLSL
 // 3.30 ones, statement for statement (the version line, the fragment shader's precision line and
 // comments aside), so a change to one without the other fails here.
 import { test } from 'node:test';
@@ -6,11 +6,11 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { kFragmentShader, kVertexShader } from '../src/renderer.js';
 
-const core = readFileSync(new URL('../../tile/gl_core.cpp', import.meta.url), 'utf8');
+const core = readFileSync(new URL('../../render/gl_core.cpp', import.meta.url), 'utf8');
 
 function cppShader(name) {
   const m = new RegExp(`constexpr const char\\* ${name} = R"\\(([\\s\\S]*?)\\)";`).exec(core);
-  assert.ok(m, `tile/gl_core.cpp: no ${name}`);
+  assert.ok(m, `render/gl_core.cpp: no ${name}`);
   return m[1];
 }
 

@@ -1,0 +1,353 @@
+#include "app/commands.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "app/render_report.h"
+#include "cli/cli_checks.h"
+#include "common/core/camera.h"
+#include "common/core/error.h"
+#include "common/core/util.h"
+#include "common/extract/surface_extractor.h"
+#include "common/io/image_io.h"
+#include "common/io/ply.h"
+#include "common/volume/phantom.h"
+#include "engine/progressive_engine.h"
+#include "render/renderer.h"
+
+namespace isowall {
+namespace {
+
+// One line per stage, then a summary line that scripts can grep for.
+struct Timings {
+    double load = 0, octree = 0, extract = 0, render = 0, write = 0;
+    double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
+    void print(std::size_t triangles) const {
+        if (frame >= 0) {
+            std::printf(
+                "timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
+                " | triangles %zu | peak RSS %.1f MiB\n",
+                load, octree, frame, write, triangles, peak_rss_mib());
+            return;
+        }
+        std::printf(
+            "timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
+            " | triangles %zu | peak RSS %.1f MiB\n",
+            load, octree, extract, render, write, triangles, peak_rss_mib());
+    }
+};
+
+std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
+                                          ThreadBudget budget = ThreadBudget::hardware()) {
+    OctreeSource src;
+    if (ov.file) src.volume_path = *ov.file;
+    src.cache_dir = ov.cache_dir;
+    OctreeStats st;
+    Stopwatch sw;
+    auto ex = make_surface_extractor(ov.volume, src, &st, budget);
+    t.octree = sw.seconds();
+    const double share = double(ex->octree_bytes()) / double(ov.volume.bytes().size());
+    if (st.from_cache) {
+        std::printf("octree: mapped %s  (%.3f s)\n", st.cache_file.c_str(), t.octree);
+    } else {
+        std::printf("octree: built in %.3f s (%.0f M voxels/s)%s%s\n", st.build_s,
+                    double(ov.volume.voxel_count()) / std::max(st.build_s, 1e-9) / 1e6,
+                    st.cache_file.empty() ? "" : ", cached to ", st.cache_file.c_str());
+    }
+    if (!st.cache_note.empty()) std::printf("octree: note: %s\n", st.cache_note.c_str());
+    const OctreeShape& shape = ex->octree_shape();
+    std::printf(
+        "octree: %zu levels, depth %d, %zu nodes, %.2f MiB = %.2f%% of the volume bytes, values "
+        "[%g, %g]\n",
+        shape.levels.size(), shape.depth(), shape.node_count,
+        double(ex->octree_bytes()) / (1024.0 * 1024.0), 100.0 * share, ex->value_min(),
+        ex->value_max());
+    return ex;
+}
+
+double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov,
+                   const SurfaceExtractor& ex) {
+    const std::string where = ov.file ? ov.file->string() : std::string("phantom");
+    if (!iso) {
+        if (!ov.file) return kPhantomSkinIso;
+        throw InputError(where, "--iso", "an isovalue is required (see `isowall info`)");
+    }
+    if (!std::isfinite(*iso) || *iso < ex.value_min() || *iso > ex.value_max()) {
+        char msg[160];
+        std::snprintf(msg, sizeof(msg), "isovalue %g is outside the volume's value range [%g, %g]",
+                      *iso, ex.value_min(), ex.value_max());
+        throw InputError(where, "--iso", msg);
+    }
+    return *iso;
+}
+
+Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
+    ExtractStats es;
+    Stopwatch sw;
+    Mesh mesh = ex.extract_full(iso, &es);
+    t.extract = sw.seconds();
+    std::printf(
+        "extract: iso %g: %zu triangles, %zu vertices, %zu active cells, %zu octree nodes "
+        "visited, %zu leaf bricks scanned (%.3f s)\n",
+        iso, mesh.triangle_count(), mesh.vertex_count(), es.cells_active, es.nodes_visited,
+        es.leaves_active, t.extract);
+    return mesh;
+}
+
+// "out/img.png" + "_c99" -> "out/img_c99.png"
+std::filesystem::path with_suffix(const std::string& path, const std::string& suffix) {
+    std::filesystem::path p(path);
+    return p.parent_path() / (p.stem().string() + suffix + p.extension().string());
+}
+
+std::filesystem::path percent_snapshot(const RenderOptions& o, double pct) {
+    return with_suffix(o.out, (o.snapshot_measure == "c" ? "_c" : "_final") + percent_label(pct));
+}
+
+std::filesystem::path rays_snapshot(const RenderOptions& o, std::size_t rays) {
+    return with_suffix(o.out, "_r" + std::to_string(rays));
+}
+
+// Every file `render` may write, checked before any work: a typo fails at once, and nothing is
+// written at all when one of them cannot be.
+void check_render_outputs(const RenderOptions& o) {
+    std::vector<OutputPath> outputs{{"--out", o.out}};
+    if (!o.depth_out.empty()) outputs.push_back({"--depth-out", o.depth_out});
+    if (!o.timeline.empty()) outputs.push_back({"--timeline", o.timeline});
+    for (double pct : o.snapshots) outputs.push_back({"--snapshots", percent_snapshot(o, pct)});
+    for (std::size_t rays : o.snapshot_rays)
+        outputs.push_back({"--snapshot-rays", rays_snapshot(o, rays)});
+    check_outputs(outputs);
+    for (const OutputPath& p : outputs)
+        if (p.option != "--timeline")
+            if (std::string problem = image_format_problem(p.path); !problem.empty())
+                throw InputError(p.path.string(), p.option, problem);
+}
+
+// The view of `render`: the front full view, turned and zoomed; InputError naming the option
+// when the result is degenerate (common/core/camera.h: camera_problem).
+Camera render_camera(const RenderOptions& o, const Box3& bounds, float aspect) {
+    const Projection proj =
+        o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
+    Camera cam = front_full_view(bounds, aspect, proj);
+    if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
+    cam = zoom(cam, float(o.zoom));
+    if (std::string p = camera_problem(cam); !p.empty())
+        throw InputError("--zoom", "value", "zoom " + percent_label(o.zoom) + ": " + p);
+    return fit_depth_range(cam, bounds);
+}
+
+// The view of `render --warm-up`'s untimed frame: the view turned kWarmUpYawDeg about the vertical
+// axis. The timed frame then finds the process as a running wall's ranks have it (memory touched,
+// the renderer's buffers and bins made) without having visited its very cells just before.
+constexpr double kWarmUpYawDeg = 30;
+FrameView warm_up_view(const FrameView& fv, const Box3& bounds) {
+    const Camera cam = fit_depth_range(orbit(fv.camera, kWarmUpYawDeg, 0), bounds);
+    return FrameView{cam, cam.frustum(float(fv.width) / float(fv.height)), fv.width, fv.height,
+                     fv.iso};
+}
+
+ThreadBudget render_threads(const RenderOptions& o) {
+    return o.threads > 0 ? ThreadBudget{o.threads} : ThreadBudget::hardware();
+}
+
+EngineOptions engine_options(const RenderOptions& o) {
+    EngineOptions e = to_engine_options(o.engine);
+    e.sample_at_rays = o.snapshot_rays;
+    e.threads = render_threads(o).usable();
+    return e;
+}
+
+// The snapshots due at replayed sample `s`, staged in `batch`.
+void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Image& img,
+                     std::vector<bool>& c_done, std::vector<bool>& r_done, OutputFiles& batch) {
+    for (std::size_t k = 0; k < o.snapshots.size(); ++k) {
+        const double m = o.snapshot_measure == "c" ? s.correctness.c : s.correctness.final_pixels;
+        if (c_done[k] || m < o.snapshots[k] / 100.0) continue;
+        c_done[k] = true;
+        const auto path = percent_snapshot(o, o.snapshots[k]);
+        write_image(batch, path, img);
+        std::printf("snapshot: %s (C %.4f, final pixels %.4f, %.3f s, %zu rays)\n", path.c_str(),
+                    s.correctness.c, s.correctness.final_pixels, s.time_s, s.rays);
+    }
+    for (std::size_t k = 0; k < o.snapshot_rays.size(); ++k) {
+        if (r_done[k] || s.rays < o.snapshot_rays[k]) continue;
+        r_done[k] = true;
+        const auto path = rays_snapshot(o, o.snapshot_rays[k]);
+        write_image(batch, path, img);
+        std::printf("snapshot: %s (C %.4f, %zu rays)\n", path.c_str(), s.correctness.c, s.rays);
+    }
+}
+
+std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                               const FrameView& fv, Timings& t, OutputFiles& batch) {
+    warm_up(renderer);
+    ProgressiveEngine engine(ex, engine_options(o));
+    auto progress = [&](const TimelineSample& s) {
+        if (o.quiet) return;
+        std::printf("  %7.2f s  level %2d  rays %9zu (%6.2f%%)  groups %6zu  triangles %9zu\n",
+                    s.time_s, s.level, s.rays,
+                    100.0 * double(s.rays) / double(fv.width) / double(fv.height), s.groups,
+                    s.triangles);
+        std::fflush(stdout);
+    };
+    if (o.warm_up) {
+        const FrameResult w = engine.run(warm_up_view(fv, ex.volume().bounds()), renderer);
+        std::printf(
+            "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
+            "%.3f s\n",
+            kWarmUpYawDeg, w.timeline.back().triangles, w.elapsed_s);
+    }
+    const double cpu0 = thread_cpu_seconds();
+    FrameResult fr = engine.run(fv, renderer, nullptr, progress);
+    const double caller_cpu = thread_cpu_seconds() - cpu0;
+    const TimelineSample& last = fr.timeline.back();
+    t.frame = fr.elapsed_s;
+    std::printf(
+        "progressive: %s order, %s intersection, %s, %d thread%s: %zu rays (%.2f%% of the screen; "
+        "box %dx%d) in %.3f s: %zu groups, %zu triangles, %zu cells visited\n",
+        std::string(to_string(engine.options().order)).c_str(), o.engine.intersect.c_str(),
+        o.engine.propagation == "angle"
+            ? "cut-off angle"
+            : ("max count " + std::to_string(o.engine.max_count)).c_str(),
+        std::min(engine.options().threads, ex.threads()),
+        std::min(engine.options().threads, ex.threads()) == 1 ? "" : "s", fr.rays_cast,
+        100.0 * double(fr.rays_cast) / double(fr.rays_screen), fr.screen_rect.width,
+        fr.screen_rect.height, fr.elapsed_s, fr.groups.size(), last.triangles, last.cells_visited);
+    std::printf(
+        "stages (summed over threads): intersection %.3f s | propagation %.3f s | extraction "
+        "%.3f s | rendering %.3f s\n",
+        last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+    if (fr.workers.sum_s > 0)
+        std::printf(
+            "CPU: the drawing thread %.3f s, the other threads %.3f s (the busiest ran %.3f s "
+            "past the drawing thread's levels)\n",
+            caller_cpu, fr.workers.sum_s, fr.workers.beyond_s);
+    std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
+    if (fr.mask_level >= 0)
+        std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",
+                    fr.mask_nodes, fr.mask_level, fr.screen_pixels);
+
+    if (o.against_full) print_against_full(ex, renderer, fv, fr.final_image);
+
+    Stopwatch sw;
+    write_image(batch, o.out, fr.final_image);
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
+    t.write = sw.seconds();
+
+    const bool want_measure =
+        !o.no_measure || !o.timeline.empty() || !o.snapshots.empty() || !o.snapshot_rays.empty();
+    if (!want_measure) return last.triangles;
+    sw.restart();
+    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
+    engine.measure(fr, fv, renderer, [&](const TimelineSample& s, const Image& img) {
+        stage_snapshots(o, s, img, c_done, r_done, batch);
+    });
+    print_thresholds(fr);
+    print_draw_only(fr, fv, renderer);
+    if (!o.timeline.empty()) {
+        write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
+        std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
+                    o.timeline.c_str(), fr.timeline.size());
+    }
+    std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
+                fr.timeline.size(), sw.seconds());
+    return last.triangles;
+}
+
+}  // namespace
+
+int run_info(const InfoOptions& o) {
+    Timings t;
+    OpenedVolume ov = open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false});
+    t.load = ov.load_s;
+    prepare(ov, t);
+    const Box3 b = ov.volume.bounds();
+    std::printf("bounds: (%g, %g, %g) - (%g, %g, %g) object units\n", double(b.min.x),
+                double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y),
+                double(b.max.z));
+    if (!ov.file)
+        std::printf("suggested isovalues: skin %g, bone %g\n", kPhantomSkinIso, kPhantomBoneIso);
+    return 0;
+}
+
+int run_extract(const ExtractOptions& o) {
+    check_outputs({{"--out", o.out}});
+    Timings t;
+    OpenedVolume ov = open_volume(o.volume);
+    t.load = ov.load_s;
+    auto ex = prepare(ov, t);
+    const double iso = checked_iso(o.iso, ov, *ex);
+    Mesh mesh = extract_timed(*ex, iso, t);
+    Stopwatch sw;
+    write_ply(o.out, mesh);
+    t.write = sw.seconds();
+    std::printf("wrote %s\n", o.out.c_str());
+    t.print(mesh.triangle_count());
+    return 0;
+}
+
+int run_render(const RenderOptions& o) {
+    const auto size = parse_size(o.size);
+    if (!size)
+        throw InputError(
+            "--size", "value",
+            "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
+    check_render_outputs(o);
+    (void)engine_options(o);  // fails early on a bad --order
+    Timings t;
+    // One thread is one core, as on a wall rank with one (app/wall_run.cpp): llvmpipe then
+    // rasterises in the drawing thread instead of its own threads on the other cores. The
+    // variable must be set before the first context; a vendor driver ignores it.
+    if (render_threads(o).usable() == 1) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+    // Create the GL context first: a missing driver should fail before the volume is read.
+    auto renderer = make_renderer(o.gl);
+    OpenedVolume ov = open_volume(o.volume);
+    t.load = ov.load_s;
+    auto ex = prepare(ov, t, render_threads(o));
+    const double iso = checked_iso(o.iso, ov, *ex);
+
+    const float aspect = float(size->x) / float(size->y);
+    const Camera cam = render_camera(o, ov.volume.bounds(), aspect);
+    FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso};
+
+    // Every output is staged here and appears at the end, all together (no partial output).
+    OutputFiles batch;
+    if (!o.full) {
+        const std::size_t triangles = render_progressive(o, *ex, *renderer, fv, t, batch);
+        const std::size_t files = batch.size();
+        batch.commit();
+        std::printf("wrote %s%s%s (%zu file(s) in all)\n", o.out.c_str(),
+                    o.depth_out.empty() ? "" : " and ", o.depth_out.c_str(), files);
+        t.print(triangles);
+        return 0;
+    }
+    if (o.warm_up) {
+        Stopwatch warm;
+        const Mesh once = ex->extract_full(iso);
+        draw_alone(*renderer, once, fv);
+        std::printf("warm-up: the full surface extracted and drawn once, untimed (%.3f s)\n",
+                    warm.seconds());
+    }
+    Mesh mesh = extract_timed(*ex, iso, t);
+    Stopwatch sw;
+    const Image image = draw_alone(*renderer, mesh, fv);
+    t.render = sw.seconds();
+    const std::size_t covered = covered_pixels(image);
+    std::printf("render: %s %dx%d, %.1f%% of pixels covered, %zu px (%.3f s)\n",
+                std::string(renderer->name()).c_str(), size->x, size->y,
+                100.0 * double(covered) / double(image.pixel_count()), covered, t.render);
+    sw.restart();
+    write_image(batch, o.out, image);
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);
+    batch.commit();
+    t.write = sw.seconds();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
+                o.depth_out.c_str());
+    t.print(mesh.triangle_count());
+    return 0;
+}
+
+}  // namespace isowall

@@ -1,0 +1,54 @@
+#pragma once
+// `isowall serve` and `isowall view` (issue 12): their options, command lines and runs.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/engine_cli.h"
+
+namespace isowall {
+
+// The port `isowall serve` listens on when the command line names none.
+inline constexpr int kServePort = 7878;
+
+struct ServeCommand {
+    std::vector<std::string> datasets;  // NAME=PATH (NRRD); "phantom" is always offered
+    std::string listen = "127.0.0.1";
+    int port = -1;       // --port; -1: not given (the port in --listen, else kServePort)
+    int http_port = -1;  // --http: the page and WebSocket on this port (0: any free); -1: none
+    std::string token;
+    double rate_mbps = 0;
+    int max_clients = 8;
+    double lod_rays_percent = 0.25;
+    std::string cache_dir;
+    EngineCli engine;
+    bool quiet = false;
+};
+
+struct ViewCommand {
+    std::string connect = "127.0.0.1:7878";
+    std::string dataset = "phantom";
+    std::string token;
+    int test_case = 0;  // 1-5: the study's cases; 0: the options below
+    std::string encoding = "compact-zstd";
+    bool lod = false, cache = false;
+    std::optional<double> iso;
+    std::string size = "800x600";
+    std::vector<double> orbit;
+    double zoom = 1.0;
+    std::string script;
+    std::string out = "view.png";
+    std::string timeline;
+    std::string gl = "osmesa";
+    double timeout_s = 120;
+    bool quiet = false;
+};
+
+CLI::App* add_serve_command(CLI::App& app, ServeCommand& o);
+CLI::App* add_view_command(CLI::App& app, ViewCommand& o);
+int run_serve(const ServeCommand& o);
+int run_view(const ViewCommand& o);
+
+}  // namespace isowall

@@ -1,0 +1,32 @@
+#pragma once
+// What `isowall render` prints about a frame besides its timings: the correctness thresholds
+// reached, the draw-only floor, the final image against the full surface, and covered pixels.
+#include <cstddef>
+#include <string>
+
+#include "common/core/image.h"
+#include "common/core/view.h"
+#include "common/extract/surface_extractor.h"
+#include "engine/progressive_engine.h"
+#include "render/renderer.h"
+
+namespace isowall {
+
+// Pixels the surface covers (depth nearer than the background); scripts compare this count with
+// other renderers' hit pixels (scripts/bench_scaling.py).
+std::size_t covered_pixels(const Image& image);
+
+// 99.9 -> "99.9", 90 -> "90".
+std::string percent_label(double pct);
+
+// Both measures' thresholds (90, 99, 99.9 and 100%): when each was first reached.
+void print_thresholds(const FrameResult& fr);
+
+// The floor for "C = 99% in time T": drawing the same triangles in one go.
+void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& renderer);
+
+// The final image against the full surface drawn in the same view (outside the timings).
+void print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                        const Image& final_image);
+
+}  // namespace isowall

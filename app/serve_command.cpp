@@ -1,0 +1,141 @@
+// `isowall serve`: options, the datasets it loads, and the accept loop until SIGINT or SIGTERM.
+#include <csignal>
+#include <cstdio>
+#include <optional>
+
+#include "app/remote_commands.h"
+#include "cli/cli_checks.h"
+#include "cli/volume_options.h"
+#include "common/core/error.h"
+#include "common/core/number.h"
+#include "common/volume/octree.h"
+#include "remote/net/endpoint.h"
+#include "remote/view_server.h"
+#include "remote/web/http_front.h"
+
+namespace isowall {
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_stop_signal(int) {
+    g_stop.store(true);
+}
+
+remote::Dataset load_dataset(const std::string& name, const std::string& path,
+                             const std::string& cache_dir) {
+    VolumeOptions vo;
+    vo.path = path;
+    vo.cache_dir = cache_dir;
+    OpenedVolume ov = open_volume(vo);
+    remote::Dataset d;
+    d.name = name;
+    d.volume = std::make_unique<Volume>(std::move(ov.volume));
+    OctreeSource src;
+    if (ov.file) src.volume_path = *ov.file;
+    src.cache_dir = ov.cache_dir;
+    d.extractor = make_surface_extractor(*d.volume, src);
+    std::printf("serve: dataset %s: values [%g, %g]\n", name.c_str(), d.extractor->value_min(),
+                d.extractor->value_max());
+    return d;
+}
+
+// "127.0.0.1" stays as it is; an IPv6 address goes in brackets, as a URL needs it.
+std::string url_host(const std::string& address) {
+    return address.find(':') == std::string::npos ? address : "[" + address + "]";
+}
+
+// --listen in the endpoint form of view --connect; a port given there and in --port is an error.
+remote::Endpoint listen_endpoint(const ServeCommand& o) {
+    remote::Endpoint at = remote::parse_listen_endpoint(o.listen, -1, "--listen", "endpoint");
+    if (at.port >= 0 && o.port >= 0)
+        throw InputError("--port", "value",
+                         "the port is given twice: in --listen " + quote(o.listen) +
+                             " and as --port " + std::to_string(o.port));
+    if (at.port < 0) at.port = o.port >= 0 ? o.port : kServePort;
+    return at;
+}
+
+}  // namespace
+
+CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
+    auto* c = app.add_subcommand(
+        "serve",
+        "Extraction server for remote viewing: streams the groups of each view a client "
+        "asks for (see isowall view)");
+    c->add_option("--dataset", o.datasets,
+                  "Offer a volume as NAME=PATH (NRRD); repeat for more. The phantom is always "
+                  "offered as 'phantom'");
+    c->add_option("--listen", o.listen,
+                  "Where to listen: HOST, HOST:PORT or [IPV6]:PORT, as view --connect takes it "
+                  "(PORT 0: any free port, printed); anything but loopback needs --token")
+        ->capture_default_str();
+    c->add_option("--port", o.port,
+                  "TCP port when --listen names none (default " + std::to_string(kServePort) +
+                      "; 0: any free port, printed)")
+        ->check(CLI::Range(0, 65535));
+    c->add_option("--http", o.http_port,
+                  "Also serve the browser page and the protocol over WebSocket (/ws) on this "
+                  "port, at the --listen address (0: any free port, printed)")
+        ->check(CLI::Range(0, 65535));
+    c->add_option("--token", o.token, "A secret every client must present in its hello");
+    c->add_option("--rate-mbps", o.rate_mbps,
+                  "Emulate a link of this many Mbit/s (token bucket on every send); 0: no limit")
+        ->transform(number_in({0, 1e6}))
+        ->capture_default_str();
+    c->add_option("--max-clients", o.max_clients, "Connections served at once")
+        ->check(CLI::Range(1, 1024))
+        ->capture_default_str();
+    c->add_option("--lod-rays", o.lod_rays_percent,
+                  "Progressive LOD: rays of each coarse level, in percent of the view's pixels")
+        ->transform(number_in({0, 100, true}))
+        ->capture_default_str();
+    c->add_option("--cache-dir", o.cache_dir, "Octree cache folder (default: beside the volume)");
+    add_engine_options(*c, o.engine);
+    c->add_flag("--quiet,-q", o.quiet, "No line per connection and request");
+    return c;
+}
+
+int run_serve(const ServeCommand& o) {
+    remote::ServerOptions so;
+    const remote::Endpoint at = listen_endpoint(o);
+    so.address = at.host;
+    so.port = at.port;
+    so.token = o.token;
+    so.rate_bits_per_s = o.rate_mbps * 1e6;
+    so.max_clients = o.max_clients;
+    so.verbose = !o.quiet;
+    so.session.engine = to_engine_options(o.engine);
+    so.session.lod_ray_share = o.lod_rays_percent / 100.0;
+    std::vector<remote::Dataset> datasets;
+    datasets.push_back(load_dataset("phantom", "", o.cache_dir));
+    for (const std::string& spec : o.datasets) {
+        const auto eq = spec.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+            throw InputError("--dataset", "value", "expected NAME=PATH, got " + quote(spec));
+        const std::string name = spec.substr(0, eq);
+        for (const remote::Dataset& d : datasets)
+            if (d.name == name)
+                throw InputError("--dataset", "value", "the name " + quote(name) + " is taken");
+        datasets.push_back(load_dataset(name, spec.substr(eq + 1), o.cache_dir));
+    }
+    remote::ViewServer server(std::move(datasets), so);
+    // After the server, so it goes first: no WebSocket is handed to a server being destroyed.
+    // A port in use throws here, and the TCP listener closes with `server`.
+    std::optional<remote::HttpFrontEnd> http;
+    if (o.http_port >= 0) http.emplace(server, o.http_port);
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+    std::printf(
+        "serve: listening on %s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
+        o.token.empty() ? "" : " (token required)",
+        o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
+    if (http)
+        std::printf("serve: page at http://%s:%d/ (WebSocket /ws)\n", url_host(at.host).c_str(),
+                    http->port());
+    std::fflush(stdout);
+    server.serve(g_stop);
+    std::printf("serve: stopped after %d connection(s)\n", server.accepted());
+    return 0;
+}
+
+}  // namespace isowall

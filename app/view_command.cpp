@@ -1,0 +1,245 @@
+// `isowall view`: the remote-viewing client. Connects, draws each view's groups as they arrive,
+// and writes the final image, snapshots and the timeline of what it had on screen.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "app/remote_commands.h"
+#include "cli/cli_checks.h"
+#include "common/core/camera.h"
+#include "common/core/error.h"
+#include "common/core/number.h"
+#include "common/core/output_files.h"
+#include "common/core/util.h"
+#include "common/io/image_io.h"
+#include "common/wall/script.h"
+#include "remote/net/endpoint.h"
+#include "remote/view_client.h"
+#include "render/renderer.h"
+
+namespace isowall {
+namespace {
+
+using namespace remote;
+
+// The study's cases (the dissertation's section 4.2, and ours as the fifth).
+struct CaseSetting {
+    GroupEncoding encoding;
+    bool lod, cache;
+};
+constexpr CaseSetting kCases[] = {
+    {GroupEncoding::vertices, false, false},     // 1 base
+    {GroupEncoding::indexed, false, false},      // 2 primitive compression
+    {GroupEncoding::indexed, true, false},       // 3 + progressive LOD
+    {GroupEncoding::indexed, true, true},        // 4 + cached primitives
+    {GroupEncoding::compact_zstd, true, true}};  // 5 ours: compact + zstd
+
+GroupEncoding parse_encoding(const std::string& s) {
+    for (GroupEncoding e : kAllGroupEncodings) {
+        std::string name = to_string(e);
+        for (char& ch : name)
+            if (ch == '_' || ch == '+') ch = '-';
+        if (name == s) return e;
+    }
+    throw InputError("--encoding", "value",
+                     "expected vertices, indexed, compact or compact-zstd, got " + quote(s));
+}
+
+struct Viewer {
+    const ViewCommand& o;
+    ViewClient& client;
+    CaseSetting setting;
+    glm::ivec2 size;
+    Camera camera;
+    double iso = 0;
+    int frames = 0;
+    std::vector<std::string> csv;
+
+    FrameView view() const {
+        const Camera c = fit_depth_range(camera, client.ready().bounds);
+        return {c, c.frustum(float(size.x) / float(size.y)), size.x, size.y, iso};
+    }
+    void send() { client.request(view(), setting.lod, setting.cache); }
+
+    void report(const ClientFrameResult& r) {
+        ++frames;
+        const ClientSample& last = r.timeline.back();
+        std::printf(
+            "view: frame %d done in %.3f s: %llu bytes, %llu groups, %llu named, %llu "
+            "triangles drawn\n",
+            frames, last.time_s, (unsigned long long)last.bytes, (unsigned long long)last.groups,
+            (unsigned long long)last.named, (unsigned long long)last.triangles);
+        for (double th : {0.90, 0.99, 0.999, 1.0}) {
+            const ClientSample* hit = nullptr;
+            for (const ClientSample& s : r.timeline)
+                if (s.correctness.c >= th - 1e-12) {
+                    hit = &s;
+                    break;
+                }
+            if (hit)
+                std::printf("  C >= %5.1f%%: %8.3f s  %12llu bytes\n", 100 * th, hit->time_s,
+                            (unsigned long long)hit->bytes);
+        }
+        for (const ClientSample& s : r.timeline) {
+            char line[256];
+            std::snprintf(line, sizeof(line), "%d,%.6f,%llu,%llu,%llu,%llu,%.6f,%.6f", frames,
+                          s.time_s, (unsigned long long)s.bytes, (unsigned long long)s.groups,
+                          (unsigned long long)s.named, (unsigned long long)s.triangles,
+                          s.correctness.final_pixels, s.correctness.c);
+            csv.emplace_back(line);
+        }
+        std::fflush(stdout);
+    }
+
+    void wait_done() {
+        if (client.frame_active()) report(client.wait_done(o.timeout_s));
+    }
+
+    // One script command; false for quit.
+    bool execute(const ScriptCommand& cmd, const std::string& where) {
+        if (apply_camera_command(cmd, camera, float(size.x) / float(size.y))) {
+        } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
+            check_iso(c->iso, where, "iso");
+            iso = c->iso;
+        } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
+            if (c->until == WaitCmd::Until::time)
+                client.receive_for(c->amount);
+            else
+                wait_done();
+            return true;
+        } else if (const auto* c = std::get_if<SnapshotCmd>(&cmd)) {
+            const auto path = std::filesystem::path(o.out).parent_path() / (c->name + ".png");
+            Image img;
+            client.frames().read_back(img);
+            write_image(path, img);
+            std::printf("snapshot: %s\n", path.c_str());
+            return true;
+        } else if (std::holds_alternative<QuitCmd>(cmd)) {
+            return false;
+        }
+        if (std::string p = camera_problem(camera); !p.empty())
+            throw InputError(where, "camera", p);
+        send();
+        return true;
+    }
+
+    void check_iso(double v, const std::string& where, const std::string& field) const {
+        const ReadyMsg& r = client.ready();
+        if (!(v >= r.value_min && v <= r.value_max)) {
+            char msg[160];
+            std::snprintf(msg, sizeof(msg),
+                          "isovalue %g is outside the dataset's value range [%g, %g]", v,
+                          r.value_min, r.value_max);
+            throw InputError(where, field, msg);
+        }
+    }
+};
+
+}  // namespace
+
+CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
+    auto* c = app.add_subcommand(
+        "view",
+        "Remote-viewing client: asks isowall serve for views and draws their groups as "
+        "they arrive");
+    c->add_option("--connect", o.connect, "Server as HOST:PORT")->capture_default_str();
+    c->add_option("--dataset", o.dataset, "Dataset name the server offers")->capture_default_str();
+    c->add_option("--token", o.token, "The server's token, if it asks for one");
+    c->add_option("--case", o.test_case,
+                  "The study's cases: 1 base, 2 indexed, 3 indexed + progressive LOD, 4 indexed "
+                  "+ LOD + cache, 5 compact+zstd + LOD + cache (overrides the three options "
+                  "below)")
+        ->check(CLI::Range(1, 5));
+    c->add_option("--encoding", o.encoding, "vertices, indexed, compact or compact-zstd")
+        ->check(CLI::IsMember({"vertices", "indexed", "compact", "compact-zstd"}))
+        ->capture_default_str();
+    c->add_flag("--lod", o.lod, "Progressive LOD: two coarser levels first");
+    c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");
+    c->add_option("--iso", o.iso, "Isovalue (default for the phantom: skin, 50)")
+        ->transform(number_in(limits::kAnyFinite));
+    c->add_option("--size", o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
+    c->add_option("--orbit", o.orbit, "Rotate the front view: YAW PITCH in degrees")
+        ->expected(2)
+        ->transform(number_in(limits::kAngleDeg));
+    c->add_option("--zoom", o.zoom, "Zoom factor (>1 moves closer)")
+        ->transform(number_in(limits::kZoom))
+        ->capture_default_str();
+    c->add_option("--script", o.script,
+                  "Commands as for the wall (orbit, zoom, pan, look, iso, wait done, wait time "
+                  "S, snapshot NAME, quit); each view change is sent at once and interrupts the "
+                  "frame in progress");
+    c->add_option("--out,-o", o.out, "The last frame's final image")->capture_default_str();
+    c->add_option("--timeline", o.timeline,
+                  "CSV: frame, time_s, bytes, groups, named, triangles, final_pixels, c");
+    c->add_option("--gl", o.gl, "OpenGL back end")
+        ->check(CLI::IsMember({"osmesa", "egl"}))
+        ->capture_default_str();
+    c->add_option("--timeout", o.timeout_s, "Give up when nothing arrives for this long (s)")
+        ->transform(number_in(limits::kSeconds))
+        ->capture_default_str();
+    return c;
+}
+
+int run_view(const ViewCommand& o) {
+    const auto size = parse_size(o.size);
+    if (!size)
+        throw InputError(
+            "--size", "value",
+            "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
+    std::vector<OutputPath> outputs{{"--out", o.out}};
+    if (!o.timeline.empty()) outputs.push_back({"--timeline", o.timeline});
+    check_outputs(outputs);
+    if (std::string p = image_format_problem(o.out); !p.empty())
+        throw InputError(o.out, "--out", p);
+    std::vector<ScriptLine> script;
+    if (!o.script.empty()) script = load_script(o.script);
+    const Endpoint ep = parse_endpoint(o.connect, "--connect", "HOST:PORT");
+    CaseSetting setting{parse_encoding(o.encoding), o.lod, o.cache};
+    if (o.test_case > 0) setting = kCases[o.test_case - 1];
+
+    auto renderer = make_renderer(o.gl);
+    ClientHello hello;
+    hello.host = ep.host;
+    hello.port = ep.port;
+    hello.dataset = o.dataset;
+    hello.token = o.token;
+    hello.encoding = setting.encoding;
+    ViewClient client(*renderer, hello);
+    std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
+                o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
+                to_string(setting.encoding), setting.lod ? ", progressive LOD" : "",
+                setting.cache ? ", cached groups" : "");
+    Viewer v{o, client, setting, *size, {}, 0, 0, {}};
+    const float aspect = float(size->x) / float(size->y);
+    v.camera = front_full_view(client.ready().bounds, aspect);
+    if (o.orbit.size() == 2) v.camera = orbit(v.camera, o.orbit[0], o.orbit[1]);
+    v.camera = zoom(v.camera, float(o.zoom));
+    if (std::string p = camera_problem(v.camera); !p.empty())
+        throw InputError("--zoom", "value", p);
+    if (!o.iso && o.dataset != "phantom")
+        throw InputError("--iso", "value",
+                         "an isovalue is required for dataset " + quote(o.dataset));
+    v.iso = o.iso.value_or(50.0);
+    v.check_iso(v.iso, "--iso", "value");
+    v.send();
+    for (const ScriptLine& l : script)
+        if (!v.execute(l.command, o.script + ":" + std::to_string(l.line))) break;
+    v.wait_done();
+    client.close();
+
+    OutputFiles batch;
+    write_image(batch, o.out, client.frames().result().final_image);
+    if (!o.timeline.empty()) {
+        std::string text = "frame,time_s,bytes,groups,named,triangles,final_pixels,c\n";
+        for (const std::string& line : v.csv) text += line + "\n";
+        std::ofstream f(batch.stage(o.timeline), std::ios::binary);
+        f << text;
+        if (!f.flush()) throw std::runtime_error(o.timeline + ": cannot write the timeline");
+    }
+    batch.commit();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.timeline.empty() ? "" : " and ",
+                o.timeline.c_str());
+    return 0;
+}
+
+}  // namespace isowall

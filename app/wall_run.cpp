@@ -1,0 +1,263 @@
+#include "app/wall_run.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <tuple>
+
+#include "app/wall_outputs.h"
+#include "common/core/error.h"
+#include "common/core/util.h"
+#include "common/extract/surface_extractor.h"
+#include "common/volume/phantom.h"
+#include "common/wall/control_layout.h"
+#include "common/wall/script.h"
+#include "common/wall/wall.h"
+#include "master/console.h"
+#include "master/control_window.h"
+#include "master/wall_master.h"
+#include "render/renderer.h"
+#include "tile/preview_show.h"
+#include "tile/tile_loop.h"
+#include "tile/tile_window.h"
+
+namespace isowall {
+namespace {
+
+std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadBudget budget) {
+    OctreeSource src;
+    if (ov.file) src.volume_path = *ov.file;
+    src.cache_dir = ov.cache_dir;
+    return make_surface_extractor(ov.volume, src, nullptr, budget);
+}
+
+// The rank's thread budget: --threads, or its share of the node's cores (common/core/
+// thread_budget.h), so that ranks emulating a wall on one machine do not oversubscribe it.
+ThreadBudget rank_budget(const WallOptions& o, const Comm& comm) {
+    if (o.threads > 0) return ThreadBudget{o.threads};
+    return node_share(cores_allowed(), ThreadBudget::hardware().threads, comm.ranks_on_host());
+}
+
+// What the master checks before any frame starts: a bad volume, isovalue, output folder, engine
+// option or script line stops the job here, with one line naming the source and the field.
+struct MasterInput {
+    std::optional<OpenedVolume> volume;
+    std::unique_ptr<SurfaceExtractor> extractor;
+    double iso = 0;
+    std::vector<ScriptLine> script;
+};
+
+MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
+    MasterInput in;
+    // The master casts no ray: its volume stays in the shared map.
+    in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
+    const OpenedVolume& ov = *in.volume;
+    in.extractor = open_extractor(ov, budget);
+    in.iso = o.iso.value_or(kPhantomSkinIso);
+    if (!o.iso && ov.file)
+        throw InputError(ov.file->string(), "--iso",
+                         "an isovalue is required (see `isowall info`)");
+    if (!(in.iso >= in.extractor->value_min() && in.iso <= in.extractor->value_max()))
+        throw InputError(
+            ov.file ? ov.file->string() : "phantom", "--iso",
+            "isovalue " + std::to_string(in.iso) + " is outside the volume's value range");
+    to_engine_options(o.engine);
+    // The console and the window would both take the operator's commands; one at a time.
+    if (o.control && o.script == "-")
+        throw InputError("--control", "--script",
+                         "the console (--script -) and the control "
+                         "window cannot both drive the wall; give one, or a script file");
+    // A folder, a device or a missing file is an error naming --script (a folder read as empty).
+    if (!o.script.empty() && o.script != "-") in.script = load_script(o.script);
+    check_wall_outputs(o, load_wall(o.wall), in.script);
+    return in;
+}
+
+int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInput& in) {
+    MasterOptions mo;
+    mo.wall_name = o.wall;
+    mo.out = o.out;
+    mo.tiles_out = o.tiles_out;
+    mo.trace = o.trace;
+    mo.timeout_s = o.timeout_s;
+    mo.startup_timeout_s = o.startup_timeout_s;
+    if (o.fault.rank == kMasterRank) mo.fault = o.fault;
+    mo.results_out = o.results_out;
+    mo.balance = o.balance;
+    if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
+    mo.zoom = o.zoom;
+    if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
+    std::tie(mo.region_w, mo.region_h) = parse_region(o.region).value_or(std::pair{0, 0});
+    mo.screen_box = to_engine_options(o.engine).screen_box;
+    mo.measure = o.measure;
+    WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),
+                      in.extractor->value_max());
+    // Opened before the tiles load: a display that cannot open ends the job at once.
+    std::optional<ControlWindow> control;
+    if (o.control) control.emplace(spec, o.control_display, o.out);
+    master.start();
+    const std::string where = o.script.empty() ? std::string("--script") : o.script;
+    bool quit = false;
+    if (o.script == "-") {
+        run_console(
+            STDIN_FILENO,
+            [&](const ScriptCommand& c, const std::string& w) { return master.execute(c, w); },
+            [&] { master.idle(); });
+    } else {
+        for (const ScriptLine& l : in.script)
+            if (!master.execute(l.command, where + ":" + std::to_string(l.line))) {
+                quit = true;
+                break;
+            }
+    }
+    if (control && !quit)
+        control->run(master);
+    else if (o.script.empty())
+        master.execute(WaitCmd{WaitCmd::Until::done, 0}, where);
+    return master.finish();
+}
+
+int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
+    const OpenedVolume ov =
+        open_volume(o.volume, /*quiet=*/true, VolumeUse{.copies_on_host = comm.ranks_on_host()});
+    auto extractor = open_extractor(ov, budget);
+    // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
+    // thread, unless the user says otherwise: the work then stays on its core and in the frame
+    // thread's CPU clock, which the trace and the emulated time read. With more, llvmpipe keeps
+    // its raster threads (groups of 2,000 triangles draw 2.3x faster with one than with none,
+    // isowall_bench_render at 1024x768), and their CPU is not in the trace. A vendor driver
+    // ignores the variable. Ranks that are threads of one process (tests) leave the shared
+    // environment alone: another rank's thread may be reading it.
+    if (budget.usable() == 1 && comm.owns_process()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+    auto renderer = make_renderer(o.gl);
+    auto help_renderer = make_renderer(o.gl);
+    TileSetup setup{*extractor, *renderer, *help_renderer, to_engine_options(o.engine),
+                    {},         o.measure};
+    setup.engine.region_clip = o.region_clip;
+    setup.engine.threads = budget.usable();
+    if (o.fault.rank == comm.rank()) setup.fault = o.fault;
+    const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
+    setup.timeout_s = o.timeout_s;
+    setup.tile_width = tile.width;
+    setup.tile_height = tile.height;
+    std::optional<TileWindow> window;
+    if (o.windows) {
+        const int t = tile_of_rank(spec, comm.rank());
+        window.emplace(tile_display(spec, t), t, comm.host());
+        setup.shows.push_back(&*window);
+    }
+    std::optional<PreviewShow> preview;
+    if (o.control) {
+        preview.emplace(comm, preview_max_side(spec));
+        setup.shows.push_back(&*preview);
+    }
+    return run_tile(comm, setup);
+}
+
+// A tile waits for the master's start (the volume is loaded and its octree cached, so the tile
+// maps the same files rather than building its own), for at most the start-up limit.
+void await_start(Comm& comm, double timeout_s) {
+    const double limit_s = timeout_s + tile_grace_s(comm.rank());
+    Stopwatch waited;
+    while (waited.seconds() < limit_s) {
+        auto e = comm.receive(kMasterRank, 0.05);
+        if (!e) continue;
+        const Message m = decode_message(e->tag, e->bytes);
+        if (std::holds_alternative<StartMsg>(m)) return;
+        if (!std::holds_alternative<AliveMsg>(m))
+            throw WireError(std::string("expected start from the master, got ") +
+                            to_string(e->tag));
+    }
+    char msg[200];
+    std::snprintf(msg, sizeof(msg),
+                  "the master (rank 0) has not started the wall within %g s (--startup-timeout): "
+                  "it is still loading the volume, has stopped, or cannot be reached",
+                  timeout_s);
+    throw std::runtime_error(msg);
+}
+
+std::string role(const WallSpec& spec, int rank) {
+    return rank == kMasterRank ? std::string("master")
+                               : "tile " + std::to_string(tile_of_rank(spec, rank));
+}
+
+// The single failure path: whatever a rank throws is printed once, as one line, and ends the job.
+// Bad input names its source and field already; any other error is prefixed with the rank.
+[[noreturn]] void fail(Comm& comm, const WallSpec& spec, const std::exception& e, bool input) {
+    std::fflush(stdout);
+    if (input)
+        std::fprintf(stderr, "isowall: error: %s\n", e.what());
+    else
+        std::fprintf(stderr, "isowall: error: rank %d (%s): %s\n", comm.rank(),
+                     role(spec, comm.rank()).c_str(), e.what());
+    std::fflush(stderr);
+    comm.abort(input ? 1 : 2);
+    throw CommAborted(input ? 1 : 2);  // not reached: abort() ends the rank
+}
+
+}  // namespace
+
+std::optional<std::pair<int, int>> parse_region(const std::string& spec) {
+    if (spec == "tile") return std::pair{0, 0};
+    int w = 0, h = 0, used = 0;
+    if (std::sscanf(spec.c_str(), "%dx%d%n", &w, &h, &used) != 2 ||
+        used != static_cast<int>(spec.size()))
+        return std::nullopt;
+    if (w < 1 || h < 1 || w > 32768 || h > 32768) return std::nullopt;
+    return std::pair{w, h};
+}
+
+int run_wall(const WallOptions& o, Comm& comm) {
+    // Every rank reads the wall file (it is small): a bad file is the same error everywhere, and
+    // every rank can check the rank count against it without waiting for the master.
+    WallSpec spec;
+    try {
+        spec = load_wall(o.wall);
+    } catch (const std::exception& e) {
+        if ((comm.rank() == kMasterRank)) std::fprintf(stderr, "isowall: error: %s\n", e.what());
+        return 1;
+    }
+    if (comm.size() != rank_count(spec)) {
+        std::fprintf(
+            stderr,
+            "isowall: error: %s: tiles: the wall has %d tile(s), so it needs mpirun -np %d "
+            "(one master + one rank per tile); this job has %d ranks (rank %d)\n",
+            o.wall.c_str(), rank_count(spec) - 1, rank_count(spec), comm.size(), comm.rank());
+        return 1;
+    }
+    try {
+        // The master loads first and writes the octree cache; the tile ranks then map the same
+        // files, so the machine holds one copy of the volume and the octree.
+        if (!(comm.rank() == kMasterRank)) {
+            const ThreadBudget budget = rank_budget(o, comm);
+            send_message(
+                comm, kMasterRank,
+                TileHelloMsg{comm.host(), static_cast<std::uint32_t>(budget.usable()), false});
+            await_start(comm, o.startup_timeout_s);
+            if (o.fault.rank == comm.rank()) raise_test_signal(o.fault, FaultMoment::load);
+            return run_tile_rank(o, comm, spec, budget);
+        }
+        if (o.fault.rank == kMasterRank) raise_test_signal(o.fault, FaultMoment::load);
+        std::optional<MasterInput> input;
+        try {
+            input.emplace(check_master_input(o, rank_budget(o, comm)));
+        } catch (const InputError& e) {
+            fail(comm, spec, e, true);
+        }
+        return run_master(o, comm, spec, *input);
+    } catch (const CommAborted&) {
+        throw;  // another rank failed and has said why
+    } catch (const InputError& e) {
+        fail(comm, spec, e, true);
+    } catch (const std::exception& e) {
+        fail(comm, spec, e, false);
+    }
+}
+
+}  // namespace isowall

@@ -1,0 +1,116 @@
+#include "cli/volume_options.h"
+
+#include <cstdio>
+
+#include "cli/cli_checks.h"
+#include "common/core/error.h"
+#include "common/core/util.h"
+#include "common/volume/octree.h"
+#include "common/volume/phantom.h"
+
+namespace isowall {
+
+void add_volume_options(CLI::App& app, VolumeOptions& o) {
+    app.add_option("--volume,-v", o.path,
+                   "Volume file: .nrrd/.nhdr (NRRD), or headerless raw with --dims and --type. "
+                   "Default: the built-in phantom");
+    app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
+        ->expected(3)
+        ->transform(number_in({1, 2147483647.0, false, true}));
+    app.add_option("--type", o.type,
+                   "Raw voxel type: uint8 int8 uint16 int16 uint32 int32 float32 float64");
+    app.add_option("--spacing", o.spacing, "Raw voxel spacing: SX SY SZ (default 1 1 1)")
+        ->expected(3)
+        ->transform(number_in({1e-6, 1e6}));
+    app.add_option("--endian", o.endian, "Raw byte order: little or big")
+        ->check(CLI::IsMember({"little", "big"}));
+    app.add_option("--header-bytes", o.header_bytes, "Raw: bytes to skip at the start of the file")
+        ->transform(number_in({0, 9007199254740992.0, false, true}));
+    app.add_option("--cache-dir", o.cache_dir,
+                   "Octree cache folder (default $ISOWALL_CACHE_DIR, else ~/.cache/isowall)");
+    app.add_flag("--no-cache", o.no_cache,
+                 "Always build the octree; never read or write the cache");
+    app.add_option("--huge-pages", o.huge_pages,
+                   "Copy the volume into transparent huge pages for the engine's random reads: "
+                   "auto (from 256 MiB, when every rank's copy fits in half the available "
+                   "memory), on, off (keep the shared memory map). Default: auto")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
+}
+
+namespace {
+
+std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
+    const bool raw = !o.dims.empty() || !o.type.empty();
+    if (!raw) return std::nullopt;
+    if (o.path.empty())
+        throw InputError("--dims/--type", "--volume", "a raw volume needs --volume FILE");
+    if (o.dims.size() != 3) throw InputError(o.path, "--dims", "a raw volume needs --dims X Y Z");
+    if (o.type.empty()) throw InputError(o.path, "--type", "a raw volume needs --type T");
+    RawSpec spec;
+    spec.dims = {o.dims[0], o.dims[1], o.dims[2]};
+    const auto type = parse_voxel_type(o.type);
+    if (!type)
+        throw InputError(
+            o.path, "--type",
+            "expected one of uint8 int8 uint16 int16 uint32 int32 float32 float64, got " +
+                quote(o.type));
+    spec.type = *type;
+    if (!o.spacing.empty()) spec.spacing = {o.spacing[0], o.spacing[1], o.spacing[2]};
+    spec.endian = o.endian == "big" ? Endian::big : Endian::little;
+    spec.header_bytes = o.header_bytes;
+    return spec;
+}
+
+}  // namespace
+
+OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
+    OpenedVolume out;
+    Stopwatch sw;
+    if (o.path.empty()) {
+        if (!o.dims.empty() || !o.type.empty())
+            throw InputError("--dims/--type", "--volume", "raw options need --volume FILE");
+        out.volume = make_phantom();
+    } else {
+        out.volume = load_volume(o.path, raw_spec(o));
+        out.file = std::filesystem::path(o.path);
+    }
+    std::string huge_note;
+    if (use.casts) {
+        const auto mode = parse_huge_pages(o.huge_pages);
+        if (!mode)
+            throw InputError("--huge-pages", "value",
+                             "expected auto, on or off, got " + quote(o.huge_pages));
+        const HugePagesChoice choice = choose_huge_pages(
+            *mode, out.volume.bytes().size(), use.copies_on_host, thp_mode(), mem_available());
+        huge_note = " (huge pages: no, " + choice.why + ")";
+        if (choice.copy) {
+            try {
+                out.volume.copy_to_huge_pages();
+                huge_note = " (" + choice.why + ")";
+            } catch (const std::runtime_error& e) {
+                // The mapping failed (no address space or memory): asked for, that is the error;
+                // under auto the volume stays in its map, which works, only slower.
+                if (*mode == HugePages::on) throw InputError("--huge-pages", "on", e.what());
+                huge_note = std::string(" (huge pages: no, ") + e.what() + ")";
+            }
+        }
+    }
+    out.load_s = sw.seconds();
+    if (out.file && !o.no_cache)
+        out.cache_dir =
+            o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
+    if (quiet) return out;
+    const Volume& v = out.volume;
+    const glm::ivec3 d = v.dims();
+    const glm::vec3 s = v.spacing();
+    const char* where = v.in_huge_pages() ? "in huge pages"
+                        : v.mapped()      ? "memory-mapped"
+                                          : "in memory";
+    std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s%s  (%.2f s)\n",
+                v.source().c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
+                double(s.x), double(s.y), double(s.z), double(v.bytes().size()) / (1024.0 * 1024.0),
+                where, huge_note.c_str(), out.load_s);
+    return out;
+}
+
+}  // namespace isowall

@@ -1,0 +1,32 @@
+#pragma once
+// The fault tests' hook (ISOWALL_TEST_FAULT=KIND:RANK), parsed once where the program starts into
+// a typed value; the wall's ranks only compare enums. KIND is one of
+//   hang            a tile stops answering after its first view, until the job ends
+//   exit            a tile ends its process at once (process only; never in process)
+//   throw           a tile, or the master, throws an error after its first view
+//   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
+//   kill@MOMENT     the same with SIGKILL
+// MOMENT is init, load, frame, migration or gather.
+#include <cstdint>
+#include <string_view>
+
+namespace isowall {
+
+enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, stop, kill };
+enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather };
+
+struct TestFault {
+    FaultAction action = FaultAction::none;
+    FaultMoment moment = FaultMoment::none;  // of stop and kill only
+    int rank = -1;                           // the rank that fails
+};
+
+// "KIND:RANK" -> the fault; no fault (action none) when `spec` is null, empty or not of that form,
+// as without the variable.
+TestFault parse_test_fault(const char* spec);
+
+// When `fault` is a stop or kill at `moment`, this process sends itself SIGSTOP or SIGKILL.
+// Anything else does nothing.
+void raise_test_signal(const TestFault& fault, FaultMoment moment);
+
+}  // namespace isowall

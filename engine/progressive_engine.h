@@ -1,0 +1,179 @@
+#pragma once
+// The progressive view-dependent engine (chapters 2-3): fills a region of one view's pixels (a
+// whole tile, or later a screen-region job) ray by ray in a progressive order until every pixel of
+// the region that the volume covers has had its ray, or until it is stopped. Each ray that finds an
+// unvisited seed starts a propagation pass; the pass's group goes at once to a group sink (drawn
+// into the frame being built: no clear, no redraw of older groups, so drawing cost follows new
+// triangles only; recorded for the replay; later streamed).
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/core/camera.h"
+#include "common/core/image.h"
+#include "common/core/view.h"
+#include "common/extract/adaptive.h"
+#include "common/extract/surface_extractor.h"
+#include "common/progressive/correctness.h"
+#include "common/progressive/ray_order.h"
+#include "common/progressive/timeline.h"
+#include "common/progressive/trace.h"
+#include "engine/group_sink.h"
+#include "engine/region_cursor.h"
+
+namespace isowall {
+
+class Renderer;
+
+struct EngineOptions {
+    RayOrderKind order = RayOrderKind::dynamic_grid;
+    IntersectMode intersect = IntersectMode::exact;
+    PropagationParams propagation;
+    bool screen_box = true;  // cast no ray outside the volume's projected bounding box
+    // Within the box, cast no ray whose pixel no active node of a coarse octree level covers
+    // (common/progressive/screen_mask.h): such a ray cannot meet the surface. Needs screen_box.
+    bool screen_mask = true;
+    // Propagation enters only cells that may project into the region being cast (ScreenClip):
+    // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
+    // whole surface within their limits, as in the text.
+    bool region_clip = false;
+    // Adaptive resolution (chapter 2.1.3): where a meta-cell of 2^i cells per side projects to
+    // less than a pixel, extract it as one cell, up to 2^adaptive_max_level cells per side. Off:
+    // every cell at full resolution, exactly as without the option. adaptive_refine: draw a
+    // meta-cell again at full resolution where a pixel's ray sees the full-resolution surface that
+    // its triangles miss (common/extract/adaptive.h); false: the text's distance rule alone.
+    bool adaptive = false;
+    int adaptive_max_level = kMaxMetaLevel;
+    bool adaptive_refine = true;
+    // The projected size, in pixels, below which a meta-cell is taken (resolution_levels): 1 is
+    // the text's rule; 2 keeps triangles about a pixel on volumes finer than the screen.
+    float adaptive_pixels = 1.0f;
+    // Threads casting rays and propagating side by side over each ray-order level: at most the
+    // extractor's workers (its thread budget); 0: all of them. The calling thread is one of them
+    // and alone draws (the renderer's context is its own), taking the groups in the order of
+    // their ids. A sink that wants seen() gets one thread. With more than one, group ids may skip
+    // a number where two threads met one seed at once (the later pass finds it taken and is
+    // dropped), and the groups found differ from run to run; the final image does not.
+    int threads = 1;
+    // Timeline sampling: after ray counts growing by this factor, and at least this often.
+    double sample_ray_factor = 1.25;
+    double sample_interval_s = 0.1;
+    // Optional per-stage spans with thread CPU time (wall runs); null: no spans.
+    TraceRecorder* trace = nullptr;
+    // How often run() calls its progress callback (at sample points).
+    double progress_interval_s = 0.5;
+    // Extra samples exactly when these ray counts are reached (snapshots by rays).
+    std::vector<std::size_t> sample_at_rays;
+    // Remote viewing (sections 4.1.3-4.1.4). uniform_level > 0: every unit is a meta-cell of
+    // 2^uniform_level cells per side (where the meta-cell is complete; the volume's border falls
+    // back to cells), with no refinement: a coarse level of progressive LOD. Overrides adaptive.
+    int uniform_level = 0;
+    // False: the frame goes on from the extractor's visited cells instead of forgetting them (the
+    // caller began the extractor's frame at the view's isovalue and may have marked cells taken
+    // by groups a client caches); new groups' ids then start at first_group_id.
+    bool begin_extractor_frame = true;
+    std::uint32_t first_group_id = 0;
+};
+
+// The CPU of the engine's threads other than the caller's (EngineOptions::threads > 1), summed
+// over the frame's levels: their CPU seconds, and by how much each level's busiest worker
+// outlasted the caller. The caller's thread CPU plus beyond_s is the frame's time on cores of its
+// own (each level ends when its last thread does); plus sum_s, the CPU it used on all of them.
+struct WorkersCpu {
+    double sum_s = 0, beyond_s = 0;
+};
+
+struct FrameResult {
+    bool completed = false;  // false: interrupted before the last ray
+    std::size_t rays_cast = 0;
+    std::size_t rays_screen = 0;  // width * height: the share of rays is rays_cast / rays_screen
+    std::size_t rays_second_pass = 0;  // approximate mode: rays cast again exactly
+    double elapsed_s = 0;
+    std::size_t group_count = 0;
+    std::vector<Group> groups;  // every group in order (the convenience run() only)
+    std::vector<TimelineSample> timeline;
+    Image final_image;  // colour and depth after the last ray (the convenience run() only; empty
+                        // when interrupted)
+    PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
+    std::size_t screen_pixels = 0;  // of them, the pixels to cast (the screen mask's, if on)
+    // The screen mask's octree level and active nodes (-1 and 0 without the mask).
+    int mask_level = -1;
+    std::size_t mask_nodes = 0;
+    WorkersCpu workers;
+};
+
+class FrameRun;
+
+class ProgressiveEngine {
+  public:
+    // The engine draws nothing: each group goes to the sink a run is given. Only the whole-screen
+    // run() and measure() below take a renderer, to draw into.
+    explicit ProgressiveEngine(SurfaceExtractor& extractor, EngineOptions options = {});
+
+    using Progress = std::function<void(const TimelineSample&)>;
+
+    // Fills `region` of `view`'s screen, handing each group to `sink`. `stop` is read between rays
+    // and inside long propagation passes (a communication thread sets it when a new view
+    // arrives); once it reads true the frame ends at once with completed = false. `progress`
+    // (optional) sees the latest sample about every options().progress_interval_s.
+    FrameResult run(const FrameView& view, const PixelRect& region, GroupSink& sink,
+                    const std::atomic<bool>& stop, const Progress& progress = {});
+
+    // The whole screen drawn into `renderer` (warmed up beforehand: render/renderer.h warm_up),
+    // keeping every group and the final image in the result (what `isowall render` and the tests
+    // use).
+    FrameResult run(const FrameView& view, Renderer& renderer,
+                    const std::atomic<bool>* stop = nullptr, const Progress& progress = {});
+
+    // Replays the frame's groups in order and measures both correctness measures of the image at
+    // every timeline sample against the final image (not part of the timed run). `on_image` sees
+    // each replayed image, e.g. to write snapshots.
+    // The replay draws into `renderer`.
+    void measure(FrameResult& frame, const FrameView& view, Renderer& renderer,
+                 const std::function<void(const TimelineSample&, const Image&)>& on_image = {});
+
+    const EngineOptions& options() const { return options_; }
+
+  private:
+    friend class EngineFrame;
+    SurfaceExtractor& extractor_;
+    EngineOptions options_;
+};
+
+// One frame cast region by region, for callers that split the screen into jobs (a wall rank).
+// Every region cast in it, of any view of the frame's camera and isovalue, shares one set of
+// visited cells: a sink that is to show a region must therefore also hold the groups found
+// earlier in the frame for other regions (see tile/tile_jobs.cpp).
+class EngineFrame {
+  public:
+    // Begins the extractor's frame for `view`'s isovalue (and its pixel size, for adaptive
+    // resolution). The engine must outlive the frame.
+    EngineFrame(ProgressiveEngine& engine, const FrameView& view, const std::atomic<bool>& stop,
+                const ProgressiveEngine::Progress& progress = {});
+    ~EngineFrame();
+    EngineFrame(const EngineFrame&) = delete;
+    EngineFrame& operator=(const EngineFrame&) = delete;
+
+    // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box, and
+    // masked by the frame's screen mask (EngineOptions::screen_mask).
+    RegionCursor cursor(const FrameView& view, const PixelRect& region) const;
+    // Casts whole levels of `c` into `sink` until it has cast `ray_limit` more rays or is done;
+    // `view` must be the one the cursor was made for. False when stopped (c stays where it was).
+    bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink,
+              std::size_t ray_limit = SIZE_MAX);
+    // The frame's figures and timeline (groups and the final image are not kept here).
+    FrameResult finish(bool completed);
+    // The latest sample: rays, groups, triangles of the frame so far.
+    const TimelineSample& now() const;
+    // The workers' CPU so far (threads > 1).
+    const WorkersCpu& workers() const;
+
+  private:
+    std::unique_ptr<FrameRun> run_;
+};
+
+}  // namespace isowall

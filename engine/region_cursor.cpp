@@ -1,0 +1,84 @@
+#include "engine/region_cursor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "common/core/pixel_rect_ops.h"
+#include "common/core/ray.h"
+#include "common/progressive/mesh_coverage.h"
+#include "common/progressive/screen_mask.h"
+#include "engine/progressive_engine.h"
+
+namespace isowall {
+
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing) {
+    ResolutionLevels levels;
+    if (opt.uniform_level > 0) return uniform_levels(opt.uniform_level);
+    if (!opt.adaptive) return levels;
+    // D[] depends on the eye, the frustum and the pixel size only: once per frame (every tile of
+    // a wall has the same pixel size, so one frame serves all of them).
+    levels = resolution_levels(view.camera, view.frustum, view.height, spacing,
+                               opt.adaptive_max_level, opt.adaptive_pixels);
+    levels.refine = opt.adaptive_refine;
+    return levels;
+}
+
+RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
+                           const std::optional<Box3>& volume_box,
+                           const std::vector<Box3>* mask_boxes) {
+    RegionCursor c;
+    c.rect = intersect(region, view.screen());
+    if (volume_box)
+        c.rect = intersect(c.rect, screen_box(*volume_box, view.camera.view(), view.frustum,
+                                              view.width, view.height));
+    if (mask_boxes) {
+        ScreenMask m = screen_mask(*mask_boxes, view.camera.view(), view.frustum, view.width,
+                                   view.height, c.rect);
+        c.rect = m.rect;
+        c.mask = std::move(m.cast);
+        c.pixels = m.count;
+    } else {
+        c.pixels = pixel_count(c.rect);
+    }
+    c.done = c.pixels == 0;
+    return c;
+}
+
+void begin_order(RegionCursor& c, RayOrderKind kind) {
+    c.order = make_ray_order(kind, c.rect.width, c.rect.height,
+                             PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
+    c.sizing = kind == RayOrderKind::dynamic_grid;
+    if (c.sizing) c.drawn.assign(pixel_count(c.rect), 0);
+}
+
+void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view) {
+    add_mesh_coverage(mesh, view_m, view.frustum, view.width, view.height, c.rect, c.drawn);
+}
+
+void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+                         std::vector<std::uint8_t>& scratch) {
+    if (c.sizing) {
+        order.set_coverage(c.drawn);
+        c.sizing = order.wants_coverage();  // still searching: no piece found in the region yet
+        if (!c.sizing) c.drawn = {};
+        return;
+    }
+    if (!sink.coverage(scratch, c.rect)) scratch.assign(pixel_count(c.rect), 0);
+    order.set_coverage(scratch);
+}
+
+ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {
+    ScreenClip clip;
+    if (rect.width <= 0 || rect.height <= 0) return clip;
+    const glm::mat4 proj = sub_frustum(view.frustum, view.width, view.height, rect).matrix();
+    clip.active = true;
+    clip.clip_from_voxel = proj * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
+    clip.ndc_per_unit = std::max(std::abs(proj[0][0]), std::abs(proj[1][1]));
+    clip.half_diagonal = 0.5f * glm::length(spacing);
+    return clip;
+}
+
+}  // namespace isowall

@@ -1,0 +1,73 @@
+#pragma once
+// A region's place in its progressive ray order, and the pieces a frame is cast from: the
+// resolution levels of a frame, a region's cursor (clipped to the screen, the volume's screen box
+// and the screen mask), its ray order and the coverage that order is given, and the clip that
+// keeps propagation inside the region. engine/progressive_engine.cpp casts with them.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "common/core/box.h"
+#include "common/core/mesh.h"
+#include "common/core/view.h"
+#include "common/extract/adaptive.h"
+#include "common/extract/surface_extractor.h"
+#include "common/progressive/ray_order.h"
+#include "engine/group_sink.h"
+
+namespace isowall {
+
+struct EngineOptions;
+
+// The clip of `rect` of `view` for propagation (EngineOptions::region_clip): the region's own
+// frustum, from the voxel space of a volume of `spacing`; inactive for an empty rect.
+ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing);
+
+// A region's place in its progressive ray order, kept between the calls that cast it (the coarse
+// and the fine band of a wall job).
+struct RegionCursor {
+    // The pixels to cast: the region clipped to the screen and the screen box, or with the screen
+    // mask, to the bounding box of the mask's pixels in it.
+    PixelRect rect;
+    std::vector<std::uint8_t> mask;   // rect-local; 0: never cast. Empty: every pixel of rect
+    std::size_t pixels = 0;           // pixels of rect to cast (the mask's count, or rect's area)
+    std::unique_ptr<RayOrder> order;  // null before the first level and between passes
+    int pass = 0;                     // 1: the exact second pass of approximate mode
+    std::size_t rays = 0;             // cast so far
+    std::size_t hits = 0;             // of them, rays that met the surface
+    bool done = false;                // every pixel to cast has had its ray
+    // The dynamic grid before it has sized its grid: the groups this region finds add the pixels
+    // they cover to `drawn` (rect-local), which the order gets as the region's coverage, with no
+    // read-back from the renderer (common/progressive/mesh_coverage.h).
+    bool sizing = false;
+    std::vector<std::uint8_t> drawn;
+};
+
+// The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
+// every cell at full resolution; `spacing` is the volume's.
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing);
+
+// The cursor of `region` of `view`: the region clipped to the screen; with `volume_box`, to the
+// volume's projected box too; with `mask_boxes` (the active octree nodes of the frame's screen
+// mask, object space), to the bounding box of the pixels they cover, casting only those.
+RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
+                           const std::optional<Box3>& volume_box,
+                           const std::vector<Box3>* mask_boxes);
+
+// A new ray order for `c`'s next pass, which sees the region as a screen of its own (pixels and
+// coverage local to it); the dynamic grid starts sizing (RegionCursor::sizing).
+void begin_order(RegionCursor& c, RayOrderKind kind);
+// Adds what `mesh` covers of `c`'s region to c.drawn (`view_m`: view's camera matrix).
+void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view);
+// Gives `order` the region's coverage after a level that wants it: while sizing, c.drawn (and
+// sizing ends once the order has its size); else what `sink` shows (`scratch` holds it), or
+// nothing covered when the sink cannot tell.
+void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+                         std::vector<std::uint8_t>& scratch);
+
+}  // namespace isowall

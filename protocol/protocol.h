@@ -1,0 +1,221 @@
+#pragma once
+// Every message between the ranks of a wall run: one typed struct per message, each with its tag
+// and version; encode and decode live side by side in protocol.cpp. Decoding checks every length,
+// count, enum and size against the bytes and the limits below and throws WireError on anything
+// malformed, truncated, of another version or with trailing bytes.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "comm/comm.h"
+#include "common/core/preview.h"
+#include "common/core/view.h"
+#include "common/core/wire.h"
+#include "common/progressive/trace.h"
+#include "common/wall/wall.h"  // kMasterRank: the rank the messages go to and come from
+
+namespace isowall {
+
+// The MPI tag of each message. 16..31 are the screen-region scheduler's job messages.
+enum class Tag : std::int32_t {
+    hello = 1,        // tile -> master: its host name, once joined and again once loaded
+    view = 2,         // master -> tile: a new frame (interrupts the current one); jobs follow
+    progress = 3,     // tile -> master: rays cast so far in a frame
+    snapshot = 4,     // master -> tile: send the image being built
+    image = 5,        // tile -> master: an image (a snapshot answer, or the final one after quit)
+    quit = 6,         // master -> tile: send the result and the final image, then stop
+    tile_result = 7,  // tile -> master: a tile's figures and trace, its last message but the image
+    release = 8,      // master -> tile: every rank has sent its result; exit now
+    start = 9,        // master -> tile: the volume and its octree cache are ready; load them
+    alive = 10,       // both ways, every kAliveIntervalS: the sender's message loop is running
+    preview = 11,     // tile -> master (--control): a small copy of what the tile shows now
+    job = 16,         // master -> worker: fill a screen region of a tile (its own or another's)
+    job_done = 17,    // worker -> master: the job's figures; the worker is free for the next
+    region = 18,      // worker -> owner: colour and depth of a region it filled for the owner
+    landed = 19,      // owner -> master: a helper's region result has been composited
+};
+const char* to_string(Tag tag);
+
+// A tile says hello twice: as soon as it has joined the job (loaded = false), and once it has
+// loaded the volume and can take views (loaded = true). The master names the tiles it has not
+// heard from when a stage of the start-up runs past --startup-timeout.
+struct TileHelloMsg {
+    static constexpr Tag kTag = Tag::hello;
+    static constexpr std::uint8_t kVersion = 3;
+    std::string host;
+    std::uint32_t threads = 1;  // the rank's engine threads (its thread budget)
+    bool loaded = false;
+};
+
+struct ViewMsg {
+    static constexpr Tag kTag = Tag::view;
+    static constexpr std::uint8_t kVersion = 2;
+    std::uint64_t generation = 0;  // grows with every change of camera or isovalue
+    FrameView view;                // the tile's own view; its pixels come as jobs
+};
+
+struct ProgressMsg {
+    static constexpr Tag kTag = Tag::progress;
+    static constexpr std::uint8_t kVersion = 3;
+    std::uint64_t generation = 0;
+    std::uint64_t rays = 0;  // cast by this rank in this frame, for any tile
+    double cpu_s = 0;        // the frame thread's CPU seconds into the frame (emulated time)
+};
+
+struct SnapshotMsg {
+    static constexpr Tag kTag = Tag::snapshot;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+struct ImageMsg {
+    static constexpr Tag kTag = Tag::image;
+    static constexpr std::uint8_t kVersion = 2;
+    std::uint64_t generation = 0;
+    std::int32_t width = 0, height = 0;
+    std::vector<std::uint8_t> rgba;  // width * height * 4, row 0 at the top
+    std::vector<float> depth;        // empty, or width * height window depths (1 = background)
+};
+
+struct QuitMsg {
+    static constexpr Tag kTag = Tag::quit;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+// One point of a tile's correctness curve against emulated time (the last frame): what its
+// display showed once the jobs that ended by `emulated_s` had landed, as sums, so that the
+// master can add the tiles' sums into wall-wide measures.
+struct CurvePoint {
+    double emulated_s = 0;       // the CPU clock of the worker whose job ended here
+    std::uint64_t final_px = 0;  // significant pixels with their final colour
+    double squared_error = 0;    // sum over significant pixels of e(P)^2
+};
+
+struct TileResultMsg {
+    static constexpr Tag kTag = Tag::tile_result;
+    static constexpr std::uint8_t kVersion = 3;
+    std::string host;
+    double cpu_s = 0;    // the frame thread's CPU seconds, all frames
+    double frame_s = 0;  // wall seconds of all frames
+    double rss_mib = 0;
+    std::uint64_t rays = 0, groups = 0, triangles = 0, frames = 0, interrupted = 0;
+    std::uint64_t jobs_own = 0, jobs_helped = 0;  // jobs run for its own tile and for others
+    std::uint64_t bytes_sent = 0;                 // region results sent to other tiles
+    std::uint64_t significant = 0;                // covered pixels of the last frame's final image
+    std::vector<CurvePoint> curve;                // empty unless measured (--measure)
+    std::vector<TraceSpan> spans;
+};
+
+struct ReleaseMsg {
+    static constexpr Tag kTag = Tag::release;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+struct StartMsg {
+    static constexpr Tag kTag = Tag::start;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+// Liveness: a rank whose peer has sent nothing, not even this, for --timeout seconds ends the job
+// naming that peer (stopped, killed without a word, or on a host that cannot be reached).
+inline constexpr double kAliveIntervalS = 0.5;
+struct AliveMsg {
+    static constexpr Tag kTag = Tag::alive;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+// With --control, each tile sends the master a scaled-down copy of what it shows
+// (common/core/preview.h: make_preview) while a frame builds and when it ends; the master's control
+// window shows them as a live mosaic of the wall.
+struct PreviewMsg : Preview {
+    static constexpr Tag kTag = Tag::preview;
+    static constexpr std::uint8_t kVersion = 1;
+};
+
+// Which ray-order levels of a region a job casts: the coarse levels (until about 1/16 of the
+// region's rays) or the rest. Coarse jobs of every tile go before fine jobs anywhere.
+enum class Band : std::uint8_t { coarse = 0, fine = 1 };
+
+struct JobMsg {
+    static constexpr Tag kTag = Tag::job;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;
+    std::uint32_t job = 0;   // the master's id, unique within a generation
+    std::int32_t owner = 0;  // the rank whose tile the region is on
+    Band band = Band::coarse;
+    FrameView view;  // the owner's view
+    PixelRect rect;  // in the owner's screen; not empty
+};
+
+struct JobDoneMsg {
+    static constexpr Tag kTag = Tag::job_done;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;
+    std::uint32_t job = 0;
+    std::uint64_t rays = 0, groups = 0, triangles = 0;
+    double cpu_s = 0;      // the job's thread CPU seconds
+    double cpu_end_s = 0;  // the worker's thread CPU seconds into the frame when the job ended
+    double start_s = 0, end_s = 0;  // wall clock (trace time base)
+    std::uint64_t bytes = 0;        // the region result sent to the owner (0 for its own)
+};
+
+struct RegionMsg {
+    static constexpr Tag kTag = Tag::region;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;
+    std::uint32_t job = 0;
+    PixelRect rect;        // in the owner's screen; rgba and depth are its pixels
+    double cpu_end_s = 0;  // the helper's emulated time at the end of the job
+    std::vector<std::uint8_t> rgba;
+    std::vector<float> depth;
+};
+
+struct LandedMsg {
+    static constexpr Tag kTag = Tag::landed;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;
+    std::uint32_t job = 0;
+};
+
+using Message = std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
+                             TileResultMsg, ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg,
+                             JobDoneMsg, RegionMsg, LandedMsg>;
+
+std::vector<std::byte> encode(const TileHelloMsg& m);
+std::vector<std::byte> encode(const ViewMsg& m);
+std::vector<std::byte> encode(const ProgressMsg& m);
+std::vector<std::byte> encode(const SnapshotMsg& m);
+std::vector<std::byte> encode(const ImageMsg& m);
+std::vector<std::byte> encode(const QuitMsg& m);
+std::vector<std::byte> encode(const TileResultMsg& m);
+std::vector<std::byte> encode(const ReleaseMsg& m);
+std::vector<std::byte> encode(const StartMsg& m);
+std::vector<std::byte> encode(const AliveMsg& m);
+std::vector<std::byte> encode(const PreviewMsg& m);
+std::vector<std::byte> encode(const JobMsg& m);
+std::vector<std::byte> encode(const JobDoneMsg& m);
+std::vector<std::byte> encode(const RegionMsg& m);
+std::vector<std::byte> encode(const LandedMsg& m);
+std::vector<std::byte> encode(const Message& m);
+Tag tag_of(const Message& m);
+
+// Throws WireError naming the message and the fault; an unknown tag is an error too.
+Message decode_message(Tag tag, std::span<const std::byte> bytes);
+
+// The message as T; a message of another kind is a WireError ("expected view, got image").
+template <class T>
+T decode_as(Tag tag, std::span<const std::byte> bytes) {
+    if (tag != T::kTag)
+        throw WireError(std::string("expected a ") + to_string(T::kTag) + " message, got " +
+                        to_string(tag));
+    return std::get<T>(decode_message(tag, bytes));
+}
+
+// Encodes `message` and sends it under its own tag.
+template <class T>
+void send_message(Comm& comm, int dest, const T& message) {
+    comm.send(dest, T::kTag, encode(message));
+}
+
+}  // namespace isowall

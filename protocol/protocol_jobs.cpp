@@ -1,0 +1,165 @@
+// The screen-region scheduler's messages (tags 16..19), and release, start and alive (8..10), each
+// encoder right above its decoder, with the same value checks as the frame messages in
+// protocol.cpp.
+#include "protocol/protocol_jobs.h"
+
+#include <string>
+
+#include "common/core/wire_pieces.h"
+
+namespace isowall {
+
+using namespace wire_pieces;
+
+std::vector<std::byte> encode(const ReleaseMsg&) {
+    return MessageWriter(ReleaseMsg::kVersion).take();
+}
+
+ReleaseMsg job_wire::decode_release(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, ReleaseMsg::kVersion, "release message");
+    r.finish();
+    return {};
+}
+
+std::vector<std::byte> encode(const StartMsg&) {
+    return MessageWriter(StartMsg::kVersion).take();
+}
+
+StartMsg job_wire::decode_start(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, StartMsg::kVersion, "start message");
+    r.finish();
+    return {};
+}
+
+std::vector<std::byte> encode(const AliveMsg&) {
+    return MessageWriter(AliveMsg::kVersion).take();
+}
+
+AliveMsg job_wire::decode_alive(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, AliveMsg::kVersion, "alive message");
+    r.finish();
+    return {};
+}
+
+std::vector<std::byte> encode(const JobMsg& m) {
+    MessageWriter w(JobMsg::kVersion);
+    w.put(m.generation);
+    w.put(m.job);
+    w.put(m.owner);
+    w.put(static_cast<std::uint8_t>(m.band));
+    put_frame_view(w, m.view);
+    put_pixel_rect(w, m.rect);
+    return w.take();
+}
+
+namespace {
+
+// A rank that paints a region indexes its image with it: it must be a non-empty rectangle of the
+// screen, or it would write out of bounds.
+PixelRect get_region_rect(MessageReader& r, int width, int height) {
+    const PixelRect rect = get_pixel_rect(r);
+    if (rect.width <= 0 || rect.height <= 0 || !inside(rect, width, height))
+        r.fail("rect: expected a non-empty rectangle inside the " + std::to_string(width) + "x" +
+               std::to_string(height) + " screen, got " + to_text(rect));
+    return rect;
+}
+
+double get_seconds(MessageReader& r, const char* field) {
+    const double v = get_finite<double>(r, field);
+    if (v < 0) r.fail(std::string(field) + ": expected seconds >= 0, got " + std::to_string(v));
+    return v;
+}
+
+}  // namespace
+
+JobMsg job_wire::decode_job(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, JobMsg::kVersion, "job message");
+    JobMsg m;
+    m.generation = r.get<std::uint64_t>();
+    m.job = r.get<std::uint32_t>();
+    m.owner = r.get<std::int32_t>();
+    if (m.owner < 1) r.fail("owner: expected a tile rank (>= 1), got " + std::to_string(m.owner));
+    const auto band = r.get<std::uint8_t>();
+    if (band > static_cast<std::uint8_t>(Band::fine))
+        r.fail("band: expected 0 (coarse) or 1 (fine), got " + std::to_string(band));
+    m.band = static_cast<Band>(band);
+    m.view = get_frame_view(r);
+    m.rect = get_region_rect(r, m.view.width, m.view.height);
+    r.finish();
+    return m;
+}
+
+std::vector<std::byte> encode(const JobDoneMsg& m) {
+    MessageWriter w(JobDoneMsg::kVersion);
+    w.put(m.generation);
+    w.put(m.job);
+    w.put(m.rays);
+    w.put(m.groups);
+    w.put(m.triangles);
+    w.put(m.cpu_s);
+    w.put(m.cpu_end_s);
+    w.put(m.start_s);
+    w.put(m.end_s);
+    w.put(m.bytes);
+    return w.take();
+}
+
+JobDoneMsg job_wire::decode_job_done(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, JobDoneMsg::kVersion, "job_done message");
+    JobDoneMsg m;
+    m.generation = r.get<std::uint64_t>();
+    m.job = r.get<std::uint32_t>();
+    m.rays = r.get<std::uint64_t>();
+    m.groups = r.get<std::uint64_t>();
+    m.triangles = r.get<std::uint64_t>();
+    m.cpu_s = get_seconds(r, "cpu_s");
+    m.cpu_end_s = get_seconds(r, "cpu_end_s");
+    m.start_s = get_finite<double>(r, "start_s");
+    m.end_s = get_finite<double>(r, "end_s");
+    m.bytes = r.get<std::uint64_t>();
+    r.finish();
+    return m;
+}
+
+std::vector<std::byte> encode(const RegionMsg& m) {
+    MessageWriter w(RegionMsg::kVersion);
+    w.put(m.generation);
+    w.put(m.job);
+    put_pixel_rect(w, m.rect);
+    w.put(m.cpu_end_s);
+    put_pixels(w, m.rgba, m.depth);
+    return w.take();
+}
+
+RegionMsg job_wire::decode_region(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, RegionMsg::kVersion, "region message");
+    RegionMsg m;
+    m.generation = r.get<std::uint64_t>();
+    m.job = r.get<std::uint32_t>();
+    // The owner checks the rect against its own screen; here it must be a possible image.
+    m.rect = get_region_rect(r, kMaxImageSide, kMaxImageSide);
+    m.cpu_end_s = get_seconds(r, "cpu_end_s");
+    const std::uint64_t pixels =
+        static_cast<std::uint64_t>(m.rect.width) * static_cast<std::uint64_t>(m.rect.height);
+    get_pixels(r, pixels, /*depth_optional=*/false, m.rgba, m.depth);
+    r.finish();
+    return m;
+}
+
+std::vector<std::byte> encode(const LandedMsg& m) {
+    MessageWriter w(LandedMsg::kVersion);
+    w.put(m.generation);
+    w.put(m.job);
+    return w.take();
+}
+
+LandedMsg job_wire::decode_landed(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, LandedMsg::kVersion, "landed message");
+    LandedMsg m;
+    m.generation = r.get<std::uint64_t>();
+    m.job = r.get<std::uint32_t>();
+    r.finish();
+    return m;
+}
+
+}  // namespace isowall

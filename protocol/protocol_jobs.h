@@ -1,0 +1,19 @@
+#pragma once
+// The decoders of the scheduler's messages (protocol/protocol_jobs.cpp), for decode_message only:
+// callers decode through decode_message, which picks one by tag.
+#include <cstddef>
+#include <span>
+
+#include "protocol/protocol.h"
+
+namespace isowall::job_wire {
+
+ReleaseMsg decode_release(std::span<const std::byte> bytes);
+StartMsg decode_start(std::span<const std::byte> bytes);
+AliveMsg decode_alive(std::span<const std::byte> bytes);
+JobMsg decode_job(std::span<const std::byte> bytes);
+JobDoneMsg decode_job_done(std::span<const std::byte> bytes);
+RegionMsg decode_region(std::span<const std::byte> bytes);
+LandedMsg decode_landed(std::span<const std::byte> bytes);
+
+}  // namespace isowall::job_wire
