@@ -86,7 +86,7 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();
     c->add_option("--lod-rays", o.lod_rays_percent,
-                  "Progressive LOD: rays of each coarse level, in percent of the view's pixels")
+                  "Progressive LOD: rays of each coarse LOD level, in percent of the view's pixels")
         ->transform(number_in({0, 100, true}))
         ->capture_default_str();
     c->add_option("--cache-dir", o.cache_dir, "Octree cache folder (default: beside the volume)");

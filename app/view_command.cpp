@@ -153,7 +153,7 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     c->add_option("--encoding", o.encoding, "vertices, indexed, compact or compact-zstd")
         ->check(CLI::IsMember({"vertices", "indexed", "compact", "compact-zstd"}))
         ->capture_default_str();
-    c->add_flag("--lod", o.lod, "Progressive LOD: two coarser levels first");
+    c->add_flag("--lod", o.lod, "Progressive LOD: two coarser LOD levels first");
     c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");
     c->add_option("--iso", o.iso, "Isovalue (default for the phantom: skin, 50)")
         ->transform(number_in(limits::kAnyFinite));

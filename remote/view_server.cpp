@@ -1,11 +1,11 @@
 #include "remote/view_server.h"
 
-#include <condition_variable>
 #include <cstdio>
 #include <list>
 #include <optional>
 
 #include "common/core/error.h"
+#include "common/core/newest_request.h"
 #include "remote/net/socket.h"
 
 namespace isowall::remote {
@@ -150,26 +150,17 @@ class ViewServer::Client {
                                                  " message from a client");
                 return;
             }
-            std::lock_guard lock(mutex_);
-            pending_ = *r;
-            stop_frame_ = true;  // under the lock: the worker resets it only when it takes pending_
-            wake_.notify_one();
+            requests_.put(*r);
         }
     }
 
     void work() {
         for (;;) {
-            RequestMsg r;
-            {
-                std::unique_lock lock(mutex_);
-                wake_.wait(lock, [this] { return pending_ || closing_; });
-                if (closing_) return;
-                r = *pending_;
-                pending_.reset();
-                stop_frame_ = false;
-            }
+            const std::optional<RequestMsg> next = requests_.take();
+            if (!next) return;
+            const RequestMsg& r = *next;
             try {
-                const RequestFigures f = session_->run(r, stop_frame_);
+                const RequestFigures f = session_->run(r, requests_.stop_flag());
                 if (server_.options_.verbose)
                     std::printf(
                         "serve: %s: request %llu %s: %llu groups, %llu named, %llu "
@@ -192,12 +183,7 @@ class ViewServer::Client {
     }
 
     void stop_worker() {
-        {
-            std::lock_guard lock(mutex_);
-            closing_ = true;
-            stop_frame_ = true;
-            wake_.notify_one();
-        }
+        requests_.close();
         if (worker_.joinable()) worker_.join();
     }
 
@@ -207,11 +193,7 @@ class ViewServer::Client {
     GroupEncoding encoding_ = GroupEncoding::compact_zstd;
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
-    std::mutex mutex_;
-    std::condition_variable wake_;
-    std::optional<RequestMsg> pending_;
-    bool closing_ = false;
-    std::atomic<bool> stop_frame_{false};
+    NewestRequest<RequestMsg> requests_;  // the reader puts, the worker takes
     std::atomic<bool> done_{false};
 };
 
