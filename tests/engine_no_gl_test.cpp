@@ -24,14 +24,19 @@ FrameView front_view(const Volume& v, int w, int h, double iso) {
     return fv;
 }
 
-TEST(EngineNoGl, AFrameIntoARecordingSinkCastsEveryRayAndFindsTheSurface) {
+// A frame of the phantom's skin into `sink`, stopped before it starts when `stopped`.
+FrameResult record_frame(RecordingSink& sink, bool stopped) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     ProgressiveEngine engine(*ex);
     const FrameView fv = front_view(p, 96, 72, kPhantomSkinIso);
+    const std::atomic<bool> stop{stopped};
+    return engine.run(fv, fv.screen(), sink, stop);
+}
+
+TEST(EngineNoGl, AFrameIntoARecordingSinkCastsEveryRayAndFindsTheSurface) {
     RecordingSink sink;
-    const std::atomic<bool> stop{false};
-    const FrameResult fr = engine.run(fv, fv.screen(), sink, stop);
+    const FrameResult fr = record_frame(sink, false);
     ASSERT_TRUE(fr.completed);
     EXPECT_EQ(fr.rays_cast, fr.screen_pixels) << "every pixel to cast had its ray";
     ASSERT_GT(sink.groups.size(), 0u);
@@ -43,13 +48,8 @@ TEST(EngineNoGl, AFrameIntoARecordingSinkCastsEveryRayAndFindsTheSurface) {
 }
 
 TEST(EngineNoGl, AStoppedFrameHandsNothingToItsSink) {
-    const Volume p = make_phantom();
-    auto ex = make_surface_extractor(p);
-    ProgressiveEngine engine(*ex);
-    const FrameView fv = front_view(p, 96, 72, kPhantomSkinIso);
     RecordingSink sink;
-    const std::atomic<bool> stop{true};
-    const FrameResult fr = engine.run(fv, fv.screen(), sink, stop);
+    const FrameResult fr = record_frame(sink, true);
     EXPECT_FALSE(fr.completed);
     EXPECT_TRUE(sink.groups.empty());
 }
