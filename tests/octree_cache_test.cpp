@@ -92,6 +92,25 @@ void flip_node_byte(const CacheScene&, const fs::path& cache_file) {
     f.put(c);
 }
 
+// A bit of the header's value range (issue 30: the range lay outside the checksum, so a flipped
+// bit was served as the volume's range). `offset`: a byte of finite_min (56..63) or finite_max
+// (64..71) in the header.
+void flip_header_byte(const fs::path& cache_file, std::streamoff offset) {
+    std::fstream f(cache_file, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekg(offset);
+    const char c = static_cast<char>(f.get() ^ 0x10);
+    f.seekp(offset);
+    f.put(c);
+}
+
+void flip_range_max(const CacheScene&, const fs::path& cache_file) {
+    flip_header_byte(cache_file, 70);  // 49.0 becomes 98.0
+}
+
+void flip_range_min(const CacheScene&, const fs::path& cache_file) {
+    flip_header_byte(cache_file, 63);
+}
+
 void truncate_cache(const CacheScene&, const fs::path& cache_file) {
     fs::resize_file(cache_file, fs::file_size(cache_file) - 8);
 }
@@ -108,6 +127,8 @@ TEST(OctreeCache, NeverServesNodesThatDoNotMatchTheirFilesOrChecksum) {
         {"data replaced behind the header", replace_data_by_rename, "stale", 98.0f},
         {"data rewritten, mtime restored", rewrite_data_same_mtime, "stale", 147.0f},
         {"a node byte flipped", flip_node_byte, "damaged", 49.0f},
+        {"the range's maximum flipped", flip_range_max, "damaged", 49.0f},
+        {"the range's minimum flipped", flip_range_min, "damaged", 49.0f},
         {"cache truncated", truncate_cache, "truncated", 49.0f},
         {"cache emptied", empty_cache, "stale", 49.0f},
     };

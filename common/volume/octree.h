@@ -159,11 +159,16 @@ std::filesystem::path file_for(const std::filesystem::path& cache_dir,
                                const std::filesystem::path& volume_path);
 // 64-bit FNV-1a over 8-byte words (the tail bytes zero-padded): a changed word always changes it.
 std::uint64_t checksum(std::span<const std::byte> bytes);
+// The header's checksum: the node bytes', continued over the value range's fields (a flipped bit
+// in the range is a damaged file, not a range to serve).
+std::uint64_t content_checksum(std::span<const std::byte> nodes, double finite_min,
+                               double finite_max, std::uint64_t has_finite);
 struct Hit {
     std::span<const std::byte> nodes;
     FiniteRange range;
 };
-// The node bytes of a cache file whose header matches `key` and whose nodes match their checksum;
+// The node bytes of a cache file whose header matches `key` and whose nodes and value range match
+// their checksum;
 // nullopt (and `why`: stale, truncated or damaged) otherwise.
 std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
                          std::string* why);

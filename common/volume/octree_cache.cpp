@@ -31,7 +31,7 @@ namespace octree_cache {
 namespace {
 
 // Bumped whenever the layout of the nodes or of the header changes.
-constexpr char kMagic[8] = {'I', 'S', 'O', 'W', 'O', 'C', 'T', '2'};
+constexpr char kMagic[8] = {'I', 'S', 'O', 'W', 'O', 'C', 'T', '3'};
 
 struct Header {
     char magic[8];
@@ -41,8 +41,9 @@ struct Header {
     std::uint32_t pad;
     std::uint64_t sources;  // Key::sources
     std::uint64_t node_bytes;
-    // What the nodes decide, after the key:
-    std::uint64_t node_checksum;    // checksum() of the node bytes
+    // What the nodes decide, after the key. The checksum covers the value range too: every byte
+    // of the file that the program trusts is either in the key or under the checksum.
+    std::uint64_t content_checksum;  // content_checksum(): the node bytes, then the range fields
     double finite_min, finite_max;  // FiniteRange, when has_finite is 1
     std::uint64_t has_finite;
 };
@@ -51,7 +52,7 @@ constexpr std::size_t kNodeOffset = 128;  // keeps the nodes 16-byte aligned for
 
 // The header without what only the nodes decide (their checksum and value range): two headers
 // for one key compare equal on these bytes.
-constexpr std::size_t kKeyBytes = offsetof(Header, node_checksum);
+constexpr std::size_t kKeyBytes = offsetof(Header, content_checksum);
 
 Header header_for(const Key& key, std::size_t node_bytes) {
     Header h{};
@@ -78,6 +79,12 @@ std::uint64_t fnv_string(std::uint64_t h, const std::string& s) {
     return fnv_mix(h, s.size());
 }
 
+std::uint64_t bits_of(double v) {
+    std::uint64_t w;
+    std::memcpy(&w, &v, sizeof(w));
+    return w;
+}
+
 }  // namespace
 
 std::uint64_t checksum(std::span<const std::byte> bytes) {
@@ -91,6 +98,14 @@ std::uint64_t checksum(std::span<const std::byte> bytes) {
     std::uint64_t tail = 0;
     if (i < bytes.size()) std::memcpy(&tail, bytes.data() + i, bytes.size() - i);
     return fnv_mix(fnv_mix(h, tail), bytes.size());
+}
+
+std::uint64_t content_checksum(std::span<const std::byte> nodes, double finite_min,
+                               double finite_max, std::uint64_t has_finite) {
+    std::uint64_t h = checksum(nodes);
+    for (std::uint64_t w : {bits_of(finite_min), bits_of(finite_max), has_finite})
+        h = fnv_mix(h, w);
+    return h;
 }
 
 std::optional<Key> key_for(const std::vector<std::filesystem::path>& files, VoxelType type,
@@ -142,7 +157,9 @@ std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t nod
     FiniteRange range;
     if (have.has_finite) range.merge(have.finite_min), range.merge(have.finite_max);
     const bool range_ok = (have.has_finite != 0) == range.any && have.has_finite <= 1;
-    if (checksum(nodes) != have.node_checksum || !range_ok) {
+    const std::uint64_t sum =
+        content_checksum(nodes, have.finite_min, have.finite_max, have.has_finite);
+    if (sum != have.content_checksum || !range_ok) {
         if (why) *why = "cache file is damaged (checksum mismatch), rebuilt";
         return std::nullopt;
     }
@@ -160,10 +177,11 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
         write_output(file, [&](const std::filesystem::path& tmp) {
             std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
             Header h = header_for(key, nodes.size());
-            h.node_checksum = checksum(nodes);
             h.has_finite = range.any ? 1 : 0;
             h.finite_min = range.min;
             h.finite_max = range.max;
+            h.content_checksum =
+                content_checksum(nodes, h.finite_min, h.finite_max, h.has_finite);
             char pad[kNodeOffset] = {};
             std::memcpy(pad, &h, sizeof(h));
             out.write(pad, kNodeOffset);
