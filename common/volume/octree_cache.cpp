@@ -44,7 +44,7 @@ struct Header {
     // What the nodes decide, after the key. The checksum covers the value range too: every byte
     // of the file that the program trusts is either in the key or under the checksum.
     std::uint64_t content_checksum;  // content_checksum(): the node bytes, then the range fields
-    double finite_min, finite_max;  // FiniteRange, when has_finite is 1
+    double finite_min, finite_max;   // FiniteRange, when has_finite is 1
     std::uint64_t has_finite;
 };
 static_assert(sizeof(Header) == 80);
@@ -180,8 +180,7 @@ bool write(const std::filesystem::path& file, const Key& key, std::span<const st
             h.has_finite = range.any ? 1 : 0;
             h.finite_min = range.min;
             h.finite_max = range.max;
-            h.content_checksum =
-                content_checksum(nodes, h.finite_min, h.finite_max, h.has_finite);
+            h.content_checksum = content_checksum(nodes, h.finite_min, h.finite_max, h.has_finite);
             char pad[kNodeOffset] = {};
             std::memcpy(pad, &h, sizeof(h));
             out.write(pad, kNodeOffset);
