@@ -39,11 +39,6 @@ remote::Dataset load_dataset(const std::string& name, const std::string& path,
     return d;
 }
 
-// "127.0.0.1" stays as it is; an IPv6 address goes in brackets, as a URL needs it.
-std::string url_host(const std::string& address) {
-    return address.find(':') == std::string::npos ? address : "[" + address + "]";
-}
-
 // --listen in the endpoint form of view --connect; a port given there and in --port is an error.
 remote::Endpoint listen_endpoint(const ServeCommand& o) {
     remote::Endpoint at = remote::parse_listen_endpoint(o.listen, -1, "--listen", "endpoint");
@@ -130,8 +125,8 @@ int run_serve(const ServeCommand& o) {
         o.token.empty() ? "" : " (token required)",
         o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
     if (http)
-        std::printf("serve: page at http://%s:%d/ (WebSocket /ws)\n", url_host(at.host).c_str(),
-                    http->port());
+        std::printf("serve: page at http://%s/ (WebSocket /ws)\n",
+                    remote::host_port(at.host, http->port()).c_str());
     std::fflush(stdout);
     server.serve(g_stop);
     std::printf("serve: stopped after %d connection(s)\n", server.accepted());

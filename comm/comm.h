@@ -1,8 +1,9 @@
 #pragma once
 // The thin messaging layer between the ranks of a wall run (STYLE.md: IceT's communicator,
 // OSPRay's MPI_CALL). Two transports: MPI (comm/mpi_comm.cpp, the only file that includes mpi.h)
-// and in-process (comm/inproc_comm.h: every rank a thread, for tests). The wall logic sees only
-// this interface and the typed messages of protocol/protocol.h.
+// and in-process (comm/inproc_comm.h: every rank a thread, for tests). A Comm carries bytes under
+// a Tag and knows no message: the wall's typed messages, the Tag's values and send_message are
+// protocol/protocol.h's.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
