@@ -56,6 +56,12 @@ std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
                     double(ov.volume.voxel_count()) / std::max(st.build_s, 1e-9) / 1e6,
                     st.cache_file.empty() ? "" : ", cached to ", st.cache_file.c_str());
     }
+    if (st.lod_from_cache)
+        std::printf("octree: meta-cell errors mapped from the cache\n");
+    else
+        std::printf("octree: meta-cell errors computed in %.3f s (%.0f M voxels/s)\n",
+                    st.lod_build_s,
+                    double(ov.volume.voxel_count()) / std::max(st.lod_build_s, 1e-9) / 1e6);
     if (!st.cache_note.empty()) std::printf("octree: note: %s\n", st.cache_note.c_str());
     const OctreeShape& shape = ex->octree_shape();
     std::printf(

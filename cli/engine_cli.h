@@ -22,6 +22,8 @@ struct EngineCli {
     int adaptive_max_level = 3;
     float adaptive_pixels = 1.0f;
     bool no_adaptive_refine = false;
+    float adaptive_error = 0.5f;
+    bool no_adaptive_error = false;
     bool facing_only = false;
 };
 

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -52,6 +53,10 @@ struct EngineOptions {
     // The projected size, in pixels, below which a meta-cell is taken (resolution_levels): 1 is
     // the text's rule; 2 keeps triangles about a pixel on volumes finer than the screen.
     float adaptive_pixels = 1.0f;
+    // The error rule (common/volume/lod_error.h): a meta-cell is also taken only where its
+    // surface lies within this many pixels of the full-resolution surface, projected. Infinite:
+    // the distance rule alone.
+    float adaptive_error_px = std::numeric_limits<float>::infinity();
     // Threads casting rays and propagating side by side over each ray-order level: at most the
     // extractor's workers (its thread budget); 0: all of them. The calling thread is one of them
     // and alone draws (the renderer's context is its own), taking the groups in the order of

@@ -21,7 +21,7 @@ ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, g
     // D[] depends on the eye, the frustum and the pixel size only: once per frame (every tile of
     // a wall has the same pixel size, so one frame serves all of them).
     levels = resolution_levels(view.camera, view.frustum, view.height, spacing,
-                               opt.adaptive_max_level, opt.adaptive_pixels);
+                               opt.adaptive_max_level, opt.adaptive_pixels, opt.adaptive_error_px);
     levels.refine = opt.adaptive_refine;
     return levels;
 }

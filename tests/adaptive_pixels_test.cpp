@@ -59,7 +59,9 @@ FrameFigures run_frame(const Volume& volume, const FrameView& fv, float pixels, 
     for (const Group& g : fr.groups) {
         r.triangles += g.mesh.triangle_count();
         r.refinements += g.refinement;
-        if (!g.refinement && g.level > 0) r.coarse_units += g.cells.size();
+        if (!g.refinement)
+            for (std::size_t i = 0; i < g.cells.size(); ++i)
+                r.coarse_units += g.level_of_cell(i) > 0;
     }
     r.c = measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv)).c;
     std::cout << "  " << pixels << " px" << (refine ? "" : ", unrefined") << ": C " << r.c << ", "

@@ -215,11 +215,12 @@ void expect_groups_partition_the_visited_cells(SurfaceExtractor& ex, const Volum
     std::vector<std::uint8_t> taken(std::size_t(cells.x) * cells.y * cells.z, 0);
     std::size_t inactive = 0, twice = 0, wrong_group = 0, misaligned = 0, covered = 0;
     for (const Group& g : fr.groups) {
-        const int s = 1 << g.level;
-        for (const glm::ivec3 base : g.cells) {
+        for (std::size_t i = 0; i < g.cells.size(); ++i) {
+            const glm::ivec3 base = g.cells[i];
+            const int level = g.level_of_cell(i), s = 1 << level;
             misaligned += glm::any(glm::notEqual(base & (s - 1), glm::ivec3(0)));
             double corner[8];
-            meta_cell_corners(v, base, g.level, corner);
+            meta_cell_corners(v, base, level, corner);
             const int cs = cell_case(corner, ex.iso());
             inactive += cs == 0 || cs == 255;
             for (int z = 0; z < s; ++z)
@@ -256,7 +257,7 @@ Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions
             continue;
         }
         ++f.groups[std::size_t(g.level)];
-        f.units[std::size_t(g.level)] += g.cells.size();
+        for (std::size_t i = 0; i < g.cells.size(); ++i) ++f.units[std::size_t(g.level_of_cell(i))];
     }
     expect_groups_partition_the_visited_cells(*ex, volume, fr);
     f.correctness =

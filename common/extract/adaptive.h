@@ -30,7 +30,9 @@
 //     Propagator::refine), so a pixel whose ray sees the surface is not left empty. (What remains:
 //     a ray that hits a triangle within rasterization precision of an edge whose other side no
 //     group has drawn; full resolution has the same tie, where it is rarer.)
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <ostream>
@@ -40,6 +42,7 @@
 
 #include "common/core/camera.h"
 #include "common/extract/marching_cubes.h"
+#include "common/volume/lod_error.h"
 
 namespace isowall {
 
@@ -56,6 +59,14 @@ struct ResolutionLevels {
     glm::vec3 eye{0};    // object space
     int max_level = 0;   // levels above this are never used; 0 = full resolution
     bool refine = true;  // refinement on ray evidence (see above); false: the text's rule alone
+    // The error rule (common/volume/lod_error.h): a meta-cell is also coarse enough only where its
+    // error, projected, is at most error_px pixels. Infinite: no error rule (distance alone).
+    float error_px = std::numeric_limits<float>::infinity();
+    float pixel_slope = 0;  // perspective: one pixel's object size per unit of distance
+    float pixel_size = 0;   // orthographic: one pixel's object size
+    // A propagation pass goes on into units of another level (the boundaries the error rule
+    // draws anywhere); false: it stops there (uniform levels, whose groups name one level).
+    bool cross_levels = true;
 
     // The largest i in [1, max_level] with distance > d[i], else 0.
     int level_at(float distance) const {
@@ -83,10 +94,12 @@ struct ResolutionLevels {
 // `pixels` is the projected size below which a meta-cell is taken: 1 is the text's rule (a
 // meta-cell smaller than a pixel, so its triangles are smaller still); 2 lets a meta-cell reach
 // two pixels, so that its triangles are about a pixel and a volume with more voxels than the
-// screen has pixels draws about as many triangles as one matched to the screen (issue 10).
+// screen has pixels draws about as many triangles as one matched to the screen (issue 10);
+// infinity, no size limit. `error_px`: the error rule's bound (infinite: off).
 ResolutionLevels resolution_levels(const Camera& camera, const Frustum& frustum, int height_px,
                                    glm::vec3 spacing, int max_level = kMaxMetaLevel,
-                                   float pixels = 1.0f);
+                                   float pixels = 1.0f,
+                                   float error_px = std::numeric_limits<float>::infinity());
 
 std::ostream& operator<<(std::ostream& os, const ResolutionLevels& r);
 
@@ -100,6 +113,7 @@ inline ResolutionLevels uniform_levels(int level) {
     levels.d[static_cast<std::size_t>(level)] = 0;  // every distance is past D[level]
     levels.max_level = level;
     levels.refine = false;
+    levels.cross_levels = false;
     return levels;
 }
 
@@ -109,17 +123,32 @@ inline ResolutionLevels uniform_levels(int level) {
 class ResolutionMap {
   public:
     ResolutionMap() = default;
-    ResolutionMap(const ResolutionLevels& levels, glm::vec3 spacing, glm::ivec3 cell_dims)
+    // `errors`: the volume's meta-cell errors, for the error rule; it must outlive the map.
+    // Without them (or with levels.error_px infinite) the distance rule decides alone.
+    ResolutionMap(const ResolutionLevels& levels, glm::vec3 spacing, glm::ivec3 cell_dims,
+                  const LodErrors* errors = nullptr)
         : spacing_(spacing),
           cell_dims_(cell_dims),
           eye_(levels.eye),
           max_level_(levels.max_level),
-          refine_(levels.refine) {
+          refine_(levels.refine),
+          cross_levels_(levels.cross_levels) {
         for (std::size_t i = 0; i < levels.d.size(); ++i) d2_[i] = levels.d[i] * levels.d[i];
+        if (errors && !errors->empty() && std::isfinite(levels.error_px)) {
+            // error (cells) * s_max <= error_px * (pixel_slope * distance + pixel_size), the
+            // object-space bound of lod_error.h against the pixel at the meta-cell's distance.
+            errors_ = errors;
+            const float s_max = std::max({spacing.x, spacing.y, spacing.z});
+            const float k = levels.error_px * levels.pixel_slope / s_max;
+            const float c = levels.error_px * levels.pixel_size / s_max;
+            err_k2_ = k * k;
+            err_c2_ = c * c;
+        }
     }
 
     int max_level() const { return max_level_; }
     bool refine() const { return refine_; }
+    bool cross_levels() const { return cross_levels_; }
 
     // Whether the meta-cell of `level` >= 1 at `base` (a multiple of 2^level) may be a unit on its
     // own account: complete, and its centre beyond D[level]. A unit also needs no coarser unit
@@ -130,7 +159,11 @@ class ResolutionMap {
             return false;
         const glm::vec3 centre = (glm::vec3(base) + 0.5f * static_cast<float>(s)) * spacing_;
         const glm::vec3 to = centre - eye_;
-        return glm::dot(to, to) > d2_[static_cast<std::size_t>(level)];
+        const float dist2 = glm::dot(to, to);
+        if (!(dist2 > d2_[static_cast<std::size_t>(level)])) return false;
+        if (!errors_) return true;
+        const float e = errors_->cells(level, base);
+        return e * e <= err_k2_ * dist2 + err_c2_;
     }
 
     // The level of the unit holding `cell`; the unit's first cell is cell & ~(2^level - 1).
@@ -155,7 +188,10 @@ class ResolutionMap {
     glm::vec3 eye_{0};
     int max_level_ = 0;
     bool refine_ = false;
+    bool cross_levels_ = false;
     std::array<float, kMaxMetaLevel + 1> d2_{};  // D[i]^2
+    const LodErrors* errors_ = nullptr;          // null: no error rule
+    float err_k2_ = 0, err_c2_ = 0;              // the error rule's bound, squared (see above)
 };
 
 }  // namespace isowall

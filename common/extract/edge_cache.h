@@ -74,12 +74,14 @@ class EdgeVertexCache {
 class HashEdgeCache {
   public:
     HashEdgeCache(glm::ivec3 dims, std::size_t expected = 1024) : dims_(dims), map_(expected) {}
+    // `axis` + 3 * level: up to kKinds kinds of edge per voxel.
+    static constexpr std::uint64_t kKinds = 12;
     std::pair<std::uint32_t*, bool> find_or_insert(glm::ivec3 p, int axis) {
         const auto voxel = (static_cast<std::uint64_t>(p.z) * static_cast<std::uint64_t>(dims_.y) +
                             static_cast<std::uint64_t>(p.y)) *
                                static_cast<std::uint64_t>(dims_.x) +
                            static_cast<std::uint64_t>(p.x);
-        return map_.find_or_insert(voxel * 3 + static_cast<std::uint64_t>(axis));
+        return map_.find_or_insert(voxel * kKinds + static_cast<std::uint64_t>(axis));
     }
     void clear() { map_.clear(); }
     std::size_t size() const { return map_.size(); }

@@ -28,6 +28,7 @@
 #include "common/extract/propagator.h"
 #include "common/extract/raycaster.h"
 #include "common/extract/visited.h"
+#include "common/volume/lod_error.h"
 #include "common/volume/octree.h"
 #include "common/volume/volume.h"
 
@@ -46,6 +47,13 @@ struct ExtractionData {
         if (!octree.finite_range().any)
             throw InputError(v.source(), "data",
                              "no finite voxel (every voxel is NaN or infinite)");
+        lod = load_or_build_lod(view, with_files(source, v), build);
+        if (stats) {
+            stats->lod_build_s = lod.build_s;
+            stats->lod_from_cache = lod.from_cache;
+            if (!lod.cache_note.empty())
+                stats->cache_note += (stats->cache_note.empty() ? "" : "; ") + lod.cache_note;
+        }
     }
     // Workers hold references to the view and the octree, so the data never moves.
     ExtractionData(const ExtractionData&) = delete;
@@ -54,6 +62,7 @@ struct ExtractionData {
     const Volume& volume;
     const VolumeView<T> view;
     const MinMaxOctree<T> octree;
+    LodTable lod;  // set once in the constructor, read-only after
 
   private:
     static OctreeSource with_files(OctreeSource s, const Volume& v) {

@@ -61,6 +61,10 @@ struct Group {
     Mesh mesh;       // object space
     // The cells this pass took, in BFS order; at level >= 1 the first cell of each meta-cell.
     std::vector<glm::ivec3> cells;
+    // The level of each unit in `cells` where a pass went on into units of other levels
+    // (adaptive resolution's boundaries); empty: every unit is at `level`.
+    std::vector<std::uint8_t> cell_levels;
+    int level_of_cell(std::size_t i) const { return cell_levels.empty() ? level : cell_levels[i]; }
     // A refinement (adaptive resolution): the full-resolution triangles of the meta-cell of
     // `level` at `seed`, drawn over its own because a ray saw the surface there that they miss.
     // It takes no cells: they stay with the pass that took the meta-cell, if any.

@@ -236,7 +236,8 @@ int cell_triangles(const VolumeView<T>& v, glm::ivec3 c, double iso,
 // Emits the triangles of case `cs` of the unit, whose corner values are known, into `mesh`,
 // sharing vertices through `cache` (HashEdgeCache or BrickEdgeCache: units triangulated with one
 // cache form one connected indexed face set). A vertex per long edge at its edge_crossing(), keyed
-// by (first voxel of the edge, axis), which is unique as long as one cache sees one level. Its
+// by (first voxel of the edge, axis + 3 * level): a pass that crosses into units of another level
+// (adaptive resolution) keeps their edges apart; the brick cache sees level 0 only. Its
 // normal is the fine central-difference gradient interpolated between the two voxels that bracket
 // the crossing: the normal the full-resolution surface has at that point. (Gradients at stride
 // 2^level at the corners were tried: they smooth away shading the pixels show, and the phantom's
@@ -251,7 +252,7 @@ inline int emit_meta_cell(const VolumeView<T>& v, glm::ivec3 base, int level, do
         const int e = edges[static_cast<std::size_t>(i)];
         const glm::ivec3 pa = edge_start(base, level, e);
         const int axis = mc::kEdgeAxis[static_cast<std::size_t>(e)];
-        auto [slot, inserted] = cache.find_or_insert(pa, axis);
+        auto [slot, inserted] = cache.find_or_insert(pa, axis + 3 * level);
         if (inserted) {
             const int ca = mc::kEdgeCorners[static_cast<std::size_t>(e)][0];
             const int cb = mc::kEdgeCorners[static_cast<std::size_t>(e)][1];

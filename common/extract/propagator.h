@@ -116,22 +116,51 @@ class Propagator {
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
         const float cos_cutoff = std::cos(p.cutoff_rad);
-        const float half = 0.5f * static_cast<float>(stride);
-        auto angle_of = [&](glm::ivec3 c) {
-            const glm::vec3 to = glm::normalize(glm::vec3(c) + half - eye);
+        auto centre = [](glm::ivec3 c, int l) { return glm::vec3(c) + 0.5f * float(1 << l); };
+        auto angle_of = [&](glm::ivec3 c, int l) {
+            const glm::vec3 to = glm::normalize(centre(c, l) - eye);
             return std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
         };
         queue_.clear();
-        queue_.push_back({seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed) : 0.0f});
+        queue_.push_back(
+            {seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed, level) : 0.0f, level});
         double timed_s = 0;
         std::size_t timed_units = 0;
         float seed_facing = 0;  // the seed's side, for facing_only; 0 until the seed is seen
         int taken = 1;
+        std::size_t taken_cells = std::size_t{1} << (3 * level);
         const glm::ivec3 cells = visited.dims();
+        // Takes the unit of `l` at `u` into this pass when the criteria allow; false when the
+        // pass is full (count mode).
+        auto take = [&](glm::ivec3 u, int l, float from_angle) {
+            if (visited.contains(u, l)) return true;
+            const int st = 1 << l;
+            if (p.clip.active && !p.clip.may_touch(centre(u, l), st)) return true;
+            float max_angle = from_angle;
+            if (p.mode == PropagationMode::max_count) {
+                if (taken >= p.max_count) return false;
+            } else {
+                const glm::vec3 to = glm::normalize(centre(u, l) - eye);
+                if (glm::dot(to, dir) < cos_cutoff) return true;
+                const float a = std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
+                if (a < from_angle - p.foldback_rad) return true;  // folds back
+                max_angle = std::max(max_angle, a);
+            }
+            // Another thread's pass may have taken it since contains(): the claim decides.
+            if (!visited.claim(u, group_id, l)) return true;
+            ++taken;
+            taken_cells += std::size_t{1} << (3 * l);
+            queue_.push_back({u, max_angle, l});
+            return true;
+        };
         while (!queue_.empty()) {
             const QueueEntry item = queue_.front();
             queue_.pop_front();
             g.cells.push_back(item.cell);
+            if (item.level != level && g.cell_levels.empty())
+                g.cell_levels.assign(g.cells.size() - 1, static_cast<std::uint8_t>(level));
+            if (!g.cell_levels.empty())
+                g.cell_levels.push_back(static_cast<std::uint8_t>(item.level));
             if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
             // Two clock reads cost about as much as a small cell's triangulation, so only one
             // unit in kTimedEvery is timed and the pass's extraction time is scaled from them.
@@ -139,14 +168,15 @@ class Propagator {
             const auto t0 =
                 timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
             double corner[8];
-            const int cs = triangulate(item.cell, level, iso, p, g.mesh, corner);
+            const int cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner);
             if (timed) {
                 timed_s +=
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 ++timed_units;
             }
+            const int stride = 1 << item.level;
             if (p.facing_only) {
-                const glm::vec3 to_eye = eye - (glm::vec3(item.cell) + half);
+                const glm::vec3 to_eye = eye - centre(item.cell, item.level);
                 const float facing = glm::dot(corner_gradient(corner), to_eye);
                 if (seed_facing == 0) seed_facing = facing;
                 if (facing * seed_facing < 0) continue;  // folds away: no neighbours from here
@@ -158,30 +188,19 @@ class Propagator {
                 for (int k = 0; k < 8; ++k)
                     if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
                 if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
+                // The cell just across the face, at the unit's first corner.
                 glm::ivec3 nb = item.cell;
-                nb[axis] += side ? stride : -stride;
+                nb[axis] = side ? nb[axis] + stride : nb[axis] - 1;
                 if (nb[axis] < 0 || nb[axis] >= cells[axis]) continue;
-                if (visited.contains(nb, level)) continue;
-                if (resolution_.max_level() > 0 && resolution_.level_of(nb) != level)
-                    continue;  // the resolution boundary
-                if (p.clip.active && !p.clip.may_touch(glm::vec3(nb) + half, stride)) continue;
-                float max_angle = item.max_angle;
-                if (p.mode == PropagationMode::max_count) {
-                    if (taken >= p.max_count) continue;
-                } else {
-                    const glm::vec3 to = glm::normalize(glm::vec3(nb) + half - eye);
-                    if (glm::dot(to, dir) < cos_cutoff) continue;
-                    const float a = std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
-                    if (a < item.max_angle - p.foldback_rad) continue;  // folds back
-                    max_angle = std::max(max_angle, a);
-                }
-                // Another thread's pass may have taken it since contains(): the claim decides.
-                if (!visited.claim(nb, group_id, level)) continue;
-                ++taken;
-                queue_.push_back({nb, max_angle});
+                const int nl = resolution_.max_level() > 0 ? resolution_.level_of(nb) : 0;
+                if (nl != item.level && !resolution_.cross_levels()) continue;
+                if (nl >= item.level)  // one unit across the face, as large or larger
+                    take(nb & ~((1 << nl) - 1), nl, item.max_angle);
+                else  // finer units (a resolution boundary): the pass goes on into them
+                    take_finer_across(nb, axis, stride, iso, take, item.max_angle);
             }
         }
-        visited.add_count(static_cast<std::size_t>(taken) << (3 * level));
+        visited.add_count(taken_cells);
         if (timed_units > 0)
             extract_s_ =
                 timed_s * static_cast<double>(g.cells.size()) / static_cast<double>(timed_units);
@@ -237,9 +256,35 @@ class Propagator {
     ResolutionMap resolution_;
     double extract_s_ = 0;
     struct QueueEntry {
-        glm::ivec3 cell;
+        glm::ivec3 cell;  // the unit's first cell
         float max_angle;  // largest distance angle along the path from the seed
+        int level;        // the unit's level
     };
+
+    // The units finer than a unit of `stride` cells that touch its face, in the slab of cells
+    // at nb[axis] (nb: the cell across the face at the unit's first corner), handed to `take`
+    // when their own corners cross the isovalue. Each unit once: at its first cell on the face.
+    template <class Take>
+    bool take_finer_across(glm::ivec3 nb, int axis, int stride, double iso, Take& take,
+                           float from_angle) {
+        const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+        const glm::ivec3 cells = v_.cell_dims();
+        for (int j = 0; j < stride && nb[a2] + j < cells[a2]; ++j)
+            for (int i = 0; i < stride && nb[a1] + i < cells[a1]; ++i) {
+                glm::ivec3 q = nb;
+                q[a1] += i;
+                q[a2] += j;
+                const int l = resolution_.level_of(q);
+                const glm::ivec3 u = q & ~((1 << l) - 1);
+                if (u[a1] != q[a1] || u[a2] != q[a2]) continue;  // met at its first cell already
+                double corner[8];
+                meta_cell_corners(v_, u, l, corner);
+                const int cs = cell_case(corner, iso);
+                if (cs == 0 || cs == 255) continue;
+                if (!take(u, l, from_angle)) return false;
+            }
+        return true;
+    }
     std::deque<QueueEntry> queue_;
 };
 
