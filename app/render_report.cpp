@@ -24,8 +24,9 @@ std::string percent_label(double pct) {
 // Both measures: the share of final pixels (chapters 2-3, which the dissertation's tables call C)
 // and C = 1 - E (section 4.2). The second counts an undrawn pixel as a full error and takes the
 // RMS, so C = 0.99 allows only 0.01% of the significant pixels to be missing.
-void print_thresholds(const FrameResult& fr) {
-    std::printf("correctness (replayed against the final image):\n");
+void print_thresholds(const FrameResult& fr, const std::vector<TimelineSample>& timeline,
+                      const char* against) {
+    std::printf("correctness (replayed against %s):\n", against);
     std::printf("  %-20s %10s %10s %12s %12s %9s\n", "point", "time s", "rays", "rays %",
                 "triangles", "groups");
     auto row = [&](const std::string& label, const std::optional<std::size_t>& i) {
@@ -33,7 +34,7 @@ void print_thresholds(const FrameResult& fr) {
             std::printf("  %-20s %10s\n", label.c_str(), "not reached");
             return;
         }
-        const TimelineSample& s = fr.timeline[*i];
+        const TimelineSample& s = timeline[*i];
         std::printf("  %-20s %10.3f %10zu %11.4f%% %12zu %9zu\n", label.c_str(), s.time_s, s.rays,
                     100.0 * double(s.rays) / double(fr.rays_screen), s.triangles, s.groups);
     };
@@ -41,10 +42,10 @@ void print_thresholds(const FrameResult& fr) {
         const char* name = m == Measure::c ? "C=1-E" : "final px";
         for (double th : {0.90, 0.99, 0.999})
             row(std::string(name) + " >= " + percent_label(100 * th) + "%",
-                first_reaching(fr.timeline, th, m));
-        row(std::string(name) + " = 100%", first_reaching(fr.timeline, 1.0, m));
+                first_reaching(timeline, th, m));
+        row(std::string(name) + " = 100%", first_reaching(timeline, 1.0, m));
     }
-    row("all rays", fr.timeline.size() - 1);
+    row("all rays", timeline.size() - 1);
 }
 
 // The floor for "C = 99% in time T": drawing the same triangles in one go, with no extraction at
@@ -72,15 +73,17 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 // The progressive frame's final image against the full surface drawn in the same view (outside
 // the timings): 1 and 100% at full resolution, up to the renderers' ties; below that, what
 // adaptive resolution's meta-cells change on screen.
-void print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                        const Image& final_image) {
+Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                         const Image& final_image) {
     Stopwatch sw;
     const Mesh mesh = ex.extract_full(fv.iso);
-    const Correctness c = measure_correctness(final_image, draw_alone(renderer, mesh, fv));
+    Image full = draw_alone(renderer, mesh, fv);
+    const Correctness c = measure_correctness(final_image, full);
     std::printf(
         "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%% (%.3f s, "
         "not part of the timings)\n",
         mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels, sw.seconds());
+    return full;
 }
 
 }  // namespace isowall

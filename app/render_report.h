@@ -19,14 +19,17 @@ std::size_t covered_pixels(const Image& image);
 // 99.9 -> "99.9", 90 -> "90".
 std::string percent_label(double pct);
 
-// Both measures' thresholds (90, 99, 99.9 and 100%): when each was first reached.
-void print_thresholds(const FrameResult& fr);
+// Both measures' thresholds (90, 99, 99.9 and 100%): when each was first reached, in `timeline`
+// (fr's, or a copy measured against another reference), under the heading `against`.
+void print_thresholds(const FrameResult& fr, const std::vector<TimelineSample>& timeline,
+                      const char* against = "the final image");
 
 // The floor for "C = 99% in time T": drawing the same triangles in one go.
 void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& renderer);
 
-// The final image against the full surface drawn in the same view (outside the timings).
-void print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                        const Image& final_image);
+// The final image against the full surface drawn in the same view (outside the timings); returns
+// that image, the truth the timeline is also measured against.
+Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                         const Image& final_image);
 
 }  // namespace isowall

@@ -73,6 +73,21 @@ def read_header(path):
     return sizes, dtype, raw, fields["type"]
 
 
+def read_spacings(path):
+    """The header's `spacings` (three numbers), or None when it has none."""
+    with open(path, "r", encoding="latin-1") as f:
+        for line in f.read().splitlines()[1:]:
+            if line.startswith("spacings:"):
+                try:
+                    values = [float(v) for v in line.split(":", 1)[1].split()]
+                except ValueError:
+                    raise InputError(f"{path}: spacings: expected three numbers, got {line}")
+                if len(values) != 3 or not all(v > 0 and v == v and v != float("inf") for v in values):
+                    raise InputError(f"{path}: spacings: expected three positive numbers, got {line}")
+                return values
+    return None
+
+
 def axis_weights(n_in, n_out):
     """For each output sample: the two input indices around it and the second one's weight."""
     pos = np.arange(n_out, dtype=np.float64) * ((n_in - 1) / (n_out - 1))
@@ -120,9 +135,13 @@ def main(argv):
     nhdr = os.path.join(a.out_dir, name + ".nhdr")
     out_raw = os.path.join(a.out_dir, name + ".raw")
     source_line = f"# resampled trilinearly from {os.path.abspath(a.input)} {sizes}"
+    # The copy spans the same object box: sample i sits at i * (n_in - 1) / (n_out - 1).
+    spacings = read_spacings(a.input)
+    spacing_line = [] if spacings is None else ["spacings: " + " ".join(
+        f"{sp * (n_in - 1) / (n_out - 1):.9g}" for sp, n_in, n_out in zip(spacings, sizes, out_sizes))]
     header = "\n".join([
         "NRRD0004", source_line, f"type: {type_name}", "dimension: 3",
-        "sizes: {} {} {}".format(*out_sizes), "endian: little", "encoding: raw",
+        "sizes: {} {} {}".format(*out_sizes), "endian: little", "encoding: raw"] + spacing_line + [
         f"data file: {name}.raw", ""])
     out_dtype = dtype.newbyteorder("<")
     expected = out_sizes[0] * out_sizes[1] * out_sizes[2] * out_dtype.itemsize

@@ -130,11 +130,43 @@ TEST_F(Cli, AgainstFullPrintsBothMeasures) {
     EXPECT_GE(c_of(full.out), 0.999) << full.out;
     auto coarse = run_isowall(dir_,
                               "render --size 160x120 -q --no-measure --against-full --adaptive "
-                              "--adaptive-pixels 8 --no-adaptive-refine --out b.png");
+                              "--adaptive-pixels 8 --no-adaptive-refine --no-adaptive-error "
+                              "--out b.png");
     ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
     const double c = c_of(coarse.out);
     EXPECT_GT(c, 0.8) << coarse.out;
     EXPECT_LT(c, c_of(full.out)) << coarse.out;
+}
+
+// --against-full with the replay: a second table measures every replayed image against the full
+// surface. At full resolution the final image is the full surface's, so the two tables agree row
+// for row; a coarse level of detail never reaches 100% of the truth.
+TEST_F(Cli, AgainstFullReplaysAgainstTheTruthToo) {
+    auto table = [](const std::string& out, const std::string& heading) {
+        const auto at = out.find("correctness (replayed against " + heading);
+        const auto end = out.find("all rays", at);
+        return at == std::string::npos || end == std::string::npos ? std::string()
+                                                                    : out.substr(at, end - at);
+    };
+    auto rows = [](const std::string& t) { return t.substr(t.find('\n')); };
+    auto full = run_isowall(dir_, "render --size 160x120 -q --threads 1 --against-full --out a.png");
+    ASSERT_EQ(full.exit_code, 0) << full.err;
+    const std::string own = table(full.out, "the final image"),
+                      truth = table(full.out, "the full surface at full resolution");
+    ASSERT_FALSE(own.empty()) << full.out;
+    ASSERT_FALSE(truth.empty()) << full.out;
+    EXPECT_EQ(rows(own), rows(truth)) << full.out;
+    auto coarse = run_isowall(dir_,
+                              "render --size 160x120 -q --threads 1 --against-full --adaptive "
+                              "--adaptive-pixels 8 --no-adaptive-refine --no-adaptive-error "
+                              "--out b.png");
+    ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
+    const std::string coarse_truth = table(coarse.out, "the full surface at full resolution");
+    ASSERT_FALSE(coarse_truth.empty()) << coarse.out;
+    const auto row = coarse_truth.find("final px = 100%");
+    ASSERT_NE(row, std::string::npos) << coarse.out;
+    const std::string line = coarse_truth.substr(row, coarse_truth.find('\n', row) - row);
+    EXPECT_NE(line.find("not reached"), std::string::npos) << coarse.out;
 }
 
 // The warm-up frame (another view, untimed) leaves nothing that changes the timed frame: the same
