@@ -146,10 +146,11 @@ TEST_F(Cli, AgainstFullReplaysAgainstTheTruthToo) {
         const auto at = out.find("correctness (replayed against " + heading);
         const auto end = out.find("all rays", at);
         return at == std::string::npos || end == std::string::npos ? std::string()
-                                                                    : out.substr(at, end - at);
+                                                                   : out.substr(at, end - at);
     };
     auto rows = [](const std::string& t) { return t.substr(t.find('\n')); };
-    auto full = run_isowall(dir_, "render --size 160x120 -q --threads 1 --against-full --out a.png");
+    auto full =
+        run_isowall(dir_, "render --size 160x120 -q --threads 1 --against-full --out a.png");
     ASSERT_EQ(full.exit_code, 0) << full.err;
     const std::string own = table(full.out, "the final image"),
                       truth = table(full.out, "the full surface at full resolution");
