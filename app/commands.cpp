@@ -187,6 +187,34 @@ void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Imag
     }
 }
 
+// The replay after the frame (outside its timings): snapshots, the correctness tables, the
+// draw-only floor and the timeline. With --against-full (`full` drawn), every replayed image is
+// also measured against the full surface: the time to C = 99% of the true picture, not only of
+// the engine's own final one.
+void replay_and_report(const RenderOptions& o, ProgressiveEngine& engine, FrameResult& fr,
+                       const FrameView& fv, Renderer& renderer, const Image& full,
+                       OutputFiles& batch) {
+    Stopwatch sw;
+    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
+    std::vector<TimelineSample> vs_full;
+    engine.measure(fr, fv, renderer, [&](const TimelineSample& s, const Image& img) {
+        stage_snapshots(o, s, img, c_done, r_done, batch);
+        if (!o.against_full) return;
+        vs_full.push_back(s);
+        vs_full.back().correctness = measure_correctness(img, full);
+    });
+    print_thresholds(fr, fr.timeline);
+    if (o.against_full) print_thresholds(fr, vs_full, "the full surface at full resolution");
+    print_draw_only(fr, fv, renderer);
+    if (!o.timeline.empty()) {
+        write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
+        std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
+                    o.timeline.c_str(), fr.timeline.size());
+    }
+    std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
+                fr.timeline.size(), sw.seconds());
+}
+
 std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
                                const FrameView& fv, Timings& t, OutputFiles& batch) {
     warm_up(renderer);
@@ -246,28 +274,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
     const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
                               !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (!want_measure) return last.triangles;
-    sw.restart();
-    std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
-    // With --against-full, every replayed image is also measured against the full surface: the
-    // time to C = 99% of the true picture, not only of the engine's own final one.
-    std::vector<TimelineSample> vs_full;
-    engine.measure(fr, fv, renderer, [&](const TimelineSample& s, const Image& img) {
-        stage_snapshots(o, s, img, c_done, r_done, batch);
-        if (!o.against_full) return;
-        vs_full.push_back(s);
-        vs_full.back().correctness = measure_correctness(img, full);
-    });
-    print_thresholds(fr, fr.timeline);
-    if (o.against_full) print_thresholds(fr, vs_full, "the full surface at full resolution");
-    print_draw_only(fr, fv, renderer);
-    if (!o.timeline.empty()) {
-        write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
-        std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
-                    o.timeline.c_str(), fr.timeline.size());
-    }
-    std::printf("measure: replayed %zu samples in %.3f s (not part of the timings above)\n",
-                fr.timeline.size(), sw.seconds());
+    if (want_measure) replay_and_report(o, engine, fr, fv, renderer, full, batch);
     return last.triangles;
 }
 

@@ -3,10 +3,16 @@
 // smooth fields, spikes and NaN.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/extract/adaptive.h"
@@ -133,6 +139,53 @@ TEST(LodErrors, TheMapTakesAMetaCellOnlyWhereItsErrorProjectsUnderTheBound) {
     EXPECT_TRUE(ResolutionMap(levels, glm::vec3(1), cells).coarse_enough({0, 0, 0}, 1));
     levels.error_px = std::numeric_limits<float>::infinity();
     EXPECT_TRUE(ResolutionMap(levels, glm::vec3(1), cells, &t).coarse_enough({0, 0, 0}, 1));
+}
+
+}  // namespace
+}  // namespace isowall
+
+namespace isowall {
+namespace {
+
+// The table is cached beside the octree (same key, `.lod`): built once, then mapped; a damaged
+// file is rebuilt with a note, never served.
+TEST(LodErrors, CacheMapsTheTableAndRebuildsADamagedOne) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("isowall_lod_cache_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto volume_file = dir / "v.raw";
+    std::ofstream(volume_file) << "voxels";  // the key stats the file; its bytes are not read
+    OctreeSource src{volume_file, dir / "cache"};
+    const glm::ivec3 dims(17, 9, 9);
+    const std::vector<std::uint8_t> want(LodErrors::byte_count(dims - 1), 7);
+    int builds = 0;
+    auto build = [&] {
+        ++builds;
+        return want;
+    };
+    const LodTable first = load_or_build_lod(src, VoxelType::u8, dims, build);
+    EXPECT_FALSE(first.from_cache);
+    const LodTable second = load_or_build_lod(src, VoxelType::u8, dims, build);
+    EXPECT_TRUE(second.from_cache) << second.cache_note;
+    EXPECT_EQ(builds, 1);
+    ASSERT_EQ(second.errors.codes().size(), want.size());
+    EXPECT_TRUE(std::equal(want.begin(), want.end(), second.errors.codes().begin()));
+    // Flip a code byte in the file: rebuilt, with a note.
+    std::filesystem::path file;
+    for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
+        if (e.path().extension() == ".lod") file = e.path();
+    ASSERT_FALSE(file.empty());
+    {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(-1, std::ios::end);
+        f.put(char(8));
+    }
+    const LodTable third = load_or_build_lod(src, VoxelType::u8, dims, build);
+    EXPECT_FALSE(third.from_cache);
+    EXPECT_EQ(builds, 2);
+    EXPECT_NE(third.cache_note.find("damaged"), std::string::npos) << third.cache_note;
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

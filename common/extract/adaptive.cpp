@@ -6,8 +6,7 @@
 namespace isowall {
 
 ResolutionLevels resolution_levels(const Camera& camera, const Frustum& frustum, int height_px,
-                                   glm::vec3 spacing, int max_level, float pixels,
-                                   float error_px) {
+                                   glm::vec3 spacing, int max_level, float pixels, float error_px) {
     ResolutionLevels r;
     r.eye = camera.eye;
     r.max_level = std::clamp(max_level, 0, kMaxMetaLevel);

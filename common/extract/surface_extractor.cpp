@@ -39,7 +39,8 @@ class TypedExtractor final : public SurfaceExtractor {
     using SurfaceExtractor::begin_frame;
     void begin_frame(double iso, const ResolutionLevels& levels) override {
         const glm::ivec3 cells = data_.view.cell_dims();
-        frame_.begin(iso, ResolutionMap(levels, data_.view.spacing, cells, &data_.lod.errors), cells);
+        frame_.begin(iso, ResolutionMap(levels, data_.view.spacing, cells, &data_.lod.errors),
+                     cells);
         for (ExtractWorker<T>& w : workers_) w.begin_frame(frame_);
     }
     double iso() const override { return frame_.iso; }
