@@ -60,13 +60,10 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
         ->transform(number_in(limits::kMetaCellPixels))
         ->capture_default_str();
     app.add_option("--adaptive-error", e.adaptive_error,
-                   "With --adaptive: take a meta-cell only where its surface lies within this "
-                   "many pixels of the full-resolution surface, projected (a bound computed "
-                   "once per volume, cached beside the octree)")
-        ->transform(number_in(limits::kMetaCellPixels))
-        ->capture_default_str();
-    app.add_flag("--no-adaptive-error", e.no_adaptive_error,
-                 "With --adaptive: the size rule alone, without the error bound");
+                   "With --adaptive: also take a meta-cell only where its surface lies within this "
+                   "many pixels of the full-resolution surface, projected (a bound computed once "
+                   "per volume, cached beside the octree; off by default: the size rule alone)")
+        ->transform(number_in(limits::kMetaCellPixels));
     app.add_flag("--no-adaptive-refine", e.no_adaptive_refine,
                  "With --adaptive: never draw a meta-cell again at full resolution where a ray "
                  "sees the fine surface its triangles miss (the text's distance rule alone)");
@@ -100,8 +97,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.adaptive_max_level = c.adaptive_max_level;
     e.adaptive_pixels = c.adaptive_pixels;
     e.adaptive_refine = !c.no_adaptive_refine;
-    e.adaptive_error_px =
-        c.no_adaptive_error ? std::numeric_limits<float>::infinity() : c.adaptive_error;
+    e.adaptive_error_px = c.adaptive_error.value_or(std::numeric_limits<float>::infinity());
     return e;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // The progressive engine's options on the command line, shared by `render` and `wall`.
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -22,8 +23,7 @@ struct EngineCli {
     int adaptive_max_level = 3;
     float adaptive_pixels = 1.0f;
     bool no_adaptive_refine = false;
-    float adaptive_error = 0.5f;
-    bool no_adaptive_error = false;
+    std::optional<float> adaptive_error;  // the error rule's bound; none: the size rule alone
     bool facing_only = false;
 };
 

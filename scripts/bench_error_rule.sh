@@ -18,8 +18,8 @@ copy() {  # NAME SCALE -> the copy's header
 }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-configs=("" "--adaptive --adaptive-pixels 4 --facing-only"
-         "--adaptive --adaptive-pixels 2.5 --no-adaptive-refine --facing-only --no-adaptive-error")
+configs=("" "--adaptive --adaptive-pixels 4 --facing-only --adaptive-error 0.5"
+         "--adaptive --adaptive-pixels 2.5 --no-adaptive-refine --facing-only")
 names=("full resolution (default)" "error rule, 4 px, facing" "size rule 2.5 px, no refine, facing")
 printf '| volume | iso | engine | C=99%% s | final px 99%% s | triangles then | every ray s | C vs full | final px vs full |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
