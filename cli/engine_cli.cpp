@@ -12,8 +12,9 @@ namespace isowall {
 void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_option("--order", e.order,
                    "Ray order: grid (fixed refining grids), readback "
-                   "(screen read-back) or dynamic (dynamic grid)")
-        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic"}))
+                   "(screen read-back), dynamic (dynamic grid) or gaps (the dynamic grid, then "
+                   "every pixel still empty, then the refining grids)")
+        ->check(CLI::IsMember({"grid", "refining", "readback", "dynamic", "gaps"}))
         ->capture_default_str();
     app.add_option("--intersect", e.intersect,
                    "exact (Moller-Trumbore on the cell's triangles) or approximate (first active "
@@ -81,7 +82,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     const auto order = parse_ray_order(c.order);
     if (!order)
         throw InputError("--order", "value",
-                         "expected grid, readback or dynamic, got " + quote(c.order));
+                         "expected grid, readback, dynamic or gaps, got " + quote(c.order));
     e.order = *order;
     e.intersect = c.intersect == "approximate" ? IntersectMode::approximate : IntersectMode::exact;
     e.propagation.mode =

@@ -50,7 +50,7 @@ RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
 void begin_order(RegionCursor& c, RayOrderKind kind) {
     c.order = make_ray_order(kind, c.rect.width, c.rect.height,
                              PixelRect{0, 0, c.rect.width, c.rect.height}, c.mask);
-    c.sizing = kind == RayOrderKind::dynamic_grid;
+    c.sizing = kind == RayOrderKind::dynamic_grid || kind == RayOrderKind::dynamic_gaps;
     if (c.sizing) c.drawn.assign(pixel_count(c.rect), 0);
 }
 

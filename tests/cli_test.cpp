@@ -130,7 +130,7 @@ TEST_F(Cli, AgainstFullPrintsBothMeasures) {
     EXPECT_GE(c_of(full.out), 0.999) << full.out;
     auto coarse = run_isowall(dir_,
                               "render --size 160x120 -q --no-measure --against-full --adaptive "
-                              "--adaptive-pixels 8 --no-adaptive-refine"
+                              "--adaptive-pixels 8 --no-adaptive-refine "
                               "--out b.png");
     ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
     const double c = c_of(coarse.out);
@@ -159,7 +159,7 @@ TEST_F(Cli, AgainstFullReplaysAgainstTheTruthToo) {
     EXPECT_EQ(rows(own), rows(truth)) << full.out;
     auto coarse = run_isowall(dir_,
                               "render --size 160x120 -q --threads 1 --against-full --adaptive "
-                              "--adaptive-pixels 8 --no-adaptive-refine"
+                              "--adaptive-pixels 8 --no-adaptive-refine "
                               "--out b.png");
     ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
     const std::string coarse_truth = table(coarse.out, "the full surface at full resolution");

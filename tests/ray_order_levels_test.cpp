@@ -134,11 +134,36 @@ TEST(RayOrder, DynamicGridSpacingFollowsTheDiskSize) {
     }
 }
 
-TEST(RayOrder, DynamicGridContinuesWithTheGapsThenFinerRefiningLevels) {
+TEST(RayOrder, DynamicGridContinuesWithFinerRefiningLevels) {
     // Disk radius 30: size ~53 px, so refining goes on with cells under ~26.6 px: 400 / 2^4.
     const int w = 400, h = 300;
     DiskScene scene(w, h, {{w * 0.5, h * 0.5, 30.0}, {40, 40, 12.0}});
     auto order = make_ray_order(RayOrderKind::dynamic_grid, w, h, {0, 0, w, h});
+    const auto levels = run_order(*order, &scene);
+    ASSERT_GE(levels.size(), 4u);
+    auto grid = make_ray_order(RayOrderKind::refining_grid, w, h, {0, 0, w, h});
+    std::vector<std::vector<glm::ivec2>> grid_levels;
+    for (std::vector<glm::ivec2> r; grid->next_level(r);) grid_levels.push_back(r);
+    // levels: 0 = centre (hits the disk), 1 = dynamic grid, 2 = refining level 4, ...
+    EXPECT_EQ(levels[0], grid_levels[0]);
+    for (std::size_t k = 2; k + 1 < levels.size(); ++k) {
+        std::vector<glm::ivec2> sorted = levels[k];
+        std::sort(sorted.begin(), sorted.end(),
+                  [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+        const auto& refining = grid_levels[k + 2];
+        EXPECT_TRUE(std::includes(
+            refining.begin(), refining.end(), sorted.begin(), sorted.end(),
+            [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; }))
+            << "level " << k << " is not inside refining level " << k + 2;
+    }
+    EXPECT_EQ(levels.size(), grid_levels.size() - 3 + 1) << "levels 1-3 replaced by one grid";
+}
+
+TEST(RayOrder, GapsOrderCastsTheGapsThenFinerRefiningLevels) {
+    // Disk radius 30: size ~53 px, so refining goes on with cells under ~26.6 px: 400 / 2^4.
+    const int w = 400, h = 300;
+    DiskScene scene(w, h, {{w * 0.5, h * 0.5, 30.0}, {40, 40, 12.0}});
+    auto order = make_ray_order(RayOrderKind::dynamic_gaps, w, h, {0, 0, w, h});
     std::vector<std::uint8_t> after_grid;  // what shows once the sized grid is cast
     std::vector<std::vector<glm::ivec2>> levels;
     for (std::vector<glm::ivec2> rays;;) {

@@ -16,6 +16,8 @@ std::string_view to_string(RayOrderKind kind) {
             return "readback";
         case RayOrderKind::dynamic_grid:
             return "dynamic";
+        case RayOrderKind::dynamic_gaps:
+            return "gaps";
     }
     return "?";
 }
@@ -24,10 +26,15 @@ std::optional<RayOrderKind> parse_ray_order(std::string_view name) {
     if (name == "grid" || name == "refining") return RayOrderKind::refining_grid;
     if (name == "readback") return RayOrderKind::screen_readback;
     if (name == "dynamic") return RayOrderKind::dynamic_grid;
+    if (name == "gaps") return RayOrderKind::dynamic_gaps;
     return std::nullopt;
 }
 
 namespace {
+
+bool is_dynamic(RayOrderKind kind) {
+    return kind == RayOrderKind::dynamic_grid || kind == RayOrderKind::dynamic_gaps;
+}
 
 bool is_empty(const PixelRect& r) {
     return r.width <= 0 || r.height <= 0;
@@ -120,7 +127,7 @@ class ProgressiveOrder : public RayOrder {
             if (dynamic_pending_) {
                 emit_dynamic_level(out);
                 dynamic_pending_ = false;
-                gap_pending_ = true;
+                gap_pending_ = kind_ == RayOrderKind::dynamic_gaps;
             } else if (gap_pending_) {
                 gap_pending_ = false;
                 if (gap_coverage_) emit_gap_level(out);
@@ -150,6 +157,8 @@ class ProgressiveOrder : public RayOrder {
             // After the surface has been sized the rest is the fixed refining order; a caster
             // may still pass coverage to put uncovered pixels first, but need not read back.
             case RayOrderKind::dynamic_grid:
+                return searching_;
+            case RayOrderKind::dynamic_gaps:
                 return searching_ || gap_pending_;
         }
         return false;
@@ -162,7 +171,7 @@ class ProgressiveOrder : public RayOrder {
         if (gap_pending_)  // after the sized grid: a caster that can tell what shows did
             gap_coverage_ = std::any_of(coverage_.begin(), coverage_.end(),
                                         [](std::uint8_t c) { return c != 0; });
-        if (kind_ != RayOrderKind::dynamic_grid || !searching_ || level_ < 0 || done()) return;
+        if (!is_dynamic(kind_) || !searching_ || level_ < 0 || done()) return;
         const double size_px = surface_piece_size(coverage_, screen_width_, rect_);
         if (size_px == 0) return;
         // The aim of the dynamic grid (section 3.1.2): one piece of surface tells roughly how

@@ -16,11 +16,14 @@
 
 namespace isowall {
 
-enum class RayOrderKind { refining_grid, screen_readback, dynamic_grid };
+// dynamic_gaps: the dynamic grid, then every pixel that still shows nothing, then the refining
+// grids (issue 29; opt-in while it costs the share of final pixels what it gains C = 1 - E).
+enum class RayOrderKind { refining_grid, screen_readback, dynamic_grid, dynamic_gaps };
 
-// The option spelling: "grid", "readback" or "dynamic" (parse_ray_order reads it back).
+// The option spelling: "grid", "readback", "dynamic" or "gaps" (parse_ray_order reads it back).
 std::string_view to_string(RayOrderKind kind);
-// "grid" or "refining" -> refining_grid, "readback" -> screen_readback, "dynamic" -> dynamic_grid.
+// "grid" or "refining" -> refining_grid, "readback" -> screen_readback, "dynamic" -> dynamic_grid,
+// "gaps" -> dynamic_gaps.
 std::optional<RayOrderKind> parse_ray_order(std::string_view name);
 
 // Hands out pixels (x right, y down from the top-left) level by level. Between levels the caster
