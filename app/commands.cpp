@@ -56,12 +56,6 @@ std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
                     double(ov.volume.voxel_count()) / std::max(st.build_s, 1e-9) / 1e6,
                     st.cache_file.empty() ? "" : ", cached to ", st.cache_file.c_str());
     }
-    if (st.lod_from_cache)
-        std::printf("octree: meta-cell errors mapped from the cache\n");
-    else
-        std::printf("octree: meta-cell errors computed in %.3f s (%.0f M voxels/s)\n",
-                    st.lod_build_s,
-                    double(ov.volume.voxel_count()) / std::max(st.lod_build_s, 1e-9) / 1e6);
     if (!st.cache_note.empty()) std::printf("octree: note: %s\n", st.cache_note.c_str());
     const OctreeShape& shape = ex->octree_shape();
     std::printf(
@@ -71,6 +65,19 @@ std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
         double(ex->octree_bytes()) / (1024.0 * 1024.0), 100.0 * share, ex->value_min(),
         ex->value_max());
     return ex;
+}
+
+// With the error rule asked for (--adaptive --adaptive-error), its meta-cell errors are built or
+// mapped here, before any frame is timed, and reported beside the octree.
+void prepare_error_rule(const EngineOptions& e, const SurfaceExtractor& ex, const Volume& volume) {
+    if (!e.adaptive || e.uniform_level > 0 || !std::isfinite(e.adaptive_error_px)) return;
+    const LodTable& lod = ex.prepare_lod_errors();
+    if (lod.from_cache)
+        std::printf("octree: meta-cell errors mapped from the cache\n");
+    else
+        std::printf("octree: meta-cell errors computed in %.3f s (%.0f M voxels/s)\n", lod.build_s,
+                    double(volume.voxel_count()) / std::max(lod.build_s, 1e-9) / 1e6);
+    if (!lod.cache_note.empty()) std::printf("octree: note: %s\n", lod.cache_note.c_str());
 }
 
 double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov,
@@ -328,6 +335,7 @@ int run_render(const RenderOptions& o) {
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
     auto ex = prepare(ov, t, render_threads(o));
+    if (!o.full) prepare_error_rule(engine_options(o), *ex, ov.volume);
     const double iso = checked_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);

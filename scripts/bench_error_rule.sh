@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The error rule of adaptive resolution (issue 29) against full resolution and the size rule alone,
-# on shared volumes and their trilinear copies, 1600x1200, front view, warm (--warm-up), 2 threads,
-# every run with the gaps order (--order gaps).
+# on shared volumes and their trilinear copies, 1600x1200, front view, warm (--warm-up), 2 threads:
+# the defaults first, then the gaps order (--order gaps) alone and with each rule.
 # For each run: time to C = 99% (against the engine's own final image), time to 99% of final
 # pixels and the triangles then, every ray, and the final image against the full surface.
 # Usage: scripts/bench_error_rule.sh [BUILD=build] [DATA=../shared/data] [COPIES=build/data]
@@ -19,9 +19,9 @@ copy() {  # NAME SCALE -> the copy's header
 }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-configs=("--order gaps" "--order gaps --adaptive --adaptive-pixels 4 --facing-only --adaptive-error 0.5"
+configs=("" "--order gaps" "--order gaps --adaptive --adaptive-pixels 4 --facing-only --adaptive-error 0.5"
          "--order gaps --adaptive --adaptive-pixels 2.5 --no-adaptive-refine --facing-only")
-names=("full resolution" "error rule, 4 px, facing" "size rule 2.5 px, no refine, facing")
+names=("defaults" "full resolution, gaps" "error rule, 4 px, facing" "size rule 2.5 px, no refine, facing")
 printf '| volume | iso | engine | C=99%% s | final px 99%% s | triangles then | every ray s | C vs full | final px vs full |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
 for spec in "engine 75 1" "engine 75 2" "engine 75 4" "cthead 600 1" "cthead 600 2" "heptane 50 1" \

@@ -47,13 +47,15 @@ struct ExtractionData {
         if (!octree.finite_range().any)
             throw InputError(v.source(), "data",
                              "no finite voxel (every voxel is NaN or infinite)");
-        lod = load_or_build_lod(view, with_files(source, v), build);
-        if (stats) {
-            stats->lod_build_s = lod.build_s;
-            stats->lod_from_cache = lod.from_cache;
-            if (!lod.cache_note.empty())
-                stats->cache_note += (stats->cache_note.empty() ? "" : "; ") + lod.cache_note;
-        }
+        lod_source_ = with_files(source, v);
+        lod_budget_ = build;
+    }
+    // The meta-cell errors of the error rule (lod_error.h): built (or mapped from the cache) on
+    // first use only, since only a frame that asks for the rule needs them; any thread may ask.
+    const LodTable& lod_table() const {
+        std::call_once(lod_once_,
+                       [this] { lod_ = load_or_build_lod(view, lod_source_, lod_budget_); });
+        return lod_;
     }
     // Workers hold references to the view and the octree, so the data never moves.
     ExtractionData(const ExtractionData&) = delete;
@@ -62,9 +64,13 @@ struct ExtractionData {
     const Volume& volume;
     const VolumeView<T> view;
     const MinMaxOctree<T> octree;
-    LodTable lod;  // set once in the constructor, read-only after
 
   private:
+    OctreeSource lod_source_;
+    ThreadBudget lod_budget_;
+    mutable std::once_flag lod_once_;
+    mutable LodTable lod_;
+
     static OctreeSource with_files(OctreeSource s, const Volume& v) {
         for (const auto& f : v.files())
             if (f != s.volume_path) s.data_files.push_back(f);

@@ -1,5 +1,6 @@
 #include "common/extract/surface_extractor.h"
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -39,11 +40,13 @@ class TypedExtractor final : public SurfaceExtractor {
     using SurfaceExtractor::begin_frame;
     void begin_frame(double iso, const ResolutionLevels& levels) override {
         const glm::ivec3 cells = data_.view.cell_dims();
-        frame_.begin(iso, ResolutionMap(levels, data_.view.spacing, cells, &data_.lod.errors),
-                     cells);
+        const LodErrors* errors =
+            std::isfinite(levels.error_px) ? &data_.lod_table().errors : nullptr;
+        frame_.begin(iso, ResolutionMap(levels, data_.view.spacing, cells, errors), cells);
         for (ExtractWorker<T>& w : workers_) w.begin_frame(frame_);
     }
     double iso() const override { return frame_.iso; }
+    const LodTable& prepare_lod_errors() const override { return data_.lod_table(); }
 
     RayHit cast_on(int w, const Ray& ray, IntersectMode mode, float t_max) override {
         return worker(w).cast(frame_, ray, mode, t_max);

@@ -42,7 +42,12 @@ class SurfaceExtractor {
     void begin_frame(double iso) { begin_frame(iso, ResolutionLevels{}); }
     // Starts a frame at `iso` with the view's D[] (adaptive resolution, chapter 2.1.3): from now on
     // cast() may hit meta-cells and propagate() runs at the level of its seed's unit.
+    // With levels.error_px finite, the first such frame builds (or maps from the cache) the
+    // volume's meta-cell errors, unless prepare_lod_errors() did.
     virtual void begin_frame(double iso, const ResolutionLevels& levels) = 0;
+    // The meta-cell errors of the error rule (common/volume/lod_error.h), built or mapped now if
+    // not yet: a caller that times its frames calls this first, outside the clock.
+    virtual const LodTable& prepare_lod_errors() const = 0;
     virtual double iso() const = 0;
 
     // `ray` in object space; t is returned in the ray's own parameter.

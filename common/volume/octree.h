@@ -75,9 +75,6 @@ struct OctreeStats {
     bool from_cache = false;  // true when the cache file was mapped
     std::filesystem::path cache_file;
     std::string cache_note;  // why the cache was not used or written, if it was not
-    // The meta-cell error table of adaptive resolution (lod_error.h), cached beside the octree.
-    double lod_build_s = 0;  // 0 when mapped from the cache
-    bool lod_from_cache = false;
 };
 
 // The range of a volume's finite voxels (NaN and +-infinity left out); `any` is false when there
