@@ -141,7 +141,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
                     {},         o.measure};
     setup.engine.region_clip = o.region_clip;
     setup.engine.threads = budget.usable();
-    if (o.fault.rank == comm.rank()) setup.fault = o.fault;
+    if (o.fault.on(comm.rank())) setup.fault = o.fault;
     const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;

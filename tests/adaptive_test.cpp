@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/engine_util.h"
+#include "tests/image_compare.h"
 
 #include <array>
 #include <cmath>
@@ -188,6 +189,7 @@ FrameView front_view(const Volume& v, int w, int h, float zoom_factor) {
 
 struct Figures {
     Correctness correctness;  // the final image against the full surface at full resolution
+    double coverage_iou = 0;  // of the two images' covered pixels
     std::size_t triangles = 0;
     std::array<std::size_t, kMaxMetaLevel + 1> groups{};  // per level
     std::array<std::size_t, kMaxMetaLevel + 1> units{};   // cells or meta-cells taken, per level
@@ -198,8 +200,8 @@ struct Figures {
 
 std::ostream& operator<<(std::ostream& os, const Figures& f) {
     os << "C " << f.correctness.c << " (final pixels " << f.correctness.final_pixels * 100
-       << "% of " << f.correctness.significant << "), " << f.triangles
-       << " triangles, groups/units per level";
+       << "% of " << f.correctness.significant << ", coverage IoU " << f.coverage_iou << "), "
+       << f.triangles << " triangles, groups/units per level";
     for (std::size_t i = 0; i < f.groups.size(); ++i)
         os << " L" << i << " " << f.groups[i] << "/" << f.units[i];
     return os << ", " << f.refinements << " refinements (" << f.refinement_triangles
@@ -260,8 +262,9 @@ Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions
         for (std::size_t i = 0; i < g.cells.size(); ++i) ++f.units[std::size_t(g.level_of_cell(i))];
     }
     expect_groups_partition_the_visited_cells(*ex, volume, fr);
-    f.correctness =
-        measure_correctness(fr.final_image, test::full_surface_image(*ex, *renderer, fv));
+    const Image full = test::full_surface_image(*ex, *renderer, fv);
+    f.correctness = measure_correctness(fr.final_image, full);
+    f.coverage_iou = test::compare_images(fr.final_image, full).mask_iou;
     return f;
 }
 
@@ -283,11 +286,24 @@ TEST(Adaptive, FrontViewMatchesTheFullResolutionSurface) {
         std::cout << "front view " << w << "x" << h << ": "
                   << resolution_levels(fv.camera, fv.frustum, fv.height, p.spacing())
                   << "\n  adaptive:        " << f << "\n  full resolution: " << full_res << "\n";
-        EXPECT_GE(f.correctness.c, 0.98) << w << "x" << h << ": " << f;
         EXPECT_LE(f.triangles, full_res.triangles) << w << "x" << h << ": " << f;
-        if (w == 128) {
+        if (w == 240) {
+            // Nothing coarse: the full-resolution engine's surface, and the full surface's image
+            // up to the renderer's ties (1 pixel of 14509 here).
+            EXPECT_EQ(f.coarse_groups(), 0u) << f;
+            EXPECT_EQ(f.triangles, full_res.triangles) << f;
+            EXPECT_GE(f.correctness.c, 0.999) << f;
+            EXPECT_GE(f.correctness.final_pixels, 0.999) << f;
+            EXPECT_GE(f.coverage_iou, 0.9999) << f;
+        } else {
+            // Meta-cells on screen: the thresholds of the issue "Resolution insensitivity" for a
+            // final image (C >= 0.99, coverage IoU >= 0.999), and most pixels at their final
+            // colour (81% here; the rest differ by a shading step or two).
             EXPECT_GT(f.groups[0], 0u) << f;
             EXPECT_GT(f.groups[1], 0u) << f;
+            EXPECT_GE(f.correctness.c, 0.99) << f;
+            EXPECT_GE(f.coverage_iou, 0.999) << f;
+            EXPECT_GE(f.correctness.final_pixels, 0.75) << f;
         }
     }
 }

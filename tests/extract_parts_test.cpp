@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <sstream>
 #include <unordered_set>
 
@@ -28,12 +29,34 @@ TEST(GroupKey, EqualKeysHashAlikeAndPrint) {
     EXPECT_EQ(os.str(), "GroupKey{seed=(1,2,3) level=1 iso=40}");
 }
 
+// A cache holds the groups of one view: seeds a cell apart, at a few levels. Their hashes must
+// differ (a hash of x + y + z gives 22 values for these 512 seeds) and fill a table's buckets
+// about as a random hash would (about 63% of 1 bucket per key, none holding many).
 TEST(GroupKey, NeighbouringSeedsSpreadOverBuckets) {
     std::unordered_set<GroupKey> keys;
-    for (int z = 0; z < 8; ++z)
-        for (int y = 0; y < 8; ++y)
-            for (int x = 0; x < 8; ++x) keys.insert(GroupKey{{x, y, z}, 0, 40.0});
-    EXPECT_EQ(keys.size(), 512u);
+    keys.reserve(3 * 512);
+    std::unordered_set<std::size_t> hashes;
+    for (int level = 0; level < 3; ++level)
+        for (int z = 0; z < 8; ++z)
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x) {
+                    const GroupKey k{{x << level, y << level, z << level}, level, 40.0};
+                    keys.insert(k);
+                    hashes.insert(std::hash<GroupKey>{}(k));
+                }
+    ASSERT_EQ(keys.size(), 3u * 512u);
+    EXPECT_GE(hashes.size(), keys.size() - 2) << "distinct hashes of " << keys.size() << " keys";
+    std::size_t occupied = 0, fullest = 0;
+    for (std::size_t b = 0; b < keys.bucket_count(); ++b) {
+        occupied += keys.bucket_size(b) > 0;
+        fullest = std::max(fullest, keys.bucket_size(b));
+    }
+    const double expected = std::min(keys.size(), keys.bucket_count()) * 0.63;
+    EXPECT_GE(double(occupied), 0.8 * expected)
+        << occupied << " of " << keys.bucket_count() << " buckets hold keys";
+    EXPECT_LE(fullest, 8u) << "the fullest bucket";
+    std::printf("group keys: %zu keys, %zu distinct hashes, %zu of %zu buckets used, fullest %zu\n",
+                keys.size(), hashes.size(), occupied, keys.bucket_count(), fullest);
 }
 
 TEST(GroupKey, PropagatedGroupRecordsItsIsovalue) {

@@ -20,7 +20,7 @@ namespace {
 using namespace ray_order_testing;
 
 constexpr RayOrderKind kAllKinds[] = {RayOrderKind::refining_grid, RayOrderKind::screen_readback,
-                                      RayOrderKind::dynamic_grid};
+                                      RayOrderKind::dynamic_grid, RayOrderKind::dynamic_gaps};
 
 TEST(RayOrder, ParseAndToStringRoundTrip) {
     for (RayOrderKind k : kAllKinds) EXPECT_EQ(parse_ray_order(to_string(k)), k) << to_string(k);
@@ -114,7 +114,8 @@ TEST(RayOrder, LargeScreenHandsOutEveryPixelOnce) {
         auto order = make_ray_order(k, w, h, {0, 0, w, h});
         std::vector<glm::ivec2> rays;
         double worst_ms = 0, total_ms = 0;
-        std::size_t total_rays = 0;
+        std::size_t total_rays = 0, outside = 0;
+        std::vector<std::uint8_t> times(std::size_t(w) * h, 0);  // rays per pixel, saturating
         std::string figures;
         while (true) {
             std::vector<std::uint8_t> covered;
@@ -126,6 +127,14 @@ TEST(RayOrder, LargeScreenHandsOutEveryPixelOnce) {
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
             if (!more) break;
+            for (glm::ivec2 p : rays) {
+                if (p.x < 0 || p.y < 0 || p.x >= w || p.y >= h) {
+                    ++outside;
+                    continue;
+                }
+                std::uint8_t& t = times[std::size_t(p.y) * w + p.x];
+                t = std::uint8_t(std::min(t + 1, 255));
+            }
             scene.cast(rays);
             worst_ms = std::max(worst_ms, ms);
             total_ms += ms;
@@ -135,6 +144,13 @@ TEST(RayOrder, LargeScreenHandsOutEveryPixelOnce) {
             figures += buf;
         }
         EXPECT_EQ(total_rays, std::size_t(w) * h) << to_string(k);
+        EXPECT_EQ(outside, 0u) << to_string(k);
+        const auto once = std::count(times.begin(), times.end(), std::uint8_t{1});
+        EXPECT_EQ(std::size_t(once), std::size_t(w) * h)
+            << to_string(k) << ": " << std::count(times.begin(), times.end(), std::uint8_t{0})
+            << " pixels never cast, "
+            << std::count_if(times.begin(), times.end(), [](std::uint8_t t) { return t > 1; })
+            << " cast more than once";
         std::printf(
             "[ ray order ] %-8s 1600x1200: worst level %.2f ms, all levels %.2f ms; "
             "rays:ms per level%s\n",

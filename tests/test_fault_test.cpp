@@ -19,11 +19,18 @@ TEST(TestFault, EachKindParsesToItsActionMomentAndRank) {
     f = parse_test_fault("kill@init:1");
     EXPECT_EQ(f.action, FaultAction::kill);
     EXPECT_EQ(f.moment, FaultMoment::init);
+    f = parse_test_fault("slow:tiles");
+    EXPECT_EQ(f.action, FaultAction::slow);
+    EXPECT_TRUE(f.on(1) && f.on(7));
+    EXPECT_FALSE(f.on(0));
+    f = parse_test_fault("slow:3");
+    EXPECT_TRUE(f.on(3));
+    EXPECT_FALSE(f.on(2));
 }
 
 TEST(TestFault, AnythingElseIsNoFault) {
     for (const char* spec : {"", "hang", "hang:", "hang:x", "hang:2x", "jump:1", "stop@never:1",
-                             "stop:1", "pause@frame:1", ":1"}) {
+                             "stop:1", "pause@frame:1", ":1", "slow:tile", "slow@frame:tiles"}) {
         const TestFault f = parse_test_fault(spec);
         EXPECT_EQ(f.action, FaultAction::none) << spec;
     }

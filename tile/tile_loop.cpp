@@ -149,6 +149,7 @@ class TileRank {
         // that often (progress messages still go out every kProgressIntervalS).
         for (const FrameShow* f : setup_.shows)
             opt.progress_interval_s = std::min(opt.progress_interval_s, f->interval_s());
+        if (setup_.fault.action == FaultAction::slow) opt.progress_interval_s = 0;
         opt.trace = &trace_;
         return opt;
     }
@@ -161,6 +162,8 @@ class TileRank {
         raise_test_signal(setup_.fault, FaultMoment::frame);
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
+            if (setup_.fault.action == FaultAction::slow)
+                std::this_thread::sleep_for(std::chrono::duration<double>(TestFault::kSlowSampleS));
             jobs_.measure_point();
             changed(/*in_job=*/true);
             if (s.time_s - last_progress_s_ < kProgressIntervalS) return;

@@ -20,6 +20,7 @@ TestFault fault_of(std::string_view kind) {
     if (kind == "hang") return {FaultAction::hang};
     if (kind == "exit") return {FaultAction::exit};
     if (kind == "throw") return {FaultAction::throw_error};
+    if (kind == "slow") return {FaultAction::slow};
     const auto at = kind.find('@');
     if (at == std::string_view::npos) return {};
     const FaultMoment moment = moment_of(kind.substr(at + 1));
@@ -38,6 +39,10 @@ TestFault parse_test_fault(const char* spec) {
     if (colon == std::string_view::npos) return {};
     TestFault f = fault_of(s.substr(0, colon));
     const std::string_view rank = s.substr(colon + 1);
+    if (rank == "tiles") {
+        f.rank = TestFault::kEveryTile;
+        return f;
+    }
     const auto r = std::from_chars(rank.data(), rank.data() + rank.size(), f.rank);
     if (f.action == FaultAction::none || r.ec != std::errc() || r.ptr != rank.data() + rank.size())
         return {};

@@ -4,21 +4,28 @@
 //   hang            a tile stops answering after its first view, until the job ends
 //   exit            a tile ends its process at once (process only; never in process)
 //   throw           a tile, or the master, throws an error after its first view
+//   slow            a tile's engine stops for kSlowSampleS at every sample point, so that its
+//                   frames last seconds whatever the machine (tests of what happens mid-frame)
 //   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
 //   kill@MOMENT     the same with SIGKILL
-// MOMENT is init, load, frame, migration or gather.
+// MOMENT is init, load, frame, migration or gather. RANK is a rank, or "tiles" for every tile.
 #include <cstdint>
 #include <string_view>
 
 namespace isowall {
 
-enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, stop, kill };
+enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, slow, stop, kill };
 enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather };
 
 struct TestFault {
     FaultAction action = FaultAction::none;
     FaultMoment moment = FaultMoment::none;  // of stop and kill only
-    int rank = -1;                           // the rank that fails
+    int rank = -1;                           // the rank that fails, or kEveryTile
+    static constexpr int kEveryTile = -2;
+    static constexpr double kSlowSampleS = 0.02;
+
+    // Whether the fault is on `rank` (the master is rank 0).
+    bool on(int r) const { return rank == r || (rank == kEveryTile && r != 0); }
 };
 
 // "KIND:RANK" -> the fault; no fault (action none) when `spec` is null, empty or not of that form,
