@@ -29,7 +29,8 @@ class RemoteStudy(unittest.TestCase):
                       "--size", "160x120", "--out", out)
             self.assertEqual(p.returncode, 0, p.stderr)
             with open(os.path.join(out, "study.json")) as f:
-                res = json.load(f)["results"]["50"]
+                study_json = json.load(f)
+            res = study_json["results"]["50"]
             self.assertEqual(sorted(res), ["2", "4", "5", "5new"])
             for case, r in res.items():
                 # Every frame reaches C = 100%, with points in time and bytes order.
@@ -46,9 +47,29 @@ class RemoteStudy(unittest.TestCase):
             self.assertIn("Bytes to reach C", md)
             self.assertIn("Seconds to reach C at 50 Mbit/s", md)
             self.assertIn("bytes, case 4, C = 90%", md)
+            self.assert_targets(md, study_json)
             for png in ("c_vs_time.png", "c_vs_bytes.png", "50mbps_case4.png"):
                 with open(os.path.join(out, png), "rb") as f:
                     self.assertEqual(f.read(8), PNG_MAGIC, png)
+
+    def assert_targets(self, md, study_json):
+        # The text's bytes are scaled by our voxels over its 256x256x209, and the factor printed.
+        dims = study_json["dims"]
+        scale = dims[0] * dims[1] * dims[2] / (256 * 256 * 209)
+        self.assertAlmostEqual(study_json["scale"], scale)
+        self.assertRegex(md, rf"- scale factor for the volume's size: {scale:.3f} = "
+                             rf"{dims[0]}x{dims[1]}x{dims[2]} / 256x256x209 voxels")
+        self.assertIn("1 run each", md)
+        # Every case in the tables gets a verdict at every C: 5 against the text's case 4, and
+        # a new isovalue in our encoding against the text's best (case 3 at 90%).
+        for case in ("2", "4", "5new", "5"):
+            for c in ("90", "99", "99.9", "100"):
+                self.assertRegex(md, rf"- bytes, case {case}, C = {c}%: .*: (holds|MISSED)\n")
+        self.assertRegex(md, rf"- bytes, case 5, C = 90%: .* \(half the text's case 4, 73, "
+                             rf"x {scale:.3f}\): (holds|MISSED)\n")
+        self.assertRegex(md, r"- bytes, case 5new, C = 90%: .* \(half the text's case 3, ")
+        self.assertIn("time to C = 90% at 1 Mbit/s: not judged (1 Mbit/s is not among --rates)",
+                      md)
 
     def test_bad_options_give_one_line_and_status_1(self):
         with tempfile.TemporaryDirectory() as out:
