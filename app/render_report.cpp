@@ -80,9 +80,10 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
     Image full = draw_alone(renderer, mesh, fv);
     const Correctness c = measure_correctness(final_image, full);
     std::printf(
-        "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%% (%.3f s, "
-        "not part of the timings)\n",
-        mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels, sw.seconds());
+        "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%%, coverage "
+        "IoU %.5f (%.3f s, not part of the timings)\n",
+        mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels,
+        coverage_iou(final_image, full), sw.seconds());
     return full;
 }
 

@@ -6,8 +6,10 @@ primary rays: scripts/fe_mesh.py and bench/peer's isowall-peer), for one volume 
 scales, all in one run, with the issue's targets marked holds or MISSED.
 
 Usage: /usr/bin/python3 scripts/bench_scaling.py [--scales 1,2] [--size 1600x1200] [--iso 40]
-           [--runs 1] [--pair-rounds 2] [--volume vhp_ct_head] [--build build] [--data ../shared/data]
-           [--out out/bench-scaling] [--threads 2] [--engines lod,full-res,...] [--cold]
+           [--runs 3] [--pair-rounds 2] [--volume vhp_ct_head] [--build build] [--data ../shared/data]
+           [--out out/bench-scaling] [--threads 2] [--engines defaults,full-res,...] [--cold]
+       /usr/bin/python3 scripts/bench_scaling.py --rerender OLD/scaling.json [--out DIR]
+           (an older run's JSON judged by today's statistic and verdicts; writes scaling-rerendered.md)
 
 Scale 1 is the volume itself; any other scale is a trilinear copy made once by
 scripts/resample_volume.py into BUILD/data and kept there (outside git). For the shared CT head:
@@ -25,21 +27,25 @@ memory it touches then is new to it: page faults, the renderer's first buffers a
 keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the peer's processes
 run with the same C library settings (MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_).
 
-Two threads against one: the targets compare lod-facing on 1 and 2 threads. After the --runs
-rounds of every engine, --pair-rounds more rounds run only those two (in turn one first, then
-the other), each followed by a one-pass machine check, and their runs join the others (the
-fastest is kept). A table gives every round's own speed-ups beside the machine's. Beside them the
-run prints, for each scale, the peer's own 2-thread gain (flying edges, BVH and rays on 1 thread,
-one run) and what the machine's two cores gave two threads of plain work at that time
-(bench/cores' isowall-cores: arithmetic, and random reads over 256 MiB; 2.0 is perfect), since on
-a shared machine that moves from hour to hour.
+Two threads against one: the targets compare the defaults on one thread (full-res) and on every
+core (defaults). After the --runs rounds of every engine, --pair-rounds more rounds run only
+those two (in turn one first, then the other), each followed by a one-pass machine check; their
+runs stay out of the medians below and count only in the two-thread verdict, the median over
+every round of that round's own speed-up. A table gives every round's speed-ups beside the
+machine's. Beside them the run prints, for each scale, the peer's own 2-thread gain (flying
+edges, BVH and rays on 1 thread, one run) and what the machine's two cores gave two threads of
+plain work at that time (bench/cores' isowall-cores: arithmetic, and random reads over 256 MiB;
+2.0 is perfect), since on a shared machine that moves from hour to hour.
 
-Each progressive configuration (--engines; the first is the one the targets judge) also prints
-its final image's C against the full surface (`render --against-full`, outside the clock).
-Every figure is wall-clock seconds measured inside the programs (loading and the octree are
-outside them); with --runs N each measure is run N times and the fastest run is kept (of each
-engine, the run with the fastest C = 99%; all of them are in the JSON), the engines' runs taking
-turns round by round. The peer's mesh goes from Python to C++ through a file in a temp folder,
+Each progressive configuration (--engines; the first, by default `defaults`, is the one the
+targets judge) also prints its final image against the full surface (`render --against-full`,
+outside the clock): C and coverage IoU. A verdict on a speed holds only when the judged final
+image matches the full-resolution one (C >= 0.99 and coverage IoU >= 0.999, the thresholds of
+the issue "Resolution insensitivity on any volume"): a fast engine that draws another picture
+does not pass. Every figure is wall-clock seconds measured inside the programs (loading and the
+octree are outside them). Every contender (each engine, --full, FE + Embree) runs --runs times
+and keeps its median run (by time to C = 99%, extract + draw, and FE + BVH + rays; all runs are
+in the JSON), the engines' runs taking turns round by round. The peer's mesh goes from Python to C++ through a file in a temp folder,
 outside the clock. Writes OUT/scaling.md, OUT/scaling.json and OUT/scaling.png (time against voxels,
 log-log). Errors: one line naming the option, exit 1.
 """
@@ -58,7 +64,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from resample_volume import InputError, read_header  # noqa: E402
-from bench_scaling_report import plot, report, targets  # noqa: E402
+from bench_scaling_report import PAIR, plot, report, targets  # noqa: E402
 
 THRESHOLDS = [("c90", 0.90), ("c99", 0.99), ("c999", 0.999), ("c100", 1.0)]
 
@@ -69,7 +75,8 @@ THRESHOLDS = [("c90", 0.90), ("c99", 0.99), ("c999", 0.999), ("c100", 1.0)]
 # map instead of the copy in huge pages that `--huge-pages auto` makes from 256 MiB up (not run by
 # default; they show what the copy gains, in the same run).
 ENGINES = {
-    "full-res": ["--threads", "1"],
+    "defaults": [],  # `isowall render` without an engine option: what users get, what targets judge
+    "full-res": ["--threads", "1"],  # the defaults on one thread
     "facing": ["--threads", "1", "--facing-only"],
     "lod": ["--threads", "1", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine"],
     "lod-refine": ["--threads", "1", "--adaptive", "--adaptive-pixels", "2.5"],
@@ -78,8 +85,6 @@ ENGINES = {
     "lod-facing-2t": ["--threads", "2", "--adaptive", "--adaptive-pixels", "2.5", "--no-adaptive-refine",
                       "--facing-only"],
 }
-# The two engines the two-thread target compares: one thread, then two.
-PAIR = ("lod-facing", "lod-facing-2t")
 ENGINES["lod-facing-mapped"] = ENGINES["lod-facing"] + ["--huge-pages", "off"]
 ENGINES["lod-facing-2t-mapped"] = ENGINES["lod-facing-2t"] + ["--huge-pages", "off"]
 
@@ -109,17 +114,18 @@ def parse_args(argv):
     ap.add_argument("--scales", default="1,2", help="factors per axis (default %(default)s; 4 is the 2048-wide head)")
     ap.add_argument("--size", default="1600x1200", help="screen WIDTHxHEIGHT (default %(default)s)")
     ap.add_argument("--iso", type=float, default=40.0, help="isovalue (default %(default)s: skin of the head)")
-    ap.add_argument("--runs", type=int, default=1, help="runs of each measure, fastest kept (default %(default)s)")
+    ap.add_argument("--runs", type=int, default=3,
+                    help="runs of each measure of every contender, the median kept (default %(default)s)")
     ap.add_argument("--pair-rounds", type=int, default=2,
-                    help="more rounds of lod-facing and lod-facing-2t only, each with a machine check "
-                    "(default %(default)s)")
+                    help="more rounds of full-res and defaults only (the two-thread target), each with a "
+                    "machine check (default %(default)s)")
     ap.add_argument("--volume", default="vhp_ct_head", help="a name in --data or an .nhdr file (default %(default)s)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="build folder (default: build)")
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"),
                     help="shared data folder (default: ../shared/data)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-scaling"), help="output folder")
     ap.add_argument("--threads", type=int, default=2, help="the peer's threads (default %(default)s)")
-    ap.add_argument("--engines", default="lod-facing-2t,lod-facing,full-res,facing,lod,lod-refine",
+    ap.add_argument("--engines", default="defaults,full-res,lod-facing-2t,lod-facing,facing,lod,lod-refine",
                     help="progressive configurations, comma-separated, of " + ", ".join(ENGINES) +
                     "; the first is the one the targets judge (default %(default)s)")
     ap.add_argument("--cold", action="store_true",
@@ -217,8 +223,10 @@ def progressive(a, volume, tmp, engine):
     res["every_ray_s"] = rows[-1]["time_s"]
     res["triangles"] = int(rows[-1]["triangles"])
     res["covered_px"] = int(re.search(r"^covered: the final image covers (\d+) px$", out, re.M).group(1))
-    m = re.search(r"^against the full surface .*: C = ([\d.]+), final px ([\d.]+)%", out, re.M)
+    m = re.search(r"^against the full surface .*: C = ([\d.]+), final px ([\d.]+)%, coverage IoU ([\d.]+)",
+                  out, re.M)
     res["c_vs_full"], res["final_px_vs_full"] = float(m.group(1)), float(m.group(2)) / 100
+    res["iou_vs_full"] = float(m.group(3))
     res["engine"] = engine
     return res
 
@@ -261,28 +269,31 @@ def peer(a, volume, tmp, threads=None):
             "triangles": int(fe["triangles"]), "hit_px": int(rays["hit_pixels"])}
 
 
-def fastest(runs, key):
-    done = [r for r in runs if r.get(key) is not None]
-    best = min(done, key=lambda r: r[key]) if done else runs[0]
-    return dict(best, runs=runs)
+def median_run(runs, key):
+    """The run whose `key` is the median of the runs that reached it (the lower middle one for an
+    even count), whole, with every run beside it: every contender gets the same statistic."""
+    done = sorted((r for r in runs if r.get(key) is not None), key=lambda r: r[key])
+    pick = done[(len(done) - 1) // 2] if done else runs[0]
+    return dict(pick, runs=runs)
 
 
 def pair_rounds(a, volume, tmp, runs):
     """--pair-rounds more rounds of the two engines the two-thread target compares (one thread
     first in even rounds, two threads first in odd ones, so a slow stretch of the machine does not
     always fall on the same one), each followed by what the machine's cores gave two threads then.
-    Their runs join the engines' (the fastest is kept as for the others); returns every round in
-    which both ran, the first --runs rounds included, with its speed-ups."""
+    Their runs stay out of the engines' medians (every contender has --runs runs); returns every
+    round in which both ran, the first --runs rounds included, with its speed-ups."""
     pair = [e for e in PAIR if e in a.engines]
     if len(pair) < 2:
         return []
     machine = [None] * a.runs
+    extra = {e: [] for e in pair}
     for k in range(a.pair_rounds):
         for e in (pair if k % 2 == 0 else pair[::-1]):
-            runs[e].append(progressive(a, volume, tmp, e))
+            extra[e].append(progressive(a, volume, tmp, e))
         machine.append(key_values(run([a.cores, "--reps", "1"], "isowall-cores")))
     rounds = []
-    for i, (one, two) in enumerate(zip(runs[pair[0]], runs[pair[1]])):
+    for i, (one, two) in enumerate(zip(runs[pair[0]] + extra[pair[0]], runs[pair[1]] + extra[pair[1]])):
         def gain(key):
             return one[key] / two[key] if one.get(key) and two.get(key) else None
         rounds.append({"round": i + 1, "c99_speedup": gain("c99"), "every_ray_speedup": gain("every_ray_s"),
@@ -295,20 +306,20 @@ def measure_scale(a, scale, skip_peer, tmp):
     run([a.isowall, "info", "-v", volume], "isowall info")  # builds the octree cache, untimed
     res = {"scale": scale, "volume": volume, "sizes": sizes, "voxels": sizes[0] * sizes[1] * sizes[2]}
     # Runs of the engines take turns (a round of every engine, then the next round), so the
-    # fastest of each comes from the same stretch of time on a shared machine: a two-thread
+    # median of each comes from the same stretch of time on a shared machine: a two-thread
     # figure and its one-thread baseline then see the same other tenants.
     runs = {e: [] for e in a.engines}
     for _ in range(a.runs):
         for e in a.engines:
             runs[e].append(progressive(a, volume, tmp, e))
     res["pair_rounds"] = pair_rounds(a, volume, tmp, runs)
-    res["engines"] = {e: fastest(runs[e], "c99") for e in a.engines}
+    res["engines"] = {e: median_run(runs[e], "c99") for e in a.engines}
     res["progressive"] = res["engines"][a.engines[0]]  # the one the targets judge
-    res["full"] = fastest([full(a, volume, tmp) for _ in range(a.runs)], "full_s")
+    res["full"] = median_run([full(a, volume, tmp) for _ in range(a.runs)], "full_s")
     if skip_peer:
         res["peer"] = {"skipped": skip_peer}
     else:
-        res["peer"] = fastest([peer(a, volume, tmp) for _ in range(a.runs)], "total_s")
+        res["peer"] = median_run([peer(a, volume, tmp) for _ in range(a.runs)], "total_s")
         # The peer on one thread (one run): how much its two threads gain on this machine.
         if a.threads == 2:
             res["peer_1t"] = peer(a, volume, tmp, 1)
@@ -317,7 +328,40 @@ def measure_scale(a, scale, skip_peer, tmp):
     return res
 
 
+def rerender(path, out):
+    """An older scaling.json judged by today's rules: each contender's median of its first --runs
+    runs (older runs kept the fastest, and the pair engines had more runs than the others)."""
+    try:
+        with open(path) as f:
+            old = json.load(f)
+        meta, results = old["meta"], old["scales"]
+    except (OSError, ValueError, KeyError) as e:
+        raise BenchError(f"--rerender: {path}: not a scaling.json ({e})")
+    n = meta["runs"]
+    for r in results:
+        r["engines"] = {e: median_run(v.get("runs", [v])[:n], "c99") for e, v in r["engines"].items()}
+        r["progressive"] = r["engines"][next(iter(meta["engines"]))]
+        r["full"] = median_run(r["full"].get("runs", [r["full"]])[:n], "full_s")
+        if "total_s" in r["peer"]:
+            r["peer"] = median_run(r["peer"].get("runs", [r["peer"]])[:n], "total_s")
+    meta.setdefault("pair", ["lod-facing", "lod-facing-2t"])  # the pair of the runs before
+    meta["statistic"] = "median, re-rendered"
+    text = report(meta, results, targets(results, meta["pair"]))
+    print(text)
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "scaling-rerendered.md"), "w") as f:
+        f.write(text)
+    return 0
+
+
 def main(argv):
+    if "--rerender" in argv:
+        ap = Parser(description="an older scaling.json judged by today's rules")
+        ap.add_argument("--rerender", required=True)
+        ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-scaling"))
+        ap.add_argument("--build")  # accepted and unused: no program runs
+        r = ap.parse_args(argv)
+        return rerender(r.rerender, r.out)
     a = parse_args(argv)
     skip_peer = peer_missing(a)
     if skip_peer:
@@ -332,9 +376,9 @@ def main(argv):
             print(f"scale {scale:g}: measured in {time.monotonic() - t0:.0f} s", flush=True)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    checks = targets(results)
+    checks = targets(results, PAIR)
     meta = {"volume": a.source, "iso": a.iso, "size": a.size, "runs": a.runs, "pair_rounds": a.pair_rounds,
-            "threads": a.threads,
+            "threads": a.threads, "statistic": "median", "pair": list(PAIR),
             "frame": "cold" if a.cold else "warm",
             "engines": {e: " ".join(ENGINES[e]) or "(defaults)" for e in a.engines},
             "date": time.strftime("%Y-%m-%d %H:%M"), "cores": os.cpu_count(),

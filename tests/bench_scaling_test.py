@@ -14,6 +14,9 @@ import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import bench_scaling  # noqa: E402
+import bench_scaling_report as report_module  # noqa: E402
 SCRIPT = os.path.join(ROOT, "scripts", "bench_scaling.py")
 DATA = os.environ.get("ISOWALL_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 TOOTH = os.path.join(DATA, "tooth.nhdr")
@@ -34,7 +37,7 @@ class BenchScaling(unittest.TestCase):
     def test_quick_run_writes_table_json_and_plot(self):
         with tempfile.TemporaryDirectory() as out:
             p = bench("--volume", TOOTH, "--iso", "620", "--scales", "0.5,1", "--size", "320x240",
-                      "--out", out)
+                      "--runs", "1", "--out", out)
             self.assertEqual(p.returncode, 0, p.stderr)
             with open(os.path.join(out, "scaling.json")) as f:
                 res = json.load(f)
@@ -67,17 +70,19 @@ class BenchScaling(unittest.TestCase):
                 for key in ("alu_speedup", "memory_speedup"):
                     self.assertMeasuredRatio(s["cores"][key], s["cores"])
                 # Every configuration ran, and each final image was measured against the full surface.
-                self.assertEqual(list(s["engines"]), ["lod-facing-2t", "lod-facing", "full-res", "facing", "lod",
-                                                      "lod-refine"])
-                self.assertEqual(prog, s["engines"]["lod-facing-2t"])
+                self.assertEqual(list(s["engines"]), ["defaults", "full-res", "lod-facing-2t", "lod-facing",
+                                                      "facing", "lod", "lod-refine"])
+                self.assertEqual(prog, s["engines"]["defaults"])  # the targets judge the defaults
                 self.assertGreater(s["engines"]["full-res"]["c_vs_full"], 0.99, s)
+                self.assertGreater(s["engines"]["defaults"]["iou_vs_full"], 0.999, s)
                 for e in s["engines"].values():
                     self.assertGreater(e["c_vs_full"], 0.9, e)
-                # The default two pair rounds: lod-facing and lod-facing-2t ran once more each
-                # time (one thread first, then two threads first), each round with a machine check.
-                self.assertEqual(len(s["engines"]["lod-facing"]["runs"]), 3)
-                self.assertEqual(len(s["engines"]["lod-facing-2t"]["runs"]), 3)
-                self.assertEqual(len(s["engines"]["lod"]["runs"]), 1)
+                    self.assertTrue(0 < e["iou_vs_full"] <= 1, e)
+                # Every contender has --runs runs: the two pair rounds of full-res and defaults
+                # (one thread first, then every core first, each with a machine check) stay out.
+                for e in s["engines"].values():
+                    self.assertEqual(len(e["runs"]), 1, e)
+                self.assertEqual(len(s["full"]["runs"]), 1)
                 rounds = s["pair_rounds"]
                 self.assertEqual([k["round"] for k in rounds], [1, 2, 3])
                 self.assertIsNone(rounds[0]["machine"])
@@ -86,12 +91,10 @@ class BenchScaling(unittest.TestCase):
                     self.assertMeasuredRatio(k["every_ray_speedup"], k)
                 for k in rounds[1:]:
                     self.assertMeasuredRatio(k["machine"]["memory_speedup"], k)
-                fastest_c99 = min(r["c99"] for r in s["engines"]["lod-facing-2t"]["runs"])
-                self.assertEqual(s["engines"]["lod-facing-2t"]["c99"], fastest_c99)
             names = {c["target"] for c in res["targets"]}
             self.assertIn("triangles by C=99% per covered pixel", names)
             self.assertIn("every ray / our --full", names)
-            self.assertIn("2 threads / 1 thread on C=99% (lod-facing)", names)
+            self.assertIn("2 threads / 1 thread on C=99% (defaults, median of rounds)", names)
             self.assertIn("growth of C=99%, scale 1 -> 4", names)
             with open(os.path.join(out, "scaling.md")) as f:
                 md = f.read()
@@ -103,10 +106,17 @@ class BenchScaling(unittest.TestCase):
             self.assertIn("median of rounds", md)
             self.assertIn("| 103x94x161 | 3 |", md)
             self.assertIn("| 103x94x161 | lod-refine |", md)
+            self.assertIn("ran 1 time(s) and each figure is its median run", md)
             self.assertTrue("holds" in md or "MISSED" in md)
             self.assertIn(md.splitlines()[0], p.stdout)
             with open(os.path.join(out, "scaling.png"), "rb") as f:
                 self.assertEqual(f.read(8), PNG_MAGIC)
+            # The run's JSON judged again by the same rules gives the same verdicts.
+            p = bench("--rerender", os.path.join(out, "scaling.json"), "--out", out)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(out, "scaling-rerendered.md")) as f:
+                again = f.read()
+            self.assertEqual(again.split("Targets:")[1], md.split("Targets:")[1])
 
     def test_bad_options_give_one_line_and_status_1(self):
         with tempfile.TemporaryDirectory() as out:
@@ -123,6 +133,33 @@ class BenchScaling(unittest.TestCase):
                 self.assertEqual(len(lines), 1, p.stderr)
                 self.assertIn(field, lines[0])
             self.assertEqual(os.listdir(out), [])
+
+
+class Rules(unittest.TestCase):
+    """The statistic and the verdicts, on made-up figures (no program runs)."""
+
+    def test_every_contender_keeps_its_median_run_whole(self):
+        runs = [{"c99": 0.5, "x": 1}, {"c99": 0.2, "x": 2}, {"c99": 0.3, "x": 3}, {"c99": None, "x": 4}]
+        picked = bench_scaling.median_run(runs, "c99")
+        self.assertEqual((picked["c99"], picked["x"]), (0.3, 3))  # lower middle of 3 that reached it
+        self.assertEqual(picked["runs"], runs)
+        self.assertEqual(bench_scaling.median_run(runs[:2], "c99")["c99"], 0.2)  # lower of two
+
+    def test_a_fast_engine_with_another_picture_does_not_hold(self):
+        def scale(c_vs_full, iou):
+            p = {"c99": 0.1, "every_ray_s": 0.2, "triangles_c99": 10, "c_vs_full": c_vs_full, "iou_vs_full": iou}
+            return {"scale": 2, "sizes": [8, 8, 8], "progressive": p, "engines": {},
+                    "full": {"full_s": 1.0, "covered_px": 100}, "peer": {"total_s": 10.0}}
+        verdicts = lambda r: {c["target"]: (c["holds"], c["note"]) for c in report_module.targets([r])}
+        good = verdicts(scale(0.995, 0.9995))
+        self.assertEqual(good["C=99% / FE + Embree"], (True, ""))
+        bad_c = verdicts(scale(0.957, 0.9995))
+        self.assertEqual(bad_c["C=99% / FE + Embree"][0], False)
+        self.assertIn("final image C 0.9570 < 0.99", bad_c["C=99% / FE + Embree"][1])
+        self.assertEqual(bad_c["triangles by C=99% per covered pixel"][0], True)  # a count, not a speed
+        bad_iou = verdicts(scale(0.995, 0.99))
+        self.assertEqual(bad_iou["every ray / our --full"][0], False)
+        self.assertIn("coverage IoU 0.9900 < 0.999", bad_iou["every ray / our --full"][1])
 
 
 class Cores(unittest.TestCase):

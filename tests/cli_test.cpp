@@ -124,10 +124,16 @@ TEST_F(Cli, AgainstFullPrintsBothMeasures) {
         const auto c = out.find("C = ", at);
         return c == std::string::npos ? -1.0 : std::stod(out.substr(c + 4));
     };
+    auto iou_of = [](const std::string& out) {
+        const auto at = out.find("coverage IoU ", out.find("against the full surface ("));
+        return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 13));
+    };
     auto full =
         run_isowall(dir_, "render --size 160x120 -q --no-measure --against-full --out a.png");
     ASSERT_EQ(full.exit_code, 0) << full.err;
     EXPECT_GE(c_of(full.out), 0.999) << full.out;
+    EXPECT_GE(iou_of(full.out), 0.999) << full.out;
+    EXPECT_LE(iou_of(full.out), 1.0) << full.out;
     auto coarse = run_isowall(dir_,
                               "render --size 160x120 -q --no-measure --against-full --adaptive "
                               "--adaptive-pixels 8 --no-adaptive-refine "

@@ -60,6 +60,19 @@ TEST(Correctness, IdenticalImagesAreFullyCorrect) {
     EXPECT_EQ(m.c, 1.0);
 }
 
+TEST(Correctness, CoverageIouCountsCoveredPixelsInBothOverEither) {
+    EXPECT_EQ(coverage_iou(background(3, 3), background(3, 3)), 1.0);  // neither covers a pixel
+    Image a = background(4, 1), b = background(4, 1);
+    draw(a, 0, 0, 1, 1, 1);
+    draw(a, 1, 0, 1, 1, 1);
+    draw(b, 1, 0, 9, 9, 9);  // colour is not coverage
+    draw(b, 2, 0, 9, 9, 9);
+    EXPECT_DOUBLE_EQ(coverage_iou(a, b), 1.0 / 3.0);
+    EXPECT_DOUBLE_EQ(coverage_iou(a, a), 1.0);
+    EXPECT_EQ(coverage_iou(a, background(4, 1)), 0.0);
+    EXPECT_THROW(coverage_iou(a, background(2, 2)), std::invalid_argument);
+}
+
 TEST(Correctness, EmptyIntermediateIsZero) {
     const Image final_image = filled(6, 2, 90, 90, 90);
     const Correctness m = measure_correctness(background(6, 2), final_image);

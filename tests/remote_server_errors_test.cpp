@@ -79,7 +79,7 @@ TEST(RemoteServerErrors, EachBadInputGetsAnErrorAndAClosedConnectionAndTheServer
 
     // A payload whose fields end early (its length agrees with the bytes sent).
     std::vector<std::byte> short_payload = frame_of(good_hello("sesame"));
-    short_payload.resize(short_payload.size() - 3);
+    short_payload.erase(short_payload.end() - 3, short_payload.end());
     const std::uint32_t len = std::uint32_t(short_payload.size() - kHeaderBytes);
     std::memcpy(short_payload.data() + 8, &len, 4);
     const ErrorMsg e = error_after(port, short_payload);
@@ -88,7 +88,7 @@ TEST(RemoteServerErrors, EachBadInputGetsAnErrorAndAClosedConnectionAndTheServer
 
     // Cut short inside a message, then the client stops sending.
     std::vector<std::byte> cut = frame_of(good_hello("sesame"));
-    cut.resize(cut.size() - 2);
+    cut.erase(cut.end() - 2, cut.end());
     EXPECT_EQ(error_after(port, cut, true).code, ErrorCode::malformed);
 
     EXPECT_EQ(error_after(port, frame_of(good_hello("wrong"))).code, ErrorCode::bad_token);

@@ -75,6 +75,21 @@ Correctness measure_correctness(const Image& intermediate, const Image& final_im
     return result;
 }
 
+double coverage_iou(const Image& a, const Image& b) {
+    if (a.width != b.width || a.height != b.height)
+        throw std::invalid_argument("coverage_iou: images of " + size_text(a) + " and " +
+                                    size_text(b));
+    check_buffers(a, "first");
+    check_buffers(b, "second");
+    std::size_t both = 0, either = 0;
+    for (std::size_t p = 0; p < a.pixel_count(); ++p) {
+        const bool ca = a.depth[p] < 1.0f, cb = b.depth[p] < 1.0f;
+        both += ca && cb;
+        either += ca || cb;
+    }
+    return either == 0 ? 1.0 : double(both) / double(either);
+}
+
 void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn) {
     check_buffers(frame, "drawn");
     drawn.resize(frame.pixel_count(), 0);

@@ -33,6 +33,10 @@ struct Correctness {
 Correctness measure_correctness(const Image& intermediate, const Image& final_image,
                                 int tolerance = 1, std::span<const std::uint8_t> drawn_before = {});
 
+// Pixels covered (depth below 1) in both images over pixels covered in either: 1 when neither
+// covers any. Throws std::invalid_argument as measure_correctness does.
+double coverage_iou(const Image& a, const Image& b);
+
 // Marks in `drawn` (resized to one entry per pixel) every pixel of `frame` whose depth is below
 // 1; entries already set stay set.
 void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn);
