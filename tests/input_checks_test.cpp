@@ -121,6 +121,11 @@ TEST(Numbers, EveryRangeRefusesNonFiniteAndOutOfRange) {
     }
     EXPECT_GT(tried, 100);
     EXPECT_NE(number_problem("2.5", limits::kRayCount), "");  // integers only
+    // Past the end by one, though a double rounds it onto the end (2^53 + 1 -> 2^53).
+    EXPECT_EQ(number_problem("9007199254740992", limits::kRayCount), "");
+    EXPECT_EQ(number_problem("9007199254740993", limits::kRayCount),
+              "expected an integer in [0, 9007199254740992], got \"9007199254740993\"");
+    EXPECT_NE(number_problem("+2147483648", limits::kCellCount), "");
     EXPECT_EQ(number_problem("-5", limits::kRayCount),
               "expected an integer in [0, 9007199254740992], got \"-5\"");
     EXPECT_EQ(number_problem("nan", limits::kAnyFinite), "expected a finite number, got \"nan\"");

@@ -198,6 +198,22 @@ std::vector<BadCase> field_cases([[maybe_unused]] const Scene& s) {
          "spacings", "unusable"},
         {"spacing_tiny.nhdr", kU8 + s222 + "spacings: 1e-300 1 1\n" + raw + "data file: v.raw\n",
          "spacings", "unusable"},
+        // A side past what a view can frame: once "--zoom: ... expected at least inf".
+        {"spacing_1e30.nhdr", kU8 + s222 + "spacings: 1e30 1 1\n" + raw + "data file: v.raw\n",
+         "spacings", "at most 1e+07 object units a side"},
+        // Teem reads "nan" as a missing spacing; the docs say a spacing is a positive number.
+        {"spacing_nan.nhdr", kU8 + s222 + "spacings: -2 nan 0.5\n" + raw + "data file: v.raw\n",
+         "spacings", "axis 1: spacing nan (expected a finite non-zero number)"},
+        {"spacing_zero.nhdr", kU8 + s222 + "spacings: 1 1 0\n" + raw + "data file: v.raw\n",
+         "header", "axis 2 spacing (0) invalid"},  // Teem's own words
+        {"direction_zero.nhdr",
+         kU8 + s222 + "space dimension: 3\nspace directions: (1,0,0) (0,0,0) (0,0,1)\n" + raw +
+             "data file: v.raw\n",
+         "space directions", "axis 1 is the zero vector"},
+        {"direction_none.nhdr",
+         kU8 + s222 + "space dimension: 3\nspace directions: (1,0,0) (0,1,0) none\n" + raw +
+             "data file: v.raw\n",
+         "space directions", "axis 2 has no direction"},
         {"direction_inf.nhdr",
          kU8 + s222 + "space dimension: 3\nspace directions: (1e300,0,0) (0,1,0) (0,0,1)\n" + raw +
              "data file: v.raw\n",
@@ -280,8 +296,8 @@ std::vector<GoodCase> good_cases(const Scene& s) {
         {"byteskip_end.nhdr", kU8 + s222 + "encoding: raw\nbyte skip: -1\ndata file: lines.raw\n",
          ramp},
         {"byteskip.nhdr", kU8 + s222 + "encoding: raw\nbyteskip: 12\ndatafile: lines.raw\n", ramp},
-        {"spacing_neg_nan.nhdr",
-         kU8 + s222 + "spacings: -2 nan 0.5\nencoding: raw\ndata file: v.raw\n",
+        {"spacing_neg.nhdr",
+         kU8 + s222 + "spacings: -2 1 0.5\nencoding: raw\ndata file: v.raw\n",
          ramp,
          {2, 1, 0.5f}},
         {"gzip.nhdr", "", ramp},

@@ -44,9 +44,20 @@ std::optional<double> parse_number(std::string_view text) {
     return v;
 }
 
+// An integer range's ends judged on the text's own value: a double rounds 2^53 + 1 to 2^53, a
+// long double (64 bits of mantissa here) holds it.
+bool past_integer_range(std::string_view text, const NumberRange& range) {
+    if (!range.integer) return false;
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    long double v = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (error != std::errc() || end != text.data() + text.size()) return false;
+    return v > static_cast<long double>(range.hi) || v < static_cast<long double>(range.lo);
+}
+
 std::string number_problem(std::string_view text, const NumberRange& range) {
     const auto v = parse_number(text);
-    if (v && range.contains(*v)) return {};
+    if (v && range.contains(*v) && !past_integer_range(text, range)) return {};
     return "expected " + range.describe() + ", got " + quote(text);
 }
 

@@ -3,8 +3,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cfloat>
 #include <climits>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <sstream>
@@ -124,6 +128,18 @@ std::string quote_bounded(std::string_view text, std::size_t limit) {
         out += one;
     }
     return "\"" + out + "\"";
+}
+
+std::string spacing_problem(double spacing, int size, int axis) {
+    const double side = spacing * std::max(size - 1, 0);
+    if (spacing >= FLT_MIN && std::isfinite(side) && side <= kMaxVolumeSide) return {};
+    char msg[200];
+    std::snprintf(msg, sizeof(msg),
+                  "axis %d: spacing %g is unusable (expected a number from %g to %g, so that the "
+                  "volume is at most %g object units a side)",
+                  axis, spacing, double(FLT_MIN),
+                  size > 1 ? kMaxVolumeSide / (size - 1) : double(FLT_MAX), kMaxVolumeSide);
+    return msg;
 }
 
 }  // namespace isowall

@@ -52,4 +52,13 @@ void check_size(const std::string& file, std::uint64_t have, std::uint64_t offse
 // "...": for quoting input in an error line.
 std::string quote_bounded(std::string_view text, std::size_t limit = 60);
 
+// The longest side of a volume, in object units: the view of the whole volume then stands well
+// within the camera's reach (1e9 from the origin, common/core/camera.cpp), so a volume that loads
+// can be looked at, and no view option is blamed for a spacing.
+inline constexpr double kMaxVolumeSide = 1e7;
+
+// Why `spacing` cannot be the spacing of an axis of `size` voxels (axis `axis`), or empty: it
+// must be a positive float32 and keep that side within kMaxVolumeSide.
+std::string spacing_problem(double spacing, int size, int axis);
+
 }  // namespace isowall

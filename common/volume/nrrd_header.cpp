@@ -88,6 +88,7 @@ bool take_field(NrrdHeaderText& h, std::string_view line, const std::string& whe
     const std::string_view value = trim(line.substr(std::min(line.find(':') + 1, line.size())));
     const bool ours = key == "datafile" || key == "lineskip" || key == "byteskip";
     if (key == "sizes") set_sizes(h, value, where);
+    if (key == "spacings") h.spacings_given = true;
     if (!ours) return false;
     const std::string name = key == "datafile"   ? "data file"
                              : key == "lineskip" ? "line skip"

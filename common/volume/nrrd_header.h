@@ -17,8 +17,9 @@ struct NrrdHeaderText {
     std::string teem_text;                 // the header without the data-location fields
     std::optional<std::string> data_file;  // as written; nullopt: the data is attached
     std::uint64_t line_skip = 0;
-    std::int64_t byte_skip = 0;              // -1: the data is the last bytes of the file
-    std::vector<std::uint64_t> sizes;        // the "sizes" field, each checked against 64 bits
+    std::int64_t byte_skip = 0;        // -1: the data is the last bytes of the file
+    std::vector<std::uint64_t> sizes;  // the "sizes" field, each checked against 64 bits
+    bool spacings_given = false;       // a "spacings" field is there (Teem reads nan as absent)
     std::optional<std::size_t> data_offset;  // first byte after the blank line, if there is one
 };
 

@@ -60,31 +60,50 @@ Encoding encoding_of(const NrrdIoState& nio, const std::string& where) {
                      "\"" + name + "\" is not supported (expected raw, gzip, bzip2, ascii or hex)");
 }
 
+// The length of an axis's space direction; an InputError naming "space directions" when the axis
+// has none ("none", or a NaN or infinite entry) or a zero vector: a space axis of a scalar volume
+// has a direction.
+double direction_length(const Nrrd& n, int axis, const std::string& where) {
+    const NrrdAxisInfo& ax = n.axis[axis];
+    double len2 = 0;
+    for (unsigned d = 0; d < n.spaceDim; ++d) {
+        if (!std::isfinite(ax.spaceDirection[d]))
+            throw InputError(where, "space directions",
+                             "axis " + std::to_string(axis) +
+                                 " has no direction (\"none\" or a non-finite entry); each of the "
+                                 "three space axes needs a vector");
+        len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
+    }
+    if (!(len2 > 0))
+        throw InputError(where, "space directions",
+                         "axis " + std::to_string(axis) + " is the zero vector");
+    return std::sqrt(len2);
+}
+
 // An axis's spacing: `spacings` (its magnitude: negative means the axis runs backwards), else the
-// length of its space direction, else 1. It must survive as a positive float32 and keep the
-// volume's extent finite: geometry is float, and an infinite or zero spacing turns it into NaN.
-float axis_spacing(const Nrrd& n, int axis, int size, const std::string& where) {
+// length of its space direction, else 1. A `spacings` value must be a non-zero number: Teem reads
+// "nan" as a missing value, which would silently become 1. It must survive as a positive float32
+// and keep the volume's extent finite: geometry is float, and an infinite or zero spacing turns
+// it into NaN.
+float axis_spacing(const Nrrd& n, bool spacings_given, int axis, int size,
+                   const std::string& where) {
     const NrrdAxisInfo& ax = n.axis[axis];
     double s = 1;
     const char* field = "spacings";
-    if (std::isfinite(ax.spacing) && ax.spacing != 0) {
-        s = std::abs(ax.spacing);
-    } else if (n.spaceDim > 0) {
-        double len2 = 0;
-        for (unsigned d = 0; d < n.spaceDim; ++d)
-            if (std::isfinite(ax.spaceDirection[d]))
-                len2 += ax.spaceDirection[d] * ax.spaceDirection[d];
-        if (len2 > 0) s = std::sqrt(len2);
-        field = "space directions";
-    }
-    const double extent = s * (size - 1);
-    if (!(s >= FLT_MIN && extent <= FLT_MAX && std::isfinite(extent))) {
+    if (spacings_given && !(std::isfinite(ax.spacing) && ax.spacing != 0)) {
         char msg[160];
-        std::snprintf(msg, sizeof(msg),
-                      "axis %d: spacing %g is unusable (expected a number from %g to about %g)",
-                      axis, s, double(FLT_MIN), double(FLT_MAX) / (size - 1));
+        std::snprintf(msg, sizeof(msg), "axis %d: spacing %g (expected a finite non-zero number)",
+                      axis, ax.spacing);
         throw InputError(where, field, msg);
     }
+    if (spacings_given) {
+        s = std::abs(ax.spacing);
+    } else if (n.spaceDim > 0) {
+        s = direction_length(n, axis, where);
+        field = "space directions";
+    }
+    if (std::string p = spacing_problem(s, size, axis); !p.empty())
+        throw InputError(where, field, p);
     return static_cast<float>(s);
 }
 
@@ -116,7 +135,8 @@ NrrdInfo parse_info(const NrrdHeaderText& text, const std::string& where) {
     }
     // Our own reading of the sizes: Teem wraps numbers past 64 bits.
     info.dims = checked_dims(where, "sizes", text.sizes, info.type);
-    for (int a = 0; a < 3; ++a) info.spacing[a] = axis_spacing(*nrrd, a, info.dims[a], where);
+    for (int a = 0; a < 3; ++a)
+        info.spacing[a] = axis_spacing(*nrrd, text.spacings_given, a, info.dims[a], where);
     info.encoding = encoding_of(*nio, where);
     info.host_order = voxel_size(info.type) == 1 || info.encoding == Encoding::ascii ||
                       (nio->endian == airEndianLittle) == (host_endian() == Endian::little);

@@ -148,8 +148,8 @@ Volume load_raw(const fs::path& path, const RawSpec& spec) {
     check_dims(where, "--dims", spec.dims, spec.type);
     check_regular_file(path, where, "file");
     for (int i = 0; i < 3; ++i)
-        if (!(spec.spacing[i] > 0) || !std::isfinite(spec.spacing[i]))
-            throw InputError(where, "--spacing", "expected three positive numbers");
+        if (std::string p = spacing_problem(spec.spacing[i], spec.dims[i], i); !p.empty())
+            throw InputError(where, "--spacing", p);
     const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
     MappedFile file(path, true);
     check_size(where, file.size(), spec.header_bytes, need);
