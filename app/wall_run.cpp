@@ -191,11 +191,12 @@ std::string role(const WallSpec& spec, int rank) {
 // Bad input names its source and field already; any other error is prefixed with the rank.
 [[noreturn]] void fail(Comm& comm, const WallSpec& spec, const std::exception& e, bool input) {
     std::fflush(stdout);
+    // clip: one bounded line, every byte a terminal could act on escaped.
     if (input)
-        std::fprintf(stderr, "isowall: error: %s\n", e.what());
+        std::fprintf(stderr, "isowall: error: %s\n", clip(e.what(), 800).c_str());
     else
         std::fprintf(stderr, "isowall: error: rank %d (%s): %s\n", comm.rank(),
-                     role(spec, comm.rank()).c_str(), e.what());
+                     role(spec, comm.rank()).c_str(), clip(e.what(), 800).c_str());
     std::fflush(stderr);
     comm.abort(input ? 1 : 2);
     throw CommAborted(input ? 1 : 2);  // not reached: abort() ends the rank
@@ -220,7 +221,8 @@ int run_wall(const WallOptions& o, Comm& comm) {
     try {
         spec = load_wall(o.wall);
     } catch (const std::exception& e) {
-        if ((comm.rank() == kMasterRank)) std::fprintf(stderr, "isowall: error: %s\n", e.what());
+        if ((comm.rank() == kMasterRank))
+            std::fprintf(stderr, "isowall: error: %s\n", clip(e.what(), 800).c_str());
         return 1;
     }
     if (comm.size() != rank_count(spec)) {

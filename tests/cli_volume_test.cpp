@@ -83,6 +83,9 @@ TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
         {"extract -v nan.raw --dims 4 4 4 --type float32 --iso 0 --out s.ply",
          {"nan.raw", "data", "no finite voxel"}},
         {"render --huge-pages maybe --out s.png", {"--huge-pages", "maybe"}},
+        // A C1 control (0x9B, a terminal's CSI) and a byte that is not UTF-8 in a file name
+        // reach the terminal escaped.
+        {"info -v \"$(printf '\\23331m\\377.nhdr')\"", {"\\x9B31m\\xFF.nhdr"}},
         {"render --huge-pages --out s.png", {"--huge-pages"}},
     };
     for (const CliCase& c : cases) {

@@ -39,6 +39,19 @@ TEST(Quote, BoundsEscapesAndNeverCutsACharacter) {
         {"\x1b[31mred", "\"\\x1B[31mred\""},
         {std::string("nul\0byte", 8), "\"nul\\x00byte\""},
         {"\x7f", "\"\\x7F\""},
+        // C1 controls (0x9B is a terminal's CSI) and bytes that are not UTF-8 are escaped too;
+        // valid characters are kept.
+        {"a\xc2\x9b"
+         "31m",
+         "\"a\\xC2\\x9B31m\""},
+        {"\x9b"
+         "31m\xff",
+         "\"\\x9B31m\\xFF\""},
+        {"\xc0\xaf", "\"\\xC0\\xAF\""},           // an overlong '/'
+        {"\xed\xa0\x80", "\"\\xED\\xA0\\x80\""},  // a surrogate
+        {"\xe2\x82", "\"\\xE2\\x82\""},           // cut short
+        {"caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x99\x82",
+         "\"caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x99\x82\""},
         // 59 ASCII then a 2-byte character: the character is kept whole, not split.
         {std::string(59, 'a') + "\xc3\xa9" + "zz", q(std::string(59, 'a') + "\xc3\xa9...")},
     };

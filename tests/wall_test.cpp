@@ -358,6 +358,10 @@ TEST(Wall, MalformedInputNamesFileAndField) {
         {"offset past a million",
          "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\noffset_px = [2147483647, 0]\n",
          "tile[0].offset_px", "got [2147483647, 0]"},
+        // Within the old [-1e6, 1e6] but past the tile: once a grey tile and exit 0.
+        {"offset past its tile",
+         "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\noffset_px = [1000000, 0]\n",
+         "tile[0].offset_px", "within the tile's size"},
     };
     for (const BadWall& c : cases) {
         try {

@@ -280,8 +280,17 @@ void read_overrides(const Reader& top, WallSpec& spec) {
             o.disabled = b->get();
         }
         if (r.find("offset_px")) {
-            const auto off = r.ints("offset_px", 2, -kMaxBezelPx, kMaxBezelPx,
-                                    "two integers in [-1e6, 1e6] (x right, y down)");
+            // A nudge of at most the tile's own size: further, the tile would show a part of
+            // the virtual screen that is not its own, or none of it (a grey tile, exit 0).
+            const long long w = spec.tile_width_px, h = spec.tile_height_px;
+            const auto off = r.ints("offset_px", 2, -std::max(w, h), std::max(w, h),
+                                    "two integers (x right, y down) within the tile's size, [-" +
+                                        std::to_string(w) + ", " + std::to_string(w) + "] and [-" +
+                                        std::to_string(h) + ", " + std::to_string(h) + "]");
+            if (std::abs(off[0]) > w || std::abs(off[1]) > h)
+                r.fail("offset_px", "(" + std::to_string(off[0]) + ", " + std::to_string(off[1]) +
+                                        ") moves the tile past its own size " + std::to_string(w) +
+                                        "x" + std::to_string(h));
             o.offset_x_px = off[0];
             o.offset_y_px = off[1];
         }
