@@ -21,6 +21,7 @@ struct ServeCommand {
     std::string token;
     double rate_mbps = 0;
     int max_clients = 8;
+    double idle_timeout_s = 300;  // --idle-timeout: a connection idle this long after its hello
     double lod_rays_percent = 0.25;
     std::string cache_dir;
     EngineCli engine;

@@ -80,6 +80,11 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
     c->add_option("--max-clients", o.max_clients, "Connections served at once")
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();
+    c->add_option("--idle-timeout", o.idle_timeout_s,
+                  "Close a connection on which nothing was received or sent for this many "
+                  "seconds after its hello, with an error naming the limit")
+        ->transform(number_in(limits::kSeconds))
+        ->capture_default_str();
     c->add_option("--lod-rays", o.lod_rays_percent,
                   "Progressive LOD: rays of each coarse LOD level, in percent of the view's pixels")
         ->transform(number_in({0, 100, true}))
@@ -98,6 +103,7 @@ int run_serve(const ServeCommand& o) {
     so.token = o.token;
     so.rate_bits_per_s = o.rate_mbps * 1e6;
     so.max_clients = o.max_clients;
+    so.idle_timeout_s = o.idle_timeout_s;
     so.verbose = !o.quiet;
     so.session.engine = to_engine_options(o.engine);
     so.session.lod_ray_share = o.lod_rays_percent / 100.0;

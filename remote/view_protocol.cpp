@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "common/core/wire_pieces.h"
+#include "remote/request_checks.h"
 #include "remote/slot_list.h"
 
 namespace isowall::remote {
@@ -136,6 +137,12 @@ static ReadyMsg decode_ready(std::span<const std::byte> bytes) {
     m.bounds.min = get_finite_vec3(r, "bounds.min");
     m.bounds.max = get_finite_vec3(r, "bounds.max");
     if (m.bounds.empty()) r.fail("bounds: expected min <= max on every axis");
+    // A volume loads only up to 1e7 object units a side (common/volume/load_checks.h), which
+    // any view can frame; a server saying more would end in a view option's error instead.
+    for (int a = 0; a < 3; ++a)
+        if (!(std::abs(m.bounds.min[a]) <= 1e9 && std::abs(m.bounds.max[a]) <= 1e9 &&
+              m.bounds.max[a] - m.bounds.min[a] <= 1e7))
+            r.fail("bounds: expected a box at most 1e7 units a side within 1e9 of the origin");
     m.value_min = get_finite<double>(r, "value_min");
     m.value_max = get_finite<double>(r, "value_max");
     if (m.value_min > m.value_max) r.fail("value_max: expected >= value_min");
@@ -166,6 +173,10 @@ static RequestMsg decode_request(std::span<const std::byte> bytes) {
     // The server would cast rays from it; a camera that cannot be drawn is the client's error.
     if (const std::string problem = camera_problem(m.view.camera); !problem.empty())
         r.fail("view.camera: " + problem);
+    // The rays and the projection come from the frustum: a degenerate or huge one drew nothing
+    // and said nothing (request_checks.h).
+    if (const std::string problem = frustum_problem(m.view.frustum); !problem.empty())
+        r.fail("view.frustum." + problem);
     m.progressive_lod = get_flag(r, "progressive_lod");
     m.cached_groups = get_flag(r, "cached_groups");
     r.finish();

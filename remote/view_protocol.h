@@ -68,8 +68,9 @@ struct RequestMsg {
     static constexpr RemoteTag kTag = RemoteTag::request;
     static constexpr std::uint8_t kVersion = 1;
     std::uint64_t request_id = 0;  // grows with every request of a connection
-    // Camera, frustum, image size (each side 1..kMaxImageSide) and isovalue; the camera must be
-    // one that can be drawn (camera_problem is empty).
+    // Camera, frustum, image size (each side 1..kMaxImageSide) and isovalue; the camera and the
+    // frustum must be ones that can be drawn (camera_problem and frustum_problem are empty). The
+    // server checks the isovalue against the dataset's range (request_checks.h).
     FrameView view;
     bool progressive_lod = false;  // case 3: start two levels coarser
     bool cached_groups = false;    // case 4: the client caches groups per isovalue

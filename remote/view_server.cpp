@@ -1,5 +1,10 @@
 #include "remote/view_server.h"
 
+#include <malloc.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <list>
 #include <optional>
@@ -7,6 +12,7 @@
 #include "common/core/error.h"
 #include "common/core/newest_request.h"
 #include "remote/net/socket.h"
+#include "remote/request_checks.h"
 
 namespace isowall::remote {
 
@@ -23,6 +29,39 @@ bool is_loopback(const std::string& address) {
 }
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// How long an error may take to go out, and a worker to stop, before the connection is shut
+// down: a send to a client that does not read waits for room in its buffers for ever.
+constexpr double kErrorSendTimeoutS = 2;
+
+std::string seconds_text(double s) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", s);
+    return buf;
+}
+
+// Runs `f` (which must not throw) and shuts `conn` down if it has not returned within
+// `timeout_s`: that ends any send or receive of `conn` that `f` waits in.
+template <class F>
+void within(MessageChannel& conn, double timeout_s, F&& f) {
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool done = false;
+    std::thread watchdog([&] {
+        std::unique_lock lock(mutex);
+        if (!changed.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return done; }))
+            conn.shutdown();
+    });
+    f();
+    {
+        std::lock_guard lock(mutex);
+        done = true;
+    }
+    changed.notify_all();
+    watchdog.join();
+}
 
 // The error code of a broken stream: the framing's and decoders' WireError texts name the field.
 ErrorCode code_of(const WireError& e) {
@@ -61,13 +100,23 @@ class ViewServer::Client {
         std::fflush(stdout);
     }
 
-    // Sends the error (if the peer still listens) and says it; the caller then closes.
+    // Sends the error (if the peer still listens) and says it; the caller then closes. A client
+    // that does not read has its connection shut down instead (kErrorSendTimeoutS).
     void refuse(ErrorCode code, const std::string& text) {
         say("serve: %s: error: %s%s\n", text);
-        try {
-            conn_.send(make_error(code, text));
-        } catch (const std::exception&) {
-        }
+        within(conn_, kErrorSendTimeoutS, [&] {
+            try {
+                conn_.send(make_error(code, text));
+            } catch (const std::exception&) {
+            }
+        });
+    }
+
+    // Something moved on the connection: a message came, or one went out whole.
+    void touch() { last_active_ = Clock::now().time_since_epoch().count(); }
+    double idle_s() const {
+        const Clock::time_point last{Clock::duration(last_active_.load())};
+        return std::chrono::duration<double>(Clock::now() - last).count();
     }
 
     const Dataset* hello() {
@@ -137,21 +186,47 @@ class ViewServer::Client {
         say("serve: %s: dataset %s%s\n", d.name);
         SessionOptions so = server_.options_.session;
         so.encoding = encoding_;
-        session_ = std::make_unique<ServerSession>(
-            *d.extractor, so, [this](const RemoteMessage& m) { return conn_.send(m); });
+        session_ =
+            std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
+                const std::size_t bytes = conn_.send(m);
+                touch();
+                return bytes;
+            });
         worker_ = std::thread([this] { work(); });
+        const double limit = server_.options_.idle_timeout_s;
+        touch();
         for (;;) {
-            std::optional<RemoteMessage> m = conn_.receive(0.5);
-            if (!m) continue;
-            if (std::holds_alternative<ByeMsg>(*m)) return;
-            const auto* r = std::get_if<RequestMsg>(&*m);
-            if (!r) {
-                refuse(ErrorCode::malformed, std::string("unexpected ") + to_string(type_of(*m)) +
-                                                 " message from a client");
+            const double idle = idle_s();
+            if (idle >= limit) {
+                refuse(ErrorCode::malformed, "idle for " + seconds_text(limit) +
+                                                 " s (--idle-timeout): nothing received or sent");
                 return;
             }
-            requests_.put(*r);
+            std::optional<RemoteMessage> m = conn_.receive(std::min(0.5, limit - idle));
+            if (!m) continue;
+            touch();
+            if (!take(*m, d)) return;
         }
+    }
+
+    // One message after the hello: false when the connection ends (a bye, or an error sent).
+    bool take(const RemoteMessage& m, const Dataset& d) {
+        if (std::holds_alternative<ByeMsg>(m)) return false;
+        const auto* r = std::get_if<RequestMsg>(&m);
+        if (!r) {
+            refuse(ErrorCode::malformed,
+                   std::string("unexpected ") + to_string(type_of(m)) + " message from a client");
+            return false;
+        }
+        // The isovalue needs the dataset; the decoder checked the rest of the view.
+        const std::string problem =
+            iso_problem(r->view.iso, d.extractor->value_min(), d.extractor->value_max());
+        if (!problem.empty()) {
+            refuse(ErrorCode::malformed, "request: view.iso: " + problem);
+            return false;
+        }
+        requests_.put(*r);
+        return true;
     }
 
     void work() {
@@ -182,9 +257,11 @@ class ViewServer::Client {
         }
     }
 
+    // A worker computing stops at its next ray; one blocked in a send to a client that does not
+    // read is woken by shutting the connection down.
     void stop_worker() {
         requests_.close();
-        if (worker_.joinable()) worker_.join();
+        if (worker_.joinable()) within(conn_, kErrorSendTimeoutS, [this] { worker_.join(); });
     }
 
     ViewServer& server_;
@@ -193,7 +270,8 @@ class ViewServer::Client {
     GroupEncoding encoding_ = GroupEncoding::compact_zstd;
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
-    NewestRequest<RequestMsg> requests_;  // the reader puts, the worker takes
+    NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes
+    std::atomic<Clock::rep> last_active_{0};  // see touch()
     std::atomic<bool> done_{false};
 };
 
@@ -215,8 +293,16 @@ int ViewServer::port() const {
 }
 
 void ViewServer::reap(bool all) {
-    std::lock_guard lock(impl_->mutex);
-    impl_->clients.remove_if([all](const std::unique_ptr<Client>& c) { return all || c->done(); });
+    std::size_t gone = 0;
+    {
+        std::lock_guard lock(impl_->mutex);
+        gone = impl_->clients.remove_if(
+            [all](const std::unique_ptr<Client>& c) { return all || c->done(); });
+    }
+    // What a client that left had the server hold goes back to the system: `isowall` keeps
+    // freed memory for the next frame (keep_freed_memory, common/core/util.h), which would keep
+    // it for as long as the server runs.
+    if (gone > 0 && !all) ::malloc_trim(0);
 }
 
 void ViewServer::serve(const std::atomic<bool>& stop) {

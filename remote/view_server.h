@@ -9,8 +9,17 @@
 // A connection begins with a hello within hello_timeout_s: protocol version, dataset, token
 // (when the server has one; compared in constant time), group encoding; the server answers
 // ready, or an error naming what was wrong and closes. Any message that does not decode, a
-// frame over the payload limit, another version, or a message a client may not send gets an
-// error and a closed connection; other connections go on.
+// frame over the payload limit, another version, a message a client may not send, or a request
+// it cannot draw (request_checks.h: a frustum that cannot be drawn, an isovalue outside the
+// volume's range) gets an error and a closed connection; other connections go on.
+//
+// After the hello, a connection on which nothing moves for idle_timeout_s (no message from the
+// client, none sent to it) gets an error naming the limit and is closed: clients that said hello
+// and then nothing used to hold every slot of max_clients for good. A client that stops reading
+// what it asked for counts as idle too (the server's send cannot finish). An error, and the stop
+// of a worker, may take 2 s: past that the connection is shut down (an error to a client that
+// does not read, a worker blocked in a send to it), so no connection holds its threads for good.
+// When a client has left, its memory goes back to the system (malloc_trim).
 //
 // Memory per connection: the reader's frame buffer (a header and at most max_payload_bytes,
 // which a client's messages never need: a request is under 200 bytes), one visited-cell bitset
@@ -49,6 +58,10 @@ struct ServerOptions {
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
     int max_clients = 8;
     double hello_timeout_s = 10;
+    // After the hello: nothing received and nothing sent for this long closes the connection.
+    // A message that takes longer than this to go out (a 32 MiB group on a link under 1 Mbit/s
+    // at the default) counts as nothing sent.
+    double idle_timeout_s = 300;
     std::uint32_t max_payload_bytes = 1 << 16;  // what a client's message may be
     SessionOptions session;                     // the encoding comes from each hello
     bool verbose = true;                        // a line per connection and request

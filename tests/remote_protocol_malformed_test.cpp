@@ -72,6 +72,9 @@ TEST(RemoteProtocolMalformed, ReadyFields) {
         {{"bounds.min.y: expected a finite number", [](ReadyMsg& m) { m.bounds.min.y = kNaN; }},
          {"bounds.max.z: expected a finite number", [](ReadyMsg& m) { m.bounds.max.z = kInf; }},
          {"bounds: expected min <= max", [](ReadyMsg& m) { m.bounds.min.x = 5; }},
+         // Once "--zoom: ... expected at least inf" in the client, though no --zoom was given.
+         {"bounds: expected a box at most 1e7 units a side",
+          [](ReadyMsg& m) { m.bounds.max.x = 1e30f; }},
          {"value_min: expected a finite number", [](ReadyMsg& m) { m.value_min = kNaN; }},
          {"value_max: expected >= value_min", [](ReadyMsg& m) { m.value_max = -2000; }},
          {"dims.y: expected 1..2147483647, got 0", [](ReadyMsg& m) { m.dims.y = 0; }},
@@ -92,7 +95,14 @@ TEST(RemoteProtocolMalformed, RequestFields) {
          {"view.iso: expected a finite number", [](RequestMsg& m) { m.view.iso = kNaN; }},
          {"view.camera: ", [](RequestMsg& m) { m.view.camera.target = m.view.camera.eye; }},
          {"camera.projection: expected 0",
-          [](RequestMsg& m) { m.view.camera.projection = static_cast<Projection>(2); }}});
+          [](RequestMsg& m) { m.view.camera.projection = static_cast<Projection>(2); }},
+         // A frustum that cannot be drawn (remote/request_checks.h), named by its field.
+         {"view.frustum.left: expected a number within 1e+09 of zero, got -1e+38",
+          [](RequestMsg& m) { m.view.frustum.left = -1e38f; }},
+         {"view.frustum.right: expected more than left",
+          [](RequestMsg& m) { m.view.frustum.right = m.view.frustum.left; }},
+         {"view.frustum.far_z: expected more than near_z",
+          [](RequestMsg& m) { m.view.frustum.far_z = 0.25f; }}});
     Bytes bytes = encode_payload(sample_request());
     bytes[bytes.size() - 2] = std::byte{2};  // progressive_lod
     expect_view_wire_error(RemoteTag::request, bytes, "progressive_lod: expected 0 or 1, got 2");

@@ -1,6 +1,8 @@
 // A server that is sent nonsense answers with an error naming it, closes that connection, never
 // allocates what a header claims, and serves the next client (issue 12).
+#include <cmath>
 #include <cstring>
+#include <utility>
 
 #include <sys/socket.h>
 
@@ -118,6 +120,89 @@ TEST(RemoteServerErrors, EachBadInputGetsAnErrorAndAClosedConnectionAndTheServer
     good.send(good_hello("sesame"));
     auto m = good.receive(20);
     ASSERT_TRUE(m && std::holds_alternative<ReadyMsg>(*m)) << "the next client was not served";
+}
+
+// Class 7 of "Nothing lies, nothing hangs, round two": a request the server cannot draw got an
+// empty frame and no error. Now it gets an error naming the field (before any group), the
+// connection closes as after any error, and the server draws the next client's request.
+ErrorMsg error_for_request(int port, const RequestMsg& r, ReadyMsg* ready = nullptr) {
+    Connection conn(connect_tcp("127.0.0.1", port, 5), "server");
+    conn.send(good_hello());
+    const std::optional<RemoteMessage> m = conn.receive(20);
+    if (!m || !std::holds_alternative<ReadyMsg>(*m)) throw std::runtime_error("no ready");
+    if (ready) *ready = std::get<ReadyMsg>(*m);
+    conn.send(r);
+    const std::optional<RemoteMessage> reply = conn.receive(20);
+    if (!reply) throw std::runtime_error("no answer within 20 s");
+    const auto* e = std::get_if<ErrorMsg>(&*reply);
+    if (!e)
+        throw std::runtime_error(std::string("expected an error, got ") +
+                                 to_string(type_of(*reply)));
+    EXPECT_THROW(conn.receive(20), PeerClosed) << "the connection stayed open";
+    return *e;
+}
+
+RequestMsg drawable_request(double iso = kPhantomSkinIso) {
+    RequestMsg r;
+    r.request_id = 1;
+    r.view = phantom_view(64, 48, 0, iso);
+    return r;
+}
+
+void expect_draws_next(int port) {
+    Connection conn(connect_tcp("127.0.0.1", port, 5), "server");
+    conn.send(good_hello());
+    auto m = conn.receive(20);
+    ASSERT_TRUE(m && std::holds_alternative<ReadyMsg>(*m));
+    conn.send(drawable_request());
+    for (;;) {
+        m = conn.receive(20);
+        ASSERT_TRUE(m) << "no end of frame within 20 s";
+        ASSERT_FALSE(std::holds_alternative<ErrorMsg>(*m)) << std::get<ErrorMsg>(*m).text;
+        if (const auto* e = std::get_if<EndOfFrameMsg>(&*m)) {
+            EXPECT_GT(e->triangles, 0u);
+            return;
+        }
+    }
+}
+
+TEST(RemoteServerErrors, AnIsovalueOutsideTheVolumesRangeGetsAnErrorNamingIt) {
+    TestServer server;
+    ReadyMsg ready;
+    ErrorMsg e = error_for_request(server.port(), drawable_request(1e6), &ready);
+    EXPECT_EQ(e.code, ErrorCode::malformed);
+    EXPECT_NE(e.text.find("view.iso"), std::string::npos) << e.text;
+    EXPECT_NE(e.text.find("1e+06"), std::string::npos) << e.text;
+    // Just outside either end of the range ready announced.
+    for (const double iso :
+         {std::nextafter(ready.value_max, 1e300), std::nextafter(ready.value_min, -1e300)}) {
+        e = error_for_request(server.port(), drawable_request(iso));
+        EXPECT_NE(e.text.find("view.iso"), std::string::npos) << iso << ": " << e.text;
+    }
+    expect_draws_next(server.port());
+}
+
+TEST(RemoteServerErrors, AnUndrawableFrustumGetsAnErrorNamingTheField) {
+    TestServer server;
+    const struct {
+        const char* field;
+        void (*spoil)(Frustum&);
+    } cases[] = {
+        {"view.frustum.left", [](Frustum& f) { f.left = -1e38f; }},
+        {"view.frustum.far_z", [](Frustum& f) { f.far_z = 1e38f; }},
+        {"view.frustum.right", [](Frustum& f) { f.right = f.left; }},
+        {"view.frustum.top", [](Frustum& f) { std::swap(f.top, f.bottom); }},
+        {"view.frustum.near_z", [](Frustum& f) { f.near_z = 0; }},
+        {"view.frustum.far_z", [](Frustum& f) { f.far_z = f.near_z; }},
+    };
+    for (const auto& c : cases) {
+        RequestMsg r = drawable_request();
+        c.spoil(r.view.frustum);
+        const ErrorMsg e = error_for_request(server.port(), r);
+        EXPECT_EQ(e.code, ErrorCode::malformed) << c.field;
+        EXPECT_NE(e.text.find(c.field), std::string::npos) << c.field << ": " << e.text;
+    }
+    expect_draws_next(server.port());
 }
 
 TEST(RemoteServerErrors, AnAddressOtherThanLoopbackNeedsAToken) {

@@ -50,12 +50,16 @@ class TestServer {
     std::thread thread_;
 };
 
-// The front view of the phantom at `w` x `h`, turned by yaw degrees, at `iso`.
-inline FrameView phantom_view(int w, int h, double yaw, double iso = kPhantomSkinIso) {
-    const Box3 bounds = make_phantom().bounds();
+// The front view of a volume of `bounds` at `w` x `h`, turned by yaw degrees, at `iso`.
+inline FrameView front_view(const Box3& bounds, int w, int h, double yaw, double iso) {
     Camera c = front_full_view(bounds, float(w) / float(h));
     c = fit_depth_range(orbit(c, yaw, 0), bounds);
     return {c, c.frustum(float(w) / float(h)), w, h, iso};
+}
+
+// The front view of the phantom at `w` x `h`, turned by yaw degrees, at `iso`.
+inline FrameView phantom_view(int w, int h, double yaw, double iso = kPhantomSkinIso) {
+    return front_view(make_phantom().bounds(), w, h, yaw, iso);
 }
 
 // What `isowall render` shows of `view` (the progressive engine's final image).

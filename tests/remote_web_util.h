@@ -31,6 +31,7 @@ class WebTestServer {
         : tcp_(std::move(o)), http_(tcp_.server(), 0) {}
     int tcp_port() const { return tcp_.port(); }
     int http_port() const { return http_.port(); }
+    remote::ViewServer& view_server() { return tcp_.server(); }
 
   private:
     TestServer tcp_;

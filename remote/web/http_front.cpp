@@ -16,6 +16,9 @@ HttpFrontEnd::HttpFrontEnd(ViewServer& server, int port) : server_(server) {
     wo.address = so.address;
     wo.port = port;
     wo.max_message_bytes = kHeaderBytes + so.max_payload_bytes;
+    // The cap on a connection's queue: the back-pressure limit and the largest message a session
+    // sends on top, so that only a queue grown some other way reaches it.
+    wo.max_queued_bytes = wo.max_buffered_bytes + kHeaderBytes + kMaxGroupBytes + (1 << 20);
     web::WebCallbacks cb;
     RouteContext context{server.dataset_names(), so.token, web_assets()};
     cb.http = [context](const web::HttpRequest& r) { return route(r, context); };

@@ -18,10 +18,17 @@ double steady_now_s() {
 
 }  // namespace
 
-void WebInbox::push(std::string bytes, bool binary) {
+void WebInbox::push(std::string message, bool binary) {
     {
         std::lock_guard lock(mutex);
-        messages.push_back({std::move(bytes), binary});
+        if (overflowed) return;
+        const std::size_t size = message.size() + kInboxMessageBytes;
+        if (bytes + size > kMaxInboxBytes) {
+            overflowed = true;
+        } else {
+            bytes += size;
+            messages.push_back({std::move(message), binary});
+        }
     }
     changed.notify_all();
 }
@@ -99,7 +106,8 @@ std::optional<RemoteMessage> WebChannel::receive(double timeout_s) {
     if (broken_) throw WireError(*broken_);
     const bool forever = !(timeout_s >= 0) || std::isinf(timeout_s);
     const auto ready = [this] {
-        return !inbox_->messages.empty() || inbox_->closed || shut_down_.load();
+        return !inbox_->messages.empty() || inbox_->overflowed || inbox_->closed ||
+               shut_down_.load();
     };
     std::unique_lock lock(inbox_->mutex);
     if (forever)
@@ -107,9 +115,17 @@ std::optional<RemoteMessage> WebChannel::receive(double timeout_s) {
     else if (!inbox_->changed.wait_for(lock, std::chrono::duration<double>(timeout_s), ready))
         return std::nullopt;
     if (shut_down_) throw_closed();
+    if (inbox_->messages.empty() && inbox_->overflowed) {
+        broken_ = "WebSocket: messages waiting unread: over the limit of " +
+                  std::to_string(kMaxInboxBytes) +
+                  " bytes (the client sends faster than "
+                  "the server reads)";
+        throw WireError(*broken_);
+    }
     if (inbox_->messages.empty()) throw PeerClosed(peer_ + ": the client closed the WebSocket");
     const WebInbox::Message message = std::move(inbox_->messages.front());
     inbox_->messages.pop_front();
+    inbox_->bytes -= message.bytes.size() + kInboxMessageBytes;
     lock.unlock();
     return decode(message);
 }

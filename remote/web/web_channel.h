@@ -5,7 +5,9 @@
 // The io thread (web_server.h) puts each arriving message into the connection's WebInbox; the
 // channel's reader takes them from there. A text message, or bytes that are not exactly one
 // frame, break the channel: receive() throws WireError (the Client answers with an ErrorMsg and
-// closes), as a broken TCP stream does.
+// closes), as a broken TCP stream does. So do messages past kMaxInboxBytes waiting unread: the
+// io thread reads whatever the client sends, and a request flood while the reader was held up
+// would otherwise queue without bound (over TCP the socket's own buffer holds the client back).
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -19,6 +21,12 @@
 
 namespace isowall::remote {
 
+// Messages waiting unread, counted with kInboxMessageBytes each for their bookkeeping. A client's
+// message is under 1 KiB (a request under 200 bytes): a thousand requests the reader has not
+// taken yet is a flood, not a user turning a view.
+inline constexpr std::size_t kMaxInboxBytes = std::size_t{1} << 20;
+inline constexpr std::size_t kInboxMessageBytes = 64;
+
 // What the io thread hands a WebSocket's channel: its messages and its end.
 struct WebInbox {
     struct Message {
@@ -28,9 +36,11 @@ struct WebInbox {
     std::mutex mutex;
     std::condition_variable changed;
     std::deque<Message> messages;
+    std::size_t bytes = 0;    // of `messages`, kInboxMessageBytes each on top
+    bool overflowed = false;  // a message found the inbox full: the channel breaks after these
     bool closed = false;
 
-    void push(std::string bytes, bool binary);
+    void push(std::string message, bool binary);
     void close();
 };
 

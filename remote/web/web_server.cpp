@@ -1,12 +1,14 @@
 // websocketpp behind web_server.h. Built as C++17 (websocketpp 0.8.2 is not C++20 code).
 #include "remote/web/web_server.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
@@ -16,17 +18,35 @@ namespace {
 
 using Endpoint = websocketpp::server<websocketpp::config::asio>;
 using Handle = websocketpp::connection_hdl;
+using Message = websocketpp::config::asio::message_type;
 namespace status = websocketpp::http::status_code;
 
 // How often a send blocked by back-pressure looks at the connection's buffer again.
 constexpr auto kDrainPoll = std::chrono::milliseconds(2);
 // How long stop() lets the connections' closing handshakes run before it stops the io thread.
 constexpr auto kCloseGrace = std::chrono::seconds(1);
+// How soon a pong waiting for the one before it looks again, in milliseconds: at first, and at
+// most (the wait doubles while a client does not read its pongs).
+constexpr long kPongPollMs = 2, kPongPollMaxMs = 256;
 
 void split_resource(const std::string& resource, std::string& path, std::string& query) {
     const std::size_t q = resource.find('?');
     path = resource.substr(0, q);
     query = q == std::string::npos ? std::string() : resource.substr(q + 1);
+}
+
+// A server's pong frame, prepared: FIN and opcode 0xA, then the length in one byte (a ping's
+// payload is at most 125 bytes, which websocketpp checks) and the payload, unmasked. Prepared
+// here rather than by websocketpp's pong() so that its owner can see when it has been written:
+// websocketpp holds a reference until then.
+Endpoint::message_ptr pong_frame(std::string payload) {
+    payload.resize(std::min<std::size_t>(payload.size(), 125));
+    auto m =
+        std::make_shared<Message>(Message::con_msg_man_ptr(), websocketpp::frame::opcode::pong, 0);
+    m->set_header(std::string{static_cast<char>(0x8A), static_cast<char>(payload.size())});
+    m->set_payload(payload);
+    m->set_prepared(true);
+    return m;
 }
 
 void refuse(const Endpoint::connection_ptr& con, status::value code, const std::string& text) {
@@ -54,12 +74,27 @@ struct WebServer::Impl {
     ConnectionId next_id = 1;
     bool stopped = false;
 
+    // At most one pong per connection in websocketpp's hands (queued or being written), and the
+    // newest ping's payload not answered yet; io thread only.
+    struct PongSlot {
+        Endpoint::message_ptr out;  // the last pong sent; still held by websocketpp until written
+        std::string next;           // the payload of the newest ping not answered yet
+        bool waiting = false;       // `next` waits for `out` to be written
+        bool timer = false;         // a timer will look again
+        long poll_ms = kPongPollMs;
+    };
+    std::map<ConnectionId, PongSlot> pongs;
+
     void install_handlers();
     bool validate(Handle h);
     void serve_http(Handle h);
     void on_open(Handle h);
     void on_end(Handle h);
     bool find(ConnectionId id, Handle& h);
+    ConnectionId id_of(Handle h);
+    bool on_ping(Handle h, std::string payload);
+    void send_pong(ConnectionId id);
+    bool over_cap(const Endpoint::connection_ptr& con, std::size_t more);
 };
 
 void WebServer::Impl::install_handlers() {
@@ -68,14 +103,10 @@ void WebServer::Impl::install_handlers() {
     endpoint.set_open_handler([this](Handle h) { on_open(h); });
     endpoint.set_close_handler([this](Handle h) { on_end(h); });
     endpoint.set_fail_handler([this](Handle h) { on_end(h); });
+    endpoint.set_ping_handler([this](Handle h, std::string p) { return on_ping(h, std::move(p)); });
     endpoint.set_message_handler([this](Handle h, Endpoint::message_ptr m) {
-        ConnectionId id = 0;
-        {
-            std::lock_guard lock(mutex);
-            const auto it = ids.find(h);
-            if (it == ids.end()) return;
-            id = it->second;
-        }
+        const ConnectionId id = id_of(h);
+        if (id == 0) return;
         const bool binary = m->get_opcode() == websocketpp::frame::opcode::binary;
         callbacks.message(id, std::move(m->get_raw_payload()), binary);
     });
@@ -136,8 +167,66 @@ void WebServer::Impl::on_end(Handle h) {
         handles.erase(id);
         ids.erase(it);
     }
+    pongs.erase(id);
     changed.notify_all();
     callbacks.closed(id);
+}
+
+ConnectionId WebServer::Impl::id_of(Handle h) {
+    std::lock_guard lock(mutex);
+    const auto it = ids.find(h);
+    return it == ids.end() ? 0 : it->second;
+}
+
+// Never websocketpp's own pong (it would queue one for every ping): the newest payload waits in
+// the connection's slot until the pong before it has been written.
+bool WebServer::Impl::on_ping(Handle h, std::string payload) {
+    const ConnectionId id = id_of(h);
+    if (id == 0) return false;
+    PongSlot& slot = pongs[id];
+    slot.next = std::move(payload);
+    slot.waiting = true;
+    send_pong(id);
+    return false;
+}
+
+void WebServer::Impl::send_pong(ConnectionId id) {
+    const auto it = pongs.find(id);
+    Handle h;
+    if (it == pongs.end() || !it->second.waiting || !find(id, h)) return;
+    PongSlot& slot = it->second;
+    if (slot.out && slot.out.use_count() > 1) {  // websocketpp still holds the last one
+        if (!slot.timer) {
+            slot.timer = true;
+            const long ms = std::exchange(slot.poll_ms, std::min(2 * slot.poll_ms, kPongPollMaxMs));
+            endpoint.set_timer(ms, [this, id](const websocketpp::lib::error_code& ec) {
+                const auto again = pongs.find(id);
+                if (again == pongs.end()) return;
+                again->second.timer = false;
+                if (!ec) send_pong(id);
+            });
+        }
+        return;
+    }
+    websocketpp::lib::error_code ec;
+    const Endpoint::connection_ptr con = endpoint.get_con_from_hdl(h, ec);
+    if (ec) return;
+    slot.out = pong_frame(std::move(slot.next));
+    slot.waiting = false;
+    slot.poll_ms = kPongPollMs;
+    if (!over_cap(con, slot.out->get_payload().size()))
+        con->send(slot.out);  // an error only when the connection is closing: no pong is due
+}
+
+// Whether `more` bytes would take the connection's queue past max_queued_bytes; if so, closes it.
+bool WebServer::Impl::over_cap(const Endpoint::connection_ptr& con, std::size_t more) {
+    if (con->get_buffered_amount() + more <= options.max_queued_bytes) return false;
+    websocketpp::lib::error_code ec;
+    con->close(websocketpp::close::status::policy_violation,
+               "over " + std::to_string(options.max_queued_bytes) +
+                   " bytes queued: the client does not read",
+               ec);
+    return true;
 }
 
 bool WebServer::Impl::find(ConnectionId id, Handle& h) {
@@ -235,6 +324,7 @@ bool WebServer::send(ConnectionId id, const void* bytes, std::size_t size,
             impl_->changed.wait_for(lock, kDrainPoll);
         }
     }
+    if (impl_->over_cap(con, size)) return false;
     return !con->send(bytes, size, websocketpp::frame::opcode::binary);
 }
 

@@ -9,6 +9,12 @@
 // refused (403 for the Origin, 404 for the path) before the handshake completes. Plain HTTP
 // requests go to the `http` callback. Every WebSocket message over `max_message_bytes` closes
 // its connection (1009, message too big) without reaching `message`.
+//
+// What a client can make a connection hold is bounded: its sends wait while max_buffered_bytes
+// wait to go out, a send that would take the queue past max_queued_bytes closes the connection
+// (1008, policy violation), and pings get at most one pong at a time (RFC 6455 5.5.3: a newer
+// ping replaces the one not yet answered). websocketpp answered every ping with a queued pong,
+// and a ping flood grew the server by 130 MiB per million pings, for as long as it lasted.
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -48,6 +54,11 @@ struct WebOptions {
     std::size_t max_message_bytes = 1 << 16;
     // A send blocks while more than this many bytes wait to go out on its connection.
     std::size_t max_buffered_bytes = std::size_t{4} << 20;
+    // A send that would queue more than this on its connection closes it (1008) instead; with
+    // the wait above, only a message larger than the difference or a server configured with
+    // max_buffered_bytes above it gets there. websocketpp writes all that is queued at once, so
+    // a connection holds at most about twice this (queued and being written).
+    std::size_t max_queued_bytes = std::size_t{64} << 20;
 };
 
 // Whether a WebSocket upgrade with these headers may go on ("" when a header is absent).
@@ -70,7 +81,8 @@ class WebServer {
 
     // Sends one binary message; any thread. Blocks while the connection holds more than
     // max_buffered_bytes unsent, until they drain, the connection closes, the server stops or
-    // `*cancel` reads true. Returns false when the message was not queued (closed, cancelled).
+    // `*cancel` reads true. Returns false when the message was not queued (closed, cancelled, or
+    // over max_queued_bytes, which closes the connection).
     bool send(ConnectionId id, const void* bytes, std::size_t size,
               const std::atomic<bool>* cancel = nullptr);
     // Starts the closing handshake (after every message already queued); any thread.

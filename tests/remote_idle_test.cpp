@@ -1,0 +1,148 @@
+// Class 4 of "Nothing lies, nothing hangs, round two": clients that said hello and then nothing
+// filled --max-clients for good (a ninth was refused at 0, 30 and 75 s). Now a connection on
+// which nothing moves for the idle limit (--idle-timeout) gets an error naming it and a close,
+// as does one that stops reading what it asked for, and the next client gets in.
+#include <chrono>
+#include <thread>
+
+#include <sys/socket.h>
+
+#include <gtest/gtest.h>
+
+#include "remote/net/connection.h"
+#include "tests/remote_view_util.h"
+
+namespace isowall::test {
+namespace {
+
+using namespace remote;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kTimeoutS = 30;
+
+HelloMsg hello(std::uint8_t encoding = 3) {
+    HelloMsg h;
+    h.dataset = "phantom";
+    h.encoding = encoding;
+    return h;
+}
+
+std::unique_ptr<Connection> said_hello(int port) {
+    auto c = std::make_unique<Connection>(connect_tcp("127.0.0.1", port, 5), "server");
+    c->send(hello());
+    return c;
+}
+
+double seconds_since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// The server's error, then its close.
+ErrorMsg expect_error_then_close(Connection& c) {
+    std::optional<RemoteMessage> m = c.receive(kTimeoutS);
+    if (!m) throw std::runtime_error("no error within the timeout");
+    const auto* e = std::get_if<ErrorMsg>(&*m);
+    if (!e)
+        throw std::runtime_error("expected an error, got " + std::string(to_string(type_of(*m))));
+    EXPECT_THROW(c.receive(kTimeoutS), PeerClosed) << "the connection stayed open";
+    return *e;
+}
+
+// Until the server takes a new client (it reaps closed ones every 100 ms): its ready.
+bool gets_in(int port, double timeout_s) {
+    const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+    while (Clock::now() < end) {
+        Connection c(connect_tcp("127.0.0.1", port, 5), "server");
+        c.send(hello());
+        const std::optional<RemoteMessage> m = c.receive(kTimeoutS);
+        if (m && std::holds_alternative<ReadyMsg>(*m)) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+}
+
+TEST(RemoteIdle, EightSilentClientsAreDroppedAndANinthGetsIn) {
+    ServerOptions o;
+    o.max_clients = 8;
+    o.idle_timeout_s = 1;
+    TestServer server(o);
+    const auto first_hello = Clock::now();
+    std::vector<std::unique_ptr<Connection>> silent;
+    for (int i = 0; i < o.max_clients; ++i) {
+        silent.push_back(said_hello(server.port()));
+        const std::optional<RemoteMessage> m = silent.back()->receive(kTimeoutS);
+        ASSERT_TRUE(m && std::holds_alternative<ReadyMsg>(*m)) << "client " << i;
+    }
+    {
+        // The lock-out, while the eight are inside their limit: the ninth is busy. On a
+        // machine slow enough that the limit passed meanwhile, it may get in instead.
+        Connection ninth(connect_tcp("127.0.0.1", server.port(), 5), "server");
+        ninth.send(hello());
+        const std::optional<RemoteMessage> m = ninth.receive(kTimeoutS);
+        ASSERT_TRUE(m);
+        if (const auto* e = std::get_if<ErrorMsg>(&*m))
+            EXPECT_NE(e->text.find("busy"), std::string::npos) << e->text;
+        else
+            EXPECT_GE(seconds_since(first_hello), o.idle_timeout_s) << "a ninth got in at once";
+    }
+    for (auto& c : silent) {
+        const ErrorMsg e = expect_error_then_close(*c);
+        EXPECT_EQ(e.code, ErrorCode::malformed);
+        EXPECT_NE(e.text.find("idle for 1 s"), std::string::npos) << e.text;
+        EXPECT_NE(e.text.find("--idle-timeout"), std::string::npos) << e.text;
+    }
+    EXPECT_TRUE(gets_in(server.port(), kTimeoutS)) << "the ninth client was still refused";
+}
+
+// The variant: a client that asks for a large frame and never reads it. The server's sends stop
+// (its socket buffers are full), nothing moves, and the limit frees its slot.
+TEST(RemoteIdle, AClientThatStopsReadingIsDroppedAndTheNextGetsIn) {
+    ServerOptions o;
+    o.max_clients = 1;
+    o.idle_timeout_s = 1;
+    TestServer server(o);
+    Socket s = connect_tcp("127.0.0.1", server.port(), 5);
+    const int small = 4096;
+    ::setsockopt(s.fd(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    Connection deaf(std::move(s), "server");
+    deaf.send(hello(0));  // triangles as separate vertices: the largest frame
+    const std::optional<RemoteMessage> ready = deaf.receive(kTimeoutS);
+    ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
+    RequestMsg r;
+    r.request_id = 1;
+    r.view = phantom_view(1600, 1200, 30);
+    deaf.send(r);
+    EXPECT_TRUE(gets_in(server.port(), kTimeoutS)) << "a client that stopped reading kept its slot";
+}
+
+// Activity resets the clock: a client that keeps asking for frames for longer than the limit is
+// never dropped.
+TEST(RemoteIdle, AClientThatKeepsAskingIsNotDropped) {
+    ServerOptions o;
+    o.idle_timeout_s = 2;
+    TestServer server(o);
+    Connection c(connect_tcp("127.0.0.1", server.port(), 5), "server");
+    c.send(hello());
+    const std::optional<RemoteMessage> ready = c.receive(kTimeoutS);
+    ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
+    const auto start = Clock::now();
+    std::uint64_t id = 0, done = 0;
+    while (seconds_since(start) < 1.5 * o.idle_timeout_s) {
+        RequestMsg r;
+        r.request_id = ++id;
+        r.view = phantom_view(64, 48, double(id));
+        c.send(r);
+        for (;;) {
+            const std::optional<RemoteMessage> m = c.receive(kTimeoutS);
+            ASSERT_TRUE(m) << "no reply within the timeout";
+            ASSERT_FALSE(std::holds_alternative<ErrorMsg>(*m)) << std::get<ErrorMsg>(*m).text;
+            if (std::holds_alternative<EndOfFrameMsg>(*m)) break;
+        }
+        ++done;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    EXPECT_GT(done, 1u);
+}
+
+}  // namespace
+}  // namespace isowall::test

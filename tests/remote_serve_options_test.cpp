@@ -1,0 +1,53 @@
+// `isowall serve --idle-timeout` ("Nothing lies, nothing hangs, round two", class 4) goes through
+// the number rules of every other option (common/core/number.h): CLI11 refuses a non-finite or
+// out-of-range value naming the option and the value, and a good one reaches the ServeCommand.
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "app/program_cli.h"
+
+namespace isowall {
+namespace {
+
+// The error CLI11 reports for `args` (split on spaces), or "" when they parse into `cli`.
+std::string parse_error(ProgramCli& cli, const std::string& args) {
+    std::vector<std::string> words{"isowall"};
+    std::istringstream in(args);
+    for (std::string w; in >> w;) words.push_back(w);
+    std::vector<const char*> argv;
+    for (const std::string& w : words) argv.push_back(w.c_str());
+    try {
+        cli.app.parse(static_cast<int>(argv.size()), argv.data());
+        return "";
+    } catch (const CLI::ParseError& e) {
+        return e.what();
+    }
+}
+
+TEST(ServeOptions, IdleTimeoutRefusesNonFiniteAndOutOfRangeValues) {
+    for (const std::string bad : {"nan", "inf", "1e999", "0x10", "5abc", "0", "-5", "1e7"}) {
+        ProgramCli cli;
+        const std::string e = parse_error(cli, "serve --idle-timeout " + bad);
+        EXPECT_NE(e.find("--idle-timeout"), std::string::npos) << bad << ": " << e;
+        EXPECT_NE(e.find(bad), std::string::npos) << bad << ": " << e;
+    }
+}
+
+TEST(ServeOptions, IdleTimeoutReachesTheServeCommand) {
+    {
+        ProgramCli cli;
+        EXPECT_EQ(parse_error(cli, "serve"), "");
+        EXPECT_EQ(cli.serve.idle_timeout_s, 300);
+    }
+    for (const double s : {0.5, 1e6}) {
+        ProgramCli cli;
+        std::ostringstream args;
+        args << "serve --idle-timeout " << s;
+        EXPECT_EQ(parse_error(cli, args.str()), "") << args.str();
+        EXPECT_EQ(cli.serve.idle_timeout_s, s);
+    }
+}
+
+}  // namespace
+}  // namespace isowall
