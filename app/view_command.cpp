@@ -174,7 +174,8 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     c->add_option("--gl", o.gl, "OpenGL back end")
         ->check(CLI::IsMember({"osmesa", "egl"}))
         ->capture_default_str();
-    c->add_option("--timeout", o.timeout_s, "Give up when nothing arrives for this long (s)")
+    c->add_option("--timeout", o.timeout_s,
+                  "Give up when nothing arrives for this long (s), from the connection on")
         ->transform(number_in(limits::kSeconds))
         ->capture_default_str();
     return c;
@@ -204,6 +205,7 @@ int run_view(const ViewCommand& o) {
     hello.dataset = o.dataset;
     hello.token = o.token;
     hello.encoding = setting.encoding;
+    hello.connect_timeout_s = o.timeout_s;  // connecting and the hello's answer too (once 10 s)
     ViewClient client(*renderer, hello);
     std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
                 o.dataset.c_str(), client.ready().value_min, client.ready().value_max,

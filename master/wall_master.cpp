@@ -333,7 +333,7 @@ Image WallMaster::gather_snapshot() {
     return compose().image;
 }
 
-Mosaic WallMaster::compose() {
+Mosaic WallMaster::compose(OutputFiles* batch) {
     const Stage left = trace_.switch_to(Stage::compose);
     const PixelSize vs = virtual_screen_size(spec_);
     Mosaic mosaic = empty_mosaic(vs.width, vs.height);
@@ -345,8 +345,9 @@ Mosaic WallMaster::compose() {
         img.height = m.height;
         img.rgba = std::move(m.rgba);
         paste(mosaic, img, tile_rect(spec_, tile));
-        if (!o_.tiles_out.empty())
+        if (batch && !o_.tiles_out.empty())
             write_image(
+                *batch,
                 std::filesystem::path(o_.tiles_out) / ("tile_" + std::to_string(tile) + ".png"),
                 img);
     }
@@ -360,15 +361,23 @@ int WallMaster::finish() {
     wait_for_tiles([](const TileState& t) { return t.result && t.image; }, o_.timeout_s);
     // Every rank has stopped working, so no helper's result is on its way any more.
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
-    const Mosaic mosaic = compose();
+    // The run's outputs (per-tile images, the mosaic, the traces) are one batch, committed after
+    // everything that can fail: all of them or none, and the last line says which.
+    OutputFiles batch;
+    const Mosaic mosaic = compose(&batch);
     trace_.switch_to(Stage::compose);
-    write_image(o_.out, mosaic.image);
-    report();
+    write_image(batch, o_.out, mosaic.image);
+    report(batch);
+    batch.commit();
+    if (!o_.trace.empty())
+        std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
+                    o_.trace.c_str());
+    if (!o_.tiles_out.empty()) std::printf("wrote the tiles' images in %s\n", o_.tiles_out.c_str());
     std::printf("wrote %s\n", o_.out.c_str());
     return 0;
 }
 
-void WallMaster::report() {
+void WallMaster::report(OutputFiles& batch) {
     std::vector<TileResultMsg> results(tiles_.size());
     for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
     print_rank_table(stdout, spec_, results);
@@ -376,11 +385,8 @@ void WallMaster::report() {
     if (o_.results_out) *o_.results_out = results;
     trace_.close();
     print_stage_table(stdout, trace_.spans(), results);
-    if (!o_.trace.empty()) {
-        write_wall_traces(o_.trace, spec_, trace_.spans(), results, migrations_);
-        std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
-                    o_.trace.c_str());
-    }
+    if (!o_.trace.empty())
+        write_wall_traces(batch, o_.trace, spec_, trace_.spans(), results, migrations_);
 }
 
 }  // namespace isowall

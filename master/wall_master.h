@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "common/core/output_files.h"
 #include "common/core/test_fault.h"
 #include "common/core/util.h"
 #include "common/core/view.h"
@@ -107,9 +108,10 @@ class WallMaster {
     bool change_view(const ScriptCommand& cmd, const std::string& where);
     // Asks every tile for its image (snapshot) and composes the mosaic.
     Image gather_snapshot();
-    Mosaic compose();
+    // With `batch`, also stages each tile's image in --tiles-out (the run's end, not snapshots).
+    Mosaic compose(OutputFiles* batch = nullptr);
     void print_map() const;
-    void report();
+    void report(OutputFiles& batch);
 
     const MasterOptions& o_;
     Comm& comm_;

@@ -119,7 +119,7 @@ void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
     for (std::size_t rank = 1; rank < results.size(); ++rank) row(rank, results[rank].spans);
 }
 
-void write_wall_traces(const std::string& prefix, const WallSpec& spec,
+void write_wall_traces(OutputFiles& batch, const std::string& prefix, const WallSpec& spec,
                        const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results,
                        const std::vector<Migration>& migrations) {
@@ -133,11 +133,8 @@ void write_wall_traces(const std::string& prefix, const WallSpec& spec,
         flows.push_back({m.owner, m.helper, m.start_s, m.start_s, "job", 0});
         flows.push_back({m.helper, m.owner, m.end_s, m.end_s, "region result", m.bytes});
     }
-    // The pair appears together or not at all.
-    OutputFiles batch;
     write_chrome_trace(batch, prefix + ".json", ranks, flows);
     write_trace_csv(batch, prefix + ".csv", ranks);
-    batch.commit();
 }
 
 }  // namespace isowall

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "common/core/output_files.h"
 #include "common/progressive/trace.h"
 #include "common/wall/wall.h"
 #include "master/job_board.h"
@@ -50,8 +51,9 @@ void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard
 // CPU seconds by stage, one row per rank (the master's first).
 void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results);
-// PREFIX.json and PREFIX.csv.
-void write_wall_traces(const std::string& prefix, const WallSpec& spec,
+// PREFIX.json and PREFIX.csv, staged in `batch` (committed by the caller with the run's other
+// outputs).
+void write_wall_traces(OutputFiles& batch, const std::string& prefix, const WallSpec& spec,
                        const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results,
                        const std::vector<Migration>& migrations = {});

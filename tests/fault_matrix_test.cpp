@@ -112,7 +112,9 @@ void expect_the_job_ends_naming_the_rank(const Fault& f) {
     } else {
         // mpirun ends the others at once; should one of them speak first, it names the dead rank.
         EXPECT_LE(lines, 1u) << log;
-        if (lines == 1) EXPECT_NE(log.find("rank " + std::to_string(f.rank)), std::string::npos);
+        if (lines == 1) {
+            EXPECT_NE(log.find("rank " + std::to_string(f.rank)), std::string::npos) << log;
+        }
     }
     EXPECT_FALSE(any_process_of(dir)) << "a rank outlived mpirun\n" << log;
     EXPECT_EQ(outputs_in(dir), "") << log;

@@ -292,9 +292,9 @@ struct BadWall {
     std::string mentions;  // and contain this
 };
 
-TEST(Wall, MalformedInputNamesFileAndField) {
+std::vector<BadWall> bad_walls() {
     const std::string size = "tile_size_px = [1024, 768]\n";
-    const std::vector<BadWall> cases = {
+    return {
         {"missing tiles", size, "tiles", "missing"},
         {"missing size", "tiles = [2, 2]\n", "tile_size_px", "missing"},
         {"zero rows", "tiles = [6, 0]\n" + size, "tiles",
@@ -363,7 +363,10 @@ TEST(Wall, MalformedInputNamesFileAndField) {
          "tiles = [2, 2]\n" + size + "[[tile]]\ncolumn = 0\nrow = 0\noffset_px = [1000000, 0]\n",
          "tile[0].offset_px", "within the tile's size"},
     };
-    for (const BadWall& c : cases) {
+}
+
+TEST(Wall, MalformedInputNamesFileAndField) {
+    for (const BadWall& c : bad_walls()) {
         try {
             const WallSpec w = parse_wall(c.text, "bad.toml");
             ADD_FAILURE() << c.name << ": accepted " << w << " from\n" << c.text;

@@ -137,6 +137,39 @@ void OutputFiles::commit() {
     staged_.clear();
 }
 
+void write_bytes_checked(const std::filesystem::path& file,
+                         std::initializer_list<std::span<const std::byte>> parts,
+                         const std::string& name) {
+    const auto fail = [&](const char* what) {
+        throw std::runtime_error(clip_source(name) + ": cannot " + what + ": " +
+                                 std::strerror(errno));
+    };
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) fail("create");
+    for (std::span<const std::byte> bytes : parts) {
+        std::size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                if (n == 0) errno = ENOSPC;  // a write that takes nothing: the device is full
+                const int saved = errno;
+                ::close(fd);
+                errno = saved;
+                fail("write");
+            }
+            done += static_cast<std::size_t>(n);
+        }
+    }
+    if (::fsync(fd) != 0 && errno != EINVAL) {  // EINVAL: a file system without fsync
+        const int saved = errno;
+        ::close(fd);
+        errno = saved;
+        fail("write");
+    }
+    if (::close(fd) != 0) fail("write");
+}
+
 void write_output(const std::filesystem::path& target,
                   const std::function<void(const std::filesystem::path& temporary)>& write) {
     OutputFiles out;

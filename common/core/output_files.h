@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,14 @@ class OutputFiles {
     };
     std::vector<Staged> staged_;
 };
+
+// Writes the `parts`, one after the other, to `file` (created or truncated), checking every write,
+// fsync and the close: a full disk or an I/O error is a std::runtime_error naming `name` and the
+// cause ("No space left on device"), never a cut-off file that looks written. Writers whose library
+// may drop a write error (an image encoder over stdio) encode into memory and write through this.
+void write_bytes_checked(const std::filesystem::path& file,
+                         std::initializer_list<std::span<const std::byte>> parts,
+                         const std::string& name);
 
 // One output alone: stage it, let `write` fill the temporary, commit.
 void write_output(const std::filesystem::path& target,

@@ -1,10 +1,12 @@
 #include "common/io/image_io.h"
 
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "common/core/error.h"
@@ -38,14 +40,26 @@ std::unique_ptr<OIIO::ImageOutput> create_output(std::string_view function,
 }
 
 // Writes `spec`-shaped pixels from `data` (with `xstride` bytes between pixels) to `temporary`,
-// the staged file of `path` (its owner removes it on an error).
+// the staged file of `path` (its owner removes it on an error). A writer that takes an I/O proxy
+// (PNG, among others) encodes into memory, and the bytes reach the file through one checked
+// writer: OpenImageIO's PNG writer over stdio drops a full disk's error and closes "fine" on a
+// cut-off file.
 void write_pixels(std::string_view function, const std::filesystem::path& path,
                   const std::filesystem::path& temporary, const OIIO::ImageSpec& spec,
                   const void* data, OIIO::stride_t xstride) {
     auto out = create_output(function, path);
-    if (!out->open(temporary.string(), spec)) fail(function, path, out->geterror());
+    const bool in_memory = out->supports("ioproxy");
+    OIIO::Filesystem::IOVecOutput memory;
+    OIIO::ImageSpec s = spec;
+    if (in_memory) {
+        OIIO::Filesystem::IOProxy* proxy = &memory;
+        s.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+    }
+    if (!out->open(temporary.string(), s)) fail(function, path, out->geterror());
     if (!out->write_image(spec.format, data, xstride)) fail(function, path, out->geterror());
     if (!out->close()) fail(function, path, out->geterror());
+    if (in_memory)
+        write_bytes_checked(temporary, {std::as_bytes(std::span(memory.buffer()))}, path.string());
 }
 
 void encode_image(const std::filesystem::path& path, const std::filesystem::path& temporary,

@@ -3,10 +3,13 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "common/core/output_files.h"
 
 namespace isowall {
 
@@ -15,8 +18,7 @@ namespace {
 // The file at `temporary` (staged for `path`, which errors name).
 void encode_ply(const std::filesystem::path& path, const std::filesystem::path& temporary,
                 const Mesh& mesh) {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
+    std::ostringstream out;
     out << "ply\nformat binary_little_endian 1.0\ncomment isowall isosurface\n"
         << "element vertex " << mesh.positions.size() << "\n"
         << "property float x\nproperty float y\nproperty float z\n"
@@ -30,8 +32,7 @@ void encode_ply(const std::filesystem::path& path, const std::filesystem::path& 
             verts[6 * i + 3 + a] = mesh.normals[i][a];
         }
     }
-    out.write(reinterpret_cast<const char*>(verts.data()),
-              static_cast<std::streamsize>(verts.size() * sizeof(float)));
+    const std::string header = out.str();
     // 13 bytes per face: the count byte and three int32 indices, packed.
     std::vector<char> faces(mesh.triangle_count() * 13);
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -43,9 +44,11 @@ void encode_ply(const std::filesystem::path& path, const std::filesystem::path& 
             std::memcpy(f + 1 + 4 * k, &idx, 4);
         }
     }
-    out.write(faces.data(), static_cast<std::streamsize>(faces.size()));
-    out.close();
-    if (!out) throw std::runtime_error(path.string() + ": write failed");
+    // Through the one checked writer: a full disk is an error naming the file and the cause.
+    write_bytes_checked(temporary,
+                        {std::as_bytes(std::span(header)), std::as_bytes(std::span(verts)),
+                         std::as_bytes(std::span(faces))},
+                        path.string());
 }
 
 }  // namespace
