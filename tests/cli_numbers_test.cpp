@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/program_cli.h"
+#include "tests/cli_parse_util.h"
 
 namespace isowall {
 namespace {
@@ -47,21 +48,7 @@ std::string fill(const std::string& slot, const std::string& value) {
     return args.replace(args.find("{}"), 2, value);
 }
 
-// The error CLI11 reports for `args` (split on spaces), or "" when they parse.
-std::string parse_error(const std::string& args) {
-    ProgramCli cli;
-    std::vector<std::string> words{"isowall"};
-    std::istringstream in(args);
-    for (std::string w; in >> w;) words.push_back(w);
-    std::vector<const char*> argv;
-    for (const std::string& w : words) argv.push_back(w.c_str());
-    try {
-        cli.app.parse(static_cast<int>(argv.size()), argv.data());
-        return "";
-    } catch (const CLI::ParseError& e) {
-        return e.what();
-    }
-}
+using test::parse_error;
 
 TEST(CliNumbers, EveryNumberOptionRefusesNonFiniteAndOutOfRangeValues) {
     int tried = 0;

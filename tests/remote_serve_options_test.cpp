@@ -6,24 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "app/program_cli.h"
+#include "tests/cli_parse_util.h"
 
 namespace isowall {
 namespace {
 
-// The error CLI11 reports for `args` (split on spaces), or "" when they parse into `cli`.
-std::string parse_error(ProgramCli& cli, const std::string& args) {
-    std::vector<std::string> words{"isowall"};
-    std::istringstream in(args);
-    for (std::string w; in >> w;) words.push_back(w);
-    std::vector<const char*> argv;
-    for (const std::string& w : words) argv.push_back(w.c_str());
-    try {
-        cli.app.parse(static_cast<int>(argv.size()), argv.data());
-        return "";
-    } catch (const CLI::ParseError& e) {
-        return e.what();
-    }
-}
+using test::parse_error;
 
 TEST(ServeOptions, IdleTimeoutRefusesNonFiniteAndOutOfRangeValues) {
     for (const std::string bad : {"nan", "inf", "1e999", "0x10", "5abc", "0", "-5", "1e7"}) {

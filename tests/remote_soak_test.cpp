@@ -142,16 +142,22 @@ void ping_flood(Soak& s, bool reading) {
     if (reader.joinable()) reader.join();
 }
 
+// A client's socket: a WebSocket through the page's port when `ws`, else plain TCP.
+Socket& connect_client(Soak& s, bool ws, std::optional<RawWs>& w, std::optional<Socket>& tcp) {
+    if (ws) {
+        w.emplace(s.http_port);
+        return w->socket();
+    }
+    tcp.emplace(connect_tcp("127.0.0.1", s.tcp_port, 5));
+    return *tcp;
+}
+
 // Requests as fast as the socket takes them, 64 frames to a send, replies read on another
 // thread. Over TCP, or over a WebSocket when `ws`.
 void request_flood(Soak& s, bool ws) {
     std::optional<RawWs> w;
     std::optional<Socket> tcp;
-    if (ws)
-        w.emplace(s.http_port);
-    else
-        tcp.emplace(connect_tcp("127.0.0.1", s.tcp_port, 5));
-    Socket& socket = ws ? w->socket() : *tcp;
+    Socket& socket = connect_client(s, ws, w, tcp);
     Registered reg(s, socket);
     const auto frame = [&](const RemoteMessage& m) {
         return ws ? RawWs::frame(ws_opcode::kBinary, encode_frame(m)) : encode_frame(m);
@@ -194,11 +200,7 @@ void silent(Soak& s) {
 void slow_reader(Soak& s, bool ws) {
     std::optional<RawWs> w;
     std::optional<Socket> tcp;
-    if (ws)
-        w.emplace(s.http_port);
-    else
-        tcp.emplace(connect_tcp("127.0.0.1", s.tcp_port, 5));
-    Socket& socket = ws ? w->socket() : *tcp;
+    Socket& socket = connect_client(s, ws, w, tcp);
     Registered reg(s, socket);
     const int small = 4096;
     ::setsockopt(socket.fd(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
