@@ -188,15 +188,20 @@ class ViewServer::Client {
         so.encoding = encoding_;
         session_ =
             std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
+                touch();             // the client's silence counts from the send's start
+                computing_ = false;  // a send the client does not read counts as idle
                 const std::size_t bytes = conn_.send(m);
                 touch();
+                computing_ = true;
                 return bytes;
             });
         worker_ = std::thread([this] { work(); });
         const double limit = server_.options_.idle_timeout_s;
         touch();
         for (;;) {
-            const double idle = idle_s();
+            // The server's own work on a request is not the client's silence (a frame may
+            // take longer than the limit: a large view, a slow build).
+            const double idle = computing_ ? 0.0 : idle_s();
             if (idle >= limit) {
                 refuse(ErrorCode::malformed, "idle for " + seconds_text(limit) +
                                                  " s (--idle-timeout): nothing received or sent");
@@ -225,6 +230,7 @@ class ViewServer::Client {
             refuse(ErrorCode::malformed, "request: view.iso: " + problem);
             return false;
         }
+        computing_ = true;  // from now until the worker has run it
         requests_.put(*r);
         return true;
     }
@@ -235,7 +241,10 @@ class ViewServer::Client {
             if (!next) return;
             const RequestMsg& r = *next;
             try {
+                computing_ = true;
                 const RequestFigures f = session_->run(r, requests_.stop_flag());
+                computing_ = false;
+                touch();
                 if (server_.options_.verbose)
                     std::printf(
                         "serve: %s: request %llu %s: %llu groups, %llu named, %llu "
@@ -247,9 +256,11 @@ class ViewServer::Client {
                         static_cast<unsigned long long>(f.triangles),
                         static_cast<unsigned long long>(f.bytes));
             } catch (const NetError&) {
+                computing_ = false;
                 conn_.shutdown();  // the reader then ends the connection
                 return;
             } catch (const std::exception& e) {
+                computing_ = false;
                 refuse(ErrorCode::internal, e.what());
                 conn_.shutdown();
                 return;
@@ -272,6 +283,7 @@ class ViewServer::Client {
     std::thread thread_, worker_;
     NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes
     std::atomic<Clock::rep> last_active_{0};  // see touch()
+    std::atomic<bool> computing_{false};      // the worker runs a request, not in a send
     std::atomic<bool> done_{false};
 };
 

@@ -144,5 +144,30 @@ TEST(RemoteIdle, AClientThatKeepsAskingIsNotDropped) {
     EXPECT_GT(done, 1u);
 }
 
+// The server's own work is not the client's silence: a frame that takes longer than the limit
+// (1600x1200 against 0.3 s; under the sanitizers any frame does) ends whole.
+TEST(RemoteIdle, AFrameLongerThanTheLimitIsNotIdleness) {
+    ServerOptions o;
+    o.idle_timeout_s = 0.3;
+    TestServer server(o);
+    Connection c(connect_tcp("127.0.0.1", server.port(), 5), "server");
+    c.send(hello());
+    const std::optional<RemoteMessage> ready = c.receive(kTimeoutS);
+    ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
+    RequestMsg r;
+    r.request_id = 1;
+    r.view = phantom_view(1600, 1200, 0);
+    c.send(r);
+    const auto start = Clock::now();
+    for (;;) {
+        const std::optional<RemoteMessage> m = c.receive(kTimeoutS);
+        ASSERT_TRUE(m) << "no reply within the timeout";
+        ASSERT_FALSE(std::holds_alternative<ErrorMsg>(*m)) << std::get<ErrorMsg>(*m).text;
+        if (std::holds_alternative<EndOfFrameMsg>(*m)) break;
+    }
+    std::printf("a 1600x1200 frame in %.2f s against an idle limit of 0.3 s\n",
+                seconds_since(start));
+}
+
 }  // namespace
 }  // namespace isowall::test
