@@ -20,16 +20,9 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kTimeoutS = 30;
 
-HelloMsg hello(std::uint8_t encoding = 3) {
-    HelloMsg h;
-    h.dataset = "phantom";
-    h.encoding = encoding;
-    return h;
-}
-
 std::unique_ptr<Connection> said_hello(int port) {
     auto c = std::make_unique<Connection>(connect_tcp("127.0.0.1", port, 5), "server");
-    c->send(hello());
+    c->send(phantom_hello());
     return c;
 }
 
@@ -53,7 +46,7 @@ bool gets_in(int port, double timeout_s) {
     const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
     while (Clock::now() < end) {
         Connection c(connect_tcp("127.0.0.1", port, 5), "server");
-        c.send(hello());
+        c.send(phantom_hello());
         const std::optional<RemoteMessage> m = c.receive(kTimeoutS);
         if (m && std::holds_alternative<ReadyMsg>(*m)) return true;
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -77,7 +70,7 @@ TEST(RemoteIdle, EightSilentClientsAreDroppedAndANinthGetsIn) {
         // The lock-out, while the eight are inside their limit: the ninth is busy. On a
         // machine slow enough that the limit passed meanwhile, it may get in instead.
         Connection ninth(connect_tcp("127.0.0.1", server.port(), 5), "server");
-        ninth.send(hello());
+        ninth.send(phantom_hello());
         const std::optional<RemoteMessage> m = ninth.receive(kTimeoutS);
         ASSERT_TRUE(m);
         if (const auto* e = std::get_if<ErrorMsg>(&*m))
@@ -105,7 +98,7 @@ TEST(RemoteIdle, AClientThatStopsReadingIsDroppedAndTheNextGetsIn) {
     const int small = 4096;
     ::setsockopt(s.fd(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
     Connection deaf(std::move(s), "server");
-    deaf.send(hello(0));  // triangles as separate vertices: the largest frame
+    deaf.send(phantom_hello(0));  // triangles as separate vertices: the largest frame
     const std::optional<RemoteMessage> ready = deaf.receive(kTimeoutS);
     ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
     RequestMsg r;
@@ -121,8 +114,8 @@ TEST(RemoteIdle, AClientThatKeepsAskingIsNotDropped) {
     ServerOptions o;
     o.idle_timeout_s = 2;
     TestServer server(o);
-    Connection c(connect_tcp("127.0.0.1", server.port(), 5), "server");
-    c.send(hello());
+    const std::unique_ptr<Connection> client = said_hello(server.port());
+    Connection& c = *client;
     const std::optional<RemoteMessage> ready = c.receive(kTimeoutS);
     ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
     const auto start = Clock::now();
@@ -152,8 +145,8 @@ TEST(RemoteIdle, AFrameLongerThanTheLimitIsNotIdleness) {
     ServerOptions o;
     o.idle_timeout_s = 1.0;
     TestServer server(o);
-    Connection c(connect_tcp("127.0.0.1", server.port(), 5), "server");
-    c.send(hello());
+    const std::unique_ptr<Connection> client = said_hello(server.port());
+    Connection& c = *client;
     const std::optional<RemoteMessage> ready = c.receive(kTimeoutS);
     ASSERT_TRUE(ready && std::holds_alternative<ReadyMsg>(*ready));
     RequestMsg r;

@@ -37,13 +37,6 @@ constexpr double kTimeoutS = 60;
 constexpr double kMaxGrowthMiB = 80;
 constexpr int kSilentClients = 4;
 
-HelloMsg hello(std::uint8_t encoding = 3) {
-    HelloMsg h;
-    h.dataset = "phantom";
-    h.encoding = encoding;
-    return h;
-}
-
 // The abusers' sockets, so that the end of the soak can wake a send the server no longer reads.
 class LiveSockets {
   public:
@@ -110,7 +103,7 @@ void drain(Soak& s, Socket& socket) {
 void ping_flood(Soak& s, bool reading) {
     RawWs ws(s.http_port);
     Registered reg(s, ws.socket());
-    ws.send_message(hello());
+    ws.send_message(phantom_hello());
     std::thread reader;
     if (reading)
         reader = std::thread([&] {
@@ -162,7 +155,7 @@ void request_flood(Soak& s, bool ws) {
     const auto frame = [&](const RemoteMessage& m) {
         return ws ? RawWs::frame(ws_opcode::kBinary, encode_frame(m)) : encode_frame(m);
     };
-    send_all(socket, frame(hello()), "server");
+    send_all(socket, frame(phantom_hello()), "server");
     std::thread reader([&] {
         try {
             drain(s, socket);
@@ -191,7 +184,7 @@ void request_flood(Soak& s, bool ws) {
 void silent(Soak& s) {
     Connection c(connect_tcp("127.0.0.1", s.tcp_port, 5), "server");
     Registered reg(s, c.socket());
-    c.send(hello());
+    c.send(phantom_hello());
     while (!s.stop) c.receive(0.1);
 }
 
@@ -208,7 +201,7 @@ void slow_reader(Soak& s, bool ws) {
     r.request_id = 1;
     r.view.width = 800;
     r.view.height = 600;
-    for (const RemoteMessage& m : {RemoteMessage(hello(0)), RemoteMessage(r)})
+    for (const RemoteMessage& m : {RemoteMessage(phantom_hello(0)), RemoteMessage(r)})
         send_all(socket, ws ? RawWs::frame(ws_opcode::kBinary, encode_frame(m)) : encode_frame(m),
                  "server");
     std::vector<std::byte> buf(4096);
@@ -222,7 +215,7 @@ void slow_reader(Soak& s, bool ws) {
 // A well-behaved client's frame over TCP: its end of frame, or a failure.
 EndOfFrameMsg good_frame(int port, const RequestMsg& r) {
     Connection c(connect_tcp("127.0.0.1", port, 5), "server");
-    c.send(hello());
+    c.send(phantom_hello());
     for (;;) {
         const std::optional<RemoteMessage> m = c.receive(kTimeoutS);
         if (!m) throw std::runtime_error("no message within the timeout");

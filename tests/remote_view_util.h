@@ -15,6 +15,14 @@
 
 namespace isowall::test {
 
+// A hello for the phantom, in `encoding` (3: compact and zstd, what `view` asks by default).
+inline remote::HelloMsg phantom_hello(std::uint8_t encoding = 3) {
+    remote::HelloMsg h;
+    h.dataset = "phantom";
+    h.encoding = encoding;
+    return h;
+}
+
 inline remote::Dataset phantom_dataset() {
     remote::Dataset d;
     d.name = "phantom";

@@ -30,13 +30,6 @@ constexpr double kFloodSeconds = 3;
 // before the fix (130 bytes a ping, for as long as a flood lasts).
 constexpr double kMaxGrowthMiB = 48;
 
-HelloMsg hello() {
-    HelloMsg h;
-    h.dataset = "phantom";
-    h.encoding = 3;
-    return h;
-}
-
 void expect_ready(RawWs& ws) {
     const RemoteMessage m = ws.receive_message(kTimeoutS);
     ASSERT_TRUE(std::holds_alternative<ReadyMsg>(m)) << to_string(type_of(m));
@@ -121,7 +114,7 @@ class PongReader {
 TEST(RemoteWebFlood, APingFloodKeepsOnePongWaitingAndTheServerSmall) {
     WebTestServer server;
     RawWs ws(server.http_port());
-    ws.send_message(hello());
+    ws.send_message(phantom_hello());
     expect_ready(ws);
     const double rss0 = current_rss_mib();
     Flood f;
@@ -153,7 +146,7 @@ TEST(RemoteWebFlood, APingFloodFromAClientThatNeverReadsKeepsTheServerSmall) {
     Flood f;
     {
         RawWs deaf(server.http_port());
-        deaf.send_message(hello());
+        deaf.send_message(phantom_hello());
         f = flood_pings(deaf, rss0);
     }
     std::printf(
@@ -164,7 +157,7 @@ TEST(RemoteWebFlood, APingFloodFromAClientThatNeverReadsKeepsTheServerSmall) {
         EXPECT_LT(f.peak_growth_mib, kMaxGrowthMiB);
     }
     RawWs next(server.http_port());
-    next.send_message(hello());
+    next.send_message(phantom_hello());
     expect_ready(next);
     EXPECT_GT(one_frame(next).triangles, 0u);
 }
@@ -203,7 +196,7 @@ TEST(RemoteWebFlood, AnIdleWebSocketIsClosedNamingTheLimit) {
     o.idle_timeout_s = 0.5;
     WebTestServer server(o);
     RawWs ws(server.http_port());
-    ws.send_message(hello());
+    ws.send_message(phantom_hello());
     expect_ready(ws);
     const RemoteMessage m = ws.receive_message(kTimeoutS);
     const auto* e = std::get_if<ErrorMsg>(&m);
