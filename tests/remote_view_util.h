@@ -65,9 +65,12 @@ inline FrameView front_view(const Box3& bounds, int w, int h, double yaw, double
     return {c, c.frustum(float(w) / float(h)), w, h, iso};
 }
 
-// The front view of the phantom at `w` x `h`, turned by yaw degrees, at `iso`.
+// The front view of the phantom at `w` x `h`, turned by yaw degrees, at `iso`. The phantom is
+// built once for its bounds: building it for each view took a client under the sanitizers
+// longer than a server's idle limit (RemoteIdle).
 inline FrameView phantom_view(int w, int h, double yaw, double iso = kPhantomSkinIso) {
-    return front_view(make_phantom().bounds(), w, h, yaw, iso);
+    static const Box3 bounds = make_phantom().bounds();
+    return front_view(bounds, w, h, yaw, iso);
 }
 
 // What `isowall render` shows of `view` (the progressive engine's final image).
