@@ -11,6 +11,7 @@
 #include "common/core/error.h"
 #include "common/core/util.h"
 #include "common/extract/surface_extractor.h"
+#include "common/formats/voxel_ops.h"
 #include "common/io/image_io.h"
 #include "common/io/ply.h"
 #include "common/volume/phantom.h"
@@ -141,10 +142,11 @@ void check_render_outputs(const RenderOptions& o) {
 
 // The view of `render`: the front full view, turned and zoomed; InputError naming the option
 // when the result is degenerate (common/core/camera.h: camera_problem).
-Camera render_camera(const RenderOptions& o, const Box3& bounds, float aspect) {
+Camera render_camera(const RenderOptions& o, const Volume& volume, float aspect) {
     const Projection proj =
         o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
-    Camera cam = front_full_view(bounds, aspect, proj);
+    const Box3 bounds = volume.bounds();
+    Camera cam = front_full_view(bounds, volume.orientation().axes, aspect, proj);
     if (o.orbit.size() == 2) cam = orbit(cam, o.orbit[0], o.orbit[1]);
     cam = zoom(cam, float(o.zoom));
     if (std::string p = camera_problem(cam); !p.empty())
@@ -285,6 +287,21 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     return last.triangles;
 }
 
+// What the file carried that a user checks (format, modality, series, scaling), and where the
+// volume lies in patient space when the file said.
+void print_file_facts(const Volume& v) {
+    for (const VolumeFact& f : v.facts()) std::printf("%s: %s\n", f.name.c_str(), f.value.c_str());
+    const Orientation& o = v.orientation();
+    if (!o.known) return;
+    const Box3 p = formats::patient_bounds(v);
+    std::printf(
+        "orientation: %s (where x, y, z point: L R left right, A P front back, S I up down)\n",
+        formats::orientation_letters(o.axes).c_str());
+    std::printf("patient bounds: (%g, %g, %g) - (%g, %g, %g) mm, LPS\n", double(p.min.x),
+                double(p.min.y), double(p.min.z), double(p.max.x), double(p.max.y),
+                double(p.max.z));
+}
+
 }  // namespace
 
 int run_info(const InfoOptions& o) {
@@ -296,6 +313,7 @@ int run_info(const InfoOptions& o) {
     std::printf("bounds: (%g, %g, %g) - (%g, %g, %g) object units\n", double(b.min.x),
                 double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y),
                 double(b.max.z));
+    print_file_facts(ov.volume);
     if (!ov.file)
         std::printf("suggested isovalues: skin %g, bone %g\n", kPhantomSkinIso, kPhantomBoneIso);
     return 0;
@@ -339,7 +357,7 @@ int run_render(const RenderOptions& o) {
     const double iso = checked_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);
-    const Camera cam = render_camera(o, ov.volume.bounds(), aspect);
+    const Camera cam = render_camera(o, ov.volume, aspect);
     FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso};
 
     // Every output is staged here and appears at the end, all together (no partial output).

@@ -213,7 +213,7 @@ int run_view(const ViewCommand& o) {
                 setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
     const float aspect = float(size->x) / float(size->y);
-    v.camera = front_full_view(client.ready().bounds, aspect);
+    v.camera = front_full_view(client.ready().bounds, client.ready().axes, aspect);
     if (o.orbit.size() == 2) v.camera = orbit(v.camera, o.orbit[0], o.orbit[1]);
     v.camera = zoom(v.camera, float(o.zoom));
     if (std::string p = camera_problem(v.camera); !p.empty())

@@ -82,6 +82,7 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
 int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInput& in) {
     MasterOptions mo;
     mo.wall_name = o.wall;
+    mo.front_axes = in.volume->volume.orientation().axes;
     mo.out = o.out;
     mo.tiles_out = o.tiles_out;
     mo.trace = o.trace;

@@ -5,6 +5,7 @@
 #include "cli/cli_checks.h"
 #include "common/core/error.h"
 #include "common/core/util.h"
+#include "common/formats/read_volume.h"
 #include "common/volume/octree.h"
 #include "common/volume/phantom.h"
 
@@ -12,8 +13,10 @@ namespace isowall {
 
 void add_volume_options(CLI::App& app, VolumeOptions& o) {
     app.add_option("--volume,-v", o.path,
-                   "Volume file: .nrrd/.nhdr (NRRD), or headerless raw with --dims and --type. "
-                   "Default: the built-in phantom");
+                   "Volume: NRRD (.nrrd/.nhdr), NIfTI (.nii, .nii.gz, .hdr/.img), a DICOM "
+                   "series (its folder, or one file of it), MetaImage (.mhd/.mha), HDF5 "
+                   "(FILE.h5:/dataset), TIFF (a multi-page .tif or a folder of slices), or "
+                   "headerless raw with --dims and --type. Default: the built-in phantom");
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
         ->expected(3)
         ->transform(number_in({1, 2147483647.0, false, true}));
@@ -71,7 +74,7 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
             throw InputError("--dims/--type", "--volume", "raw options need --volume FILE");
         out.volume = make_phantom();
     } else {
-        out.volume = load_volume(o.path, raw_spec(o));
+        out.volume = formats::read_volume(o.path, raw_spec(o));
         out.file = std::filesystem::path(o.path);
     }
     std::string huge_note;

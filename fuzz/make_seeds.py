@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""Writes the seed corpora of the text harnesses (fuzz/corpus/{nrrd,wall,script}); the wire
+"""Writes the seed corpora of the text harnesses (fuzz/corpus/{nrrd,metaimage,wall,script}); the wire
 seeds come from the fuzz_wire_seeds program (fuzz/wire_seeds.cpp). Run from anywhere; the files
 it writes are committed. NRRD seeds are tiny volumes of each encoding Teem reads, attached and
 detached (after a line "@data.raw" comes data.raw, see fuzz/fuzz_nrrd.cpp)."""
 import bz2
 import gzip
 import struct
+import zlib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,6 +51,34 @@ def nrrd_seeds():
         b"encoding: raw\n\n" + u8
 
 
+def mha(type_, data_file, extra=()):
+    lines = ["ObjectType = Image", "NDims = 3", "BinaryData = True", "DimSize = 2 2 2",
+             *extra, f"ElementType = {type_}", f"ElementDataFile = {data_file}"]
+    return ("\n".join(lines) + "\n").encode()
+
+
+def metaimage_seeds():
+    """MetaImage headers (fuzz/fuzz_metaimage.cpp): LOCAL ones with their data after the header,
+    detached ones with data.raw after a line "@data.raw"."""
+    u8 = bytes(range(8))
+    i16be = struct.pack(">8h", *range(-4, 4))
+    f32 = struct.pack("<8f", *[0.5 * i for i in range(8)])
+    yield "local-u8", mha("MET_UCHAR", "LOCAL", ["ElementSpacing = 1 1 2"]) + u8
+    yield "local-i16-msb", mha("MET_SHORT", "LOCAL", [
+        "BinaryDataByteOrderMSB = True", "ElementByteOrderMSB = True"]) + i16be
+    yield "local-zlib-f32", mha("MET_FLOAT", "LOCAL", [
+        "CompressedData = True", f"CompressedDataSize = {len(zlib.compress(f32))}"]) + \
+        zlib.compress(f32)
+    yield "local-oriented", mha("MET_UCHAR", "LOCAL", [
+        "TransformMatrix = 0 1 0 -1 0 0 0 0 1", "Offset = -10 20 5.5",
+        "AnatomicalOrientation = RAI", "ElementSize = 0.5 0.5 1"]) + u8
+    yield "detached-raw", mha("MET_UCHAR", "data.raw") + MARK + u8
+    yield "detached-headersize-end", mha("MET_UCHAR", "data.raw", ["HeaderSize = -1"]) + \
+        MARK + b"junk" + u8
+    yield "detached-headersize", mha("MET_UCHAR", "data.raw", ["HeaderSize = 4"]) + \
+        MARK + b"junk" + u8
+
+
 def write(folder, name, data):
     folder.mkdir(parents=True, exist_ok=True)
     (folder / name).write_bytes(data)
@@ -58,6 +87,8 @@ def write(folder, name, data):
 def main():
     for name, data in nrrd_seeds():
         write(CORPUS / "nrrd", name, data)
+    for name, data in metaimage_seeds():
+        write(CORPUS / "metaimage", name, data)
     for toml in sorted((ROOT / "walls").glob("*.toml")):
         write(CORPUS / "wall", toml.name, toml.read_bytes())
     scripts = {

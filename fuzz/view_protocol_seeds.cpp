@@ -29,7 +29,12 @@ std::vector<RemoteMessage> samples() {
     const GroupKey key{{4, 5, 6}, 2, 105.5, true};
     return {
         HelloMsg{1, "ct_head", "s3cret", 2},
-        ReadyMsg{{{0, 0, 0}, {1, 2, 3}}, -1024, 3071, {256, 256, 113}, {1, 1, 2}},
+        ReadyMsg{{{0, 0, 0}, {1, 2, 3}},
+                 -1024,
+                 3071,
+                 {256, 256, 113},
+                 {1, 1, 2},
+                 glm::mat3(glm::vec3(0, 1, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1))},
         request,
         GroupMsg{3, key, true, 3, {std::byte{1}, std::byte{2}, std::byte{3}}},
         VisibleMsg{3, {0, 1, 2, 5, 7, 11}},  // a bitmap; the deltas form is in the fuzzer's reach

@@ -28,7 +28,7 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     : o_(o), comm_(comm), spec_(spec), bounds_(bounds), iso_(iso), lo_(value_min), hi_(value_max) {
     const PixelSize vs = virtual_screen_size(spec);
     aspect_ = float(vs.width) / float(vs.height);
-    camera_ = front_full_view(bounds, aspect_);
+    camera_ = front_full_view(bounds, o.front_axes, aspect_);
     camera_ = orbit(camera_, o.orbit.first, o.orbit.second);
     camera_ = zoom(camera_, o.zoom);
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);

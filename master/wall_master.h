@@ -34,6 +34,9 @@ struct MasterOptions {
     // The first view: the front full view turned, zoomed and panned by these.
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
+    // The volume's axes in patient space (common/volume/volume.h: Orientation), so that the
+    // front view is the patient's front whatever the acquisition.
+    glm::mat3 front_axes{1.0f};
     bool balance = true;
     int region_w = 128, region_h = 96;
     bool screen_box = true;  // the engine casts no ray outside the volume's screen box

@@ -128,6 +128,7 @@ static std::vector<std::byte> encode(const ReadyMsg& m) {
     w.put(m.value_max);
     for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(m.dims[a]));
     w.put(m.spacing);
+    for (int c = 0; c < 3; ++c) w.put(m.axes[c]);
     return w.take();
 }
 
@@ -152,6 +153,14 @@ static ReadyMsg decode_ready(std::span<const std::byte> bytes) {
     m.spacing = get_finite_vec3(r, "spacing");
     if (!(m.spacing.x > 0 && m.spacing.y > 0 && m.spacing.z > 0))
         r.fail("spacing: expected positive numbers");
+    const char* columns[] = {"axes.x", "axes.y", "axes.z"};
+    for (int c = 0; c < 3; ++c) {
+        m.axes[c] = get_finite_vec3(r, columns[c]);
+        if (std::abs(glm::length(m.axes[c]) - 1.0f) > 1e-3f)
+            r.fail(std::string(columns[c]) + ": expected a unit vector");
+    }
+    if (std::abs(glm::determinant(m.axes) - 1.0f) > 1e-2f)
+        r.fail("axes: expected a rotation (orthogonal unit columns, determinant 1)");
     r.finish();
     return m;
 }

@@ -57,11 +57,15 @@ struct HelloMsg {
 
 struct ReadyMsg {
     static constexpr RemoteTag kTag = RemoteTag::ready;
-    static constexpr std::uint8_t kVersion = 1;
+    // 2: axes, so a client's front view is the patient's front (version 1 had none).
+    static constexpr std::uint8_t kVersion = 2;
     Box3 bounds{glm::vec3(0), glm::vec3(1)};  // object space; finite, min <= max
     double value_min = 0, value_max = 0;      // finite, min <= max
     glm::ivec3 dims{1};                       // samples per axis, each >= 1
     glm::vec3 spacing{1};                     // finite, each > 0
+    // The volume's axes in patient space (common/volume/volume.h: Orientation): finite unit
+    // columns making a rotation, identity when the file gave none.
+    glm::mat3 axes{1.0f};
 };
 
 struct RequestMsg {

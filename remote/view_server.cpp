@@ -9,6 +9,7 @@
 #include <list>
 #include <optional>
 
+#include "common/core/camera.h"
 #include "common/core/error.h"
 #include "common/core/newest_request.h"
 #include "remote/net/socket.h"
@@ -181,6 +182,7 @@ class ViewServer::Client {
         ready.value_max = d.extractor->value_max();
         ready.dims = d.volume->dims();
         ready.spacing = d.volume->spacing();
+        ready.axes = frame_rotation(d.volume->orientation().axes);
         conn_.send(ready);
         if (server_.options_.rate_bits_per_s > 0) conn_.set_rate(server_.options_.rate_bits_per_s);
         say("serve: %s: dataset %s%s\n", d.name);

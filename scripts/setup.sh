@@ -13,6 +13,7 @@ PACKAGES=(
     libgtest-dev libgmock-dev libbenchmark-dev
     libmeshoptimizer-dev libzstd-dev libwebsocketpp-dev libasio-dev
     libembree-dev python3-vtk9
+    libgdcm-dev libnifti2-dev libhdf5-dev
     python3 python3-numpy python3-matplotlib
     libx11-dev libxext-dev xvfb xdotool x11-apps x11-utils iproute2
     nodejs chromium

@@ -1,5 +1,5 @@
-// Golden images: fixed views of the built-in phantom, drawn with the OSMesa back end (llvmpipe),
-// against baselines in tests/golden/NAME.png.
+// Golden images: fixed views of the built-in phantom (and one shared file), drawn with the
+// OSMesa back end (llvmpipe), against baselines in tests/golden/NAME.png.
 //
 // Baselines change only on purpose, never in a normal run. To create or update them:
 //     build/tests/engine_test --update-golden --gtest_filter='*Golden*'
@@ -16,11 +16,13 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 
+#include "common/formats/read_volume.h"
 #include "common/io/image_io.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
@@ -50,6 +52,7 @@ struct GoldenView {
     Projection projection;
     Source source;
     int width_px = 160, height_px = 120;
+    const char* file = nullptr;  // under ../shared/data; the phantom when none
 };
 
 std::ostream& operator<<(std::ostream& os, const GoldenView& g) {
@@ -63,11 +66,19 @@ const GoldenView kViews[] = {
     // The same view as bone_orbit_30_20, so the two baselines should look alike.
     {"bone_orbit_30_20_progressive", kPhantomBoneIso, 30, 20, Projection::perspective,
      Source::progressive},
+    // A head CT acquired turned about x (its sform): the front view shows the face upright, as
+    // the unrotated heads' front views do (common/formats, Orientation).
+    {"ct_pitch_front", 60, 0, 0, Projection::perspective, Source::progressive, 160, 160,
+     "formats/ct_pitch.nii.gz"},
 };
 
-const Volume& phantom() {
-    static const Volume volume = make_phantom();
-    return volume;
+// The view's volume: the phantom, or its file read as --volume reads it (nullopt when the shared
+// data is absent).
+std::optional<Volume> volume_of(const GoldenView& g) {
+    if (!g.file) return make_phantom();
+    const auto dir = test::shared_data_dir();
+    if (!dir || !std::filesystem::exists(*dir / g.file)) return std::nullopt;
+    return formats::read_volume((*dir / g.file).string(), std::nullopt);
 }
 
 FrameView frame_view(const Volume& volume, const GoldenView& g) {
@@ -76,14 +87,14 @@ FrameView frame_view(const Volume& volume, const GoldenView& g) {
     fv.width = g.width_px;
     fv.height = g.height_px;
     fv.iso = g.iso;
-    const Camera front = front_full_view(volume.bounds(), aspect, g.projection);
+    const Camera front =
+        front_full_view(volume.bounds(), volume.orientation().axes, aspect, g.projection);
     fv.camera = fit_depth_range(orbit(front, g.yaw_deg, g.pitch_deg), volume.bounds());
     fv.frustum = fv.camera.frustum(aspect);
     return fv;
 }
 
-Image render(const GoldenView& g) {
-    const Volume& volume = phantom();
+Image render(const GoldenView& g, const Volume& volume) {
     auto extractor = make_surface_extractor(volume);
     auto renderer = make_renderer("osmesa");
     const FrameView fv = frame_view(volume, g);
@@ -105,7 +116,9 @@ class Golden : public ::testing::TestWithParam<GoldenView> {};
 
 TEST_P(Golden, MatchesTheBaseline) {
     const GoldenView& g = GetParam();
-    const Image rendered = render(g);
+    const std::optional<Volume> volume = volume_of(g);
+    if (!volume) GTEST_SKIP() << "../shared/data/" << g.file << " absent";
+    const Image rendered = render(g, *volume);
     ASSERT_EQ(rendered.width, g.width_px);
     ASSERT_EQ(rendered.height, g.height_px);
     const auto baseline_path = golden_path(g);

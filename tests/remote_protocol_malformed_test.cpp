@@ -80,7 +80,11 @@ TEST(RemoteProtocolMalformed, ReadyFields) {
          {"dims.y: expected 1..2147483647, got 0", [](ReadyMsg& m) { m.dims.y = 0; }},
          {"dims.z: expected 1..2147483647, got -3", [](ReadyMsg& m) { m.dims.z = -3; }},
          {"spacing: expected positive", [](ReadyMsg& m) { m.spacing.x = 0; }},
-         {"spacing.z: expected a finite number", [](ReadyMsg& m) { m.spacing.z = -kInf; }}});
+         {"spacing.z: expected a finite number", [](ReadyMsg& m) { m.spacing.z = -kInf; }},
+         {"axes.y.x: expected a finite number", [](ReadyMsg& m) { m.axes[1].x = kNaN; }},
+         {"axes.z: expected a unit vector", [](ReadyMsg& m) { m.axes[2] *= 2.0f; }},
+         // A mirrored frame would draw the patient mirror-imaged: the server sends rotations.
+         {"axes: expected a rotation", [](ReadyMsg& m) { m.axes[0] = -m.axes[0]; }}});
 }
 
 TEST(RemoteProtocolMalformed, RequestFields) {

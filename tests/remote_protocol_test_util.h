@@ -20,7 +20,7 @@ inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
 inline bool operator==(const ReadyMsg& a, const ReadyMsg& b) {
     return a.bounds.min == b.bounds.min && a.bounds.max == b.bounds.max &&
            a.value_min == b.value_min && a.value_max == b.value_max && a.dims == b.dims &&
-           a.spacing == b.spacing;
+           a.spacing == b.spacing && a.axes == b.axes;
 }
 inline bool operator==(const RequestMsg& a, const RequestMsg& b) {
     return a.request_id == b.request_id && a.view == b.view &&
@@ -51,7 +51,13 @@ inline HelloMsg sample_hello() {
     return {7, "ct_head 256", "s3cret token", 3};
 }
 inline ReadyMsg sample_ready() {
-    return {{{-1, -2, -3}, {1, 2, 3}}, -1024.5, 3071.25, {256, 255, 113}, {0.5f, 0.75f, 2}};
+    // A volume turned a quarter about z: its x runs to the patient's back.
+    return {{{-1, -2, -3}, {1, 2, 3}},
+            -1024.5,
+            3071.25,
+            {256, 255, 113},
+            {0.5f, 0.75f, 2},
+            glm::mat3(glm::vec3(0, 1, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1))};
 }
 inline RequestMsg sample_request() {
     RequestMsg m;

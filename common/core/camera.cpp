@@ -136,6 +136,37 @@ Camera front_full_view(const Box3& bounds, float aspect, Projection projection) 
     return fit_depth_range(c, bounds);
 }
 
+glm::mat3 frame_rotation(const glm::mat3& m) {
+    const glm::vec3 x = m[0];
+    const glm::vec3 y = m[1] - glm::dot(m[1], x) / std::max(glm::dot(x, x), 1e-30f) * x;
+    if (!(glm::length(x) > 1e-6f) || !(glm::length(y) > 1e-6f)) return glm::mat3(1.0f);
+    const glm::vec3 nx = glm::normalize(x), ny = glm::normalize(y);
+    return glm::mat3(nx, ny, glm::cross(nx, ny));
+}
+
+Camera front_full_view(const Box3& bounds, const glm::mat3& axes, float aspect,
+                       Projection projection) {
+    const glm::mat3 r = frame_rotation(axes);
+    if (r == glm::mat3(1.0f)) return front_full_view(bounds, aspect, projection);
+    // The front view of the box the volume fills in patient space, about its centre, then
+    // carried back into the volume's own axes (r is a rotation: its inverse is its transpose).
+    const glm::vec3 centre = bounds.center();
+    Box3 patient;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 corner((i & 1) ? bounds.max.x : bounds.min.x,
+                               (i & 2) ? bounds.max.y : bounds.min.y,
+                               (i & 4) ? bounds.max.z : bounds.min.z);
+        patient.merge(r * (corner - centre));
+    }
+    const Camera p = front_full_view(patient, aspect, projection);
+    const glm::mat3 back = glm::transpose(r);
+    Camera c = p;
+    c.target = centre + back * (p.target - patient.center());
+    c.eye = centre + back * (p.eye - patient.center());
+    c.up = back * p.up;
+    return fit_depth_range(c, bounds);
+}
+
 Camera orbit(const Camera& c, double yaw_deg, double pitch_deg) {
     Camera out = c;
     glm::vec3 offset = c.eye - c.target;

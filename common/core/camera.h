@@ -4,6 +4,7 @@
 #include <ostream>
 #include <string>
 
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -60,6 +61,19 @@ struct Camera {
 // Front full view: looking along +y of the volume (front of a head scan) with +z up, at the
 // nearest distance where every corner of `bounds` is in view (4% margin).
 Camera front_full_view(const Box3& bounds, float aspect,
+                       Projection projection = Projection::perspective);
+
+// A rotation made from the columns of `m` by Gram-Schmidt (x kept, y made perpendicular, z their
+// cross product), so a sheared or scaled frame still gives one; the identity when a column is
+// zero or x and y are parallel.
+glm::mat3 frame_rotation(const glm::mat3& m);
+
+// The front full view of a volume whose x, y and z run along the columns of `axes` in patient
+// space (common/volume/volume.h: Orientation, LPS): the eye in front of the patient (-y), the
+// head (+z) up, the patient's left (+x) on the screen's right, as front_full_view shows a volume
+// stored in that order. `axes` is made orthonormal first; with the identity this is
+// front_full_view itself.
+Camera front_full_view(const Box3& bounds, const glm::mat3& axes, float aspect,
                        Projection projection = Projection::perspective);
 
 // Rotate the eye around the target: yaw about the up vector, pitch about the right vector. The

@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include "common/core/box.h"
@@ -52,6 +53,24 @@ struct VolumeView {
     }
 };
 
+// Where the voxels lie in the patient's (or the scanner's) space: DICOM's LPS millimetres (x
+// toward the patient's left, y posterior, z superior). The columns of `axes` are the unit
+// directions of the volume's x, y and z there; `origin` is where voxel (0, 0, 0) is. The readers
+// keep `axes` a rotation (determinant +1: a mirrored file has its x reversed when read), so the
+// front view of a patient is the patient's front (common/core/camera.h: front_full_view with
+// axes). Identity and `known` false when the file says nothing (raw, most NRRD).
+struct Orientation {
+    glm::mat3 axes{1.0f};
+    glm::vec3 origin{0.0f};
+    bool known = false;
+};
+
+// One thing a file carried that a user checks (`isowall info`): "modality" "MR", "scaling"
+// "value = 2.5 * stored + 0 (applied)".
+struct VolumeFact {
+    std::string name, value;
+};
+
 class Volume {
   public:
     Volume() = default;
@@ -70,6 +89,12 @@ class Volume {
     // generated volume. The octree cache key covers each.
     const std::vector<std::filesystem::path>& files() const { return files_; }
     void set_files(std::vector<std::filesystem::path> files) { files_ = std::move(files); }
+    const Orientation& orientation() const { return orientation_; }
+    void set_orientation(const Orientation& o) { orientation_ = o; }
+    const std::vector<VolumeFact>& facts() const { return facts_; }
+    void add_fact(std::string name, std::string value) {
+        facts_.push_back({std::move(name), std::move(value)});
+    }
     std::span<const std::byte> bytes() const { return bytes_; }
     bool mapped() const { return file_.size() > 0; }
     bool in_huge_pages() const { return huge_.size() > 0; }
@@ -92,6 +117,8 @@ class Volume {
     VoxelType type_ = VoxelType::u8;
     std::string source_;
     std::vector<std::filesystem::path> files_;
+    Orientation orientation_;
+    std::vector<VolumeFact> facts_;
     MappedFile file_;
     std::vector<std::byte> owned_;
     HugePageBuffer huge_;

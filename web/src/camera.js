@@ -137,9 +137,50 @@ export function frustum(c, aspect) {
 }
 
 // What `isowall render --orbit YAW PITCH --zoom F` draws, for an image of width x height.
-export function viewCamera(bounds, width, height, yaw, pitch, zoomFactor) {
+const IDENTITY = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+
+// frame_rotation: a rotation from the columns of `m` (Gram-Schmidt; the identity when x is zero
+// or parallel to y).
+export function frameRotation(m) {
+  const x = m[0];
+  const y = sub(m[1], scale(x, f(dot(m[1], x) / Math.max(dot(x, x), 1e-30))));
+  if (!(length(x) > 1e-6) || !(length(y) > 1e-6)) return IDENTITY;
+  const nx = normalize(x), ny = normalize(y);
+  return [nx, ny, cross(nx, ny)];
+}
+
+const isIdentity = (r) => r.every((col, c) => col.every((v, i) => v === (c === i ? 1 : 0)));
+// r * v and its transpose, r given as columns.
+const toPatient = (r, v) => add(add(scale(r[0], v[0]), scale(r[1], v[1])), scale(r[2], v[2]));
+const fromPatient = (r, v) => [dot(r[0], v), dot(r[1], v), dot(r[2], v)];
+
+// front_full_view(bounds, axes, aspect): the patient's front for a volume whose axes (columns, in
+// patient LPS space) the server's ready message names.
+export function frontFullViewOf(bounds, axes, aspect, projection = Projection.perspective) {
+  const r = frameRotation(axes ?? IDENTITY);
+  if (isIdentity(r)) return frontFullView(bounds, aspect, projection);
+  const centre = boxCenter(bounds);
+  const patient = { min: [Infinity, Infinity, Infinity], max: [-Infinity, -Infinity, -Infinity] };
+  for (let i = 0; i < 8; ++i) {
+    const corner = [0, 1, 2].map((a) => ((i >> a) & 1 ? bounds.max[a] : bounds.min[a]));
+    const p = toPatient(r, sub(corner, centre));
+    for (let a = 0; a < 3; ++a) {
+      patient.min[a] = Math.min(patient.min[a], p[a]);
+      patient.max[a] = Math.max(patient.max[a], p[a]);
+    }
+  }
+  const p = frontFullView(patient, aspect, projection);
+  const pc = boxCenter(patient);
+  const c = copyCamera(p);
+  c.target = add(centre, fromPatient(r, sub(p.target, pc)));
+  c.eye = add(centre, fromPatient(r, sub(p.eye, pc)));
+  c.up = fromPatient(r, p.up);
+  return fitDepthRange(c, bounds);
+}
+
+export function viewCamera(bounds, width, height, yaw, pitch, zoomFactor, axes = IDENTITY) {
   const aspect = f(f(width) / f(height));
-  let cam = frontFullView(bounds, aspect);
+  let cam = frontFullViewOf(bounds, axes, aspect);
   cam = orbit(cam, yaw, pitch);
   cam = zoom(cam, zoomFactor);
   cam = fitDepthRange(cam, bounds);

@@ -139,7 +139,8 @@ function sendRequest() {
   if (!readyMsg || !ws || ws.readyState !== WebSocket.OPEN) return;
   const [width, height] = layoutCanvas();
   const v = api.view;
-  const { camera, frustum } = viewCamera(readyMsg.bounds, width, height, v.yaw, v.pitch, v.zoom);
+  const { camera, frustum } = viewCamera(readyMsg.bounds, width, height, v.yaw, v.pitch, v.zoom,
+    readyMsg.axes);
   const problem = cameraProblem(camera);
   if (problem) {
     complain(`this view cannot be drawn: ${problem}`);

@@ -32,7 +32,7 @@ export const kMaxGroupLevel = 30;
 export const kMaxImageSide = 32768;
 const MAGIC = [0x49, 0x57, 0x56, 0x50];
 
-const VERSION = { hello: 1, ready: 1, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1 };
+const VERSION = { hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1 };
 
 // ---- text ----------------------------------------------------------------------------------
 
@@ -153,6 +153,7 @@ const encoders = {
     w.f64(m.value_min); w.f64(m.value_max);
     for (const d of m.dims) w.i32(d);
     w.vec3(m.spacing);
+    for (const col of m.axes ?? [[1, 0, 0], [0, 1, 0], [0, 0, 1]]) w.vec3(col);
     return w.take();
   },
   request(m) {
@@ -215,6 +216,16 @@ const decoders = {
     m.dims = ['dims.x', 'dims.y', 'dims.z'].map((n) => getIntIn(r, n, 1, 2147483647));
     m.spacing = r.finiteVec3('spacing');
     if (!m.spacing.every((s) => s > 0)) r.fail('spacing: expected positive numbers');
+    // The volume's axes in patient space: unit columns making a rotation (version 2).
+    m.axes = ['axes.x', 'axes.y', 'axes.z'].map((n) => {
+      const col = r.finiteVec3(n);
+      if (Math.abs(Math.hypot(...col) - 1) > 1e-3) r.fail(`${n}: expected a unit vector`);
+      return col;
+    });
+    const [a, b, c] = m.axes;
+    const det = a[0] * (b[1] * c[2] - b[2] * c[1]) - b[0] * (a[1] * c[2] - a[2] * c[1]) +
+      c[0] * (a[1] * b[2] - a[2] * b[1]);
+    if (Math.abs(det - 1) > 1e-2) r.fail('axes: expected a rotation (orthogonal unit columns, determinant 1)');
     return m;
   },
   request(r) {

@@ -76,3 +76,15 @@ test('normal matrix of a rotation is the rotation', () => {
   const m3 = [v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10]];
   close(Array.from(n), m3, 'normal matrix', 1e-6);
 });
+
+test('the front view of a turned volume is the patient\'s front, and the identity changes nothing', async () => {
+  const { frontFullView, frontFullViewOf } = await import('../src/camera.js');
+  const b = { min: [0, 0, 0], max: [100, 200, 50] };
+  assert.deepEqual(frontFullViewOf(b, [[1, 0, 0], [0, 1, 0], [0, 0, 1]], 1.5), frontFullView(b, 1.5));
+  // The volume's y runs toward the patient's feet (-z) and its z toward the back (+y): the eye
+  // looks along the volume's z (the patient's +y), and the volume's -y is up.
+  const c = frontFullViewOf(b, [[1, 0, 0], [0, 0, -1], [0, 1, 0]], 1.5);
+  const d = [0, 1, 2].map((a) => c.target[a] - c.eye[a]);
+  assert.ok(d[2] > 0 && Math.abs(d[0]) < 1e-3 && Math.abs(d[1]) < 1e-3, `view direction ${d}`);
+  assert.ok(c.up[1] < -0.999, `up ${c.up}`);
+});

@@ -37,8 +37,9 @@ test('corpus values are the seeds\' (fuzz/view_protocol_seeds.cpp)', () => {
   const msg = (n) => decodeFrame(read(corpus, `stream-${n}`).subarray(2)).msg;
   assert.deepEqual(msg('hello'), { protocol_version: 1, dataset: 'ct_head', token: 's3cret', encoding: 2 });
   const r = msg('ready');
-  assert.deepEqual([r.bounds, r.value_min, r.value_max, r.dims, r.spacing],
-    [{ min: [0, 0, 0], max: [1, 2, 3] }, -1024, 3071, [256, 256, 113], [1, 1, 2]]);
+  assert.deepEqual([r.bounds, r.value_min, r.value_max, r.dims, r.spacing, r.axes],
+    [{ min: [0, 0, 0], max: [1, 2, 3] }, -1024, 3071, [256, 256, 113], [1, 1, 2],
+      [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]]);
   const q = msg('request');
   assert.equal(q.request_id, 3);
   assert.deepEqual(q.view.camera.eye, [1, -40, 3]);
@@ -118,6 +119,8 @@ test('decoders name the message and the field', () => {
   assert.throws(() => decodePayload(MsgType.error, err), /error message: code: expected 1..6, got 9/);
   const ready = encodePayload(MsgType.ready, { bounds: { min: [0, 0, 0], max: [1, 1, 1] }, value_min: 5, value_max: 1, dims: [2, 2, 2], spacing: [1, 1, 1] });
   assert.throws(() => decodePayload(MsgType.ready, ready), /ready message: value_max: expected >= value_min/);
+  const mirrored = encodePayload(MsgType.ready, { bounds: { min: [0, 0, 0], max: [1, 1, 1] }, value_min: 0, value_max: 1, dims: [2, 2, 2], spacing: [1, 1, 1], axes: [[-1, 0, 0], [0, 1, 0], [0, 0, 1]] });
+  assert.throws(() => decodePayload(MsgType.ready, mirrored), /ready message: axes: expected a rotation/);
   assert.throws(() => decodePayload(9, new Uint8Array([1])), /view protocol: unknown message type 9/);
 });
 

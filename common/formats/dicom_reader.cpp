@@ -1,0 +1,327 @@
+// DICOM through GDCM: its Scanner reads the few header fields of every file in the folder, its
+// ImageReader decodes each slice's pixels in whatever transfer syntax GDCM supports (raw, RLE,
+// deflate, JPEG lossless, JPEG-LS through CharLS, JPEG 2000 through OpenJPEG). What we do: choose
+// the series, order the slices (dicom_slices.h), check each slice's pixels, and scale.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <sstream>
+
+#include <gdcmDirectory.h>
+#include <gdcmImageReader.h>
+#include <gdcmScanner.h>
+#include <gdcmTrace.h>
+#include <gdcmUIDs.h>
+
+#include "common/core/error.h"
+#include "common/formats/dicom_lengths.h"
+#include "common/formats/dicom_slices.h"
+#include "common/formats/readers.h"
+#include "common/formats/voxel_ops.h"
+#include "common/volume/load_checks.h"
+
+namespace isowall::formats {
+namespace fs = std::filesystem;
+namespace {
+
+const gdcm::Tag kSeriesUid(0x0020, 0x000e), kPosition(0x0020, 0x0032), kOrientation(0x0020, 0x0037),
+    kRows(0x0028, 0x0010), kColumns(0x0028, 0x0011), kPixelSpacing(0x0028, 0x0030),
+    kModality(0x0008, 0x0060), kDescription(0x0008, 0x103e), kSeriesNumber(0x0020, 0x0011),
+    kPixelData(0x7fe0, 0x0010), kBitsAllocated(0x0028, 0x0100), kFrames(0x0028, 0x0008);
+
+// The most bytes one slice may hold: 512 MiB (16384 x 16384 at 16 bits). Checked on the header
+// before GDCM decodes, since GDCM sizes its buffers from the header; a volume of slices past it
+// could not be held in memory anyway.
+constexpr std::uint64_t kMaxSliceBytes = std::uint64_t(1) << 29;
+
+std::string trimmed(const char* v) {
+    std::string s = v ? v : "";
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
+    while (!s.empty() && s.front() == ' ') s.erase(s.begin());
+    return s;
+}
+
+// The numbers of a backslash-separated decimal string ("0.41\0.41").
+std::vector<double> numbers(const std::string& text) {
+    std::vector<double> out;
+    std::stringstream in(text);
+    std::string piece;
+    while (std::getline(in, piece, '\\')) {
+        char* end = nullptr;
+        const double v = std::strtod(piece.c_str(), &end);
+        if (end == piece.c_str() || !std::isfinite(v)) return {};
+        out.push_back(v);
+    }
+    return out;
+}
+
+struct Series {
+    std::vector<std::string> files;
+    std::string description, number, modality;
+};
+
+// The DICOM Part 10 files among `files`, each checked (dicom_lengths.h) before GDCM reads it;
+// other files (notes, a DICOMDIR is Part 10 too and has no series) are passed over.
+gdcm::Directory::FilenamesType part10_files(const gdcm::Directory::FilenamesType& files) {
+    gdcm::Directory::FilenamesType out;
+    for (const std::string& f : files) {
+        std::ifstream in(f, std::ios::binary);
+        const std::vector<char> text((std::istreambuf_iterator<char>(in)),
+                                     std::istreambuf_iterator<char>());
+        const auto bytes = std::as_bytes(std::span(text));
+        if (!has_part10_magic(bytes)) continue;
+        if (std::string problem = dicom_length_problem(bytes); !problem.empty())
+            throw InputError(f, "DICOM", problem + " (a damaged file)");
+        out.push_back(f);
+    }
+    return out;
+}
+
+// The folder's DICOM files by series (files that are not DICOM, or have no series, are passed
+// over: a scanner's folder may hold a DICOMDIR or notes).
+std::map<std::string, Series> scan_series(const fs::path& dir, gdcm::Scanner& scanner) {
+    gdcm::Directory d;
+    d.Load(dir.string(), false);
+    for (const gdcm::Tag& t : {kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing,
+                               kModality, kDescription, kSeriesNumber, kBitsAllocated, kFrames})
+        scanner.AddTag(t);
+    gdcm::Directory::FilenamesType files = part10_files(d.GetFilenames());
+    std::sort(files.begin(), files.end());
+    scanner.Scan(files);
+    std::map<std::string, Series> out;
+    for (const std::string& f : files) {
+        const std::string uid = trimmed(scanner.GetValue(f.c_str(), kSeriesUid));
+        if (uid.empty()) continue;
+        Series& s = out[uid];
+        s.files.push_back(f);
+        s.description = trimmed(scanner.GetValue(f.c_str(), kDescription));
+        s.number = trimmed(scanner.GetValue(f.c_str(), kSeriesNumber));
+        s.modality = trimmed(scanner.GetValue(f.c_str(), kModality));
+    }
+    return out;
+}
+
+std::string series_label(const std::string& uid, const Series& s) {
+    std::string label = "series " + (s.number.empty() ? uid : s.number);
+    if (!s.description.empty()) label += " \"" + s.description + "\"";
+    return label + " (" + std::to_string(s.files.size()) + " files)";
+}
+
+// The series to read: the one of `file` when a file was named, the folder's only one otherwise.
+const std::pair<const std::string, Series>& choose_series(const std::map<std::string, Series>& all,
+                                                          const fs::path& path,
+                                                          const std::string& file,
+                                                          const gdcm::Scanner& scanner) {
+    if (all.empty())
+        throw InputError(path.string(), "SeriesInstanceUID",
+                         "no DICOM image series here (no file GDCM reads with a series UID)");
+    if (!file.empty()) {
+        const std::string uid = trimmed(scanner.GetValue(file.c_str(), kSeriesUid));
+        const auto it = all.find(uid);
+        if (it == all.end())
+            throw InputError(file, "SeriesInstanceUID", "not a DICOM image of a series");
+        return *it;
+    }
+    if (all.size() > 1) {
+        std::string list;
+        for (const auto& [uid, s] : all) list += (list.empty() ? "" : "; ") + series_label(uid, s);
+        throw InputError(path.string(), "SeriesInstanceUID",
+                         std::to_string(all.size()) + " series in one folder (" + list +
+                             "): give --volume one file of the series to read");
+    }
+    return *all.begin();
+}
+
+std::optional<VoxelType> voxel_type_of_pixels(const gdcm::PixelFormat& p) {
+    switch (p.GetScalarType()) {
+        case gdcm::PixelFormat::UINT8:
+            return VoxelType::u8;
+        case gdcm::PixelFormat::INT8:
+            return VoxelType::i8;
+        case gdcm::PixelFormat::UINT12:
+        case gdcm::PixelFormat::UINT16:
+            return VoxelType::u16;
+        case gdcm::PixelFormat::INT12:
+        case gdcm::PixelFormat::INT16:
+            return VoxelType::i16;
+        case gdcm::PixelFormat::UINT32:
+            return VoxelType::u32;
+        case gdcm::PixelFormat::INT32:
+            return VoxelType::i32;
+        case gdcm::PixelFormat::FLOAT32:
+            return VoxelType::f32;
+        case gdcm::PixelFormat::FLOAT64:
+            return VoxelType::f64;
+        default:
+            return std::nullopt;
+    }
+}
+
+SliceHeader slice_header(const std::string& f, const gdcm::Scanner& scanner) {
+    SliceHeader h;
+    h.file = f;
+    const std::vector<double> pos = numbers(trimmed(scanner.GetValue(f.c_str(), kPosition)));
+    if (pos.size() != 3)
+        throw InputError(f, "ImagePositionPatient", "missing or not three numbers");
+    const std::vector<double> dir = numbers(trimmed(scanner.GetValue(f.c_str(), kOrientation)));
+    if (dir.size() != 6)
+        throw InputError(f, "ImageOrientationPatient", "missing or not six numbers");
+    h.position = {pos[0], pos[1], pos[2]};
+    h.row = {dir[0], dir[1], dir[2]};
+    h.column = {dir[3], dir[4], dir[5]};
+    h.rows = std::atoi(trimmed(scanner.GetValue(f.c_str(), kRows)).c_str());
+    h.columns = std::atoi(trimmed(scanner.GetValue(f.c_str(), kColumns)).c_str());
+    const int bits = std::atoi(trimmed(scanner.GetValue(f.c_str(), kBitsAllocated)).c_str());
+    if (std::uint64_t(std::max(h.rows, 0)) * std::uint64_t(std::max(h.columns, 0)) *
+            std::uint64_t(std::max(bits, 8) / 8) >
+        kMaxSliceBytes)
+        throw InputError(f, "Rows/Columns",
+                         std::to_string(h.columns) + "x" + std::to_string(h.rows) + " at " +
+                             std::to_string(bits) + " bits is more than " +
+                             std::to_string(kMaxSliceBytes >> 20) + " MiB a slice");
+    if (std::atoi(trimmed(scanner.GetValue(f.c_str(), kFrames)).c_str()) > 1)
+        throw InputError(f, "NumberOfFrames",
+                         "a multi-frame file (" + trimmed(scanner.GetValue(f.c_str(), kFrames)) +
+                             " frames); isowall reads series of single-frame files");
+    return h;
+}
+
+// "JPEG-LS Lossless Image Compression (1.2.840.10008.1.2.4.80)".
+std::string transfer_syntax_text(const gdcm::TransferSyntax& ts) {
+    const char* uid = gdcm::TransferSyntax::GetTSString(ts);
+    gdcm::UIDs names;
+    if (!uid || !names.SetFromUID(uid)) return uid ? uid : "unknown";
+    return std::string(names.GetName()) + " (" + uid + ")";
+}
+
+struct SlicePixels {
+    VoxelType type;
+    Scaling scaling;
+    std::string transfer_syntax;
+    std::vector<std::byte> bytes;
+};
+
+// One slice's pixels, decoded, of the type of the series' first slice when `expected` is set.
+SlicePixels read_slice(const SliceHeader& h, const std::optional<VoxelType>& expected) {
+    const std::string& f = h.file;
+    gdcm::ImageReader reader;
+    reader.SetFileName(f.c_str());
+    if (!reader.Read())
+        throw InputError(f, "PixelData",
+                         "no image GDCM decodes (no pixel data, or a transfer syntax it lacks)");
+    const gdcm::Image& img = reader.GetImage();
+    const gdcm::PixelFormat& pf = img.GetPixelFormat();
+    if (pf.GetSamplesPerPixel() != 1)
+        throw InputError(
+            f, "SamplesPerPixel",
+            std::to_string(pf.GetSamplesPerPixel()) + " (colour); a volume is one value per voxel");
+    const auto type = voxel_type_of_pixels(pf);
+    if (!type)
+        throw InputError(
+            f, "BitsAllocated",
+            std::string(pf.GetScalarTypeAsString()) + " pixels are not a type isowall reads");
+    if (expected && *type != *expected)
+        throw InputError(f, "PixelRepresentation",
+                         std::string(type_name(*type)) +
+                             " pixels where the series' first slice has " +
+                             std::string(type_name(*expected)));
+    const std::size_t need = std::size_t(h.rows) * std::size_t(h.columns) * voxel_size(*type);
+    // Uncompressed pixels must all be there before a buffer of the header's size is made.
+    const gdcm::DataElement& pd = reader.GetFile().GetDataSet().GetDataElement(kPixelData);
+    if (const gdcm::ByteValue* bv = pd.GetByteValue(); bv && bv->GetLength() < need)
+        throw InputError(f, "PixelData",
+                         std::to_string(bv->GetLength()) + " bytes of pixels where " +
+                             std::to_string(h.columns) + "x" + std::to_string(h.rows) + " " +
+                             std::string(type_name(*type)) + " needs " + std::to_string(need));
+    if (img.GetDimension(0) != unsigned(h.columns) || img.GetDimension(1) != unsigned(h.rows) ||
+        img.GetBufferLength() != need)
+        throw InputError(f, "PixelData",
+                         std::to_string(img.GetBufferLength()) + " bytes of pixels where " +
+                             std::to_string(h.columns) + "x" + std::to_string(h.rows) + " " +
+                             std::string(type_name(*type)) + " needs " + std::to_string(need));
+    SlicePixels out{*type,
+                    {img.GetSlope(), img.GetIntercept()},
+                    transfer_syntax_text(img.GetTransferSyntax()),
+                    std::vector<std::byte>(need)};
+    if (!img.GetBuffer(reinterpret_cast<char*>(out.bytes.data())))
+        throw InputError(f, "PixelData", "GDCM could not decode the pixels");
+    return out;
+}
+
+}  // namespace
+
+Volume read_dicom(const fs::path& path) {
+    gdcm::Trace::SetWarning(false);  // its warnings go to stderr; ours is the one line
+    gdcm::Trace::SetError(false);
+    std::error_code ec;
+    const bool folder = fs::is_directory(path, ec);
+    const fs::path dir = folder ? path : path.parent_path().empty() ? "." : path.parent_path();
+    gdcm::Scanner scanner;
+    const std::map<std::string, Series> all = scan_series(dir, scanner);
+    const auto& [uid, series] = choose_series(all, path, folder ? "" : path.string(), scanner);
+    const std::string where = folder ? path.string() : dir.string();
+    std::vector<SliceHeader> headers;
+    for (const std::string& f : series.files) headers.push_back(slice_header(f, scanner));
+    const SliceOrder order = order_slices(headers, where);
+    const SliceHeader& first = headers[order.order.front()];
+    const std::vector<double> ps =
+        numbers(trimmed(scanner.GetValue(series.files.front().c_str(), kPixelSpacing)));
+    if (ps.size() != 2)
+        throw InputError(series.files.front(), "PixelSpacing", "missing or not two numbers");
+    Decoded d;
+    d.spacing = {float(ps[1]), float(ps[0]), float(order.spacing)};  // PixelSpacing: row, column
+    std::vector<Scaling> scalings;
+    std::string syntax;
+    for (std::size_t k = 0; k < order.order.size(); ++k) {
+        const SliceHeader& h = headers[order.order[k]];
+        SlicePixels p = read_slice(h, k == 0 ? std::nullopt : std::optional(d.type));
+        if (k == 0) {
+            d.type = p.type;
+            d.dims = checked_dims(
+                where, "Rows/Columns",
+                std::vector<std::uint64_t>{std::uint64_t(h.columns), std::uint64_t(h.rows),
+                                           std::uint64_t(headers.size())},
+                d.type);
+            check_fits_memory(voxel_bytes(d.dims, d.type), where, "Rows/Columns");
+            d.bytes.reserve(voxel_bytes(d.dims, d.type));
+            syntax = p.transfer_syntax;
+        }
+        d.bytes.insert(d.bytes.end(), p.bytes.begin(), p.bytes.end());
+        scalings.push_back(p.scaling);
+    }
+    const bool one_scaling = std::all_of(scalings.begin(), scalings.end(), [&](const Scaling& s) {
+        return s.slope == scalings[0].slope && s.intercept == scalings[0].intercept;
+    });
+    if (one_scaling) {
+        d.scaling = scalings[0];
+    } else {
+        // Some scanners scale each slice to its own range: each slice to float32 by its own.
+        const std::size_t slice_bytes = d.bytes.size() / scalings.size();
+        std::vector<std::byte> values;
+        for (std::size_t k = 0; k < scalings.size(); ++k) {
+            const std::vector<std::byte> v = to_float32(
+                std::span(d.bytes).subspan(k * slice_bytes, slice_bytes), d.type, scalings[k]);
+            values.insert(values.end(), v.begin(), v.end());
+        }
+        d.bytes = std::move(values);
+        d.type = VoxelType::f32;
+        d.facts.push_back({"scaling", "RescaleSlope/Intercept per slice (applied: float32)"});
+    }
+    d.orientation.axes =
+        glm::mat3(glm::vec3(first.row), glm::vec3(first.column), glm::vec3(order.normal));
+    d.orientation.origin = glm::vec3(first.position);
+    d.orientation.known = true;
+    d.format = "DICOM";
+    d.files.assign(series.files.begin(), series.files.end());
+    if (!series.modality.empty()) d.facts.push_back({"modality", series.modality});
+    d.facts.push_back({"series", series_label(uid, series)});
+    d.facts.push_back({"slices", std::to_string(headers.size()) + ", " +
+                                     std::to_string(order.spacing) + " mm apart"});
+    d.facts.push_back({"transfer syntax", syntax});
+    return finish_volume(std::move(d), where, "RescaleSlope");
+}
+
+}  // namespace isowall::formats

@@ -1,0 +1,85 @@
+#include "common/formats/read_volume.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <fstream>
+
+#include "common/core/error.h"
+#include "common/formats/readers.h"
+#include "common/volume/load_checks.h"
+
+namespace isowall::formats {
+namespace fs = std::filesystem;
+namespace {
+
+std::string lower(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return s;
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+bool is_hdf5_name(const std::string& name) {
+    const std::string n = lower(name);
+    return ends_with(n, ".h5") || ends_with(n, ".hdf5") || ends_with(n, ".he5") ||
+           ends_with(n, ".hdf");
+}
+
+// A DICOM Part 10 file has "DICM" after a 128-byte preamble.
+bool has_dicom_magic(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::array<char, 132> head{};
+    if (!in.read(head.data(), head.size())) return false;
+    return std::string_view(head.data() + 128, 4) == "DICM";
+}
+
+// A folder is a stack of TIFF slices when its files are .tif/.tiff, else a DICOM series.
+bool is_tiff_folder(const fs::path& dir) {
+    bool any = false;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (!e.is_regular_file()) continue;
+        const std::string n = lower(e.path().filename().string());
+        if (n.starts_with(".")) continue;
+        if (!ends_with(n, ".tif") && !ends_with(n, ".tiff")) return false;
+        any = true;
+    }
+    return any;
+}
+
+Volume read_file(const fs::path& p, const std::string& name) {
+    const std::string n = lower(name);
+    if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return load_nrrd(p);
+    if (ends_with(n, ".nii") || ends_with(n, ".nii.gz") || ends_with(n, ".hdr") ||
+        ends_with(n, ".img") || ends_with(n, ".img.gz"))
+        return read_nifti(p);
+    if (ends_with(n, ".mhd") || ends_with(n, ".mha")) return read_metaimage(p);
+    if (is_hdf5_name(n)) return read_hdf5(p, "");
+    if (ends_with(n, ".tif") || ends_with(n, ".tiff")) return read_tiff_stack(p);
+    if (ends_with(n, ".dcm") || has_dicom_magic(p)) return read_dicom(p);
+    throw InputError(p.string(), "format",
+                     "not a format isowall reads (NRRD, NIfTI, DICOM, MetaImage, HDF5, TIFF by "
+                     "name or content); for headerless data give --dims X Y Z and --type T");
+}
+
+}  // namespace
+
+Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw) {
+    if (raw) return load_raw(path, *raw);
+    const fs::path p(path);
+    std::error_code ec;
+    if (fs::is_directory(p, ec)) return is_tiff_folder(p) ? read_tiff_stack(p) : read_dicom(p);
+    // FILE.h5:/path/to/dataset, when FILE.h5 is a file (a name may hold a colon itself).
+    const std::size_t colon = path.rfind(":/");
+    if (colon != std::string::npos && !fs::exists(p, ec)) {
+        const std::string file = path.substr(0, colon);
+        if (is_hdf5_name(file)) return read_hdf5(file, path.substr(colon + 1));
+    }
+    check_regular_file(p, path, "file");
+    return read_file(p, p.filename().string());
+}
+
+}  // namespace isowall::formats

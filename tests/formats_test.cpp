@@ -1,0 +1,307 @@
+// The readers of other formats against the shared files' twins (common/formats): a scanner's
+// DICOM series (and the same re-encoded to JPEG-LS and JPEG 2000 with GDCM here), NIfTI twins,
+// the value scaling, the orientation, and the bad files of the issue "Bring your own data".
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <map>
+#include <set>
+#include <span>
+
+#include <gdcmImageChangeTransferSyntax.h>
+#include <gdcmImageReader.h>
+#include <gdcmImageWriter.h>
+#include <gdcmReader.h>
+#include <gdcmWriter.h>
+#include <gtest/gtest.h>
+#include <nifti2_io.h>
+
+#include "common/core/error.h"
+#include "common/extract/surface_extractor.h"
+#include "common/formats/dicom_lengths.h"
+#include "common/formats/read_volume.h"
+#include "common/formats/voxel_ops.h"
+#include "tests/test_util.h"
+
+namespace isowall::test {
+namespace {
+
+namespace fs = std::filesystem;
+using formats::read_volume;
+
+std::optional<fs::path> formats_dir() {
+    const auto d = shared_data_dir();
+    if (!d || !fs::exists(*d / "formats")) return std::nullopt;
+    return *d / "formats";
+}
+
+#define NEED_FORMATS(dir)           \
+    const auto dir = formats_dir(); \
+    if (!dir) GTEST_SKIP() << "../shared/data/formats absent: the readers' twins are there"
+
+Volume twin(const std::string& name) {
+    return load_nrrd(*shared_data_dir() / (name + ".nhdr"));
+}
+
+void expect_same_voxels(const Volume& a, const Volume& b) {
+    ASSERT_EQ(a.dims(), b.dims());
+    ASSERT_EQ(a.type(), b.type());
+    ASSERT_EQ(a.bytes().size(), b.bytes().size());
+    EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.bytes().size()), 0)
+        << a.source() << " and " << b.source() << " differ in their voxels";
+}
+
+std::string error_of(const std::string& path) {
+    try {
+        read_volume(path, std::nullopt);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+TEST(FormatsDicom, TheScannersSeriesEqualsItsRawTwin) {
+    NEED_FORMATS(dir);
+    const Volume v = read_volume((*dir / "mrhead_t1_dicom").string(), std::nullopt);
+    expect_same_voxels(v, twin("mrhead_t1"));
+    EXPECT_NEAR(v.spacing().x, 0.41015625, 1e-6);
+    EXPECT_NEAR(v.spacing().z, 1.5, 1e-4);
+    EXPECT_EQ(v.files().size(), 120u);
+    EXPECT_TRUE(v.orientation().known);
+    EXPECT_EQ(formats::orientation_letters(v.orientation().axes), "LPS");
+}
+
+TEST(FormatsDicom, OneFileOfTheSeriesReadsTheWholeSeries) {
+    NEED_FORMATS(dir);
+    const Volume v = read_volume((*dir / "mrhead_t1_dicom" / "1-077.dcm").string(), std::nullopt);
+    EXPECT_EQ(v.dims(), glm::ivec3(512, 512, 120));
+}
+
+// Every file of the series through GDCM's change of transfer syntax (the encoders GDCM links:
+// CharLS for JPEG-LS, OpenJPEG for JPEG 2000), read back voxel for voxel.
+fs::path reencoded_series(const fs::path& from, const gdcm::TransferSyntax& ts,
+                          const std::string& name) {
+    const fs::path out = scratch_dir(name);
+    for (const auto& e : fs::directory_iterator(from)) {
+        gdcm::ImageReader r;
+        r.SetFileName(e.path().c_str());
+        EXPECT_TRUE(r.Read()) << e.path();
+        gdcm::ImageChangeTransferSyntax change;
+        change.SetTransferSyntax(ts);
+        change.SetInput(r.GetImage());
+        EXPECT_TRUE(change.Change()) << "GDCM could not encode " << e.path();
+        gdcm::ImageWriter w;
+        w.SetFileName((out / e.path().filename()).c_str());
+        w.SetFile(r.GetFile());
+        w.SetImage(change.GetOutput());
+        EXPECT_TRUE(w.Write());
+    }
+    return out;
+}
+
+TEST(FormatsDicom, JpegLsAndJpeg2000SeriesEqualTheRawTwin) {
+    NEED_FORMATS(dir);
+    const Volume raw = twin("mrhead_t1");
+    for (const auto& [ts, uid] :
+         {std::pair{gdcm::TransferSyntax::JPEGLSLossless, "1.2.840.10008.1.2.4.80"},
+          std::pair{gdcm::TransferSyntax::JPEG2000Lossless, "1.2.840.10008.1.2.4.90"}}) {
+        const fs::path series =
+            reencoded_series(*dir / "mrhead_t1_dicom", gdcm::TransferSyntax(ts), uid);
+        const Volume v = read_volume(series.string(), std::nullopt);
+        expect_same_voxels(v, raw);
+        std::string syntax;
+        for (const VolumeFact& f : v.facts())
+            if (f.name == "transfer syntax") syntax = f.value;
+        EXPECT_NE(syntax.find(uid), std::string::npos) << "read as " << syntax;
+    }
+}
+
+// The series copied into a scratch folder, `change` applied to the data set of each file it
+// names (by index in name order), `drop` files left out.
+fs::path series_copy(const fs::path& from, const std::string& name,
+                     const std::map<int, std::function<void(gdcm::DataSet&)>>& change,
+                     const std::set<int>& drop = {}) {
+    const fs::path out = scratch_dir(name);
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(from)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (int i = 0; i < int(files.size()); ++i) {
+        if (drop.count(i)) continue;
+        const auto c = change.find(i);
+        if (c == change.end()) {
+            fs::copy_file(files[i], out / files[i].filename());
+            continue;
+        }
+        gdcm::Reader r;
+        r.SetFileName(files[i].c_str());
+        EXPECT_TRUE(r.Read());
+        c->second(r.GetFile().GetDataSet());
+        gdcm::Writer w;
+        w.SetFileName((out / files[i].filename()).c_str());
+        w.SetFile(r.GetFile());
+        EXPECT_TRUE(w.Write());
+    }
+    return out;
+}
+
+void set_text(gdcm::DataSet& ds, gdcm::Tag tag, std::string value) {
+    if (value.size() % 2) value += ' ';
+    gdcm::DataElement e(tag);
+    e.SetByteValue(value.data(), gdcm::VL(std::uint32_t(value.size())));
+    ds.Replace(e);
+}
+
+struct BadSeries {
+    std::string name;
+    std::map<int, std::function<void(gdcm::DataSet&)>> change;
+    std::set<int> drop;
+    std::vector<std::string> expect;  // pieces of the one error line
+};
+
+TEST(FormatsDicom, BadSeriesGetOneLineNamingTheFileAndTheField) {
+    NEED_FORMATS(dir);
+    const auto other_series = [](gdcm::DataSet& ds) {
+        set_text(ds, gdcm::Tag(0x0020, 0x000e), "1.2.3.4.5.6.7");
+        set_text(ds, gdcm::Tag(0x0020, 0x0011), "7");
+    };
+    std::string position_of_10;
+    {
+        gdcm::Reader r;
+        r.SetFileName((*dir / "mrhead_t1_dicom" / "1-011.dcm").c_str());
+        ASSERT_TRUE(r.Read());
+        const gdcm::ByteValue* v =
+            r.GetFile().GetDataSet().GetDataElement(gdcm::Tag(0x0020, 0x0032)).GetByteValue();
+        ASSERT_TRUE(v);
+        position_of_10.assign(v->GetPointer(), v->GetLength());
+    }
+    const std::vector<BadSeries> cases = {
+        {"missing_slice", {}, {60}, {"1-062.dcm: ImagePositionPatient", "slices are missing"}},
+        {"two_series",
+         {{0, other_series}, {1, other_series}},
+         {},
+         {"SeriesInstanceUID", "2 series in one folder", "series 7"}},
+        {"mixed_sizes",
+         {{5,
+           [](gdcm::DataSet& ds) {
+               const std::uint16_t rows = 256;
+               gdcm::DataElement e(gdcm::Tag(0x0028, 0x0010));
+               e.SetByteValue(reinterpret_cast<const char*>(&rows), 2);
+               ds.Replace(e);
+           }}},
+         {},
+         {"Rows/Columns", "512x256"}},
+        {"no_pixel_data",
+         {{3, [](gdcm::DataSet& ds) { ds.Remove(gdcm::Tag(0x7fe0, 0x0010)); }}},
+         {},
+         {"1-004.dcm: PixelData"}},
+        {"same_position",
+         {{9, [&](gdcm::DataSet& ds) { set_text(ds, gdcm::Tag(0x0020, 0x0032), position_of_10); }}},
+         {},
+         {"ImagePositionPatient", "the same position as"}},
+    };
+    for (const BadSeries& c : cases) {
+        const fs::path series = series_copy(*dir / "mrhead_t1_dicom", c.name, c.change, c.drop);
+        const std::string e = error_of(series.string());
+        for (const std::string& piece : c.expect)
+            EXPECT_NE(e.find(piece), std::string::npos) << c.name << ": " << e;
+    }
+}
+
+// The check before GDCM reads a file (common/formats/dicom_lengths.h): a scanner's file passes;
+// the same with one element's length raised past the end of the file, or an item tag put where
+// a data element belongs, is named.
+TEST(FormatsDicom, DeclaredLengthsAreCheckedBeforeGdcmReads) {
+    NEED_FORMATS(dir);
+    std::ifstream in(*dir / "mrhead_t1_dicom" / "1-001.dcm", std::ios::binary);
+    std::vector<char> text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(formats::dicom_length_problem(std::as_bytes(std::span(text))), "");
+    // The data set is implicit VR: tag (4 bytes), length (4 bytes). Find (0008,0060) Modality.
+    const std::string modality("\x08\x00\x60\x00", 4);
+    const auto at = std::search(text.begin() + 132, text.end(), modality.begin(), modality.end());
+    ASSERT_NE(at, text.end());
+    std::vector<char> long_one = text;
+    const std::uint32_t huge = 0xfffffff0;
+    std::memcpy(&long_one[std::size_t(at - text.begin()) + 4], &huge, 4);
+    const std::string p = formats::dicom_length_problem(std::as_bytes(std::span(long_one)));
+    EXPECT_NE(p.find("element (0008,0060) declares 4294967280 bytes"), std::string::npos) << p;
+    std::vector<char> item_tag = text;
+    const char item[] = {'\xfe', '\xff', '\x00', '\xe0'};
+    std::memcpy(&item_tag[std::size_t(at - text.begin())], item, 4);
+    EXPECT_NE(formats::dicom_length_problem(std::as_bytes(std::span(item_tag)))
+                  .find("outside any sequence"),
+              std::string::npos);
+    EXPECT_NE(formats::dicom_length_problem(std::as_bytes(std::span(text).first(100))).find("DICM"),
+              std::string::npos);
+}
+
+TEST(FormatsNifti, EngineAndHeptaneEqualTheirRawTwins) {
+    NEED_FORMATS(dir);
+    for (const std::string name : {"engine", "heptane"}) {
+        const Volume v = read_volume((*dir / (name + ".nii.gz")).string(), std::nullopt);
+        expect_same_voxels(v, twin(name));
+        EXPECT_EQ(v.spacing(), glm::vec3(1.0f)) << name;
+    }
+}
+
+// A small NIfTI-1 written through niftilib: a ball of uint8 values, with the given scaling.
+fs::path write_nifti(const fs::path& path, float slope, float inter, int n = 24) {
+    const int64_t dims[8] = {3, n, n, n, 1, 1, 1, 1};
+    nifti_image* nim = nifti_make_new_nim(dims, DT_UINT8, 1);
+    auto* data = static_cast<std::uint8_t*>(nim->data);
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double r = std::hypot(x - n / 2.0, y - n / 2.0, z - n / 2.0);
+                data[(z * n + y) * n + x] = std::uint8_t(std::max(0.0, 200 - 20 * r));
+            }
+    nim->scl_slope = slope;
+    nim->scl_inter = inter;
+    nifti_set_filenames(nim, path.c_str(), 0, 1);
+    nifti_image_write(nim);
+    nifti_image_free(nim);
+    return path;
+}
+
+TEST(FormatsNifti, AScaleOf2Point5GivesTheSameSurfaceAt2Point5TimesTheIsovalue) {
+    const fs::path dir = scratch_dir("nifti_scale");
+    const Volume plain = read_volume(write_nifti(dir / "plain.nii", 0, 0).string(), std::nullopt);
+    const Volume scaled =
+        read_volume(write_nifti(dir / "scaled.nii", 2.5f, 0).string(), std::nullopt);
+    EXPECT_EQ(plain.type(), VoxelType::u8);
+    EXPECT_EQ(scaled.type(), VoxelType::f32) << "2.5 is not an integer slope";
+    const Mesh a = make_surface_extractor(plain)->extract_full(100);
+    const Mesh b = make_surface_extractor(scaled)->extract_full(250);
+    ASSERT_GT(a.triangle_count(), 100u);
+    ASSERT_EQ(a.triangle_count(), b.triangle_count());
+    for (std::size_t i = 0; i < a.positions.size(); ++i)
+        ASSERT_LT(glm::length(a.positions[i] - b.positions[i]), 1e-4f) << "vertex " << i;
+}
+
+TEST(FormatsNifti, AnIntegerScaleWidensOnlyAsFarAsTheValuesNeed) {
+    const fs::path dir = scratch_dir("nifti_widen");
+    // 0..200 * 1 - 1024: int16, as a CT's Hounsfield units.
+    const Volume v = read_volume(write_nifti(dir / "ct.nii", 1, -1024).string(), std::nullopt);
+    EXPECT_EQ(v.type(), VoxelType::i16);
+    EXPECT_EQ(v.view<std::int16_t>().at(12, 12, 12), 200 - 1024);
+}
+
+TEST(FormatsNifti, ANanScaleIsNamed) {
+    const fs::path dir = scratch_dir("nifti_nan");
+    const fs::path p = write_nifti(dir / "nan.nii", 1, 0);
+    {
+        // scl_slope is the float at byte 112 of a NIfTI-1 header.
+        std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+        const float nan = std::nanf("");
+        f.seekp(112);
+        f.write(reinterpret_cast<const char*>(&nan), sizeof nan);
+    }
+    const std::string e = error_of(p.string());
+    EXPECT_NE(e.find("nan.nii: scl_slope: "), std::string::npos) << e;
+    EXPECT_NE(e.find("not a finite number"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace isowall::test
