@@ -60,6 +60,11 @@ class Comm {
     virtual void barrier() = 0;
     // Ends every rank of the job at once (a failing rank must not leave others waiting).
     [[noreturn]] virtual void abort(int code) = 0;
+    // This rank's last phase has begun (a tile released, the master finishing): from here a stop
+    // of this process that lasts the end limit is ended from outside (comm/end_watch.h), since
+    // no message of the wall reaches a rank that the others no longer wait for. In process:
+    // nothing.
+    virtual void ending() {}
 };
 
 // How long MPI_Init and MPI_Finalize may take: they wait for every rank, so a stopped rank would

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "comm/end_watch.h"
 
 namespace isowall {
 namespace {
@@ -91,7 +92,13 @@ int rank_before_init() {
 
 class MpiComm final : public Comm {
   public:
-    MpiComm(int& argc, char**& argv, const MpiLimits& limits) : limits_(limits) {
+    MpiComm(int& argc, char**& argv, const MpiLimits& limits)
+        : limits_(limits),
+          // Forked first: before MPI and before the start-up watchdog's thread.
+          end_watch_(limits.end_s, "isowall: error: " + who_before_init() + " stayed stopped for " +
+                                       seconds(limits.end_s) +
+                                       " in its last phase (--timeout): it is ended, so that the "
+                                       "job ends\n") {
         Watchdog watchdog(watchdog_limit(limits.startup_s, rank_before_init()),
                           "isowall: error: " + who_before_init() +
                               ": MPI start-up did not finish within " + seconds(limits.startup_s) +
@@ -117,7 +124,10 @@ class MpiComm final : public Comm {
         MPI_Comm_free(&node);
     }
     ~MpiComm() override {
-        Watchdog watchdog(watchdog_limit(limits_.end_s, rank_),
+        end_watch_.arm();
+        // 2 s past the end watch's limit: a rank stopped in its last phase is named by its own
+        // watcher (comm/end_watch.h), which knows who; this line is for ranks cut off.
+        Watchdog watchdog(watchdog_limit(limits_.end_s, rank_) + 2,
                           "isowall: error: rank " + std::to_string(rank_) + " (host " + host() +
                               "): MPI did not end within " + seconds(limits_.end_s) +
                               " (--timeout): a rank of this job has stopped or cannot be "
@@ -137,6 +147,7 @@ class MpiComm final : public Comm {
         MPI_Comm_free(&comm_);
         MPI_Finalize();
     }
+    void ending() override { end_watch_.arm(); }
     int rank() const override { return rank_; }
     int size() const override { return size_; }
     int ranks_on_host() const override { return on_host_; }
@@ -246,6 +257,7 @@ class MpiComm final : public Comm {
     int rank_ = 0;
     int size_ = 1;
     int on_host_ = 1;  // ranks sharing this host (MPI_COMM_TYPE_SHARED)
+    EndWatch end_watch_;
 };
 
 }  // namespace

@@ -356,6 +356,7 @@ Mosaic WallMaster::compose(OutputFiles* batch) {
 }
 
 int WallMaster::finish() {
+    comm_.ending();
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
     wait_for_tiles([](const TileState& t) { return t.result && t.image; }, o_.timeout_s);
@@ -374,6 +375,7 @@ int WallMaster::finish() {
                     o_.trace.c_str());
     if (!o_.tiles_out.empty()) std::printf("wrote the tiles' images in %s\n", o_.tiles_out.c_str());
     std::printf("wrote %s\n", o_.out.c_str());
+    raise_test_signal(o_.fault, FaultMoment::end);
     return 0;
 }
 

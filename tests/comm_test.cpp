@@ -2,8 +2,15 @@
 // ends every rank on abort; the tile inbox raises the stop flag for views and quit only.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <functional>
 #include <thread>
 
+#include "comm/end_watch.h"
 #include "comm/inproc_comm.h"
 #include "tile/tile_inbox.h"
 
@@ -85,6 +92,71 @@ TEST(TileInbox, CloseWithAnErrorRethrowsItOnceTheQueueIsEmpty) {
     EXPECT_TRUE(inbox.stop_flag());
     EXPECT_TRUE(inbox.pop().has_value());
     EXPECT_THROW(inbox.pop(), WireError);
+}
+
+}  // namespace
+}  // namespace isowall
+
+// comm/end_watch.h: a process stopped after its watcher is armed is ended (SIGKILL) once the
+// limit passes, with the line; one that is only stopped before the arming is left alone.
+namespace isowall {
+namespace {
+
+// Runs `body` in a child process and returns how it ended (waitpid status) within `limit_s`,
+// or -1 when it was still there (it is then killed).
+int child_status(const std::function<void()>& body, double limit_s) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        body();
+        ::_exit(0);
+    }
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+    int status = 0;
+    while (std::chrono::steady_clock::now() < end) {
+        if (::waitpid(pid, &status, WNOHANG | WUNTRACED) == pid && !WIFSTOPPED(status))
+            return status;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    return -1;
+}
+
+TEST(EndWatch, AStopAfterTheArmingIsEndedAfterTheLimit) {
+    const int status = child_status(
+        [] {
+            EndWatch watch(0.3, "isowall: error: test rank stayed stopped\n");
+            watch.arm();
+            ::raise(SIGSTOP);
+        },
+        10);
+    ASSERT_NE(status, -1) << "the stopped process was not ended";
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+}
+
+TEST(EndWatch, AnUnarmedWatchLetsAStoppedProcessBe) {
+    const int status = child_status(
+        [] {
+            EndWatch watch(0.2, "isowall: error: should not print\n");
+            ::raise(SIGSTOP);
+        },
+        1.5);
+    EXPECT_EQ(status, -1) << "an unarmed watcher ended its process";
+}
+
+TEST(EndWatch, ProcessStoppedReadsTheState) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        for (;;) ::pause();
+    }
+    EXPECT_FALSE(process_stopped(pid));
+    ::kill(pid, SIGSTOP);
+    int status = 0;
+    ::waitpid(pid, &status, WUNTRACED);
+    EXPECT_TRUE(process_stopped(pid));
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    EXPECT_FALSE(process_stopped(pid)) << "a reaped process is not stopped";
 }
 
 }  // namespace

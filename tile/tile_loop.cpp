@@ -127,6 +127,8 @@ class TileRank {
                 send_result();
                 send_image();
             } else if (std::holds_alternative<ReleaseMsg>(*m) && quit) {
+                comm_.ending();
+                raise_test_signal(setup_.fault, FaultMoment::end);
                 return 0;
             } else {
                 throw WireError(std::string("a tile does not take ") + to_string(tag_of(*m)) +

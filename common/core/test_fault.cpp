@@ -13,6 +13,7 @@ FaultMoment moment_of(std::string_view s) {
     if (s == "frame") return FaultMoment::frame;
     if (s == "migration") return FaultMoment::migration;
     if (s == "gather") return FaultMoment::gather;
+    if (s == "end") return FaultMoment::end;
     return FaultMoment::none;
 }
 

@@ -8,14 +8,15 @@
 //                   frames last seconds whatever the machine (tests of what happens mid-frame)
 //   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
 //   kill@MOMENT     the same with SIGKILL
-// MOMENT is init, load, frame, migration or gather. RANK is a rank, or "tiles" for every tile.
+// MOMENT is init, load, frame, migration, gather or end (a tile released, the master after its
+// outputs). RANK is a rank, or "tiles" for every tile.
 #include <cstdint>
 #include <string_view>
 
 namespace isowall {
 
 enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, slow, stop, kill };
-enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather };
+enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather, end };
 
 struct TestFault {
     FaultAction action = FaultAction::none;
