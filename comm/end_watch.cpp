@@ -86,9 +86,10 @@ EndWatch::EndWatch(double limit_s, const std::string& line) {
     arm_fd_ = fds[1];
 }
 
-EndWatch::~EndWatch() {
-    if (arm_fd_ >= 0) ::close(arm_fd_);
-}
+// The arming pipe stays open until the process exits: its closing is how the watcher learns
+// that the rank has gone, and the teardown after MPI (destructors, exit) is part of the last
+// phase a stop can hit.
+EndWatch::~EndWatch() = default;
 
 void EndWatch::arm() {
     if (armed_ || arm_fd_ < 0) return;
