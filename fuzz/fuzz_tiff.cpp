@@ -1,5 +1,5 @@
-// Harness: the TIFF stack reader (common/formats/tiff_reader.cpp through OpenImageIO). The bytes are a
-// multi-page TIFF file.
+// Harness: the TIFF stack reader (common/formats/tiff_reader.cpp through OpenImageIO). The
+// bytes are a multi-page TIFF file.
 #include "common/core/error.h"
 #include "common/formats/read_volume.h"
 #include "fuzz/fuzz_files.h"
