@@ -14,7 +14,8 @@ namespace isowall {
 inline constexpr int kServePort = 7878;
 
 struct ServeCommand {
-    std::vector<std::string> datasets;  // NAME=PATH (any format --volume reads); "phantom" is always offered
+    std::vector<std::string>
+        datasets;  // NAME=PATH (any format --volume reads); "phantom" is always offered
     std::string listen = "127.0.0.1";
     int port = -1;       // --port; -1: not given (the port in --listen, else kServePort)
     int http_port = -1;  // --http: the page and WebSocket on this port (0: any free); -1: none

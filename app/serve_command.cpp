@@ -58,7 +58,8 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
         "Extraction server for remote viewing: streams the groups of each view a client "
         "asks for (see isowall view)");
     c->add_option("--dataset", o.datasets,
-                  "Offer a volume as NAME=PATH (any format --volume reads); repeat for more. The phantom is always "
+                  "Offer a volume as NAME=PATH (any format --volume reads); repeat for more. The "
+                  "phantom is always "
                   "offered as 'phantom'");
     c->add_option("--listen", o.listen,
                   "Where to listen: HOST, HOST:PORT or [IPV6]:PORT, as view --connect takes it "
