@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "common/formats/read_volume.h"
 #include "common/formats/readers.h"
 #include "tests/formats_more_util.h"
 #include "tests/test_util.h"
@@ -106,6 +107,9 @@ TEST(FormatsTiff, FolderOfSlicesInNaturalOrder) {
     const Volume v = formats::read_tiff_stack(dir);
     test::expect_test_volume<std::uint16_t>(v, dims);
     EXPECT_EQ(v.files(), want);
+    // --volume's choice agrees: a folder with TIFF slices (and a note) is a TIFF stack.
+    const Volume front_door = formats::read_volume(dir.string(), std::nullopt);
+    EXPECT_EQ(front_door.files(), want);
 }
 
 TEST(FormatsTiff, ImageJSpacingFromDescriptionAndResolution) {

@@ -37,17 +37,16 @@ bool has_dicom_magic(const fs::path& p) {
     return std::string_view(head.data() + 128, 4) == "DICM";
 }
 
-// A folder is a stack of TIFF slices when its files are .tif/.tiff, else a DICOM series.
+// A folder is a stack of TIFF slices when it holds .tif/.tiff files (the reader passes over
+// anything else, a note or a thumbnail), else a DICOM series.
 bool is_tiff_folder(const fs::path& dir) {
-    bool any = false;
     for (const auto& e : fs::directory_iterator(dir)) {
-        if (!e.is_regular_file()) continue;
         const std::string n = lower(e.path().filename().string());
-        if (n.starts_with(".")) continue;
-        if (!ends_with(n, ".tif") && !ends_with(n, ".tiff")) return false;
-        any = true;
+        if (e.is_regular_file() && !n.starts_with(".") &&
+            (ends_with(n, ".tif") || ends_with(n, ".tiff")))
+            return true;
     }
-    return any;
+    return false;
 }
 
 Volume read_file(const fs::path& p, const std::string& name) {
