@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "common/core/error.h"
 #include "common/volume/volume.h"
 #include "fuzz/fuzz_check.h"
 
@@ -46,6 +47,19 @@ inline void check_volume(const Volume& v) {
     std::uint64_t sum = 0;
     for (const std::byte b : v.bytes()) sum += static_cast<std::uint64_t>(b);
     check(sum <= 255u * v.bytes().size(), "bytes are bytes");
+}
+
+// The fuzzer's bytes as the file `name` in this harness's folder, read as --volume reads it: a
+// volume that loads passes check_volume, an InputError is the reader saying no.
+template <class Read>
+void read_as_file(const std::string& harness, const std::string& name, const std::uint8_t* data,
+                  std::size_t size, Read read) {
+    const auto path = scratch_folder(harness) / name;
+    write_file(path, as_text(data, size));
+    try {
+        check_volume(read(path.string()));
+    } catch (const InputError&) {
+    }
 }
 
 }  // namespace isowall::fuzz

@@ -229,19 +229,19 @@ SlicePixels read_slice(const SliceHeader& h, const std::optional<VoxelType>& exp
                              " pixels where the series' first slice has " +
                              std::string(type_name(*expected)));
     const std::size_t need = std::size_t(h.rows) * std::size_t(h.columns) * voxel_size(*type);
+    const auto wrong_size = [&](std::uint64_t have) {
+        return InputError(f, "PixelData",
+                          std::to_string(have) + " bytes of pixels where " +
+                              std::to_string(h.columns) + "x" + std::to_string(h.rows) + " " +
+                              std::string(type_name(*type)) + " needs " + std::to_string(need));
+    };
     // Uncompressed pixels must all be there before a buffer of the header's size is made.
     const gdcm::DataElement& pd = reader.GetFile().GetDataSet().GetDataElement(kPixelData);
     if (const gdcm::ByteValue* bv = pd.GetByteValue(); bv && bv->GetLength() < need)
-        throw InputError(f, "PixelData",
-                         std::to_string(bv->GetLength()) + " bytes of pixels where " +
-                             std::to_string(h.columns) + "x" + std::to_string(h.rows) + " " +
-                             std::string(type_name(*type)) + " needs " + std::to_string(need));
+        throw wrong_size(bv->GetLength());
     if (img.GetDimension(0) != unsigned(h.columns) || img.GetDimension(1) != unsigned(h.rows) ||
         img.GetBufferLength() != need)
-        throw InputError(f, "PixelData",
-                         std::to_string(img.GetBufferLength()) + " bytes of pixels where " +
-                             std::to_string(h.columns) + "x" + std::to_string(h.rows) + " " +
-                             std::string(type_name(*type)) + " needs " + std::to_string(need));
+        throw wrong_size(img.GetBufferLength());
     SlicePixels out{*type,
                     {img.GetSlope(), img.GetIntercept()},
                     transfer_syntax_text(img.GetTransferSyntax()),

@@ -4,8 +4,10 @@
 #include <array>
 #include <cctype>
 #include <fstream>
+#include <span>
 
 #include "common/core/error.h"
+#include "common/formats/dicom_lengths.h"
 #include "common/formats/readers.h"
 #include "common/volume/load_checks.h"
 
@@ -29,12 +31,11 @@ bool is_hdf5_name(const std::string& name) {
            ends_with(n, ".hdf");
 }
 
-// A DICOM Part 10 file has "DICM" after a 128-byte preamble.
+// A DICOM Part 10 file by its first 132 bytes (dicom_lengths.h).
 bool has_dicom_magic(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     std::array<char, 132> head{};
-    if (!in.read(head.data(), head.size())) return false;
-    return std::string_view(head.data() + 128, 4) == "DICM";
+    return in.read(head.data(), head.size()) && has_part10_magic(std::as_bytes(std::span(head)));
 }
 
 // A folder is a stack of TIFF slices when it holds .tif/.tiff files (the reader passes over
