@@ -9,11 +9,13 @@
 
 namespace isowall {
 
+// Every default here is the engine's own (EngineOptions, PropagationParams): the defaults are
+// chosen once, there (CliEngineDefaults.AreTheEnginesOwn checks each).
 struct EngineCli {
     std::string order = "dynamic";
     std::string intersect = "exact";
     std::string propagation = "count";
-    int max_count = 2000;  // measured best on vhp_ct_head skin and bone (README, Benchmarks)
+    int max_count = PropagationParams{}.max_count;
     float cutoff_deg = 2.0f;
     float foldback_deg = 0.5f;
     bool no_interpolant_cache = false;

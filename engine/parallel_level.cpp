@@ -12,6 +12,7 @@
 
 #include "common/core/ray.h"
 #include "common/progressive/trace.h"
+#include "engine/beside_seeds.h"
 
 namespace isowall {
 namespace {
@@ -28,6 +29,7 @@ struct alignas(64) WorkerTally {
     std::size_t rays = 0, hits = 0;
     double intersect_s = 0, cpu_s = 0;
     std::size_t next = 0, end = 0;  // the pixels claimed and not cast yet
+    std::vector<BesideSeed> beside;
     // `rays` as of the thread's last claim, for the caller's samples: a line the caller reads at
     // every one of its rays, which this thread writes once per claim, not once per ray.
     alignas(64) std::atomic<std::size_t> published{0};
@@ -58,15 +60,19 @@ class LevelCast {
         }
         if (failed_.load(std::memory_order_relaxed) || job_.stopped()) return false;
         const std::size_t i = t.next++;
-        const Ray ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
-                                  job_.view.height, job_.pixels[i] + job_.origin);
+        const glm::ivec2 px = job_.pixels[i] + job_.origin;
+        const Ray ray =
+            pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width, job_.view.height, px);
         const auto t0 = Clock::now();
         const RayHit hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
         t.intersect_s += since(t0);
         ++t.rays;
         if (!hit.found) return true;
         ++t.hits;
-        if (!hit.refine && job_.ex.visited(hit.cell)) return true;
+        if (!hit.refine && job_.ex.visited(hit.cell)) {
+            note_beside(job_.ex, hit, ray, px, job_.mode == IntersectMode::exact, t.beside);
+            return true;
+        }
         const std::uint32_t id = next_id_.fetch_add(1, std::memory_order_relaxed);
         FoundGroup f;
         const auto t1 = Clock::now();
@@ -131,7 +137,8 @@ class LevelCast {
     LevelTally finish() {
         if (failure_) std::rethrow_exception(failure_);
         LevelTally sum;
-        for (const WorkerTally& t : tally_) {
+        for (WorkerTally& t : tally_) {
+            sum.beside.insert(sum.beside.end(), t.beside.begin(), t.beside.end());
             sum.rays += t.rays;
             sum.hits += t.hits;
             sum.intersect_s += t.intersect_s;

@@ -13,6 +13,7 @@
 #include <glm/vec2.hpp>
 
 #include "common/core/view.h"
+#include "common/extract/hit_neighbours.h"
 #include "common/extract/surface_extractor.h"
 
 namespace isowall {
@@ -45,6 +46,8 @@ struct LevelTally {
     // start to its end, summed; and the largest one (the caller's own CPU is its thread clock).
     double workers_cpu_s = 0, busiest_worker_cpu_s = 0;
     std::uint32_t next_id = 0;  // the first id not handed out
+    // Unvisited cells beside hits on visited ones, for the region's end (hit_neighbours.h).
+    std::vector<BesideSeed> beside;
 };
 
 // Casts every pixel of `job` on `threads` threads (at most the extractor's workers). `draw` and

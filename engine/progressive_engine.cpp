@@ -8,6 +8,7 @@
 #include <glm/matrix.hpp>
 
 #include "common/core/ray.h"
+#include "engine/beside_seeds.h"
 #include "engine/parallel_level.h"
 
 namespace isowall {
@@ -18,12 +19,6 @@ constexpr double kRefreshS = 1.0 / 60.0;
 // How often a present in flight is asked whether it is done (a context switch and a fence query
 // per ask): a sample's time is late by at most this and one propagation pass.
 constexpr double kPollS = 0.25e-3;
-// The screen mask's node budget: the finest octree level with at most this many active nodes.
-// A few thousand boxes project in well under a millisecond (8 corners each), while the mask's
-// cost per region is its pixels; on the 512^2 CT head's skin this is the level of 16^3 cells,
-// whose boxes hug the surface to within about 16 voxels on screen.
-constexpr std::size_t kMaskNodes = 4096;
-
 double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -82,6 +77,7 @@ class FrameRun {
             else
                 c.done = true;
         }
+        if (c.done && !seed_beside()) return false;
         // A sample at every job's end, but no present (groups show at the next refresh: a
         // present flushes the renderer, which llvmpipe pays per call, not per triangle), unless
         // the last level's present was put off (see cast_level).
@@ -115,11 +111,7 @@ class FrameRun {
         const ResolutionLevels levels = frame_levels(opt_, view, ex_.volume().spacing());
         if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
         if (masked()) {
-            // Meta-cells of level i are 2^i cells at multiples of 2^i, so a node of level
-            // i - kLeafLog2 or above holds each one whole: an active meta-cell then lies inside an
-            // active node (its corners are in the node's range), and the mask stays conservative.
-            const int finest = std::max(0, levels.max_level - OctreeShape::kLeafLog2);
-            active_ = ex_.active_boxes(view.iso, kMaskNodes, finest);
+            active_ = screen_mask_nodes(ex_, view.iso, levels);
             frame_.mask_level = active_.level;
             frame_.mask_nodes = active_.boxes.size();
         }
@@ -171,9 +163,22 @@ class FrameRun {
         if (!hit.found) return true;
         if (!hit.refine && ex_.visited(hit.cell)) {
             if (sink_->wants_seen()) sink_->seen(ex_.group_of(hit.cell));
+            note_beside(ex_, hit, ray, px, mode == IntersectMode::exact, beside_);
             return true;
         }
         return seed(hit, ray);
+    }
+
+    // The region's end: seeds the cells beside hits whose pixels still show nothing
+    // (beside_seeds.h); false when the frame was stopped in a pass.
+    bool seed_beside() {
+        stage(Stage::render);
+        const std::vector<BesideSeed> todo =
+            take_still_empty(beside_, *sink_, rect_, ex_, covered_);
+        stage(Stage::intersection);
+        for (const BesideSeed& b : todo)  // (a pass of one may have taken another's cell)
+            if (!ex_.visited(b.cell) && (stopped() || !seed({true, b.cell}, b.ray))) return false;
+        return true;
     }
 
     // The put-off sample of the level before (see cast_level), then the new level's number.
@@ -204,6 +209,7 @@ class FrameRun {
             std::max(0.0, t.busiest_worker_cpu_s - (thread_cpu_seconds() - own0));
         if (opt_.trace) opt_.trace->add_cpu(t.workers_cpu_s);
         ids_used_ = t.next_id - opt_.first_group_id;
+        beside_.insert(beside_.end(), t.beside.begin(), t.beside.end());
         now_.t_intersect_s += t.intersect_s;
         cursor_->hits += t.hits;
         if (second_pass) frame_.rays_second_pass += t.rays;
@@ -339,6 +345,7 @@ class FrameRun {
     Clock::time_point start_;
     glm::mat4 view_m_{1.0f}, view_inv_{1.0f};
     ActiveBoxes active_;              // the screen mask's nodes at this frame's isovalue
+    std::vector<BesideSeed> beside_;  // for the region's end (seed_beside)
     PixelRect rect_;                  // the region being cast
     RegionCursor* cursor_ = nullptr;  // its cursor
     PropagationParams params_;        // the options, with the clip of the region being cast

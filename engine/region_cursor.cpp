@@ -81,4 +81,18 @@ ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 s
     return clip;
 }
 
+ActiveBoxes screen_mask_nodes(const SurfaceExtractor& ex, double iso,
+                              const ResolutionLevels& levels) {
+    // The screen mask's node budget: the finest octree level with at most this many active nodes.
+    // A few thousand boxes project in well under a millisecond (8 corners each), while the mask's
+    // cost per region is its pixels; on the 512^2 CT head's skin this is the level of 16^3 cells,
+    // whose boxes hug the surface to within about 16 voxels on screen.
+    constexpr std::size_t kMaskNodes = 4096;
+    // Meta-cells of level i are 2^i cells at multiples of 2^i, so a node of level i - kLeafLog2
+    // or above holds each one whole: an active meta-cell then lies inside an active node (its
+    // corners are in the node's range), and the mask stays conservative.
+    const int finest = std::max(0, levels.max_level - OctreeShape::kLeafLog2);
+    return ex.active_boxes(iso, kMaskNodes, finest);
+}
+
 }  // namespace isowall

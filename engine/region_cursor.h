@@ -52,6 +52,11 @@ struct RegionCursor {
 // every cell at full resolution; `spacing` is the volume's.
 ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing);
 
+// The screen mask's nodes for a frame at `iso` with resolution `levels`: the active octree nodes
+// of the finest level within its budget that still holds each meta-cell whole.
+ActiveBoxes screen_mask_nodes(const SurfaceExtractor& ex, double iso,
+                              const ResolutionLevels& levels);
+
 // The cursor of `region` of `view`: the region clipped to the screen; with `volume_box`, to the
 // volume's projected box too; with `mask_boxes` (the active octree nodes of the frame's screen
 // mask, object space), to the bounding box of the pixels they cover, casting only those.

@@ -52,7 +52,7 @@ inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
 // 2: `indexed` sends uint16 indices for groups of at most kMaxNarrowIndexedVertices vertices.
 inline constexpr std::uint8_t kGroupCodecVersion = 2;
 inline constexpr std::size_t kMaxNarrowIndexedVertices = 65536;
-// One propagation pass makes a few thousand triangles (max_count 2000 cells); the whole skin of
+// One propagation pass makes a few thousand triangles (max_count 1000 cells); the whole skin of
 // the shared CT head at iso 40 is 0.72 M. 4 M triangles (288 MiB as `vertices`) bounds what one
 // group may claim, and so what a decoder may allocate for one.
 inline constexpr std::uint32_t kMaxGroupTriangles = 1u << 22;

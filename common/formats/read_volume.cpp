@@ -8,6 +8,7 @@
 
 #include "common/core/error.h"
 #include "common/formats/dicom_lengths.h"
+#include "common/formats/isolated_read.h"
 #include "common/formats/readers.h"
 #include "common/volume/load_checks.h"
 
@@ -50,6 +51,17 @@ bool is_tiff_folder(const fs::path& dir) {
     return false;
 }
 
+// GDCM and libhdf5 read in a child process (isolated_read.h): a crash of theirs on a damaged file
+// is then one line, not the end of isowall.
+Volume dicom(const fs::path& p) {
+    return read_isolated(p.string(), "the DICOM decoder (GDCM)", [&] { return read_dicom(p); });
+}
+
+Volume hdf5(const fs::path& file, const std::string& dataset) {
+    return read_isolated(file.string(), "the HDF5 library (libhdf5)",
+                         [&] { return read_hdf5(file, dataset); });
+}
+
 Volume read_file(const fs::path& p, const std::string& name) {
     const std::string n = lower(name);
     if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return load_nrrd(p);
@@ -57,9 +69,9 @@ Volume read_file(const fs::path& p, const std::string& name) {
         ends_with(n, ".img") || ends_with(n, ".img.gz"))
         return read_nifti(p);
     if (ends_with(n, ".mhd") || ends_with(n, ".mha")) return read_metaimage(p);
-    if (is_hdf5_name(n)) return read_hdf5(p, "");
+    if (is_hdf5_name(n)) return hdf5(p, "");
     if (ends_with(n, ".tif") || ends_with(n, ".tiff")) return read_tiff_stack(p);
-    if (ends_with(n, ".dcm") || has_dicom_magic(p)) return read_dicom(p);
+    if (ends_with(n, ".dcm") || has_dicom_magic(p)) return dicom(p);
     throw InputError(p.string(), "format",
                      "not a format isowall reads (NRRD, NIfTI, DICOM, MetaImage, HDF5, TIFF by "
                      "name or content); for headerless data give --dims X Y Z and --type T");
@@ -71,12 +83,12 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw) {
     if (raw) return load_raw(path, *raw);
     const fs::path p(path);
     std::error_code ec;
-    if (fs::is_directory(p, ec)) return is_tiff_folder(p) ? read_tiff_stack(p) : read_dicom(p);
+    if (fs::is_directory(p, ec)) return is_tiff_folder(p) ? read_tiff_stack(p) : dicom(p);
     // FILE.h5:/path/to/dataset, when FILE.h5 is a file (a name may hold a colon itself).
     const std::size_t colon = path.rfind(":/");
     if (colon != std::string::npos && !fs::exists(p, ec)) {
         const std::string file = path.substr(0, colon);
-        if (is_hdf5_name(file)) return read_hdf5(file, path.substr(colon + 1));
+        if (is_hdf5_name(file)) return hdf5(file, path.substr(colon + 1));
     }
     check_regular_file(p, path, "file");
     return read_file(p, p.filename().string());

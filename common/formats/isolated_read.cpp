@@ -1,0 +1,219 @@
+#include "common/formats/isolated_read.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+#include "common/core/error.h"
+#include "common/core/wire.h"
+
+namespace isowall::formats {
+namespace {
+
+constexpr std::uint8_t kHeaderVersion = 1;
+constexpr std::size_t kVoxelsAlign = 4096;  // the voxels start on a page of the memory file
+
+using Clock = std::chrono::steady_clock;
+
+// A file descriptor closed with its owner.
+class Fd {
+  public:
+    explicit Fd(int fd = -1) : fd_(fd) {}
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    ~Fd() { reset(); }
+    int get() const { return fd_; }
+    void reset() {
+        if (fd_ >= 0) ::close(fd_);
+        fd_ = -1;
+    }
+
+  private:
+    int fd_;
+};
+
+bool write_all(int fd, const void* data, std::size_t n) {
+    const auto* p = static_cast<const char*>(data);
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return false;
+        p += w;
+        n -= std::size_t(w);
+    }
+    return true;
+}
+
+// The child's whole life: read, write the volume (or the error's line) and leave.
+[[noreturn]] void child(const std::function<Volume()>& read, int data_fd, int error_fd) {
+    char kind = 'E';
+    std::string line;
+    try {
+        const Volume v = read();
+        const std::vector<std::byte> header = encode_volume_header(v);
+        const std::uint64_t length = header.size();
+        const std::size_t offset =
+            (8 + header.size() + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
+        const std::vector<char> pad(offset - 8 - header.size(), 0);
+        const std::span<const std::byte> voxels = v.bytes();
+        if (write_all(data_fd, &length, 8) && write_all(data_fd, header.data(), header.size()) &&
+            write_all(data_fd, pad.data(), pad.size()) &&
+            write_all(data_fd, voxels.data(), voxels.size()))
+            ::_exit(0);
+        line = std::string("cannot hand the volume over: ") + std::strerror(errno);
+    } catch (const InputError& e) {
+        kind = 'I';
+        line = e.what();
+    } catch (const std::exception& e) {
+        line = e.what();
+    } catch (...) {
+        line = "an unknown error";
+    }
+    write_all(error_fd, &kind, 1);
+    write_all(error_fd, line.data(), line.size());
+    ::_exit(1);
+}
+
+// Everything the child writes to `fd` until it closes it, or until `deadline` (then false).
+bool read_until_closed(int fd, Clock::time_point deadline, std::string& out) {
+    char buf[4096];
+    for (;;) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        if (left.count() <= 0) return false;
+        pollfd p{fd, POLLIN, 0};
+        const int r = ::poll(&p, 1, int(std::min<long long>(left.count(), 1000)));
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) continue;
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return true;
+        if (out.size() < 4096) out.append(buf, std::size_t(n));
+    }
+}
+
+int wait_for(pid_t pid) {
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return status;
+}
+
+}  // namespace
+
+std::vector<std::byte> encode_volume_header(const Volume& v) {
+    MessageWriter w(kHeaderVersion);
+    w.put(v.dims().x);
+    w.put(v.dims().y);
+    w.put(v.dims().z);
+    w.put(static_cast<std::uint8_t>(v.type()));
+    w.put(v.spacing());
+    w.put_string(v.source());
+    w.put(static_cast<std::uint64_t>(v.files().size()));
+    for (const auto& f : v.files()) w.put_string(f.string());
+    const Orientation& o = v.orientation();
+    for (int c = 0; c < 3; ++c) w.put(glm::vec3(o.axes[c]));
+    w.put(o.origin);
+    w.put(static_cast<std::uint8_t>(o.known));
+    w.put(static_cast<std::uint64_t>(v.facts().size()));
+    for (const VolumeFact& f : v.facts()) {
+        w.put_string(f.name);
+        w.put_string(f.value);
+    }
+    return w.take();
+}
+
+Volume decode_volume(std::span<const std::byte> header, MappedFile file, std::size_t offset) {
+    MessageReader r(header, kHeaderVersion, "volume from the reader");
+    glm::ivec3 dims;
+    dims.x = r.get<int>();
+    dims.y = r.get<int>();
+    dims.z = r.get<int>();
+    const auto type = r.get<std::uint8_t>();
+    if (type > static_cast<std::uint8_t>(VoxelType::f64)) r.fail("voxel type out of range");
+    const glm::vec3 spacing = r.get_vec3();
+    std::string source = r.get_string();
+    std::vector<std::filesystem::path> files(r.get_count(8));
+    for (auto& f : files) f = r.get_string();
+    Orientation o;
+    for (int c = 0; c < 3; ++c) o.axes[c] = r.get_vec3();
+    o.origin = r.get_vec3();
+    o.known = r.get_bool();
+    std::vector<VolumeFact> facts(r.get_count(16));
+    for (VolumeFact& f : facts) {
+        f.name = r.get_string();
+        f.value = r.get_string();
+    }
+    r.finish();
+    if (glm::any(glm::lessThan(dims, glm::ivec3(1)))) r.fail("dims not positive");
+    const std::size_t size = voxel_size(static_cast<VoxelType>(type));
+    const std::size_t room = offset <= file.size() ? file.size() - offset : 0;
+    if (std::size_t(dims.x) > room / size / std::size_t(dims.y) / std::size_t(dims.z))
+        throw std::runtime_error("the reader's voxels are cut short");
+    Volume v(dims, static_cast<VoxelType>(type), spacing, std::move(file), offset,
+             std::move(source));
+    v.set_files(std::move(files));
+    v.set_orientation(o);
+    for (VolumeFact& f : facts) v.add_fact(std::move(f.name), std::move(f.value));
+    return v;
+}
+
+Volume read_isolated(const std::string& where, const std::string& decoder,
+                     const std::function<Volume()>& read, std::chrono::milliseconds limit) {
+    Fd data(::memfd_create("isowall-volume", MFD_CLOEXEC));
+    if (data.get() < 0)
+        throw std::runtime_error(
+            where + ": cannot make a memory file for the reader: " + std::strerror(errno));
+    int ends[2];
+    if (::pipe2(ends, O_CLOEXEC) != 0)
+        throw std::runtime_error(where +
+                                 ": cannot make a pipe for the reader: " + std::strerror(errno));
+    Fd from_child(ends[0]), to_parent(ends[1]);
+    const pid_t pid = ::fork();
+    if (pid < 0)
+        throw std::runtime_error(where + ": cannot start the reader: " + std::strerror(errno));
+    if (pid == 0) child(read, data.get(), to_parent.get());
+    to_parent.reset();
+    std::string message;
+    if (!read_until_closed(from_child.get(), Clock::now() + limit, message)) {
+        ::kill(pid, SIGKILL);
+        wait_for(pid);
+        throw InputError(where, "data",
+                         decoder + " did not finish within " +
+                             std::to_string(limit.count() / 1000) + " s: it was ended");
+    }
+    const int status = wait_for(pid);
+    if (WIFSIGNALED(status))
+        throw InputError(where, "data",
+                         decoder + " failed on this data and ended (signal " +
+                             std::to_string(WTERMSIG(status)) + ", " +
+                             ::strsignal(WTERMSIG(status)) +
+                             "): the file is damaged or of a kind it cannot decode");
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        if (message.size() > 1 && message[0] == 'I') throw InputError::relayed(message.substr(1));
+        if (message.size() > 1) throw std::runtime_error(message.substr(1));
+        throw InputError(where, "data",
+                         decoder + " failed on this data (exit status " +
+                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                             "): the file is damaged or of a kind it cannot decode");
+    }
+    MappedFile file("/proc/self/fd/" + std::to_string(data.get()));
+    const std::span<const std::byte> all = file.bytes();
+    std::uint64_t length = 0;
+    if (all.size() < 8) throw std::runtime_error(where + ": the reader handed over no volume");
+    std::memcpy(&length, all.data(), 8);
+    if (length > all.size() - 8)
+        throw std::runtime_error(where + ": the reader's volume is cut short");
+    const std::vector<std::byte> header(all.begin() + 8, all.begin() + 8 + std::ptrdiff_t(length));
+    const std::size_t offset = (8 + length + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
+    return decode_volume(header, std::move(file), offset);
+}
+
+}  // namespace isowall::formats
