@@ -21,6 +21,7 @@ std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, Group
     if (all.empty() || !sink.coverage(scratch, rect)) return out;
     for (const BesideSeed& b : all) {
         const glm::ivec2 p = b.pixel - glm::ivec2(rect.x, rect.y);
+        if (p.x < 0 || p.y < 0 || p.x >= rect.width || p.y >= rect.height) continue;
         const std::size_t i = std::size_t(p.y) * std::size_t(rect.width) + std::size_t(p.x);
         if (!scratch[i] && !ex.visited(b.cell)) out.push_back(b);
     }

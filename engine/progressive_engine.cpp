@@ -163,7 +163,7 @@ class FrameRun {
         if (!hit.found) return true;
         if (!hit.refine && ex_.visited(hit.cell)) {
             if (sink_->wants_seen()) sink_->seen(ex_.group_of(hit.cell));
-            note_beside(ex_, hit, ray, px, mode == IntersectMode::exact, beside_);
+            note_beside(ex_, hit, ray, px, mode == IntersectMode::exact, cursor_->beside);
             return true;
         }
         return seed(hit, ray);
@@ -174,7 +174,7 @@ class FrameRun {
     bool seed_beside() {
         stage(Stage::render);
         const std::vector<BesideSeed> todo =
-            take_still_empty(beside_, *sink_, rect_, ex_, covered_);
+            take_still_empty(cursor_->beside, *sink_, rect_, ex_, covered_);
         stage(Stage::intersection);
         for (const BesideSeed& b : todo)  // (a pass of one may have taken another's cell)
             if (!ex_.visited(b.cell) && (stopped() || !seed({true, b.cell}, b.ray))) return false;
@@ -209,7 +209,7 @@ class FrameRun {
             std::max(0.0, t.busiest_worker_cpu_s - (thread_cpu_seconds() - own0));
         if (opt_.trace) opt_.trace->add_cpu(t.workers_cpu_s);
         ids_used_ = t.next_id - opt_.first_group_id;
-        beside_.insert(beside_.end(), t.beside.begin(), t.beside.end());
+        cursor_->beside.insert(cursor_->beside.end(), t.beside.begin(), t.beside.end());
         now_.t_intersect_s += t.intersect_s;
         cursor_->hits += t.hits;
         if (second_pass) frame_.rays_second_pass += t.rays;
@@ -345,7 +345,6 @@ class FrameRun {
     Clock::time_point start_;
     glm::mat4 view_m_{1.0f}, view_inv_{1.0f};
     ActiveBoxes active_;              // the screen mask's nodes at this frame's isovalue
-    std::vector<BesideSeed> beside_;  // for the region's end (seed_beside)
     PixelRect rect_;                  // the region being cast
     RegionCursor* cursor_ = nullptr;  // its cursor
     PropagationParams params_;        // the options, with the clip of the region being cast

@@ -16,6 +16,7 @@
 #include "common/core/mesh.h"
 #include "common/core/view.h"
 #include "common/extract/adaptive.h"
+#include "common/extract/hit_neighbours.h"
 #include "common/extract/surface_extractor.h"
 #include "common/progressive/ray_order.h"
 #include "engine/group_sink.h"
@@ -46,6 +47,9 @@ struct RegionCursor {
     // read-back from the renderer (common/progressive/mesh_coverage.h).
     bool sizing = false;
     std::vector<std::uint8_t> drawn;
+    // Unvisited cells beside hits on visited ones, seeded at the region's end if their pixels
+    // still show nothing then (engine/beside_seeds.h).
+    std::vector<BesideSeed> beside;
 };
 
 // The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or

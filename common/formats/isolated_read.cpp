@@ -53,6 +53,10 @@ bool write_all(int fd, const void* data, std::size_t n) {
 
 // The child's whole life: read, write the volume (or the error's line) and leave.
 [[noreturn]] void child(const std::function<Volume()>& read, int data_fd, int error_fd) {
+    // A crash ends the child by its signal: handlers the parent installed (a fuzzer's, which would
+    // report the parent's input as its own finding) are not the child's to run.
+    for (const int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP})
+        std::signal(sig, SIG_DFL);
     char kind = 'E';
     std::string line;
     try {
