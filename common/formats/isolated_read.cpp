@@ -14,6 +14,17 @@
 #include "common/core/error.h"
 #include "common/core/wire.h"
 
+#if defined(__SANITIZE_ADDRESS__)
+#define ISOWALL_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ISOWALL_ASAN 1
+#endif
+#endif
+#ifdef ISOWALL_ASAN
+#include <sanitizer/common_interface_defs.h>
+#endif
+
 namespace isowall::formats {
 namespace {
 
@@ -54,9 +65,13 @@ bool write_all(int fd, const void* data, std::size_t n) {
 // The child's whole life: read, write the volume (or the error's line) and leave.
 [[noreturn]] void child(const std::function<Volume()>& read, int data_fd, int error_fd) {
     // A crash ends the child by its signal: handlers the parent installed (a fuzzer's, which would
-    // report the parent's input as its own finding) are not the child's to run.
+    // report the parent's input as its own finding) are not the child's to run, nor is a
+    // sanitizer's death callback (libFuzzer's writes the input as a crash of its own).
     for (const int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP})
         std::signal(sig, SIG_DFL);
+#ifdef ISOWALL_ASAN
+    __sanitizer_set_death_callback(nullptr);
+#endif
     char kind = 'E';
     std::string line;
     try {
