@@ -25,7 +25,8 @@ struct ServeCommand {
     double idle_timeout_s = 300;  // --idle-timeout: a connection idle this long after its hello
     double lod_rays_percent = 0.25;
     std::string cache_dir;
-    EngineCli engine;
+    // Its max count is remote viewing's own (kServeMaxCount), chosen on the bytes a client needs.
+    EngineCli engine = serve_engine_defaults();
     bool quiet = false;
 };
 

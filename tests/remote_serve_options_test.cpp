@@ -22,6 +22,21 @@ TEST(ServeOptions, IdleTimeoutRefusesNonFiniteAndOutOfRangeValues) {
     }
 }
 
+// serve's max count is remote viewing's own; every other engine default is the engine's, and
+// --max-count still sets it.
+TEST(ServeOptions, TheMaxCountIsRemoteViewingsOwn) {
+    {
+        ProgramCli cli;
+        EXPECT_EQ(parse_error(cli, "serve"), "");
+        EXPECT_EQ(cli.serve.engine.max_count, kServeMaxCount);
+        EXPECT_EQ(to_engine_options(cli.serve.engine).propagation.max_count, kServeMaxCount);
+        EXPECT_EQ(to_engine_options(cli.serve.engine).order, EngineOptions{}.order);
+    }
+    ProgramCli cli;
+    EXPECT_EQ(parse_error(cli, "serve --max-count 700"), "");
+    EXPECT_EQ(cli.serve.engine.max_count, 700);
+}
+
 TEST(ServeOptions, IdleTimeoutReachesTheServeCommand) {
     {
         ProgramCli cli;
