@@ -19,9 +19,9 @@ void note_beside(const SurfaceExtractor& ex, const RayHit& hit, const Ray& ray, 
                  bool exact, std::vector<BesideSeed>& out);
 
 // Empties `pending` and returns those of its seeds whose pixel `sink` shows nothing at in `rect`
-// (`scratch` holds its coverage) and whose cell is still unvisited; none when `sink` cannot tell.
+// (`scratch` holds its coverage); none when `sink` cannot tell. Whether a seed's cell is still
+// unvisited is the caller's to check as it seeds: one seed's pass may take another's cell.
 std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, GroupSink& sink,
-                                         const PixelRect& rect, const SurfaceExtractor& ex,
-                                         std::vector<std::uint8_t>& scratch);
+                                         const PixelRect& rect, std::vector<std::uint8_t>& scratch);
 
 }  // namespace isowall

@@ -174,9 +174,9 @@ class FrameRun {
     bool seed_beside() {
         stage(Stage::render);
         const std::vector<BesideSeed> todo =
-            take_still_empty(cursor_->beside, *sink_, rect_, ex_, covered_);
+            take_still_empty(cursor_->beside, *sink_, rect_, covered_);
         stage(Stage::intersection);
-        for (const BesideSeed& b : todo)  // (a pass of one may have taken another's cell)
+        for (const BesideSeed& b : todo)  // a pass of one may have taken another's cell
             if (!ex_.visited(b.cell) && (stopped() || !seed({true, b.cell}, b.ray))) return false;
         return true;
     }

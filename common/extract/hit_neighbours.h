@@ -14,7 +14,6 @@
 // screen coarser than the volume's cells, most of them too small to show).
 #include <array>
 #include <cstddef>
-#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -78,15 +77,6 @@ HitNeighbours unvisited_beside_hit(const RayHit& hit, const Ray& ray, bool exact
         if (!visited(all.cells[std::size_t(i)]))
             out.cells[std::size_t(out.count++)] = all.cells[std::size_t(i)];
     return out;
-}
-
-// Appends unvisited_beside_hit(...) to `out` as seeds for the region's end.
-template <class Visited>
-void note_beside_hit(const RayHit& hit, const Ray& ray, glm::ivec2 pixel, bool exact,
-                     glm::vec3 spacing, glm::ivec3 cell_dims, const Visited& visited,
-                     std::vector<BesideSeed>& out) {
-    const HitNeighbours n = unvisited_beside_hit(hit, ray, exact, spacing, cell_dims, visited);
-    for (int i = 0; i < n.count; ++i) out.push_back({n.cells[std::size_t(i)], ray, pixel});
 }
 
 }  // namespace isowall

@@ -33,6 +33,12 @@ constexpr std::size_t kVoxelsAlign = 4096;  // the voxels start on a page of the
 
 using Clock = std::chrono::steady_clock;
 
+// Where the voxels start in the memory file: after the header's length (8 bytes) and the header,
+// on the next page.
+std::size_t voxels_offset(std::size_t header_bytes) {
+    return (8 + header_bytes + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
+}
+
 // A file descriptor closed with its owner.
 class Fd {
   public:
@@ -78,9 +84,7 @@ bool write_all(int fd, const void* data, std::size_t n) {
         const Volume v = read();
         const std::vector<std::byte> header = encode_volume_header(v);
         const std::uint64_t length = header.size();
-        const std::size_t offset =
-            (8 + header.size() + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
-        const std::vector<char> pad(offset - 8 - header.size(), 0);
+        const std::vector<char> pad(voxels_offset(header.size()) - 8 - header.size(), 0);
         const std::span<const std::byte> voxels = v.bytes();
         if (write_all(data_fd, &length, 8) && write_all(data_fd, header.data(), header.size()) &&
             write_all(data_fd, pad.data(), pad.size()) &&
@@ -231,8 +235,7 @@ Volume read_isolated(const std::string& where, const std::string& decoder,
     if (length > all.size() - 8)
         throw std::runtime_error(where + ": the reader's volume is cut short");
     const std::vector<std::byte> header(all.begin() + 8, all.begin() + 8 + std::ptrdiff_t(length));
-    const std::size_t offset = (8 + length + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
-    return decode_volume(header, std::move(file), offset);
+    return decode_volume(header, std::move(file), voxels_offset(std::size_t(length)));
 }
 
 }  // namespace isowall::formats
