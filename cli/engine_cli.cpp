@@ -47,6 +47,10 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_flag("--no-screen-mask", e.no_screen_mask,
                  "Cast every ray of the volume's projected box, also where no active octree node "
                  "projects (the box alone, to measure what the mask saves)");
+    app.add_flag("--no-frontier-seeds", e.no_frontier_seeds,
+                 "Do not go on, at each ray-order level's end, from the units a full propagation "
+                 "pass left out where their pixels still show nothing (the text's passes alone: "
+                 "only rays find what a pass stopped short of)");
     app.add_flag("--adaptive", e.adaptive,
                  "Adaptive resolution: extract regions whose cells project below a pixel as "
                  "meta-cells of 2^i cells per side");
@@ -94,6 +98,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.propagation.facing_only = c.facing_only;
     e.screen_box = !c.no_screen_box;
     e.screen_mask = !c.no_screen_mask;
+    e.frontier_seeds = !c.no_frontier_seeds;
     e.adaptive = c.adaptive;
     e.adaptive_max_level = c.adaptive_max_level;
     e.adaptive_pixels = c.adaptive_pixels;

@@ -21,6 +21,7 @@ struct EngineCli {
     bool no_interpolant_cache = false;
     bool no_screen_box = false;
     bool no_screen_mask = false;
+    bool no_frontier_seeds = !EngineOptions{}.frontier_seeds;
     bool adaptive = false;
     int adaptive_max_level = 3;
     float adaptive_pixels = 1.0f;

@@ -60,18 +60,27 @@ class LevelCast {
         }
         if (failed_.load(std::memory_order_relaxed) || job_.stopped()) return false;
         const std::size_t i = t.next++;
-        const glm::ivec2 px = job_.pixels[i] + job_.origin;
-        const Ray ray =
-            pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width, job_.view.height, px);
-        const auto t0 = Clock::now();
-        const RayHit hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
-        t.intersect_s += since(t0);
-        ++t.rays;
-        if (!hit.found) return true;
-        ++t.hits;
-        if (!hit.refine && job_.ex.visited(hit.cell)) {
-            note_beside(job_.ex, hit, ray, px, job_.mode == IntersectMode::exact, t.beside);
-            return true;
+        RayHit hit;
+        Ray ray;
+        if (job_.seeds) {
+            const BesideSeed& s = (*job_.seeds)[i];
+            if (job_.ex.visited(s.cell)) return true;  // an earlier seed's pass took it
+            hit = {true, s.cell};
+            ray = s.ray;
+        } else {
+            const glm::ivec2 px = job_.pixels[i] + job_.origin;
+            ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
+                            job_.view.height, px);
+            const auto t0 = Clock::now();
+            hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
+            t.intersect_s += since(t0);
+            ++t.rays;
+            if (!hit.found) return true;
+            ++t.hits;
+            if (!hit.refine && job_.ex.visited(hit.cell)) {
+                note_beside(job_.ex, hit, ray, px, job_.mode == IntersectMode::exact, t.beside);
+                return true;
+            }
         }
         const std::uint32_t id = next_id_.fetch_add(1, std::memory_order_relaxed);
         FoundGroup f;
@@ -153,7 +162,7 @@ class LevelCast {
     // Takes the next pixels of the level for `t`: an eighth of each thread's share of what is
     // left, 1 to kMaxClaim. False when none is left.
     bool claim(WorkerTally& t) {
-        const std::size_t n = job_.pixels.size();
+        const std::size_t n = job_.size();
         std::size_t i = next_pixel_.load(std::memory_order_relaxed);
         for (;;) {
             if (i >= n) return false;

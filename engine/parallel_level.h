@@ -29,6 +29,10 @@ struct LevelJob {
     const PropagationParams& refine_params;  // refinement
     const std::function<bool()>& stopped;    // polled between rays and inside passes
     std::uint32_t first_id;                  // the first group id to hand out
+    // Not null: the level is these seeds instead of `pixels` (frontier seeds, beside_seeds.h):
+    // each still unvisited is propagated from, with no ray cast.
+    const std::vector<BesideSeed>* seeds = nullptr;
+    std::size_t size() const { return seeds ? seeds->size() : pixels.size(); }
 };
 
 // A group found by a worker, with the seconds of its pass and of marching cubes in it. A pass

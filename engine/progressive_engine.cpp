@@ -19,6 +19,8 @@ constexpr double kRefreshS = 1.0 / 60.0;
 // How often a present in flight is asked whether it is done (a context switch and a fence query
 // per ask): a sample's time is late by at most this and one propagation pass.
 constexpr double kPollS = 0.25e-3;
+// Frontier units kept for the fill level (seed_frontier) past which the visited ones are dropped.
+constexpr std::size_t kFrontierPrune = std::size_t{1} << 18;
 double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -54,6 +56,7 @@ class FrameRun {
         rect_ = c.rect;
         cursor_ = &c;
         params_ = opt_.propagation;
+        params_.keep_frontier = opt_.frontier_seeds;
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
         // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
         // c.rays, so a region's second band would cast nothing.
@@ -141,7 +144,7 @@ class FrameRun {
                 record(false);
             }
         }
-        if (order.wants_coverage()) give_coverage(order);
+        if (order.wants_coverage() && give_coverage(order) && !seed_frontier()) return false;
         // After a level on several threads, its sample (and present, which waits for the
         // rasteriser) waits until the next level's other threads cast, or the job's end.
         present_due_ = parallel;
@@ -181,6 +184,26 @@ class FrameRun {
         return true;
     }
 
+    // A level's end, with covered_ just read back for the order (before the fill level): seeds
+    // the frontier units of full passes and the cells beside hits whose pixels still show
+    // nothing (beside_seeds.h); false when the frame was stopped in a pass. No coverage is read
+    // while the dynamic grid sizes itself from the groups' own projections, so the seeds wait.
+    bool seed_frontier() {
+        if (!opt_.frontier_seeds || (cursor_->frontier.empty() && cursor_->beside.empty()))
+            return true;
+        // The cells beside hits (pinholes) go too: the fill level would reach their pixels late.
+        std::vector<BesideSeed> todo = take_still_empty(cursor_->beside, rect_, covered_);
+        const std::vector<BesideSeed> frontier =
+            take_frontier_still_empty(cursor_->frontier, ex_, *view_, view_inv_, rect_, covered_);
+        todo.insert(todo.end(), frontier.begin(), frontier.end());
+        const int n = workers();
+        if (n > 1 && todo.size() > 1)
+            return cast_level_parallel(n, opt_.intersect, false, now_.level, &todo);
+        for (const BesideSeed& b : todo)
+            if (!ex_.visited(b.cell) && (stopped() || !seed({true, b.cell}, b.ray))) return false;
+        return true;
+    }
+
     // The put-off sample of the level before (see cast_level), then the new level's number.
     void begin_level(int level) {
         if (present_due_) record(true);
@@ -189,12 +212,22 @@ class FrameRun {
     }
 
     // One level over `n` threads (engine/parallel_level.h); false when the frame was stopped.
-    bool cast_level_parallel(int n, IntersectMode mode, bool second_pass, int level) {
+    // With `seeds`, the level is those seeds instead of the order's pixels (seed_frontier).
+    bool cast_level_parallel(int n, IntersectMode mode, bool second_pass, int level,
+                             const std::vector<BesideSeed>* seeds = nullptr) {
         const std::size_t rays_before = now_.rays;
         bool begun = false;
-        const LevelJob job{
-            ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
-            mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_};
+        const LevelJob job{ex_,
+                           pixels_,
+                           {rect_.x, rect_.y},
+                           *view_,
+                           view_inv_,
+                           mode,
+                           params_,
+                           opt_.propagation,
+                           interrupted_,
+                           opt_.first_group_id + ids_used_,
+                           seeds};
         const double own0 = thread_cpu_seconds();
         const LevelTally t = isowall::cast_level_parallel(
             job, n, [this](FoundGroup& f) { add_found(f); },
@@ -220,8 +253,19 @@ class FrameRun {
     // Hands a group to the sink, charging its pass to the stages; true when it was one. A pass
     // whose seed another worker took first found no cell, and a refinement done already has no
     // triangle: neither is a group.
-    bool add_found(const FoundGroup& f) {
-        const Group& g = f.group;
+    bool add_found(FoundGroup& f) {
+        Group& g = f.group;
+        if (!g.frontier.empty()) {
+            std::vector<glm::ivec3>& all = cursor_->frontier;
+            // Most of a frontier is taken by later passes: drop those before the list grows past
+            // a few megabytes on a heavy surface.
+            if (all.size() > std::max(kFrontierPrune, 2 * cursor_->frontier_kept)) {
+                std::erase_if(all, [this](glm::ivec3 c) { return ex_.visited(c); });
+                cursor_->frontier_kept = all.size();
+            }
+            all.insert(all.end(), g.frontier.begin(), g.frontier.end());
+            g.frontier = {};
+        }
         now_.t_extract_s += f.extract_s;
         now_.t_propagate_s += f.pass_s - f.extract_s;
         if (g.refinement ? g.mesh.indices.empty() : g.cells.empty()) return false;
@@ -257,16 +301,18 @@ class FrameRun {
         return true;
     }
 
-    void give_coverage(RayOrder& order) {
+    // True when covered_ holds what the sink shows now (a read-back).
+    bool give_coverage(RayOrder& order) {
         // Before any ray of the region has met the surface, what shows there is at most the edge
         // of a group found elsewhere: the order is left searching, which saves a read-back (a
         // renderer flush) and a screen-sized copy per level in every region of background.
-        if (cursor_->hits == 0) return;
+        if (cursor_->hits == 0) return false;
         stage(Stage::render);
         const auto t0 = Clock::now();
-        give_order_coverage(order, *cursor_, *sink_, covered_);
+        const bool read = give_order_coverage(order, *cursor_, *sink_, covered_);
         now_.t_render_s += since(t0);
         stage(Stage::intersection);
+        return read;
     }
 
     // A timeline sample, after ray counts growing by a factor and at least every interval.

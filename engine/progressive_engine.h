@@ -42,6 +42,13 @@ struct EngineOptions {
     // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
     // whole surface within their limits, as in the text.
     bool region_clip = false;
+    // Frontier seeds: a propagation pass that fills its max count (count mode) stops short of
+    // the surface beyond it, which then waits for the rays of its own pixels; at the screen's
+    // fill level (the last, with most of the rays) those are the slivers between passes'
+    // patches that keep C = 1 - E below 99%. With this, when the order reads what shows before
+    // that level, the engine first seeds the units full passes left out whose pixels still show
+    // nothing. Needs a sink that can tell coverage; off: the text's passes alone.
+    bool frontier_seeds = true;
     // Adaptive resolution (chapter 2.1.3): where a meta-cell of 2^i cells per side projects to
     // less than a pixel, extract it as one cell, up to 2^adaptive_max_level cells per side. Off:
     // every cell at full resolution, exactly as without the option. adaptive_refine: draw a

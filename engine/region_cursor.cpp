@@ -58,16 +58,18 @@ void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const
     add_mesh_coverage(mesh, view_m, view.frustum, view.width, view.height, c.rect, c.drawn);
 }
 
-void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
                          std::vector<std::uint8_t>& scratch) {
     if (c.sizing) {
         order.set_coverage(c.drawn);
         c.sizing = order.wants_coverage();  // still searching: no piece found in the region yet
         if (!c.sizing) c.drawn = {};
-        return;
+        return false;
     }
-    if (!sink.coverage(scratch, c.rect)) scratch.assign(pixel_count(c.rect), 0);
+    const bool read = sink.coverage(scratch, c.rect);
+    if (!read) scratch.assign(pixel_count(c.rect), 0);
     order.set_coverage(scratch);
+    return read;
 }
 
 ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {

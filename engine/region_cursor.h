@@ -50,6 +50,10 @@ struct RegionCursor {
     // Unvisited cells beside hits on visited ones, seeded at the region's end if their pixels
     // still show nothing then (engine/beside_seeds.h).
     std::vector<BesideSeed> beside;
+    // Frontier units of the region's full passes (Group::frontier), seeded at the next level's
+    // end where their pixels still show nothing then (engine/beside_seeds.h).
+    std::vector<glm::ivec3> frontier;
+    std::size_t frontier_kept = 0;  // its size after the last drop of visited units
 };
 
 // The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
@@ -75,8 +79,8 @@ void begin_order(RegionCursor& c, RayOrderKind kind);
 void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view);
 // Gives `order` the region's coverage after a level that wants it: while sizing, c.drawn (and
 // sizing ends once the order has its size); else what `sink` shows (`scratch` holds it), or
-// nothing covered when the sink cannot tell.
-void give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+// nothing covered when the sink cannot tell. True when `scratch` holds what the sink shows now.
+bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
                          std::vector<std::uint8_t>& scratch);
 
 }  // namespace isowall

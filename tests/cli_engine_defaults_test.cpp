@@ -24,6 +24,7 @@ TEST(CliEngineDefaults, AreTheEnginesOwn) {
     EXPECT_EQ(cli.propagation.facing_only, engine.propagation.facing_only);
     EXPECT_EQ(cli.screen_box, engine.screen_box);
     EXPECT_EQ(cli.screen_mask, engine.screen_mask);
+    EXPECT_EQ(cli.frontier_seeds, engine.frontier_seeds);
     EXPECT_EQ(cli.adaptive, engine.adaptive);
     EXPECT_EQ(cli.adaptive_max_level, engine.adaptive_max_level);
     EXPECT_EQ(cli.adaptive_pixels, engine.adaptive_pixels);

@@ -146,7 +146,8 @@ TEST(RayOrder, DynamicGridContinuesWithFinerRefiningLevels) {
     for (std::vector<glm::ivec2> r; grid->next_level(r);) grid_levels.push_back(r);
     // levels: 0 = centre (hits the disk), 1 = dynamic grid, 2 = refining level 4, ...
     EXPECT_EQ(levels[0], grid_levels[0]);
-    for (std::size_t k = 2; k + 1 < levels.size(); ++k) {
+    // The last two levels are the fill level's two parts (DynamicFillLevel... below).
+    for (std::size_t k = 2; k + 2 < levels.size(); ++k) {
         std::vector<glm::ivec2> sorted = levels[k];
         std::sort(sorted.begin(), sorted.end(),
                   [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
@@ -156,7 +157,8 @@ TEST(RayOrder, DynamicGridContinuesWithFinerRefiningLevels) {
             [](glm::ivec2 a, glm::ivec2 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; }))
             << "level " << k << " is not inside refining level " << k + 2;
     }
-    EXPECT_EQ(levels.size(), grid_levels.size() - 3 + 1) << "levels 1-3 replaced by one grid";
+    EXPECT_EQ(levels.size(), grid_levels.size() - 3 + 1 + 1)
+        << "levels 1-3 replaced by one grid, and the fill level in two parts";
 }
 
 TEST(RayOrder, GapsOrderCastsTheGapsThenFinerRefiningLevels) {
@@ -202,6 +204,44 @@ TEST(RayOrder, GapsOrderCastsTheGapsThenFinerRefiningLevels) {
     std::size_t total = 0;
     for (const auto& l : levels) total += l.size();
     EXPECT_EQ(total, std::size_t(w) * h);  // every pixel once
+}
+
+TEST(RayOrder, DynamicFillLevelHandsOutWhatShowsNothingFirst) {
+    // Before the fill level (every pixel left) the dynamic orders ask once more what shows, and
+    // the fill level comes in two: the pixels that showed nothing, then (after one more ask) the
+    // others. C = 1 - E counts a missing pixel as wholly wrong, so the last holes, not the pixels
+    // already drawn, decide it.
+    const int w = 400, h = 300;
+    // (The gaps order hands out every pixel that shows nothing before its refining levels, so
+    // its fill level has only the second part.)
+    for (RayOrderKind kind : {RayOrderKind::dynamic_grid}) {
+        DiskScene scene(w, h, {{w * 0.5, h * 0.5, 30.0}, {40, 40, 12.0}, {300, 200, 50.0}});
+        auto order = make_ray_order(kind, w, h, {0, 0, w, h});
+        std::vector<std::vector<std::uint8_t>> given;  // the coverage given before each level
+        std::vector<std::vector<glm::ivec2>> levels;
+        std::size_t total = 0;
+        for (std::vector<glm::ivec2> rays;;) {
+            const bool asks = order->wants_coverage();
+            if (asks) order->set_coverage(scene.coverage());
+            if (!order->next_level(rays)) break;
+            given.push_back(asks ? scene.coverage() : std::vector<std::uint8_t>{});
+            levels.push_back(rays);
+            total += rays.size();
+            scene.cast(rays);
+        }
+        EXPECT_EQ(total, std::size_t(w) * h) << to_string(kind) << ": every pixel once";
+        ASSERT_GE(levels.size(), 3u);
+        const std::size_t first = levels.size() - 2, second = levels.size() - 1;
+        ASSERT_FALSE(given[first].empty()) << to_string(kind) << ": no ask before the fill level";
+        ASSERT_FALSE(given[second].empty()) << to_string(kind) << ": no ask between its parts";
+        auto shows = [&](std::size_t k, glm::ivec2 p) {
+            return given[k][std::size_t(p.y) * w + p.x] != 0;
+        };
+        for (glm::ivec2 p : levels[first]) ASSERT_FALSE(shows(first, p)) << to_string(kind);
+        for (glm::ivec2 p : levels[second]) ASSERT_TRUE(shows(first, p)) << to_string(kind);
+        EXPECT_FALSE(levels[first].empty());
+        EXPECT_FALSE(levels[second].empty());
+    }
 }
 
 TEST(RayOrder, DynamicGridWithoutSurfaceIsTheRefiningGrid) {

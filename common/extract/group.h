@@ -69,6 +69,9 @@ struct Group {
     // `level` at `seed`, drawn over its own because a ray saw the surface there that they miss.
     // It takes no cells: they stay with the pass that took the meta-cell, if any.
     bool refinement = false;
+    // The units the pass left out because it was full (PropagationParams::keep_frontier): the
+    // rim it would have gone on over, unvisited when the pass ended. Not part of the mesh.
+    std::vector<glm::ivec3> frontier;
 
     GroupKey key() const { return {seed, level, iso, refinement}; }
 };

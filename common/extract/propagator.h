@@ -73,8 +73,15 @@ struct PropagationParams {
     // then stops one unit past a silhouette instead of running on over the back of the surface;
     // what it leaves out stays unvisited, so a later ray that sees it seeds it then.
     bool facing_only = false;
+    // Count mode: a pass that fills max_count lists the units it had to leave out (Group::frontier),
+    // so the engine can go on from those its picture still misses (engine/frontier_seeds.h).
+    bool keep_frontier = false;
     ScreenClip clip;  // inactive: no limit on screen
 };
+
+// The most frontier units one pass lists: a pass of max_count units has a rim of a few times
+// sqrt(max_count) units, each met from one to three taken neighbours.
+inline constexpr std::size_t kMaxFrontier = 4096;
 
 // The value gradient of a unit from its eight corners (differences across the unit, voxel space
 // per unit side): the direction the surface's normal takes, up to sign.
@@ -145,7 +152,11 @@ class Propagator {
             if (p.clip.active && !p.clip.may_touch(centre(u, l), st)) return true;
             float max_angle = from_angle;
             if (p.mode == PropagationMode::max_count) {
-                if (taken >= p.max_count) return false;
+                if (taken >= p.max_count) {
+                    if (p.keep_frontier && g.frontier.size() < kMaxFrontier)
+                        g.frontier.push_back(u);
+                    return false;
+                }
             } else {
                 const glm::vec3 to = glm::normalize(centre(u, l) - eye);
                 if (glm::dot(to, dir) < cos_cutoff) return true;

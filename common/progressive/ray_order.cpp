@@ -156,10 +156,14 @@ class ProgressiveOrder : public RayOrder {
                 return true;
             // After the surface has been sized the rest is the fixed refining order; a caster
             // may still pass coverage to put uncovered pixels first, but need not read back.
+            // Before the fill level (every pixel left, most of the screen's rays) the caster
+            // tells what shows once more, and again between its two parts: the fill level then
+            // hands out the pixels that show nothing first (the last slivers and pinholes, which
+            // decide C = 1 - E; see emit_fill_level).
             case RayOrderKind::dynamic_grid:
-                return searching_;
+                return searching_ || fill_next();
             case RayOrderKind::dynamic_gaps:
-                return searching_ || gap_pending_;
+                return searching_ || gap_pending_ || fill_next();
         }
         return false;
     }
@@ -188,6 +192,9 @@ class ProgressiveOrder : public RayOrder {
 
   private:
     bool done() const { return cast_count_ == area_; }
+    bool fill_next() const {
+        return !dynamic_pending_ && !gap_pending_ && next_refining_ > last_refining_;
+    }
 
     bool is_covered(int x, int y) const {
         return coverage_[std::size_t(y) * std::size_t(screen_width_) + std::size_t(x)] != 0;
@@ -242,7 +249,18 @@ class ProgressiveOrder : public RayOrder {
                 if (!is_covered(rect_.x + lx, rect_.y + ly)) take(lx, ly, out);
     }
 
+    // Every pixel not cast yet. Once a caster has told what shows (the dynamic orders ask before
+    // this level), in two levels: first the pixels that showed nothing (the last holes, which
+    // decide C = 1 - E), then, after the caster could seed what is still missing beside them,
+    // the pixels that show the surface (a nearer piece may still hide in front of them).
     void emit_fill_level(std::vector<glm::ivec2>& out) {
+        if (is_dynamic(kind_) && !fill_split_ && !coverage_.empty()) {
+            fill_split_ = true;
+            for (int ly = 0; ly < rect_.height; ++ly)
+                for (int lx = 0; lx < rect_.width; ++lx)
+                    if (!is_covered(rect_.x + lx, rect_.y + ly)) take(lx, ly, out);
+            if (!out.empty()) return;
+        }
         out.reserve(area_ - cast_count_);
         for (int ly = 0; ly < rect_.height; ++ly)
             for (int lx = 0; lx < rect_.width; ++lx) take(lx, ly, out);
@@ -264,6 +282,7 @@ class ProgressiveOrder : public RayOrder {
     bool gap_pending_ = false;            // dynamic grid: the gap level is the next level
     bool gap_coverage_ = false;           // coverage after the sized grid shows something
     int dynamic_spacing_ = 0;
+    bool fill_split_ = false;  // the fill level's pixels that showed nothing are handed out
 };
 
 }  // namespace
