@@ -54,8 +54,7 @@ std::optional<glm::ivec2> cell_pixel(const glm::mat4& clip_from_voxel, glm::ivec
 }
 
 std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pending,
-                                                  const SurfaceExtractor& ex,
-                                                  const FrameView& view,
+                                                  const SurfaceExtractor& ex, const FrameView& view,
                                                   const glm::mat4& view_inverse,
                                                   const PixelRect& rect,
                                                   std::vector<std::uint8_t>& covered) {
@@ -71,10 +70,12 @@ std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pendi
         if (!px) continue;
         const glm::ivec2 p = *px - glm::ivec2(rect.x, rect.y);
         if (p.x < 0 || p.y < 0 || p.x >= rect.width || p.y >= rect.height) continue;
-        std::uint8_t& shown = covered[std::size_t(p.y) * std::size_t(rect.width) + std::size_t(p.x)];
+        std::uint8_t& shown =
+            covered[std::size_t(p.y) * std::size_t(rect.width) + std::size_t(p.x)];
         if (shown) continue;
         shown = 1;  // one seed per pixel: its pass reaches the others' cells if they are one piece
-        out.push_back({c, pixel_ray(view_inverse, view.frustum, view.width, view.height, *px), *px});
+        out.push_back(
+            {c, pixel_ray(view_inverse, view.frustum, view.width, view.height, *px), *px});
     }
     return out;
 }

@@ -21,8 +21,8 @@ void note_beside(const SurfaceExtractor& ex, const RayHit& hit, const Ray& ray, 
                  bool exact, std::vector<BesideSeed>& out);
 
 // The pixel (top-left origin) of a `width` x `height` screen where the centre of the cell at
-// `cell` (voxel space) projects through `clip_from_voxel` (projection * view * voxel-to-object); nullopt
-// behind the eye or off the screen.
+// `cell` (voxel space) projects through `clip_from_voxel` (projection * view * voxel-to-object);
+// nullopt behind the eye or off the screen.
 std::optional<glm::ivec2> cell_pixel(const glm::mat4& clip_from_voxel, glm::ivec3 cell, int width,
                                      int height);
 
@@ -32,8 +32,7 @@ std::optional<glm::ivec2> cell_pixel(const glm::mat4& clip_from_voxel, glm::ivec
 // through that pixel: where a pass had to stop short of what the picture still misses. At most
 // one seed per pixel (its pixel is marked in `covered`).
 std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pending,
-                                                  const SurfaceExtractor& ex,
-                                                  const FrameView& view,
+                                                  const SurfaceExtractor& ex, const FrameView& view,
                                                   const glm::mat4& view_inverse,
                                                   const PixelRect& rect,
                                                   std::vector<std::uint8_t>& covered);

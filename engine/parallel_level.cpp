@@ -69,8 +69,8 @@ class LevelCast {
             ray = s.ray;
         } else {
             const glm::ivec2 px = job_.pixels[i] + job_.origin;
-            ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width,
-                            job_.view.height, px);
+            ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width, job_.view.height,
+                            px);
             const auto t0 = Clock::now();
             hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
             t.intersect_s += since(t0);

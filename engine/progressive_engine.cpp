@@ -217,17 +217,10 @@ class FrameRun {
                              const std::vector<BesideSeed>* seeds = nullptr) {
         const std::size_t rays_before = now_.rays;
         bool begun = false;
-        const LevelJob job{ex_,
-                           pixels_,
-                           {rect_.x, rect_.y},
-                           *view_,
-                           view_inv_,
-                           mode,
-                           params_,
-                           opt_.propagation,
-                           interrupted_,
-                           opt_.first_group_id + ids_used_,
-                           seeds};
+        const LevelJob job{
+            ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
+            mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_,
+            seeds};
         const double own0 = thread_cpu_seconds();
         const LevelTally t = isowall::cast_level_parallel(
             job, n, [this](FoundGroup& f) { add_found(f); },

@@ -29,9 +29,8 @@ bool face_neighbours(glm::ivec3 a, glm::ivec3 b) {
 // A pass from the phantom's skin, seeded where the front view's centre ray meets it.
 Group pass_from_centre(SurfaceExtractor& ex, const FrameView& fv, const PropagationParams& p) {
     ex.begin_frame(fv.iso);
-    const Ray ray =
-        pixel_ray(glm::inverse(fv.camera.view()), fv.frustum, fv.width, fv.height,
-                  {fv.width / 2, fv.height / 2});
+    const Ray ray = pixel_ray(glm::inverse(fv.camera.view()), fv.frustum, fv.width, fv.height,
+                              {fv.width / 2, fv.height / 2});
     const RayHit hit = ex.cast(ray, IntersectMode::exact);
     EXPECT_TRUE(hit.found);
     return ex.propagate(hit.cell, 0, p, ray);
@@ -49,9 +48,9 @@ TEST(Frontier, AFullPassListsTheUnvisitedUnitsItLeftOut) {
     ASSERT_FALSE(g.frontier.empty());
     for (const glm::ivec3 u : g.frontier) {
         EXPECT_FALSE(ex->visited(u)) << u.x << "," << u.y << "," << u.z;
-        EXPECT_TRUE(std::any_of(g.cells.begin(), g.cells.end(),
-                                [u](glm::ivec3 c) { return face_neighbours(c, u); }))
-            << "a frontier unit beside no cell of the pass";
+        EXPECT_TRUE(std::any_of(g.cells.begin(), g.cells.end(), [u](glm::ivec3 c) {
+            return face_neighbours(c, u);
+        })) << "a frontier unit beside no cell of the pass";
     }
     // Not asked for, or a pass that did not fill its count: no frontier.
     p.keep_frontier = false;
@@ -65,8 +64,8 @@ TEST(Frontier, ACellsPixelIsTheOneWhoseRayPassesByItsCentre) {
     const Volume v = make_phantom();
     for (const FrameView& fv : {test::make_view(v, 160, 120, kPhantomSkinIso, 35, -20),
                                 test::make_view(v, 97, 211, kPhantomSkinIso, -60, 10, 1.5f)}) {
-        const glm::mat4 clip = fv.frustum.matrix() * fv.camera.view() *
-                               glm::scale(glm::mat4(1.0f), v.spacing());
+        const glm::mat4 clip =
+            fv.frustum.matrix() * fv.camera.view() * glm::scale(glm::mat4(1.0f), v.spacing());
         const glm::mat4 view_inv = glm::inverse(fv.camera.view());
         const float pixel = fv.frustum.height() / float(fv.height) / fv.frustum.near_z;
         std::size_t on_screen = 0;

@@ -73,8 +73,9 @@ struct PropagationParams {
     // then stops one unit past a silhouette instead of running on over the back of the surface;
     // what it leaves out stays unvisited, so a later ray that sees it seeds it then.
     bool facing_only = false;
-    // Count mode: a pass that fills max_count lists the units it had to leave out (Group::frontier),
-    // so the engine can go on from those its picture still misses (engine/frontier_seeds.h).
+    // Count mode: a pass that fills max_count lists the units it had to leave out
+    // (Group::frontier), so the engine can go on from those its picture still misses
+    // (engine/frontier_seeds.h).
     bool keep_frontier = false;
     ScreenClip clip;  // inactive: no limit on screen
 };
