@@ -72,6 +72,17 @@ bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
     return read;
 }
 
+void keep_frontier(RegionCursor& c, std::vector<glm::ivec3>& units, const SurfaceExtractor& ex) {
+    if (units.empty()) return;
+    constexpr std::size_t kFirstDrop = std::size_t{1} << 18;
+    if (c.frontier.size() > std::max(kFirstDrop, 2 * c.frontier_kept)) {
+        std::erase_if(c.frontier, [&ex](glm::ivec3 u) { return ex.visited(u); });
+        c.frontier_kept = c.frontier.size();
+    }
+    c.frontier.insert(c.frontier.end(), units.begin(), units.end());
+    units = {};
+}
+
 ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing) {
     ScreenClip clip;
     if (rect.width <= 0 || rect.height <= 0) return clip;

@@ -77,6 +77,11 @@ RegionCursor region_cursor(const FrameView& view, const PixelRect& region,
 void begin_order(RegionCursor& c, RayOrderKind kind);
 // Adds what `mesh` covers of `c`'s region to c.drawn (`view_m`: view's camera matrix).
 void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const FrameView& view);
+// Moves a pass's frontier units (Group::frontier, emptied) to c.frontier, first dropping the
+// units there that `ex` has visited since once the list has doubled since the last such drop: most
+// of a frontier is taken by later passes, and a heavy surface would grow it by megabytes.
+void keep_frontier(RegionCursor& c, std::vector<glm::ivec3>& units, const SurfaceExtractor& ex);
+
 // Gives `order` the region's coverage after a level that wants it: while sizing, c.drawn (and
 // sizing ends once the order has its size); else what `sink` shows (`scratch` holds it), or
 // nothing covered when the sink cannot tell. True when `scratch` holds what the sink shows now.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <string>
@@ -141,10 +142,16 @@ TEST(Threads, EveryLevelEndsWithASampleOfItsOwn) {
     }
     ASSERT_GE(end_one.size(), 3u);
     ASSERT_EQ(end_two.size(), end_one.size());
+    // The fill level's first part holds the pixels that showed nothing before it (ray_order.h),
+    // which depends on what the threads drew by then: its end may differ by a few rays.
+    const int fill_first = std::prev(end_one.end(), 2)->first;
     for (const auto& [level, rays] : end_one) {
         ASSERT_TRUE(end_two.count(level)) << "level " << level;
-        EXPECT_GE(end_two[level], rays) << "level " << level;
+        if (level != fill_first) {
+            EXPECT_GE(end_two[level], rays) << "level " << level;
+        }
     }
+    EXPECT_EQ(end_two.rbegin()->second, end_one.rbegin()->second) << "every ray, in the end";
 }
 
 TEST(Threads, AStopEndsEveryThread) {
