@@ -206,12 +206,18 @@ void replay_and_report(const RenderOptions& o, ProgressiveEngine& engine, FrameR
     Stopwatch sw;
     std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
     std::vector<TimelineSample> vs_full;
-    engine.measure(fr, fv, renderer, [&](const TimelineSample& s, const Image& img) {
+    // Whole images only for snapshots and --against-full: without them the replay reads back
+    // the final picture's box alone.
+    const bool images = o.against_full || !o.snapshots.empty() || !o.snapshot_rays.empty();
+    auto on_image = [&](const TimelineSample& s, const Image& img) {
         stage_snapshots(o, s, img, c_done, r_done, batch);
         if (!o.against_full) return;
         vs_full.push_back(s);
         vs_full.back().correctness = measure_correctness(img, full);
-    });
+    };
+    engine.measure(
+        fr, fv, renderer,
+        images ? std::function<void(const TimelineSample&, const Image&)>(on_image) : nullptr);
     print_thresholds(fr, fr.timeline);
     if (o.against_full) print_thresholds(fr, vs_full, "the full surface at full resolution");
     print_draw_only(fr, fv, renderer);

@@ -47,10 +47,9 @@ std::optional<glm::ivec2> cell_pixel(const glm::mat4& clip_from_voxel, glm::ivec
                                      int height) {
     const glm::vec4 c = clip_from_voxel * glm::vec4(glm::vec3(cell) + 0.5f, 1.0f);
     if (!(c.w > 1e-6f)) return std::nullopt;
-    const float x = (c.x / c.w + 1.0f) * 0.5f * float(width);
-    const float y = (1.0f - c.y / c.w) * 0.5f * float(height);
-    if (!(x >= 0 && y >= 0 && x < float(width) && y < float(height))) return std::nullopt;
-    return glm::ivec2(int(x), int(y));
+    const glm::vec2 w = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
+    if (!(w.x >= 0 && w.y >= 0 && w.x < float(width) && w.y < float(height))) return std::nullopt;
+    return glm::ivec2(int(w.x), int(w.y));
 }
 
 std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pending,

@@ -143,8 +143,9 @@ class ProgressiveEngine {
 
     // Replays the frame's groups in order and measures both correctness measures of the image at
     // every timeline sample against the final image (not part of the timed run). `on_image` sees
-    // each replayed image, e.g. to write snapshots.
-    // The replay draws into `renderer`.
+    // each replayed image (the whole screen), e.g. to write snapshots; without it the replay
+    // reads back only the box of the pixels the final image covers (the only ones that count),
+    // and never twice for samples that show the same groups. The replay draws into `renderer`.
     void measure(FrameResult& frame, const FrameView& view, Renderer& renderer,
                  const std::function<void(const TimelineSample&, const Image&)>& on_image = {});
 

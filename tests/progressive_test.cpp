@@ -2,9 +2,12 @@
 // invariants; an interrupt stops a frame and the next frame is the new view only.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <tuple>
 
+#include "common/core/image_ops.h"
+#include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
 #include "common/volume/phantom.h"
 #include "common/volume/volume.h"
@@ -270,6 +273,51 @@ TEST(Engine, TimelineIsMonotoneAndReachesFullCorrectness) {
             EXPECT_LT(double(s.rays) / (double(box.width) * double(box.height)), 0.05);
             break;
         }
+}
+
+// Without a caller that wants whole images the replay reads back only the final picture's box,
+// and once per set of groups shown: the same figures as the whole-screen replay, sample by sample.
+TEST(Engine, TheBoxReplayMeasuresWhatTheWholeScreenReplayDoes) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    auto renderer = make_renderer("osmesa");
+    EngineOptions opt;
+    opt.sample_ray_factor = 1.05;  // many samples, some with no new group
+    ProgressiveEngine engine(*ex, opt);
+    const FrameView fv = make_view(p, 240, 180, kPhantomBoneIso, 30, 20);
+    FrameResult box = engine.run(fv, *renderer);
+    ASSERT_TRUE(box.completed);
+    FrameResult whole = box;
+    engine.measure(box, fv, *renderer);
+    std::size_t images = 0;
+    engine.measure(whole, fv, *renderer, [&](const TimelineSample&, const Image& img) {
+        EXPECT_EQ(img.width, fv.width);
+        ++images;
+    });
+    EXPECT_EQ(images, whole.timeline.size());
+    std::size_t repeats = 0;
+    for (std::size_t i = 0; i < box.timeline.size(); ++i) {
+        EXPECT_EQ(box.timeline[i].correctness.c, whole.timeline[i].correctness.c) << i;
+        EXPECT_EQ(box.timeline[i].correctness.final_pixels,
+                  whole.timeline[i].correctness.final_pixels)
+            << i;
+        EXPECT_EQ(box.timeline[i].correctness.significant,
+                  whole.timeline[i].correctness.significant);
+        repeats += i > 0 && box.timeline[i].groups == box.timeline[i - 1].groups;
+    }
+    EXPECT_GT(repeats, 0u) << "no sample showed the groups of the one before: the case is weak";
+    const PixelRect r = covered_box(box.final_image);
+    EXPECT_LT(pixel_count(r), box.final_image.pixel_count()) << "the box is the whole screen";
+    const Image part = crop(box.final_image, r);
+    auto covered = [](const Image& img) {
+        return std::count_if(img.depth.begin(), img.depth.end(), [](float d) { return d < 1; });
+    };
+    EXPECT_EQ(covered(part), covered(box.final_image));
+    const PixelRect again = covered_box(part);
+    EXPECT_EQ(again.x, 0);
+    EXPECT_EQ(again.y, 0);
+    EXPECT_EQ(again.width, r.width);
+    EXPECT_EQ(again.height, r.height);
 }
 
 }  // namespace

@@ -77,4 +77,38 @@ Image resample_nearest(const Image& src, int width, int height) {
     return out;
 }
 
+PixelRect covered_box(const Image& img) {
+    if (img.depth.size() != img.pixel_count()) return {};
+    int x0 = img.width, y0 = img.height, x1 = -1, y1 = -1;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            if (img.depth[std::size_t(y) * std::size_t(img.width) + std::size_t(x)] < 1.0f) {
+                x0 = std::min(x0, x);
+                x1 = std::max(x1, x);
+                y0 = std::min(y0, y);
+                y1 = std::max(y1, y);
+            }
+    if (x1 < 0) return {};
+    return {x0, y0, x1 - x0 + 1, y1 - y0 + 1};
+}
+
+Image crop(const Image& img, const PixelRect& r) {
+    Image out;
+    out.width = r.width;
+    out.height = r.height;
+    out.rgba.resize(std::size_t(r.width) * std::size_t(r.height) * 4);
+    const bool depth = img.depth.size() == img.pixel_count();
+    if (depth) out.depth.resize(std::size_t(r.width) * std::size_t(r.height));
+    for (int y = 0; y < r.height; ++y) {
+        const std::size_t from = std::size_t(r.y + y) * std::size_t(img.width) + std::size_t(r.x);
+        const std::size_t to = std::size_t(y) * std::size_t(r.width);
+        std::copy_n(img.rgba.begin() + std::ptrdiff_t(from * 4), std::size_t(r.width) * 4,
+                    out.rgba.begin() + std::ptrdiff_t(to * 4));
+        if (depth)
+            std::copy_n(img.depth.begin() + std::ptrdiff_t(from), r.width,
+                        out.depth.begin() + std::ptrdiff_t(to));
+    }
+    return out;
+}
+
 }  // namespace isowall

@@ -31,6 +31,13 @@ void for_each_placed_pixel(const Image& dst, const Image& src, const PixelRect& 
 // depth. `src` covers `where` of dst; both must carry depth (std::invalid_argument otherwise).
 void composite_by_depth(Image& dst, const Image& src, const PixelRect& where);
 
+// The smallest rect holding every pixel `img` covers (depth below 1); empty when it covers none
+// or has no depth.
+PixelRect covered_box(const Image& img);
+
+// The pixels of `r` (inside `img`) as an image of their own, colour and depth (where img has it).
+Image crop(const Image& img, const PixelRect& r);
+
 // Copies `src` into `where` of dst, colour and depth (where dst has depth).
 void place(Image& dst, const Image& src, const PixelRect& where);
 
