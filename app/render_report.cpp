@@ -56,7 +56,7 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
         if (!i) continue;
         Mesh merged;
         for (std::size_t g = 0; g < fr.timeline[*i].groups; ++g) merged.append(fr.groups[g].mesh);
-            renderer.clear();
+        renderer.clear();
         renderer.finish();
         Stopwatch draw;
         renderer.draw(merged, fv.camera.view(), fv.frustum.matrix());
