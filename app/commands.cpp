@@ -23,6 +23,7 @@ namespace {
 
 // One line per stage, then a summary line that scripts can grep for.
 struct Timings {
+    Stopwatch command;  // from the command's start: GL context, volume, octree, frame
     double load = 0, octree = 0, extract = 0, render = 0, write = 0;
     double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
     void print(std::size_t triangles) const {
@@ -249,6 +250,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
             "%.3f s\n",
             kWarmUpYawDeg, w.timeline.back().triangles, w.elapsed_s);
     }
+    const double frame_at = t.command.seconds();
     const double cpu0 = thread_cpu_seconds();
     FrameResult fr = engine.run(fv, renderer, nullptr, progress);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
@@ -275,6 +277,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
             "past the drawing thread's levels)\n",
             caller_cpu, fr.workers.sum_s, fr.workers.beyond_s);
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
+    print_first_picture(fr, frame_at, t.load, t.octree);
     if (fr.mask_level >= 0)
         std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",
                     fr.mask_nodes, fr.mask_level, fr.screen_pixels);
@@ -356,7 +359,9 @@ int run_render(const RenderOptions& o) {
     if (render_threads(o).usable() == 1) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     // Create the GL context first: a missing driver should fail before the volume is read.
     auto renderer = make_renderer(o.gl);
-    OpenedVolume ov = open_volume(o.volume);
+    // One frame keeps the map under --huge-pages auto; --warm-up times the frame as a running
+    // wall's ranks have it, and they hold the copy.
+    OpenedVolume ov = open_volume(o.volume, /*quiet=*/false, VolumeUse{.one_frame = !o.warm_up});
     t.load = ov.load_s;
     auto ex = prepare(ov, t, render_threads(o));
     if (!o.full) prepare_error_rule(engine_options(o), *ex, ov.volume);

@@ -1,5 +1,6 @@
 #include "app/render_report.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 
@@ -85,6 +86,19 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
         mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels,
         coverage_iou(final_image, full), sw.seconds());
     return full;
+}
+
+void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s) {
+    const auto first = std::find_if(fr.timeline.begin(), fr.timeline.end(),
+                                    [](const TimelineSample& s) { return s.triangles > 0; });
+    if (first == fr.timeline.end()) {
+        std::printf("first picture: none (the frame drew nothing)\n");
+        return;
+    }
+    std::printf(
+        "first picture: %.3f s after the command began (volume %.3f s, octree %.3f s; the first "
+        "group showed %.3f s into the frame)\n",
+        frame_at + first->time_s, load_s, octree_s, first->time_s);
 }
 
 }  // namespace isowall

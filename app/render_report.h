@@ -32,4 +32,9 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image);
 
+// When the frame's first group showed, counted from the command's start (the frame began
+// `frame_at` seconds after it; `load_s` and `octree_s` of that went to the volume and its octree):
+// what a user waits before a picture, a cold volume's read included.
+void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s);
+
 }  // namespace isowall

@@ -83,8 +83,9 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         if (!mode)
             throw InputError("--huge-pages", "value",
                              "expected auto, on or off, got " + quote(o.huge_pages));
-        const HugePagesChoice choice = choose_huge_pages(
-            *mode, out.volume.bytes().size(), use.copies_on_host, thp_mode(), mem_available());
+        const HugePagesChoice choice =
+            choose_huge_pages(*mode, out.volume.bytes().size(), use.copies_on_host, thp_mode(),
+                              mem_available(), use.one_frame);
         huge_note = " (huge pages: no, " + choice.why + ")";
         if (choice.copy) {
             try {

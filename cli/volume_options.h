@@ -38,6 +38,7 @@ struct OpenedVolume {
 struct VolumeUse {
     bool casts = true;
     int copies_on_host = 1;
+    bool one_frame = false;  // the process draws one frame (choose_huge_pages)
 };
 
 // Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -195,6 +196,24 @@ TEST_F(Cli, WarmUpFrameLeavesTheTimedFrameAlone) {
         EXPECT_TRUE(a.rgba == b.rgba) << "warm-up changed the image" << mode;
         EXPECT_GT(std::count(a.rgba.begin(), a.rgba.end(), 0), 0);
     }
+}
+
+// A user sees how long the picture took to come, the volume's read included: the first picture's
+// time from the command's start is at least the load and octree time and at most the whole run.
+TEST_F(Cli, RenderPrintsTheFirstPictureFromTheCommandsStart) {
+    auto r = run_isowall(dir_, "render --size 160x120 -q --out first.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto at = r.out.find("first picture: ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    double first = -1, load = -1, octree = -1, into = -1;
+    ASSERT_EQ(std::sscanf(r.out.c_str() + at,
+                          "first picture: %lf s after the command began (volume %lf s, octree "
+                          "%lf s; the first group showed %lf s into the frame)",
+                          &first, &load, &octree, &into),
+              4)
+        << r.out.substr(at, 200);
+    EXPECT_GE(first, load + octree + into - 1e-3);
+    EXPECT_LT(first, 60.0);
 }
 
 TEST_F(Cli, HelpListsTheSubcommands) {

@@ -66,6 +66,13 @@ TEST(HugePages, ChoosesByModeKernelSizeAndMemory) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("--huge-pages"), std::string::npos) << e.what();
     }
+    // One frame (a single render): auto keeps the map; on still copies.
+    const auto once =
+        choose_huge_pages(HugePages::automatic, big, 1, ThpMode::madvise, avail, true);
+    EXPECT_FALSE(once.copy);
+    EXPECT_NE(once.why.find("one frame"), std::string::npos) << once.why;
+    EXPECT_TRUE(choose_huge_pages(HugePages::automatic, big, 1, ThpMode::madvise, avail).copy);
+    EXPECT_TRUE(choose_huge_pages(HugePages::on, big, 1, ThpMode::madvise, avail, true).copy);
     // on copies any size, with either mode that grants them, even when memory is unknown.
     EXPECT_TRUE(choose_huge_pages(HugePages::on, small, 1, ThpMode::madvise, avail).copy);
     EXPECT_TRUE(choose_huge_pages(HugePages::on, 1, 25, ThpMode::always, std::nullopt).copy);

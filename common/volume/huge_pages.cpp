@@ -72,7 +72,8 @@ std::optional<std::size_t> mem_available() {
 }
 
 HugePagesChoice choose_huge_pages(HugePages mode, std::size_t bytes, int copies_on_host,
-                                  ThpMode thp, std::optional<std::size_t> available_bytes) {
+                                  ThpMode thp, std::optional<std::size_t> available_bytes,
+                                  bool one_frame) {
     if (mode == HugePages::off) return {false, "--huge-pages off"};
     if (thp == ThpMode::never) {
         if (mode == HugePages::on)
@@ -83,6 +84,7 @@ HugePagesChoice choose_huge_pages(HugePages mode, std::size_t bytes, int copies_
     }
     if (mode == HugePages::on) return {true, "--huge-pages on"};
     if (bytes < kHugePagesMinBytes) return {false, "under " + mib(kHugePagesMinBytes)};
+    if (one_frame) return {false, "one frame: the copy would cost more than it saves"};
     const std::size_t copies = static_cast<std::size_t>(std::max(1, copies_on_host));
     if (!available_bytes || bytes > *available_bytes / 2 / copies)
         return {false, std::to_string(copies) + " cop" + (copies == 1 ? "y" : "ies") +

@@ -42,11 +42,15 @@ struct HugePagesChoice {
 
 // Whether to copy a volume of `bytes` into huge pages. `copies_on_host`: how many processes on
 // this machine would each hold a copy (the wall's tile ranks). auto copies a volume of at least
-// kHugePagesMinBytes when the kernel grants huge pages on advice and every copy fits in half of
-// the available memory; on copies whenever the kernel grants them (throws InputError naming
-// --huge-pages when it never does); off never copies.
+// kHugePagesMinBytes when the kernel grants huge pages on advice, every copy fits in half of the
+// available memory and the process draws more than one frame (`one_frame`: a single `render`,
+// whose copy would cost more than it saves: 0.4 s warm and 1.6 s from a cold cache for the
+// engine block's 512 MiB copy, against a frame no faster than from the map; a frame from the map
+// reads only the pages its rays and passes touch); on copies whenever the kernel grants them
+// (throws InputError naming --huge-pages when it never does); off never copies.
 HugePagesChoice choose_huge_pages(HugePages mode, std::size_t bytes, int copies_on_host,
-                                  ThpMode thp, std::optional<std::size_t> available_bytes);
+                                  ThpMode thp, std::optional<std::size_t> available_bytes,
+                                  bool one_frame = false);
 
 // An anonymous, private, read-write mapping whose start is 2 MiB aligned, advised with
 // MADV_HUGEPAGE (RAII, move-only). Throws std::runtime_error when the mapping fails.
