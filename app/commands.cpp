@@ -21,26 +21,6 @@
 namespace isowall {
 namespace {
 
-// One line per stage, then a summary line that scripts can grep for.
-struct Timings {
-    Stopwatch command;  // from the command's start: GL context, volume, octree, frame
-    double load = 0, octree = 0, extract = 0, render = 0, write = 0;
-    double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
-    void print(std::size_t triangles) const {
-        if (frame >= 0) {
-            std::printf(
-                "timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
-                " | triangles %zu | peak RSS %.1f MiB\n",
-                load, octree, frame, write, triangles, peak_rss_mib());
-            return;
-        }
-        std::printf(
-            "timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
-            " | triangles %zu | peak RSS %.1f MiB\n",
-            load, octree, extract, render, write, triangles, peak_rss_mib());
-    }
-};
-
 std::unique_ptr<SurfaceExtractor> prepare(const OpenedVolume& ov, Timings& t,
                                           ThreadBudget budget = ThreadBudget::hardware()) {
     OctreeSource src;

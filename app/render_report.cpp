@@ -10,6 +10,20 @@
 
 namespace isowall {
 
+void Timings::print(std::size_t triangles) const {
+    if (frame >= 0) {
+        std::printf(
+            "timing: load %.3f s | octree %.3f s | progressive frame %.3f s | write %.3f s"
+            " | triangles %zu | peak RSS %.1f MiB\n",
+            load, octree, frame, write, triangles, peak_rss_mib());
+        return;
+    }
+    std::printf(
+        "timing: load %.3f s | octree %.3f s | extract %.3f s | render %.3f s | write %.3f s"
+        " | triangles %zu | peak RSS %.1f MiB\n",
+        load, octree, extract, render, write, triangles, peak_rss_mib());
+}
+
 std::size_t covered_pixels(const Image& image) {
     std::size_t covered = 0;
     for (float d : image.depth) covered += d < 1.0f;

@@ -5,12 +5,21 @@
 #include <string>
 
 #include "common/core/image.h"
+#include "common/core/util.h"
 #include "common/core/view.h"
 #include "common/extract/surface_extractor.h"
 #include "engine/progressive_engine.h"
 #include "render/renderer.h"
 
 namespace isowall {
+
+// One line per stage, then a summary line that scripts can grep for.
+struct Timings {
+    Stopwatch command;  // from the command's start: GL context, volume, octree, frame
+    double load = 0, octree = 0, extract = 0, render = 0, write = 0;
+    double frame = -1;  // the progressive frame (extraction and drawing interleaved), if any
+    void print(std::size_t triangles) const;
+};
 
 // Pixels the surface covers (depth nearer than the background); scripts compare this count with
 // other renderers' hit pixels (scripts/bench_scaling.py).
