@@ -48,9 +48,9 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
                  "Cast every ray of the volume's projected box, also where no active octree node "
                  "projects (the box alone, to measure what the mask saves)");
     app.add_flag("--no-frontier-seeds", e.no_frontier_seeds,
-                 "Do not go on, at each ray-order level's end, from the units a full propagation "
-                 "pass left out where their pixels still show nothing (the text's passes alone: "
-                 "only rays find what a pass stopped short of)");
+                 "Do not seed, before the ray order's fill level, the units full propagation "
+                 "passes left out and the cells beside missed hits whose pixels still show "
+                 "nothing (the text's passes alone: only rays find what a pass stopped short of)");
     app.add_flag("--adaptive", e.adaptive,
                  "Adaptive resolution: extract regions whose cells project below a pixel as "
                  "meta-cells of 2^i cells per side");

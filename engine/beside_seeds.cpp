@@ -1,7 +1,5 @@
 #include "engine/beside_seeds.h"
 
-#include <cmath>
-
 #include <glm/common.hpp>
 #include <glm/ext/matrix_transform.hpp>
 

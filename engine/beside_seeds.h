@@ -1,7 +1,8 @@
 #pragma once
-// The engine's side of common/extract/hit_neighbours.h: a region's rays note the unvisited cells
-// beside their hits on visited ones, and at the region's end the engine seeds those whose pixel
-// still shows nothing.
+// Seeds taken where the picture still shows nothing: the engine's side of
+// common/extract/hit_neighbours.h (a region's rays note the unvisited cells beside their hits on
+// visited ones) and the frontier units of full passes (Group::frontier). The engine seeds them
+// before the ray order's fill level and, the cells beside hits, again at the region's end.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -37,13 +38,13 @@ std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pendi
                                                   const PixelRect& rect,
                                                   std::vector<std::uint8_t>& covered);
 
-// Empties `pending` and returns those of its seeds whose pixel `sink` shows nothing at in `rect`
-// (`scratch` holds its coverage); none when `sink` cannot tell. Whether a seed's cell is still
-// unvisited is the caller's to check as it seeds: one seed's pass may take another's cell.
-// The same with the coverage given: `covered` is rect-local, what the sink shows in `rect` (none
-// taken when it is not that size).
+// Empties `pending` and returns those of its seeds whose pixel shows nothing in `covered`
+// (rect-local, what the sink shows in `rect`; none taken when it is not that size). Whether a
+// seed's cell is still unvisited is the caller's to check as it seeds: one seed's pass may take
+// another's cell.
 std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, const PixelRect& rect,
                                          const std::vector<std::uint8_t>& covered);
+// The same with the coverage read from `sink` into `scratch`; none when `sink` cannot tell.
 std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, GroupSink& sink,
                                          const PixelRect& rect, std::vector<std::uint8_t>& scratch);
 

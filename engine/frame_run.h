@@ -63,7 +63,7 @@ class FrameRun {
         rect_ = c.rect;
         cursor_ = &c;
         params_ = opt_.propagation;
-        params_.keep_frontier = opt_.frontier_seeds;
+        params_.keep_frontier = opt_.frontier_seeds && sink.tells_coverage();
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
         // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
         // c.rays, so a region's second band would cast nothing.

@@ -77,4 +77,10 @@ bool TeeSink::coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect
     return false;
 }
 
+bool TeeSink::tells_coverage() const {
+    for (const GroupSink* s : sinks_)
+        if (s->tells_coverage()) return true;
+    return false;
+}
+
 }  // namespace isowall

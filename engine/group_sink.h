@@ -36,6 +36,9 @@ class GroupSink {
     virtual bool coverage(std::vector<std::uint8_t>& /*covered*/, const PixelRect& /*rect*/) {
         return false;
     }
+    // Whether coverage() can tell: the engine keeps no frontier of full passes for a sink that
+    // cannot (EngineOptions::frontier_seeds).
+    virtual bool tells_coverage() const { return false; }
     // Whether seen() is wanted: the engine then looks up the group of every visited cell a ray
     // meets (a hash lookup per such ray), else it does not.
     virtual bool wants_seen() const { return false; }
@@ -54,6 +57,7 @@ class RendererSink final : public GroupSink {
     bool present_async() override;
     bool presented(bool wait) override;
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
+    bool tells_coverage() const override { return true; }
     // The frame as drawn so far (finishes pending draws first).
     void read_back(Image& out);
     void read_back(Image& out, const PixelRect& rect);
@@ -83,6 +87,7 @@ class TeeSink final : public GroupSink {
     bool present_async() override;
     bool presented(bool wait) override;
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override;
+    bool tells_coverage() const override;
 
   private:
     std::vector<GroupSink*> sinks_;

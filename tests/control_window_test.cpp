@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "common/core/image_ops.h"
 #include "common/core/preview.h"
 #include "common/core/util.h"
 #include "common/io/image_io.h"
@@ -126,19 +127,6 @@ class ControlWindowTest : public testing::Test {
     test::Xvfb x_{{"1280x1024"}};
     std::filesystem::path dir_ = test::scratch_dir("control_window");
 };
-
-// The part of `img` in rect r.
-Image crop(const Image& img, const PixelRect& r) {
-    Image out;
-    out.resize(r.width, r.height);
-    for (int y = 0; y < r.height; ++y)
-        for (int x = 0; x < r.width; ++x)
-            for (int c = 0; c < 4; ++c)
-                out.rgba[(static_cast<std::size_t>(y) * r.width + x) * 4 + c] =
-                    img.rgba[(static_cast<std::size_t>(y + r.y) * img.width + x + r.x) * 4 + c];
-    out.depth.clear();
-    return out;
-}
 
 // The mosaic part of the control window (status bar aside), as it should show `mosaic`: each
 // tile's previews composed by the window's own layout (tiles at full size on this small wall).

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -84,6 +85,32 @@ TEST(Frontier, ACellsPixelIsTheOneWhoseRayPassesByItsCentre) {
                     EXPECT_LE(off, 0.71f * pixel * along) << x << "," << y << "," << z;
                 }
         EXPECT_GT(on_screen, 100u);
+    }
+}
+
+// A sink that cannot tell what shows (a remote client's, a recording) can have no frontier seeds:
+// its passes keep no frontier. One that can tells the engine so, and the frontier fills.
+TEST(FrontierSeeds, KeptOnlyForASinkThatCanTellWhatShows) {
+    const Volume v = make_phantom();
+    auto ex = make_surface_extractor(v);
+    auto renderer = make_renderer("osmesa");
+    const FrameView fv = test::make_view(v, 160, 120, kPhantomSkinIso);
+    EngineOptions opt;
+    opt.propagation.max_count = 40;
+    ProgressiveEngine engine(*ex, opt);
+    RecordingSink recording;
+    RendererSink drawing(*renderer);
+    EXPECT_FALSE(recording.tells_coverage());
+    EXPECT_TRUE(drawing.tells_coverage());
+    EXPECT_TRUE(TeeSink({&recording, &drawing}).tells_coverage());
+    const std::atomic<bool> stop{false};
+    for (GroupSink* sink :
+         {static_cast<GroupSink*>(&recording), static_cast<GroupSink*>(&drawing)}) {
+        EngineFrame frame(engine, fv, stop);
+        sink->begin(fv);
+        RegionCursor c = frame.cursor(fv, fv.screen());
+        ASSERT_TRUE(frame.cast(fv, c, *sink, 200));  // the first levels only: no fill level yet
+        EXPECT_EQ(c.frontier.empty(), sink == &recording) << c.frontier.size();
     }
 }
 

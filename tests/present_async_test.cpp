@@ -110,6 +110,7 @@ class LaggingSink final : public GroupSink {
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
         return inner_.coverage(covered, rect);
     }
+    bool tells_coverage() const override { return inner_.tells_coverage(); }
     void read_back(Image& out) { inner_.read_back(out); }
 
     std::size_t added = 0, added_in_flight = 0;

@@ -39,6 +39,9 @@ class TileJobs::JobSink final : public GroupSink {
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
         return help_ ? help_->coverage(covered, rect) : jobs_.tile_sink_.coverage(covered, rect);
     }
+    bool tells_coverage() const override {
+        return help_ ? help_->tells_coverage() : jobs_.tile_sink_.tells_coverage();
+    }
 
   private:
     TileJobs& jobs_;

@@ -75,7 +75,7 @@ struct PropagationParams {
     bool facing_only = false;
     // Count mode: a pass that fills max_count lists the units it had to leave out
     // (Group::frontier), so the engine can go on from those its picture still misses
-    // (engine/frontier_seeds.h).
+    // (engine/beside_seeds.h).
     bool keep_frontier = false;
     ScreenClip clip;  // inactive: no limit on screen
 };
