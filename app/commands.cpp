@@ -201,7 +201,9 @@ void replay_and_report(const RenderOptions& o, ProgressiveEngine& engine, FrameR
         images ? std::function<void(const TimelineSample&, const Image&)>(on_image) : nullptr);
     print_thresholds(fr, fr.timeline);
     if (o.against_full) print_thresholds(fr, vs_full, "the full surface at full resolution");
-    print_draw_only(fr, fv, renderer);
+    // The draw-only floor draws the triangles again in one go (about as long as the replay on a
+    // volume finer than the screen): a figure for studies, with their options.
+    if (o.against_full || !o.timeline.empty()) print_draw_only(fr, fv, renderer);
     if (!o.timeline.empty()) {
         write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
         std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
@@ -234,6 +236,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     const double cpu0 = thread_cpu_seconds();
     FrameResult fr = engine.run(fv, renderer, nullptr, progress);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
+    preload_image_io();  // OpenImageIO loads beside the report, not after it
     const TimelineSample& last = fr.timeline.back();
     t.frame = fr.elapsed_s;
     std::printf(
@@ -265,14 +268,15 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     Image full;
     if (o.against_full) full = print_against_full(ex, renderer, fv, fr.final_image);
 
+    const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
+                              !o.snapshots.empty() || !o.snapshot_rays.empty();
+    if (want_measure) replay_and_report(o, engine, fr, fv, renderer, full, batch);
+
+    // After the replay, by when OpenImageIO has loaded beside it (preload_image_io above).
     Stopwatch sw;
     write_image(batch, o.out, fr.final_image);
     if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
     t.write = sw.seconds();
-
-    const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
-                              !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (want_measure) replay_and_report(o, engine, fr, fv, renderer, full, batch);
     return last.triangles;
 }
 

@@ -110,5 +110,22 @@ TEST(ImageIo, AStagedWriteAppearsAtCommit) {
     EXPECT_EQ(read_ply(dir / "a.ply").triangle_count(), 0u);
 }
 
+// The extensions image_format_problem() accepts without loading OpenImageIO: each must be one it
+// writes, and reads back at the written size, or a command would learn otherwise after its work.
+TEST(ImageIo, EveryExtensionKnownWithoutOpenImageIoIsOneItWrites) {
+    const auto dir = test::scratch_dir("image_io_extensions");
+    for (const std::string& ext : common_image_extensions()) {
+        SCOPED_TRACE(ext);
+        const auto path = dir / ("a" + ext);
+        EXPECT_EQ(image_format_problem(path), "");
+        write_image(path, test_pattern(6, 5));
+        const Image back = read_image(path);
+        EXPECT_EQ(back.width, 6);
+        EXPECT_EQ(back.height, 5);
+    }
+    EXPECT_NE(image_format_problem(dir / "a.nosuchformat"), "");
+    EXPECT_EQ(image_format_problem(dir / "A.PNG"), "");
+}
+
 }  // namespace
 }  // namespace isowall

@@ -3,10 +3,9 @@
 // What we add: the slices in order (pages of one file, or files of a folder in natural name
 // order), the check that every slice has one size and type before the stack is allocated, and
 // the spacing ImageJ writes (its description's spacing= for z, the resolution tags for x and y).
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cctype>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,13 +15,33 @@
 #include "common/core/number.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
+#include "common/io/oiio_module.h"
 #include "common/volume/load_checks.h"
 
 namespace isowall::formats {
 namespace fs = std::filesystem;
 namespace {
 
-using Input = std::unique_ptr<OIIO::ImageInput>;
+// An image file open through the OpenImageIO module.
+class Input {
+  public:
+    explicit Input(void* file) : file_(file) {}
+    Input(const Input&) = delete;
+    Input& operator=(const Input&) = delete;
+    ~Input() { oiio::api().close_file(file_); }
+    int page_count() const { return oiio::api().page_count(file_); }
+    oiio::PageInfo spec(int page) const {
+        oiio::PageInfo info;
+        oiio::api().page_info(file_, page, info);
+        return info;
+    }
+    bool read(int page, oiio::Sample sample, void* out, std::string& error) const {
+        return oiio::api().read_page(file_, page, sample, out, error);
+    }
+
+  private:
+    void* file_;
+};
 
 // What every slice must share.
 struct Slice {
@@ -36,85 +55,78 @@ std::string describe(const Slice& s) {
            std::string(type_name(s.type));
 }
 
-std::optional<VoxelType> voxel_type_of(OIIO::TypeDesc t) {
-    switch (t.basetype) {
-        case OIIO::TypeDesc::UINT8:
+std::optional<VoxelType> voxel_type_of(oiio::Sample t) {
+    switch (t) {
+        case oiio::Sample::u8:
             return VoxelType::u8;
-        case OIIO::TypeDesc::INT8:
+        case oiio::Sample::i8:
             return VoxelType::i8;
-        case OIIO::TypeDesc::UINT16:
+        case oiio::Sample::u16:
             return VoxelType::u16;
-        case OIIO::TypeDesc::INT16:
+        case oiio::Sample::i16:
             return VoxelType::i16;
-        case OIIO::TypeDesc::UINT32:
+        case oiio::Sample::u32:
             return VoxelType::u32;
-        case OIIO::TypeDesc::INT32:
+        case oiio::Sample::i32:
             return VoxelType::i32;
-        case OIIO::TypeDesc::FLOAT:
+        case oiio::Sample::f32:
             return VoxelType::f32;
-        case OIIO::TypeDesc::DOUBLE:
+        case oiio::Sample::f64:
             return VoxelType::f64;
         default:
             return std::nullopt;
     }
 }
 
-OIIO::TypeDesc type_desc(VoxelType t) {
+oiio::Sample sample_of(VoxelType t) {
     switch (t) {
         case VoxelType::u8:
-            return OIIO::TypeDesc::UINT8;
+            return oiio::Sample::u8;
         case VoxelType::i8:
-            return OIIO::TypeDesc::INT8;
+            return oiio::Sample::i8;
         case VoxelType::u16:
-            return OIIO::TypeDesc::UINT16;
+            return oiio::Sample::u16;
         case VoxelType::i16:
-            return OIIO::TypeDesc::INT16;
+            return oiio::Sample::i16;
         case VoxelType::u32:
-            return OIIO::TypeDesc::UINT32;
+            return oiio::Sample::u32;
         case VoxelType::i32:
-            return OIIO::TypeDesc::INT32;
+            return oiio::Sample::i32;
         case VoxelType::f32:
-            return OIIO::TypeDesc::FLOAT;
+            return oiio::Sample::f32;
         case VoxelType::f64:
-            return OIIO::TypeDesc::DOUBLE;
+            return oiio::Sample::f64;
     }
-    return OIIO::TypeDesc::UINT8;
+    return oiio::Sample::u8;
 }
 
 // The slice a page holds: one channel, one plane, one of our types.
-Slice slice_of(const OIIO::ImageSpec& spec, const std::string& where, const std::string& field) {
-    if (spec.nchannels != 1)
+Slice slice_of(const oiio::PageInfo& spec, const std::string& where, const std::string& field) {
+    if (spec.channels != 1)
         throw InputError(where, field,
-                         std::to_string(spec.nchannels) +
+                         std::to_string(spec.channels) +
                              " channels (colour or alpha); isowall reads one-channel slices");
     if (spec.depth != 1)
         throw InputError(
             where, field,
             "a volume TIFF of depth " + std::to_string(spec.depth) + "; isowall reads 2-D slices");
-    const auto type = voxel_type_of(spec.format);
+    const auto type = voxel_type_of(spec.sample);
     if (!type)
-        throw InputError(where, field,
-                         std::string(spec.format.c_str()) +
-                             " samples; isowall reads 8, 16 and 32-bit integers and floats");
+        throw InputError(
+            where, field,
+            spec.format + " samples; isowall reads 8, 16 and 32-bit integers and floats");
     return {spec.width, spec.height, *type};
 }
 
-Input open_tiff(const fs::path& file, const std::string& where) {
+std::unique_ptr<Input> open_tiff(const fs::path& file, const std::string& where) {
     check_regular_file(file, where, "file");
-    Input in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(where, "file", "OpenImageIO cannot read it: " + OIIO::geterror());
-    if (std::string_view(in->format_name()) != "tiff")
-        throw InputError(
-            where, "file",
-            std::string("not a TIFF (OpenImageIO reads it as ") + in->format_name() + ")");
+    std::string format, error;
+    void* handle = oiio::api().open_file(file.string(), format, error);
+    if (!handle) throw InputError(where, "file", "OpenImageIO cannot read it: " + error);
+    auto in = std::make_unique<Input>(handle);
+    if (format != "tiff")
+        throw InputError(where, "file", "not a TIFF (OpenImageIO reads it as " + format + ")");
     return in;
-}
-
-int page_count(OIIO::ImageInput& in) {
-    int n = 0;
-    while (in.seek_subimage(n, 0)) ++n;
-    in.geterror();  // seeking past the last page may leave a message we do not want
-    return n;
 }
 
 // Names with their runs of digits compared as numbers: s2 before s10, s02 beside s2.
@@ -175,23 +187,23 @@ std::string imagej_value(std::string_view description, std::string_view key) {
     return {};
 }
 
-bool is_imagej(const OIIO::ImageSpec& spec) {
-    return std::string(spec.get_string_attribute("ImageDescription")).starts_with("ImageJ=");
+bool is_imagej(const oiio::PageInfo& spec) {
+    return spec.description.starts_with("ImageJ=");
 }
 
 // ImageJ's spacing: z from its description's spacing=, x and y from the resolution tags
 // (pixels per unit); the unit from the description, else ResolutionUnit. Otherwise 1 1 1.
-glm::vec3 stack_spacing(const OIIO::ImageSpec& spec, std::vector<VolumeFact>& facts) {
-    const std::string text = spec.get_string_attribute("ImageDescription");
+glm::vec3 stack_spacing(const oiio::PageInfo& spec, std::vector<VolumeFact>& facts) {
+    const std::string& text = spec.description;
     const auto z = is_imagej(spec) ? parse_number(imagej_value(text, "spacing")) : std::nullopt;
-    const float xres = spec.get_float_attribute("XResolution", 0);
-    const float yres = spec.get_float_attribute("YResolution", 0);
+    const float xres = spec.x_resolution;
+    const float yres = spec.y_resolution;
     if (!z || !(xres > 0) || !(yres > 0)) {
         facts.push_back({"spacing from", "none in the file (1 1 1)"});
         return glm::vec3(1.0f);
     }
     std::string unit = imagej_value(text, "unit");
-    if (unit.empty()) unit = spec.get_string_attribute("ResolutionUnit", "none");
+    if (unit.empty()) unit = spec.resolution_unit.empty() ? "none" : spec.resolution_unit;
     facts.push_back({"spacing from",
                      "ImageJ description (spacing=) and X/YResolution, unit " + clip(unit, 20)});
     return {1.0f / xres, 1.0f / yres, float(*z)};
@@ -199,9 +211,9 @@ glm::vec3 stack_spacing(const OIIO::ImageSpec& spec, std::vector<VolumeFact>& fa
 
 // An ImageJ hyperstack keeps its channels and time points as pages too: read as slices they
 // would interleave silently.
-void check_imagej_stack(const OIIO::ImageSpec& spec, int pages, const std::string& where) {
+void check_imagej_stack(const oiio::PageInfo& spec, int pages, const std::string& where) {
     if (!is_imagej(spec)) return;
-    const std::string text = spec.get_string_attribute("ImageDescription");
+    const std::string& text = spec.description;
     for (const char* key : {"channels", "frames"}) {
         const auto n = parse_number(imagej_value(text, key));
         if (n && *n > 1)
@@ -235,23 +247,24 @@ Decoded allocate_stack(const Slice& first, std::uint64_t slices, const std::stri
     return d;
 }
 
-void read_slice(OIIO::ImageInput& in, int page, int z, Decoded& d, const std::string& where) {
+void read_slice(const Input& in, int page, int z, Decoded& d, const std::string& where) {
     const std::size_t slice_bytes = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
-    if (!in.read_image(page, 0, 0, 1, type_desc(d.type), d.bytes.data() + slice_bytes * z))
+    std::string error;
+    if (!in.read(page, sample_of(d.type), d.bytes.data() + slice_bytes * z, error))
         throw InputError(where, "page " + std::to_string(page),
-                         "OpenImageIO cannot decode it: " + in.geterror());
+                         "OpenImageIO cannot decode it: " + error);
 }
 
 Decoded read_pages(const fs::path& file, const std::string& where) {
-    Input in = open_tiff(file, where);
-    const int pages = page_count(*in);
-    const OIIO::ImageSpec spec0 = in->spec(0, 0);
+    const auto in = open_tiff(file, where);
+    const int pages = in->page_count();
+    const oiio::PageInfo spec0 = in->spec(0);
     check_imagej_stack(spec0, pages, where);
     check_count(std::size_t(pages), where, "pages");
     const Slice first = slice_of(spec0, where, "page 0");
     for (int p = 1; p < pages; ++p) {
         const std::string field = "page " + std::to_string(p);
-        const Slice s = slice_of(in->spec(p, 0), where, field);
+        const Slice s = slice_of(in->spec(p), where, field);
         if (!(s == first))
             throw InputError(
                 where, field,
@@ -271,16 +284,16 @@ Decoded read_folder(const fs::path& dir, const std::string& where) {
     const std::vector<fs::path> files = slice_files(dir);
     check_count(files.size(), where, "slices");
     Slice first;
-    OIIO::ImageSpec spec0;
+    oiio::PageInfo spec0;
     for (const fs::path& f : files) {
         const std::string at = f.string();
-        const Input in = open_tiff(f, at);
-        if (page_count(*in) != 1)
+        const auto in = open_tiff(f, at);
+        if (in->page_count() != 1)
             throw InputError(at, "pages", "a slice of a folder must be a single page");
-        const Slice s = slice_of(in->spec(0, 0), at, "slice");
+        const Slice s = slice_of(in->spec(0), at, "slice");
         if (f == files.front()) {
             first = s;
-            spec0 = in->spec(0, 0);
+            spec0 = in->spec(0);
         } else if (!(s == first)) {
             throw InputError(at, "size",
                              describe(s) + ", but the first slice (" +
