@@ -1,0 +1,126 @@
+#!/usr/bin/python3
+"""Tests of scripts/bench_volumes.py (issue 29): the README's isovalues are read; a quick run on
+the shared tooth at half and full size on a small screen writes a table per isovalue, the
+targets, the worst case, the JSON and a plot, with times against the full surface in order and
+the final image matching it; a memory share too small for any case skips every case and says
+why; the verdicts judge growth, picture and peer as the issue states them; bad options give one
+line and status 1. Skips (status 77) without ../shared/data.
+
+Run: /usr/bin/python3 tests/bench_volumes_test.py BUILD_DIR   (CTest passes the path)
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import bench_volumes  # noqa: E402
+import bench_volumes_report as report  # noqa: E402
+from bench_scaling import BenchError  # noqa: E402
+SCRIPT = os.path.join(ROOT, "scripts", "bench_volumes.py")
+DATA = os.environ.get("ISOWALL_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+BUILD = None
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def bench(*args):
+    return subprocess.run([sys.executable, SCRIPT, "--build", BUILD, "--data", DATA, *args],
+                          capture_output=True, text=True, timeout=600)
+
+
+def case(scale, c99, c_full=1.0, iou=1.0, peer=None, tris=1000, covered=1000):
+    c = {"volume": "v", "iso": 10.0, "scale": scale, "voxels": 1000 * scale ** 3,
+         "engine": {"truth": {"c90": c99, "c99": c99, "c999": c99, "fp99": c99, "tris_c99": tris},
+                    "own": {"c99": c99}, "every_ray_s": c99, "c_vs_full": c_full, "iou_vs_full": iou,
+                    "covered_px": covered, "triangles": tris}}
+    if peer:
+        c["peer"] = {"total_s": peer}
+    return c
+
+
+class BenchVolumes(unittest.TestCase):
+    def test_readme_isovalues(self):
+        iso = bench_volumes.suggested_isovalues(os.path.join(DATA, "README.md"))
+        self.assertEqual(iso["engine"], [(75.0, 584282), (190.0, 134536)])
+        self.assertEqual([v for v, _ in iso["vhp_ct_head"]], [40.0, 105.0])
+        with tempfile.NamedTemporaryFile("w", suffix=".md") as f:
+            f.write("# no table here\n")
+            f.flush()
+            with self.assertRaises(BenchError):
+                bench_volumes.suggested_isovalues(f.name)
+
+    def test_quick_run_on_the_tooth(self):
+        with tempfile.TemporaryDirectory() as out:
+            p = bench("--volumes", "tooth", "--scales", "0.5,1", "--size", "320x240", "--runs", "1",
+                      "--no-peer", "--out", out)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(out, "volumes.json")) as f:
+                cases = json.load(f)["cases"]
+            self.assertEqual([(c["iso"], c["scale"]) for c in cases],
+                             [(620.0, 0.5), (620.0, 1.0), (1000.0, 0.5), (1000.0, 1.0)])
+            for c in cases:
+                truth = c["engine"]["truth"]
+                times = [truth[k] for k in ("c90", "c99", "c999")]
+                self.assertTrue(all(t is not None for t in times), c)
+                self.assertEqual(times, sorted(times), c)
+                # At full resolution the engine's final image is the full surface's.
+                self.assertGreaterEqual(c["engine"]["c_vs_full"], 0.99, c)
+                self.assertGreaterEqual(c["engine"]["iou_vs_full"], 0.999, c)
+                self.assertGreater(truth["tris_c99"], 0)
+            self.assertEqual(cases[1]["sizes"], [103, 94, 161])
+            with open(os.path.join(out, "volumes.md")) as f:
+                text = f.read()
+            for heading in ("## tooth, iso 620", "## tooth, iso 1000", "## Targets", "## The worst case"):
+                self.assertIn(heading, text)
+            with open(os.path.join(out, "volumes-tooth.png"), "rb") as f:
+                self.assertEqual(f.read(8), PNG_MAGIC)
+
+    def test_a_case_that_does_not_fit_is_skipped_and_says_why(self):
+        with tempfile.TemporaryDirectory() as out:
+            p = bench("--volumes", "tooth", "--isos", "first", "--scales", "1", "--runs", "1",
+                      "--no-peer", "--memory-share", "1e-9", "--out", out)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            self.assertIn("tooth 620 1x: skipped: needs about", p.stdout)
+            with open(os.path.join(out, "volumes.json")) as f:
+                (only,) = json.load(f)["cases"]
+            self.assertNotIn("engine", only)
+            self.assertIn("available", only["skipped"])
+
+    def test_verdicts_follow_the_issue(self):
+        fast = [case(1, 0.10, peer=1.0), case(2, 0.14, peer=4.0), case(4, 0.19, peer=10.0, tris=1500)]
+        (v,) = report.verdicts(fast)
+        self.assertAlmostEqual(v["growth"], 1.9)
+        self.assertFalse(v["growth_holds"])  # over 1.5x
+        self.assertTrue(v["growth_resolved"])  # within 2x
+        self.assertTrue(v["picture_holds"])
+        self.assertAlmostEqual(v["peer_ratio_4x"], 0.019)
+        self.assertTrue(v["peer_holds"])
+        self.assertAlmostEqual(v["tris_per_px"], 1.5)
+        wrong = [case(1, 0.10), case(4, 0.12, c_full=0.985, tris=2500)]
+        (w,) = report.verdicts(wrong)
+        self.assertFalse(w["picture_holds"])
+        self.assertFalse(w["tris_holds"])
+        self.assertIsNone(w["peer_holds"])  # no peer measured
+        # Without a 4x case the growth is printed but not judged.
+        (h,) = report.verdicts([case(1, 0.1), case(2, 0.3)])
+        self.assertAlmostEqual(h["growth"], 3.0)
+        self.assertIsNone(h["growth_holds"])
+
+    def test_bad_options_give_one_line(self):
+        for args in (["--volumes", "nosuch"], ["--runs", "0"], ["--scales", "x"], ["--size", "0x5"],
+                     ["--memory-share", "2"]):
+            p = bench(*args)
+            self.assertEqual(p.returncode, 1, args)
+            self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+            self.assertTrue(p.stderr.startswith("bench_volumes: error: "), p.stderr)
+
+
+if __name__ == "__main__":
+    BUILD = sys.argv.pop(1)
+    if not os.path.exists(os.path.join(DATA, "README.md")):
+        print(f"bench_volumes_test: skipped: {DATA}/README.md not found (../shared/data or $ISOWALL_SHARED_DATA)")
+        sys.exit(77)
+    unittest.main()
