@@ -55,49 +55,23 @@ std::string describe(const Slice& s) {
            std::string(type_name(s.type));
 }
 
+// oiio::Sample lists VoxelType's types in VoxelType's order, then `other`.
+static_assert(int(oiio::Sample::u8) == int(VoxelType::u8) &&
+              int(oiio::Sample::i8) == int(VoxelType::i8) &&
+              int(oiio::Sample::u16) == int(VoxelType::u16) &&
+              int(oiio::Sample::i16) == int(VoxelType::i16) &&
+              int(oiio::Sample::u32) == int(VoxelType::u32) &&
+              int(oiio::Sample::i32) == int(VoxelType::i32) &&
+              int(oiio::Sample::f32) == int(VoxelType::f32) &&
+              int(oiio::Sample::f64) == int(VoxelType::f64));
+
 std::optional<VoxelType> voxel_type_of(oiio::Sample t) {
-    switch (t) {
-        case oiio::Sample::u8:
-            return VoxelType::u8;
-        case oiio::Sample::i8:
-            return VoxelType::i8;
-        case oiio::Sample::u16:
-            return VoxelType::u16;
-        case oiio::Sample::i16:
-            return VoxelType::i16;
-        case oiio::Sample::u32:
-            return VoxelType::u32;
-        case oiio::Sample::i32:
-            return VoxelType::i32;
-        case oiio::Sample::f32:
-            return VoxelType::f32;
-        case oiio::Sample::f64:
-            return VoxelType::f64;
-        default:
-            return std::nullopt;
-    }
+    if (t == oiio::Sample::other) return std::nullopt;
+    return static_cast<VoxelType>(static_cast<int>(t));
 }
 
 oiio::Sample sample_of(VoxelType t) {
-    switch (t) {
-        case VoxelType::u8:
-            return oiio::Sample::u8;
-        case VoxelType::i8:
-            return oiio::Sample::i8;
-        case VoxelType::u16:
-            return oiio::Sample::u16;
-        case VoxelType::i16:
-            return oiio::Sample::i16;
-        case VoxelType::u32:
-            return oiio::Sample::u32;
-        case VoxelType::i32:
-            return oiio::Sample::i32;
-        case VoxelType::f32:
-            return oiio::Sample::f32;
-        case VoxelType::f64:
-            return oiio::Sample::f64;
-    }
-    return oiio::Sample::u8;
+    return static_cast<oiio::Sample>(static_cast<int>(t));
 }
 
 // The slice a page holds: one channel, one plane, one of our types.

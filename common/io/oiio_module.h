@@ -16,7 +16,8 @@ namespace isowall::oiio {
 
 inline constexpr int kApiVersion = 1;
 
-// The sample types a slice may hold that isowall reads (other: any other, named in `format`).
+// The sample types a slice may hold that isowall reads, in the order of VoxelType
+// (common/volume/volume.h; the TIFF reader checks it); other: any other, named in `format`.
 enum class Sample { u8, i8, u16, i16, u32, i32, f32, f64, other };
 
 // One page (subimage) of an image file, as OpenImageIO describes it.
