@@ -299,13 +299,20 @@ TEST(WallBalance, AnInterruptWhileJobsMigrateLeavesNothingOfTheOldView) {
     WallOptions o = balance_wall(dir, true, true);
     o.fault = {FaultAction::slow, FaultMoment::none, TestFault::kEveryTile};
     o.script = write_script(dir, "wait time 1\norbit 70 -30\nwait done\n").string();
-    const WallRun r = run_wall_in_process(o);
-    for (int code : r.codes) ASSERT_EQ(code, 0) << r.err;
+    // The view changes after a second of wall-clock time: on a loaded machine (the suite's other
+    // tests beside it) the helpers may not hold a region yet at that moment, and the run then
+    // tests nothing. Up to three runs, until one interrupts a helper.
+    WallRun r;
     std::uint64_t interrupted = 0, helpers_interrupted = 0;
-    for (std::size_t rank = 1; rank < r.results.size(); ++rank) {
-        const TileResultMsg& t = r.results[rank];
-        interrupted += t.interrupted;
-        helpers_interrupted += t.interrupted > 0 && t.jobs_helped > 0;
+    for (int attempt = 0; attempt < 3 && helpers_interrupted == 0; ++attempt) {
+        r = run_wall_in_process(o);
+        for (int code : r.codes) ASSERT_EQ(code, 0) << r.err;
+        interrupted = helpers_interrupted = 0;
+        for (std::size_t rank = 1; rank < r.results.size(); ++rank) {
+            const TileResultMsg& t = r.results[rank];
+            interrupted += t.interrupted;
+            helpers_interrupted += t.interrupted > 0 && t.jobs_helped > 0;
+        }
     }
     EXPECT_GT(jobs_helped(r), 0u);
     // The first view was cut short on a tile that ran jobs of another.
