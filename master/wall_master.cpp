@@ -360,10 +360,11 @@ int WallMaster::finish() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
     wait_for_tiles([](const TileState& t) { return t.result && t.image; }, o_.timeout_s);
-    // Every rank has stopped working, so no helper's result is on its way any more.
-    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
     // The run's outputs (per-tile images, the mosaic, the traces) are one batch, committed after
-    // everything that can fail: all of them or none, and the last line says which.
+    // everything that can fail: all of them or none, and the last line says which. They are
+    // written before the tiles are let go: a tile that dies once released ends the job, and what
+    // was finished must be on disk by then (the first image written also loads OpenImageIO,
+    // half a second).
     OutputFiles batch;
     const Mosaic mosaic = compose(&batch);
     trace_.switch_to(Stage::compose);
@@ -375,6 +376,9 @@ int WallMaster::finish() {
                     o_.trace.c_str());
     if (!o_.tiles_out.empty()) std::printf("wrote the tiles' images in %s\n", o_.tiles_out.c_str());
     std::printf("wrote %s\n", o_.out.c_str());
+    std::fflush(stdout);
+    // Every rank has stopped working, so no helper's result is on its way any more.
+    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
     raise_test_signal(o_.fault, FaultMoment::end);
     return 0;
 }

@@ -4,9 +4,11 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <array>
 #include <exception>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/io/oiio_module.h"
@@ -151,48 +153,28 @@ int page_count(void* file) {
     return n;
 }
 
+// Each Sample but `other` beside OpenImageIO's base type.
+constexpr std::array<std::pair<Sample, OIIO::TypeDesc::BASETYPE>, 8> kSamples{{
+    {Sample::u8, OIIO::TypeDesc::UINT8},
+    {Sample::i8, OIIO::TypeDesc::INT8},
+    {Sample::u16, OIIO::TypeDesc::UINT16},
+    {Sample::i16, OIIO::TypeDesc::INT16},
+    {Sample::u32, OIIO::TypeDesc::UINT32},
+    {Sample::i32, OIIO::TypeDesc::INT32},
+    {Sample::f32, OIIO::TypeDesc::FLOAT},
+    {Sample::f64, OIIO::TypeDesc::DOUBLE},
+}};
+
 Sample sample_of(OIIO::TypeDesc t) {
-    switch (t.basetype) {
-        case OIIO::TypeDesc::UINT8:
-            return Sample::u8;
-        case OIIO::TypeDesc::INT8:
-            return Sample::i8;
-        case OIIO::TypeDesc::UINT16:
-            return Sample::u16;
-        case OIIO::TypeDesc::INT16:
-            return Sample::i16;
-        case OIIO::TypeDesc::UINT32:
-            return Sample::u32;
-        case OIIO::TypeDesc::INT32:
-            return Sample::i32;
-        case OIIO::TypeDesc::FLOAT:
-            return Sample::f32;
-        case OIIO::TypeDesc::DOUBLE:
-            return Sample::f64;
-        default:
-            return Sample::other;
-    }
+    for (const auto& [sample, base] : kSamples)
+        if (t.basetype == base) return sample;
+    return Sample::other;
 }
 
 OIIO::TypeDesc type_of(Sample s) {
-    switch (s) {
-        case Sample::i8:
-            return OIIO::TypeDesc::INT8;
-        case Sample::u16:
-            return OIIO::TypeDesc::UINT16;
-        case Sample::i16:
-            return OIIO::TypeDesc::INT16;
-        case Sample::u32:
-            return OIIO::TypeDesc::UINT32;
-        case Sample::i32:
-            return OIIO::TypeDesc::INT32;
-        case Sample::f32:
-            return OIIO::TypeDesc::FLOAT;
-        case Sample::f64:
-            return OIIO::TypeDesc::DOUBLE;
-        default:
-            return OIIO::TypeDesc::UINT8;
-    }
+    for (const auto& [sample, base] : kSamples)
+        if (sample == s) return base;
+    return OIIO::TypeDesc::UINT8;
 }
 
 bool page_info(void* file, int page, PageInfo& out) {
