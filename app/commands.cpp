@@ -295,6 +295,12 @@ void print_file_facts(const Volume& v) {
                 double(p.max.z));
 }
 
+// A store's reads (common/store/paged_voxels.h), when the volume is one.
+void print_paging(const OpenedVolume& ov) {
+    if (ov.pager)
+        std::printf("store: %s\n", store::paging_line(ov.pager->stats(), ov.pager->cap()).c_str());
+}
+
 }  // namespace
 
 int run_info(const InfoOptions& o) {
@@ -320,6 +326,7 @@ int run_extract(const ExtractOptions& o) {
     auto ex = prepare(ov, t);
     const double iso = checked_iso(o.iso, ov, *ex);
     Mesh mesh = extract_timed(*ex, iso, t);
+    print_paging(ov);
     Stopwatch sw;
     write_ply(o.out, mesh);
     t.write = sw.seconds();
@@ -363,6 +370,7 @@ int run_render(const RenderOptions& o) {
         batch.commit();
         std::printf("wrote %s%s%s (%zu file(s) in all)\n", o.out.c_str(),
                     o.depth_out.empty() ? "" : " and ", o.depth_out.c_str(), files);
+        print_paging(ov);
         t.print(triangles);
         return 0;
     }
@@ -388,6 +396,7 @@ int run_render(const RenderOptions& o) {
     t.write = sw.seconds();
     std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
                 o.depth_out.c_str());
+    print_paging(ov);
     t.print(mesh.triangle_count());
     return 0;
 }

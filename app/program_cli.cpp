@@ -201,6 +201,7 @@ ProgramCli::ProgramCli() {
     wall_cmd = add_wall_command(app, wall);
     serve_cmd = add_serve_command(app, serve);
     view_cmd = add_view_command(app, view);
+    import_cmd = add_import_command(app, import);
     wall_cmd->add_flag("--ranks-needed", ranks_needed,
                        "Print the -np this wall file needs (1 + its tiles) and exit, without MPI");
 }

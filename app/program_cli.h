@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "app/import_command.h"
 #include "app/remote_commands.h"
 #include "app/wall_run.h"
 
@@ -23,6 +24,7 @@ struct ProgramCli {
     WallOptions wall;
     ServeCommand serve;
     ViewCommand view;
+    ImportCommand import;
     bool ranks_needed = false;
     CLI::App* info_cmd = nullptr;
     CLI::App* ex_cmd = nullptr;
@@ -30,6 +32,7 @@ struct ProgramCli {
     CLI::App* wall_cmd = nullptr;
     CLI::App* serve_cmd = nullptr;
     CLI::App* view_cmd = nullptr;
+    CLI::App* import_cmd = nullptr;
 };
 
 // The first argument when it is a word that names no subcommand ("isowall frobnicate"): the

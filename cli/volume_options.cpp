@@ -6,6 +6,8 @@
 #include "common/core/error.h"
 #include "common/core/util.h"
 #include "common/formats/read_volume.h"
+#include "common/store/open_store.h"
+#include "common/store/store_format.h"
 #include "common/volume/octree.h"
 #include "common/volume/phantom.h"
 
@@ -16,7 +18,9 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "Volume: NRRD (.nrrd/.nhdr), NIfTI (.nii, .nii.gz, .hdr/.img), a DICOM "
                    "series (its folder, or one file of it), MetaImage (.mhd/.mha), HDF5 "
                    "(FILE.h5:/dataset), TIFF (a multi-page .tif or a folder of slices), or "
-                   "headerless raw with --dims and --type. Default: the built-in phantom");
+                   "headerless raw with --dims and --type, or a store made by `isowall import` "
+                   "(its folder; read on first touch under --memory-limit). Default: the "
+                   "built-in phantom");
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
         ->expected(3)
         ->transform(number_in({1, 2147483647.0, false, true}));
@@ -38,6 +42,10 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "auto (from 256 MiB, when every rank's copy fits in half the available "
                    "memory), on, off (keep the shared memory map). Default: auto")
         ->check(CLI::IsMember({"auto", "on", "off"}));
+    app.add_option("--memory-limit", o.memory_limit,
+                   "A store's voxels in memory at most (e.g. 512M, 8G); the rest stays on disk "
+                   "and is read when a ray or the surface first needs it. Default: half the "
+                   "available memory, shared by the processes of this host");
 }
 
 namespace {
@@ -69,16 +77,39 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     OpenedVolume out;
     Stopwatch sw;
+    std::string store_note;
     if (o.path.empty()) {
         if (!o.dims.empty() || !o.type.empty())
             throw InputError("--dims/--type", "--volume", "raw options need --volume FILE");
         out.volume = make_phantom();
+    } else if (store::is_store(o.path)) {
+        if (!o.dims.empty() || !o.type.empty())
+            throw InputError(o.path, "--dims/--type", "a store carries its own size and type");
+        std::uint64_t cap = store::default_memory_limit(use.copies_on_host);
+        if (!o.memory_limit.empty()) {
+            const auto parsed = store::parse_byte_size(o.memory_limit);
+            if (!parsed)
+                throw InputError("--memory-limit", "value",
+                                 "expected a size such as 512M or 8G, got " +
+                                     quote(o.memory_limit));
+            cap = *parsed;
+        }
+        const std::filesystem::path path = store::store_path(o.path);
+        store::OpenedStore opened = store::open_store(path, cap);
+        out.volume = std::move(opened.volume);
+        out.pager = std::move(opened.pager);
+        out.file = path;
+        store_note = " (" + opened.how + ")";
     } else {
         out.volume = formats::read_volume(o.path, raw_spec(o));
         out.file = std::filesystem::path(o.path);
+        if (!o.memory_limit.empty())
+            throw InputError("--memory-limit", "value",
+                             "applies to a store (`isowall import`), not to " + quote(o.path));
     }
     std::string huge_note;
-    if (use.casts) {
+    // A store's voxels stay paged: a copy would read them all.
+    if (use.casts && !out.volume.paged()) {
         const auto mode = parse_huge_pages(o.huge_pages);
         if (!mode)
             throw InputError("--huge-pages", "value",
@@ -108,12 +139,13 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     const glm::ivec3 d = v.dims();
     const glm::vec3 s = v.spacing();
     const char* where = v.in_huge_pages() ? "in huge pages"
+                        : v.paged()       ? "in a store"
                         : v.mapped()      ? "memory-mapped"
                                           : "in memory";
     std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s%s  (%.2f s)\n",
                 v.source().c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
                 double(s.x), double(s.y), double(s.z), double(v.bytes().size()) / (1024.0 * 1024.0),
-                where, huge_note.c_str(), out.load_s);
+                where, (huge_note + store_note).c_str(), out.load_s);
     return out;
 }
 

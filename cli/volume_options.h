@@ -1,12 +1,14 @@
 #pragma once
 // The volume options every subcommand shares, and opening the volume they describe.
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "common/store/paged_voxels.h"
 #include "common/volume/volume.h"
 
 namespace isowall {
@@ -21,6 +23,7 @@ struct VolumeOptions {
     std::string cache_dir;
     bool no_cache = false;
     std::string huge_pages = "auto";  // auto, on, off (common/volume/huge_pages.h)
+    std::string memory_limit;          // a store's cap ("512M", "8G"); empty: the default share
 };
 
 void add_volume_options(CLI::App& app, VolumeOptions& opts);
@@ -30,6 +33,8 @@ struct OpenedVolume {
     std::optional<std::filesystem::path> file;  // nullopt for the phantom
     std::filesystem::path cache_dir;            // empty: no octree cache
     double load_s = 0;
+    // A store's pager (common/store/paged_voxels.h), for what it read; null for other volumes.
+    std::shared_ptr<const store::PagedVoxels> pager;
 };
 
 // Who holds the volume: `casts` when this process runs the engine over it (the master of a wall

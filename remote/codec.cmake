@@ -1,6 +1,6 @@
 # The group codecs: how a group travels from the extraction server to the client.
 find_package(meshoptimizer REQUIRED)
-pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+# PkgConfig::ZSTD: found in common/CMakeLists.txt (the stores use it too).
 
 add_library(isowall_remote_codec group_codec.cpp compact_mesh.cpp)
 target_include_directories(isowall_remote_codec PUBLIC ${PROJECT_SOURCE_DIR})

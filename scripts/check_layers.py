@@ -15,7 +15,7 @@ from pathlib import Path
 FLOORS = [
     ["common/core"],
     ["common/volume", "common/progressive", "common/wall", "common/io"],
-    ["common/extract", "common/formats"],
+    ["common/extract", "common/formats", "common/store"],
     ["comm", "render", "display"],
     ["engine"],
     ["protocol", "cli"],

@@ -88,6 +88,16 @@ Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile fi
     bytes_ = file_.bytes().subspan(offset, voxel_count() * voxel_size(type));
 }
 
+Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
+               std::shared_ptr<const void> keeper, std::span<const std::byte> bytes,
+               std::string source)
+    : dims_(dims),
+      spacing_(spacing),
+      type_(type),
+      source_(std::move(source)),
+      keeper_(std::move(keeper)),
+      bytes_(bytes) {}
+
 void Volume::copy_to_huge_pages() {
     HugePageBuffer buffer(bytes_.size());
     std::copy(bytes_.begin(), bytes_.end(), buffer.bytes().begin());
@@ -95,6 +105,7 @@ void Volume::copy_to_huge_pages() {
     bytes_ = huge_.bytes();
     file_ = MappedFile();
     owned_ = std::vector<std::byte>();
+    keeper_.reset();
 }
 
 Box3 Volume::bounds() const {

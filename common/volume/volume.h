@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -80,6 +81,11 @@ class Volume {
     // A volume over `count` bytes at `offset` of a mapped file.
     Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, MappedFile file, std::size_t offset,
            std::string source);
+    // A volume over bytes someone else owns and keeps alive through `keeper` (a store's pager,
+    // common/store/paged_voxels.h: the bytes are filled on first touch, so nothing may copy or
+    // scan them all behind the user's back).
+    Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::shared_ptr<const void> keeper,
+           std::span<const std::byte> bytes, std::string source);
 
     glm::ivec3 dims() const { return dims_; }
     glm::vec3 spacing() const { return spacing_; }
@@ -97,6 +103,7 @@ class Volume {
     }
     std::span<const std::byte> bytes() const { return bytes_; }
     bool mapped() const { return file_.size() > 0; }
+    bool paged() const { return keeper_ != nullptr; }
     bool in_huge_pages() const { return huge_.size() > 0; }
     // Moves the voxels into a HugePageBuffer (common/volume/huge_pages.h says why) and lets go of
     // the file's map or the owned bytes. The voxels and everything else stay as they were.
@@ -122,6 +129,7 @@ class Volume {
     MappedFile file_;
     std::vector<std::byte> owned_;
     HugePageBuffer huge_;
+    std::shared_ptr<const void> keeper_;
     std::span<const std::byte> bytes_;
 };
 

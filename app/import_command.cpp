@@ -1,0 +1,125 @@
+#include "app/import_command.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <thread>
+
+#include "cli/cli_checks.h"
+#include "common/core/error.h"
+#include "common/core/util.h"
+#include "common/store/store_writer.h"
+#include "common/volume/octree.h"
+
+namespace isowall {
+namespace {
+
+// One line redrawn in place on a terminal; elsewhere (a log, CI) a line at each quarter.
+class ProgressBar {
+  public:
+    explicit ProgressBar(bool quiet) : quiet_(quiet), tty_(::isatty(2) == 1) {}
+    void update(const store::ImportProgress& p) {
+        if (quiet_ || p.chunks_total == 0) return;
+        const double done = double(p.chunks_done) / double(p.chunks_total);
+        const double s = sw_.seconds();
+        const double mib = double(p.bytes_in) / (1024.0 * 1024.0);
+        const double rate = mib / std::max(s, 1e-9);
+        const double left = done > 0 ? s * (1 - done) / done : 0;
+        const int quarter = static_cast<int>(done * 4);
+        if (!tty_ && quarter == last_quarter_) return;
+        last_quarter_ = quarter;
+        constexpr int kWidth = 30;
+        const int filled = static_cast<int>(done * kWidth);
+        std::string bar(static_cast<std::size_t>(filled), '#');
+        bar.append(static_cast<std::size_t>(kWidth - filled), '.');
+        std::fprintf(stderr, "%simport: [%s] %3.0f%%  %.0f MiB  %.0f MiB/s  %.1f s left%s",
+                     tty_ ? "\r" : "", bar.c_str(), 100 * done, mib, rate, left, tty_ ? "" : "\n");
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (!quiet_ && tty_) std::fprintf(stderr, "\n");
+    }
+
+  private:
+    bool quiet_, tty_;
+    int last_quarter_ = -1;
+    Stopwatch sw_;
+};
+
+}  // namespace
+
+CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
+    auto* c = app.add_subcommand(
+        "import",
+        "Write a volume as a store (Zarr v2 with OME-Zarr metadata, zstd chunks with "
+        "checksums) that --volume then reads on first touch, under --memory-limit");
+    c->add_option("source", o.source,
+                  "The volume to import: any file or folder --volume reads (or give --volume)");
+    add_volume_options(*c, o.volume);
+    c->add_option("--out,-o", o.out, "The store folder to write")->required();
+    c->add_flag("--force", o.force, "Replace a store already at --out");
+    c->add_option("--level", o.level, "zstd level, 1 (fastest) to 19 (smallest). Default: 3")
+        ->transform(number_in({1, 19, false, true}));
+    c->add_flag("--quiet,-q", o.quiet, "No progress bar");
+    return c;
+}
+
+int run_import(const ImportCommand& o) {
+    VolumeOptions vo = o.volume;
+    if (!o.source.empty() && !vo.path.empty() && o.source != vo.path)
+        throw InputError(
+            "source", "value",
+            "the volume is given twice: " + quote(o.source) + " and --volume " + quote(vo.path));
+    if (!o.source.empty()) vo.path = o.source;
+    if (vo.path.empty())
+        throw InputError("source", "value", "name the volume to import (a file or folder)");
+    check_outputs({{"--out", o.out}});
+    const std::filesystem::path out = store::store_path(o.out);
+    OpenedVolume ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
+    if (ov.volume.paged() && std::filesystem::equivalent(*ov.file, out))
+        throw InputError(o.out, "--out", "is the store being imported");
+
+    ProgressBar bar(o.quiet);
+    store::ImportOptions opts;
+    opts.replace = o.force;
+    opts.zstd_level = o.level;
+    opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
+    Stopwatch sw;
+    const store::ImportResult r = store::write_store(ov.volume, out, opts);
+    bar.finish();
+    const double write_s = sw.seconds();
+
+    // The octree, from the voxels at hand, into the cache under the store's key: the first
+    // `--volume STORE` maps it instead of reading every chunk to build it.
+    std::string octree_note = "not cached (--no-cache)";
+    if (!vo.no_cache) {
+        OctreeSource src;
+        src.volume_path = out;
+        src.cache_dir = vo.cache_dir.empty() ? octree_cache::default_dir()
+                                             : std::filesystem::path(vo.cache_dir);
+        src.data_files = {out / ".zattrs", out / "0" / ".zarray"};
+        OctreeStats st;
+        dispatch_voxel_type(ov.volume.type(), [&](auto zero) {
+            using T = decltype(zero);
+            (void)MinMaxOctree<T>::load_or_build(ov.volume.view<T>(), src, &st);
+        });
+        octree_note = st.cache_note.empty() ? "cached to " + st.cache_file.string()
+                                            : "not cached: " + st.cache_note;
+    }
+    const double mib = 1024.0 * 1024.0;
+    const store::StoreLayout& l = r.layout;
+    std::printf(
+        "import: wrote %s  %dx%dx%d %s, %zu chunks of %dx%dx%d, %.1f MiB -> %.1f MiB "
+        "(%.2f:1) in %.2f s (%.0f MiB/s)\n",
+        out.c_str(), l.dims.x, l.dims.y, l.dims.z, std::string(type_name(l.type)).c_str(),
+        l.chunk_count(), l.dims.x, l.chunk_rows, l.chunk_slices, double(r.bytes_in) / mib,
+        double(r.bytes_out) / mib,
+        double(r.bytes_in) / double(std::max<std::uint64_t>(r.bytes_out, 1)), write_s,
+        double(r.bytes_in) / mib / std::max(write_s, 1e-9));
+    std::printf("import: octree %s\n", octree_note.c_str());
+    return 0;
+}
+
+}  // namespace isowall

@@ -1,0 +1,24 @@
+#pragma once
+// `isowall import SOURCE --out STORE` (issue 32): any volume isowall reads, as a chunked,
+// compressed store that `--volume STORE` then reads on first touch under a memory limit.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/volume_options.h"
+
+namespace isowall {
+
+struct ImportCommand {
+    VolumeOptions volume;  // the source: --volume, or the positional SOURCE
+    std::string source;
+    std::string out;
+    bool force = false;
+    int level = 3;
+    bool quiet = false;
+};
+
+CLI::App* add_import_command(CLI::App& app, ImportCommand& o);
+int run_import(const ImportCommand& o);
+
+}  // namespace isowall

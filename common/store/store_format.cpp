@@ -1,0 +1,257 @@
+#include "common/store/store_format.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+
+#include <nlohmann/json.hpp>
+
+#include "common/core/error.h"
+
+namespace isowall::store {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+glm::ivec2 StoreLayout::chunk_extent(int cy, int cz) const {
+    return {std::min(chunk_rows, dims.y - cy * chunk_rows),
+            std::min(chunk_slices, dims.z - cz * chunk_slices)};
+}
+
+std::size_t StoreLayout::chunk_bytes(int cy, int cz) const {
+    const glm::ivec2 e = chunk_extent(cy, cz);
+    return static_cast<std::size_t>(e.x) * static_cast<std::size_t>(e.y) * row_bytes();
+}
+
+StoreLayout layout_for(glm::ivec3 dims, VoxelType type, glm::vec3 spacing) {
+    constexpr double kTargetBytes = 1 << 20;
+    StoreLayout l;
+    l.dims = dims;
+    l.type = type;
+    l.spacing = spacing;
+    const double rows = kTargetBytes / static_cast<double>(l.row_bytes());
+    int c = 4;
+    while (c < 64 && double(2 * c) * double(2 * c) <= rows) c *= 2;
+    l.chunk_rows = c;
+    l.chunk_slices = c;
+    return l;
+}
+
+namespace {
+
+struct DtypeName {
+    VoxelType type;
+    std::string_view name;
+};
+constexpr DtypeName kDtypes[] = {
+    {VoxelType::u8, "|u1"},  {VoxelType::i8, "|i1"},  {VoxelType::u16, "<u2"},
+    {VoxelType::i16, "<i2"}, {VoxelType::u32, "<u4"}, {VoxelType::i32, "<i4"},
+    {VoxelType::f32, "<f4"}, {VoxelType::f64, "<f8"},
+};
+
+[[noreturn]] void bad(const std::string& store, const std::string& field, const std::string& why) {
+    throw InputError(store, field, why);
+}
+
+// A positive int within `limit` from json, or the line naming store/file: field.
+int positive_int(const json& j, const std::string& store, const std::string& field, long limit) {
+    if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > limit)
+        bad(store, field,
+            "expected an integer from 1 to " + std::to_string(limit) + ", got " + quote(j.dump()));
+    return static_cast<int>(j.get<long long>());
+}
+
+json parse_json(std::string_view text, const std::string& store, const std::string& file) {
+    json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded() || !j.is_object()) bad(store, file, "not a JSON object");
+    return j;
+}
+
+const json& member(const json& j, const char* name, const std::string& store,
+                   const std::string& file) {
+    const auto it = j.find(name);
+    if (it == j.end()) bad(store, file + ": " + name, "missing");
+    return *it;
+}
+
+}  // namespace
+
+std::string zarr_dtype(VoxelType t) {
+    for (const auto& d : kDtypes)
+        if (d.type == t) return std::string(d.name);
+    return "|u1";
+}
+
+std::optional<VoxelType> parse_zarr_dtype(std::string_view s) {
+    for (const auto& d : kDtypes)
+        if (d.name == s) return d.type;
+    return std::nullopt;
+}
+
+std::string zgroup_json() {
+    return json{{"zarr_format", 2}}.dump(4) + "\n";
+}
+
+std::string zarray_json(const StoreLayout& l) {
+    const json j = {
+        {"zarr_format", 2},
+        {"shape", {l.dims.z, l.dims.y, l.dims.x}},
+        {"chunks", {l.chunk_slices, l.chunk_rows, l.dims.x}},
+        {"dtype", zarr_dtype(l.type)},
+        {"compressor", {{"id", "zstd"}, {"level", l.zstd_level}, {"checksum", true}}},
+        {"fill_value", 0},
+        {"order", "C"},
+        {"filters", nullptr},
+        {"dimension_separator", "/"},
+    };
+    return j.dump(4) + "\n";
+}
+
+std::string zattrs_json(const StoreLayout& l) {
+    const json axes = json::array({{{"name", "z"}, {"type", "space"}},
+                                   {{"name", "y"}, {"type", "space"}},
+                                   {{"name", "x"}, {"type", "space"}}});
+    const json scale = {{"type", "scale"}, {"scale", {l.spacing.z, l.spacing.y, l.spacing.x}}};
+    const json j = {
+        {"multiscales",
+         json::array({{{"version", "0.4"},
+                       {"name", fs::path(l.source).filename().string()},
+                       {"axes", axes},
+                       {"datasets",
+                        json::array({{{"path", "0"},
+                                      {"coordinateTransformations", json::array({scale})}}})}}})},
+        {"isowall",
+         {{"format", kFormatVersion},
+          {"source", l.source},
+          {"value_min", l.value_min},
+          {"value_max", l.value_max},
+          {"chunks", l.chunk_count()}}},
+    };
+    return j.dump(4) + "\n";
+}
+
+StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
+                         const std::string& store) {
+    constexpr long kMaxSide = 2147483647;
+    const std::string za = "0/.zarray", at = ".zattrs";
+    const json a = parse_json(zarray, store, za);
+    const json t = parse_json(zattrs, store, at);
+    StoreLayout l;
+    if (member(a, "zarr_format", store, za) != 2)
+        bad(store, za + ": zarr_format", "expected 2 (isowall reads Zarr v2 stores)");
+    const json& shape = member(a, "shape", store, za);
+    const json& chunks = member(a, "chunks", store, za);
+    if (!shape.is_array() || shape.size() != 3)
+        bad(store, za + ": shape", "expected 3 sizes (z, y, x), got " + quote(shape.dump()));
+    if (!chunks.is_array() || chunks.size() != 3)
+        bad(store, za + ": chunks", "expected 3 sizes (z, y, x), got " + quote(chunks.dump()));
+    l.dims = {positive_int(shape[2], store, za + ": shape", kMaxSide),
+              positive_int(shape[1], store, za + ": shape", kMaxSide),
+              positive_int(shape[0], store, za + ": shape", kMaxSide)};
+    if (glm::any(glm::lessThan(l.dims, glm::ivec3(2))))
+        bad(store, za + ": shape",
+            "every side needs at least 2 voxels, got " + quote(shape.dump()));
+    l.chunk_slices = positive_int(chunks[0], store, za + ": chunks", kMaxSide);
+    l.chunk_rows = positive_int(chunks[1], store, za + ": chunks", kMaxSide);
+    if (positive_int(chunks[2], store, za + ": chunks", kMaxSide) != l.dims.x)
+        bad(store, za + ": chunks",
+            "isowall reads chunks of whole rows (the last chunk size equal to shape's x), got " +
+                quote(chunks.dump()));
+    const json& dtype = member(a, "dtype", store, za);
+    const auto type = dtype.is_string() ? parse_zarr_dtype(dtype.get<std::string>()) : std::nullopt;
+    if (!type)
+        bad(store, za + ": dtype",
+            "expected a little-endian |u1 |i1 <u2 <i2 <u4 <i4 <f4 <f8, got " + quote(dtype.dump()));
+    l.type = *type;
+    const json& comp = member(a, "compressor", store, za);
+    if (!comp.is_object() || comp.value("id", "") != "zstd")
+        bad(store, za + ": compressor", "expected zstd, got " + quote(comp.dump()));
+    if (a.value("order", "C") != "C")
+        bad(store, za + ": order", "expected \"C\", got " + quote(a["order"].dump()));
+    if (a.contains("filters") && !a["filters"].is_null())
+        bad(store, za + ": filters", "expected null, got " + quote(a["filters"].dump()));
+    if (a.value("dimension_separator", ".") != "/")
+        bad(store, za + ": dimension_separator", "expected \"/\"");
+
+    const json& iso = member(t, "isowall", store, at);
+    if (!iso.is_object() || iso.value("format", 0) != kFormatVersion)
+        bad(store, at + ": isowall.format",
+            "expected " + std::to_string(kFormatVersion) + " (a store isowall wrote)");
+    l.source = iso.value("source", std::string());
+    if (!iso.contains("value_min") || !iso["value_min"].is_number() || !iso.contains("value_max") ||
+        !iso["value_max"].is_number())
+        bad(store, at + ": isowall.value_min", "expected two numbers, value_min and value_max");
+    l.value_min = iso["value_min"].get<double>();
+    l.value_max = iso["value_max"].get<double>();
+    if (!iso.contains("chunks") || !iso["chunks"].is_number_unsigned() ||
+        iso["chunks"].get<std::uint64_t>() != l.chunk_count())
+        bad(store, at + ": isowall.chunks",
+            "disagrees with 0/.zarray (which makes " + std::to_string(l.chunk_count()) +
+                " chunks of its shape), got " + quote(iso.value("chunks", json()).dump()));
+    // The spacing: the first dataset's scale transform, z y x.
+    try {
+        const json& s = t.at("multiscales")
+                            .at(0)
+                            .at("datasets")
+                            .at(0)
+                            .at("coordinateTransformations")
+                            .at(0)
+                            .at("scale");
+        const double sx = s.at(2).get<double>(), sy = s.at(1).get<double>(),
+                     sz = s.at(0).get<double>();
+        for (double v : {sx, sy, sz})
+            if (!(v > 0) || !std::isfinite(v) || v > 1e6) throw std::runtime_error("range");
+        l.spacing = {float(sx), float(sy), float(sz)};
+    } catch (const std::exception&) {
+        bad(store, at + ": multiscales", "expected a scale of three positive numbers for path 0");
+    }
+    return l;
+}
+
+std::string chunk_key(int cy, int cz) {
+    return "0/" + std::to_string(cz) + "/" + std::to_string(cy) + "/0";
+}
+
+fs::path store_path(const std::string& text) {
+    fs::path p = fs::path(text).lexically_normal();
+    if (!p.has_filename() && p.has_parent_path()) p = p.parent_path();
+    return p;
+}
+
+bool is_store(const fs::path& path) {
+    std::error_code ec;
+    return fs::is_directory(path, ec) && fs::exists(path / ".zattrs", ec) &&
+           fs::exists(path / "0" / ".zarray", ec);
+}
+
+std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
+    std::string s(text);
+    std::size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(s, &used);
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+    std::string unit = s.substr(used);
+    std::transform(unit.begin(), unit.end(), unit.begin(),
+                   [](unsigned char c) { return char(std::toupper(c)); });
+    double scale = 1;
+    if (unit.empty() || unit == "B")
+        scale = 1;
+    else if (unit == "K" || unit == "KB" || unit == "KIB")
+        scale = 1024.0;
+    else if (unit == "M" || unit == "MB" || unit == "MIB")
+        scale = 1024.0 * 1024;
+    else if (unit == "G" || unit == "GB" || unit == "GIB")
+        scale = 1024.0 * 1024 * 1024;
+    else if (unit == "T" || unit == "TB" || unit == "TIB")
+        scale = 1024.0 * 1024 * 1024 * 1024;
+    else
+        return std::nullopt;
+    const double bytes = v * scale;
+    if (!std::isfinite(bytes) || bytes < 1 || bytes > 1.8e19) return std::nullopt;
+    return static_cast<std::uint64_t>(bytes);
+}
+
+}  // namespace isowall::store

@@ -1,0 +1,113 @@
+#include "common/store/store_reader.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <zstd.h>
+
+#include "common/core/error.h"
+
+namespace isowall::store {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The whole of a small metadata file; InputError when it cannot be read or is implausibly large.
+std::string read_text(const fs::path& file, const std::string& store, const std::string& name) {
+    constexpr std::uintmax_t kMaxMeta = 1 << 20;
+    std::error_code ec;
+    const auto size = fs::file_size(file, ec);
+    if (ec) throw InputError(store, name, "cannot read: " + ec.message());
+    if (size > kMaxMeta) throw InputError(store, name, "larger than 1 MiB: not store metadata");
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    if (!in && !in.eof()) throw InputError(store, name, "cannot read");
+    return s.str();
+}
+
+struct Fd {
+    int fd = -1;
+    ~Fd() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+}  // namespace
+
+StoreReader::StoreReader(const fs::path& store) : path_(store) {
+    const std::string where = store.string();
+    if (!is_store(store))
+        throw InputError(where, "store", "not a store (no .zattrs and 0/.zarray in the folder)");
+    layout_ = parse_layout(read_text(store / "0" / ".zarray", where, "0/.zarray"),
+                           read_text(store / ".zattrs", where, ".zattrs"), where);
+    const glm::ivec2 grid = layout_.chunk_grid();
+    for (int cz = 0; cz < grid.y; ++cz)
+        for (int cy = 0; cy < grid.x; ++cy) {
+            struct stat st {};
+            const fs::path f = store / chunk_key(cy, cz);
+            if (::stat(f.c_str(), &st) != 0)
+                throw InputError(where, chunk_key(cy, cz),
+                                 std::string("chunk missing: ") + std::strerror(errno));
+            if (!S_ISREG(st.st_mode) || st.st_size == 0)
+                throw InputError(where, chunk_key(cy, cz), "chunk is not a non-empty file");
+            bytes_on_disk_ += static_cast<std::uint64_t>(st.st_size);
+        }
+}
+
+std::string StoreReader::chunk_name(int cy, int cz) const {
+    return (path_ / chunk_key(cy, cz)).string();
+}
+
+std::size_t StoreReader::read_chunk(int cy, int cz, std::span<std::byte> out) const {
+    const std::string where = path_.string(), key = chunk_key(cy, cz);
+    const std::size_t want = layout_.chunk_bytes(cy, cz);
+    if (out.size() != want) throw InputError(where, key, "internal: wrong chunk buffer size");
+    Fd f;
+    f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC);
+    if (f.fd < 0) throw InputError(where, key, std::string("cannot open: ") + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(f.fd, &st) != 0 || !S_ISREG(st.st_mode))
+        throw InputError(where, key, "chunk is not a file");
+    // zstd never expands data by more than a small bound; a chunk larger than that is not ours.
+    const std::size_t size = static_cast<std::size_t>(st.st_size);
+    if (size > ZSTD_compressBound(want) + 64)
+        throw InputError(where, key, "chunk larger than its voxels could compress to");
+    std::vector<std::byte> packed(size);
+    std::size_t got = 0;
+    while (got < size) {
+        const ssize_t n = ::read(f.fd, packed.data() + got, size - got);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0)
+            throw InputError(where, key, std::string("cannot read: ") + std::strerror(errno));
+        if (n == 0) break;
+        got += static_cast<std::size_t>(n);
+    }
+    if (got != size) throw InputError(where, key, "chunk shorter than its size (truncated)");
+    const unsigned long long content = ZSTD_getFrameContentSize(packed.data(), size);
+    if (content == ZSTD_CONTENTSIZE_ERROR)
+        throw InputError(where, key, "not a zstd frame (a damaged or foreign chunk)");
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != want)
+        throw InputError(where, key,
+                         "holds " + std::to_string(content) + " bytes, the layout needs " +
+                             std::to_string(want) + " (metadata and chunks disagree)");
+    const std::size_t n = ZSTD_decompress(out.data(), out.size(), packed.data(), size);
+    if (ZSTD_isError(n))
+        throw InputError(
+            where, key,
+            std::string("cannot decompress (") + ZSTD_getErrorName(n) + "): the chunk is damaged");
+    if (n != want)
+        throw InputError(where, key,
+                         "decompressed to " + std::to_string(n) + " bytes, the layout needs " +
+                             std::to_string(want));
+    return size;
+}
+
+}  // namespace isowall::store

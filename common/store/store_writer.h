@@ -1,0 +1,42 @@
+#pragma once
+// Writing a store (store_format.h) from a volume, one slab of chunks at a time.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+
+#include "common/store/store_format.h"
+#include "common/volume/volume.h"
+
+namespace isowall::store {
+
+struct ImportProgress {
+    std::size_t chunks_done = 0, chunks_total = 0;
+    std::uint64_t bytes_in = 0;   // voxel bytes compressed so far
+    std::uint64_t bytes_out = 0;  // chunk bytes written so far
+};
+
+struct ImportResult {
+    StoreLayout layout;
+    std::uint64_t bytes_in = 0, bytes_out = 0;
+};
+
+struct ImportOptions {
+    bool replace = false;  // an existing store at `out` is replaced (else it is an error)
+    int threads = 1;       // chunks compressed at once
+    int zstd_level = 3;
+    std::function<void(const ImportProgress&)> progress;  // after each slab of chunks
+};
+
+// Writes `volume` as a store at `out`. The store is built under a temporary name beside `out`
+// and renamed into place only when whole, so a run that is stopped leaves no store (and the next
+// run starts over); a store is never half old, half new. Memory stays bounded by a slab of chunks
+// per thread: a memory-mapped source lets go of each slab's pages once it is written. Errors
+// (a full or read-only disk, an existing `out`) are InputErrors naming `out`; the temporary is
+// removed.
+ImportResult write_store(const Volume& volume, const std::filesystem::path& out,
+                         const ImportOptions& options);
+
+// Where write_store builds the store before renaming it (".NAME.importing" beside it).
+std::filesystem::path temporary_for(const std::filesystem::path& out);
+
+}  // namespace isowall::store
