@@ -74,8 +74,15 @@ int run_import(const ImportCommand& o) {
     if (!o.source.empty()) vo.path = o.source;
     if (vo.path.empty())
         throw InputError("source", "value", "name the volume to import (a file or folder)");
-    check_outputs({{"--out", o.out}});
     const std::filesystem::path out = store::store_path(o.out);
+    {
+        // The store is a folder, so the file checks of other outputs do not apply; its parent must
+        // be there (a typo'd path is not created).
+        const std::filesystem::path parent = std::filesystem::absolute(out).parent_path();
+        std::error_code ec;
+        if (!std::filesystem::is_directory(parent, ec))
+            throw InputError(o.out, "--out", "folder " + parent.string() + " does not exist");
+    }
     OpenedVolume ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
     if (ov.volume.paged() && std::filesystem::equivalent(*ov.file, out))
         throw InputError(o.out, "--out", "is the store being imported");

@@ -1,0 +1,246 @@
+// Volume stores (common/store): the metadata, import, paging under a cap, and damaged stores.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "common/core/error.h"
+#include "common/extract/surface_extractor.h"
+#include "common/store/open_store.h"
+#include "common/store/store_writer.h"
+#include "common/volume/phantom.h"
+#include "tests/test_util.h"
+
+namespace isowall::store {
+namespace {
+namespace fs = std::filesystem;
+
+// A volume whose every voxel says where it is, so a voxel from the wrong place shows.
+Volume pattern_volume(glm::ivec3 dims) {
+    std::vector<std::byte> bytes(std::size_t(dims.x) * dims.y * dims.z * 2);
+    auto* p = reinterpret_cast<std::uint16_t*>(bytes.data());
+    for (int z = 0; z < dims.z; ++z)
+        for (int y = 0; y < dims.y; ++y)
+            for (int x = 0; x < dims.x; ++x)
+                *p++ = static_cast<std::uint16_t>(x * 7 + y * 131 + z * 1031);
+    return Volume(dims, VoxelType::u16, {1.0f, 0.5f, 2.0f}, std::move(bytes), "pattern");
+}
+
+fs::path import_to(const Volume& v, const std::string& name) {
+    const fs::path dir = test::scratch_dir(name);
+    ImportOptions o;
+    o.threads = 2;
+    write_store(v, dir / "store", o);
+    return dir / "store";
+}
+
+void expect_line(const std::function<void()>& f, std::initializer_list<std::string> mentions) {
+    try {
+        f();
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        for (const auto& m : mentions) EXPECT_NE(what.find(m), std::string::npos) << what;
+    }
+}
+
+TEST(StoreFormat, ByteSizesParseAndNonsenseDoesNot) {
+    EXPECT_EQ(parse_byte_size("512M"), 512ull << 20);
+    EXPECT_EQ(parse_byte_size("8G"), 8ull << 30);
+    EXPECT_EQ(parse_byte_size("1.5GiB"), 3ull << 29);
+    EXPECT_EQ(parse_byte_size("4096"), 4096u);
+    EXPECT_EQ(parse_byte_size("64kb"), 64u << 10);
+    for (const char* bad : {"", "M", "0", "-1G", "12X", "nan", "inf", "1e30T", "5 M"})
+        EXPECT_FALSE(parse_byte_size(bad)) << bad;
+}
+
+TEST(StoreFormat, LayoutIsWholeRowsNearOneMebibyte) {
+    const StoreLayout small = layout_for({100, 90, 80}, VoxelType::u8, glm::vec3(1));
+    EXPECT_EQ(small.chunk_rows, 64);  // rows of 100 bytes: 64 x 64 rows is 400 KiB
+    const StoreLayout big = layout_for({2048, 2048, 2048}, VoxelType::f32, glm::vec3(1));
+    EXPECT_EQ(big.chunk_rows, 8);  // rows of 8 KiB: 8 x 8 rows is 512 KiB
+    EXPECT_EQ(big.chunk_slices, big.chunk_rows);
+    // Edge chunks are short.
+    const StoreLayout l = layout_for({10, 70, 65}, VoxelType::u8, glm::vec3(1));
+    EXPECT_EQ(l.chunk_grid(), glm::ivec2(2, 2));
+    EXPECT_EQ(l.chunk_extent(1, 1), glm::ivec2(70 - 64, 65 - 64));
+    EXPECT_EQ(l.chunk_bytes(1, 1), std::size_t(6 * 1 * 10));
+}
+
+TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
+    StoreLayout l = layout_for({33, 20, 17}, VoxelType::i16, {0.5f, 0.25f, 3.0f});
+    l.value_min = -12;
+    l.value_max = 900;
+    l.source = "head.nrrd";
+    const StoreLayout back = parse_layout(zarray_json(l), zattrs_json(l), "s");
+    EXPECT_EQ(back.dims, l.dims);
+    EXPECT_EQ(back.type, l.type);
+    EXPECT_EQ(back.spacing, l.spacing);
+    EXPECT_EQ(back.chunk_rows, l.chunk_rows);
+    EXPECT_EQ(back.chunk_slices, l.chunk_slices);
+    EXPECT_EQ(back.value_min, -12);
+    EXPECT_EQ(back.value_max, 900);
+    EXPECT_EQ(back.source, "head.nrrd");
+    for (VoxelType t : {VoxelType::u8, VoxelType::i8, VoxelType::u16, VoxelType::i16,
+                        VoxelType::u32, VoxelType::i32, VoxelType::f32, VoxelType::f64})
+        EXPECT_EQ(parse_zarr_dtype(zarr_dtype(t)), t);
+
+    auto with = [&](std::string text, const std::string& from, const std::string& to) {
+        const auto at = text.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return text.replace(at, from.size(), to);
+    };
+    const std::string za = zarray_json(l), at = zattrs_json(l);
+    expect_line([&] { parse_layout("{", at, "s"); }, {"s", "0/.zarray", "JSON"});
+    expect_line([&] { parse_layout(with(za, "\"<i2\"", "\">i2\""), at, "s"); }, {"dtype"});
+    expect_line([&] { parse_layout(with(za, "\"zstd\"", "\"blosc\""), at, "s"); }, {"compressor"});
+    expect_line([&] { parse_layout(with(za, "33\n", "32\n"), at, "s"); }, {"chunks", "whole rows"});
+    expect_line([&] { parse_layout(za, with(at, "\"chunks\": 1", "\"chunks\": 7"), "s"); },
+                {".zattrs", "isowall.chunks", "disagrees"});
+    expect_line([&] { parse_layout(za, with(at, "\"format\": 1", "\"format\": 2"), "s"); },
+                {"isowall.format"});
+    expect_line(
+        [&] { parse_layout(with(za, "\"zarr_format\": 2", "\"zarr_format\": 3"), at, "s"); },
+        {"zarr_format"});
+}
+
+TEST(StoreImport, EveryVoxelComesBackUnderACapThatForcesEvictions) {
+    const Volume v = pattern_volume({300, 260, 200});
+    const fs::path store = import_to(v, "store_pattern");
+    EXPECT_TRUE(is_store(store));
+    EXPECT_FALSE(fs::exists(temporary_for(store)));
+    const StoreReader reader(store);
+    const std::uint64_t cap = PagedVoxels::min_cap(reader.layout());
+    ASSERT_LT(cap * 2, v.bytes().size()) << "the cap must be well under the volume";
+    OpenedStore opened = open_store(store, cap);
+    ASSERT_TRUE(opened.pager) << opened.how;
+    const Volume& pv = opened.volume;
+    EXPECT_EQ(pv.dims(), v.dims());
+    EXPECT_EQ(pv.spacing(), v.spacing());
+    EXPECT_TRUE(pv.paged());
+    // Two threads, random voxels then a sweep: every byte as imported.
+    auto check = [&](unsigned seed, std::size_t* bad) {
+        std::mt19937_64 rng(seed);
+        const auto a = v.bytes(), b = pv.bytes();
+        for (int i = 0; i < 1500; ++i) {  // each a refault, mostly: about 2 ms each
+            const std::size_t k = rng() % a.size();
+            if (a[k] != b[k]) ++*bad;
+        }
+    };
+    std::size_t bad1 = 0, bad2 = 0;
+    std::thread t1(check, 1u, &bad1), t2(check, 2u, &bad2);
+    t1.join();
+    t2.join();
+    EXPECT_EQ(bad1 + bad2, 0u);
+    EXPECT_EQ(std::memcmp(v.bytes().data(), pv.bytes().data(), v.bytes().size()), 0);
+    const PagingStats s = opened.pager->stats();
+    EXPECT_GT(s.evictions, 0u);
+    EXPECT_GT(s.refaults, 0u);
+    EXPECT_LE(s.peak_bytes, cap);
+    EXPECT_GE(s.chunks_read, reader.layout().chunk_count());
+}
+
+TEST(StoreImport, TheSurfaceFromAPagedStoreIsTheSurfaceFromMemory) {
+    const Volume v = make_phantom({{260, 230, 210}, glm::vec3(1.0f)});
+    const fs::path store = import_to(v, "store_phantom");
+    const StoreReader reader(store);
+    OpenedStore opened = open_store(store, PagedVoxels::min_cap(reader.layout()));
+    const Mesh want = make_surface_extractor(v)->extract_full(kPhantomSkinIso);
+    const Mesh got = make_surface_extractor(opened.volume)->extract_full(kPhantomSkinIso);
+    ASSERT_GT(want.triangle_count(), 1000u);
+    EXPECT_EQ(got.triangle_count(), want.triangle_count());
+    EXPECT_EQ(got.positions, want.positions);
+    EXPECT_GT(opened.pager->stats().evictions, 0u);
+}
+
+TEST(StoreImport, AnExistingStoreIsKeptUnlessReplacedAndNeverHalfWritten) {
+    const Volume a = pattern_volume({40, 30, 20});
+    const fs::path store = import_to(a, "store_replace");
+    ImportOptions o;
+    expect_line([&] { write_store(a, store, o); }, {"store", "--out", "--force"});
+    const Volume b = make_phantom({{50, 40, 30}, glm::vec3(1.0f)});
+    o.replace = true;
+    write_store(b, store, o);
+    EXPECT_EQ(StoreReader(store).layout().dims, glm::ivec3(50, 40, 30));
+    EXPECT_FALSE(fs::exists(temporary_for(store)));
+    // A folder that is not a store is never replaced.
+    const fs::path other = store.parent_path() / "notes";
+    fs::create_directories(other);
+    expect_line([&] { write_store(b, other, o); }, {"notes", "not a store"});
+    // What a stopped import left is cleared by the next one.
+    fs::create_directories(temporary_for(store.parent_path() / "fresh") / "junk");
+    write_store(b, store.parent_path() / "fresh", {});
+    EXPECT_TRUE(is_store(store.parent_path() / "fresh"));
+    EXPECT_FALSE(fs::exists(temporary_for(store.parent_path() / "fresh")));
+}
+
+TEST(StoreDamage, AMissingChunkIsRefusedAtOpenNamingIt) {
+    const fs::path store = import_to(pattern_volume({40, 300, 200}), "store_missing");
+    const std::string key = chunk_key(1, 2);
+    fs::remove(store / key);
+    expect_line([&] { StoreReader r(store); }, {store.string(), key, "missing"});
+}
+
+TEST(StoreDamage, MetadataThatDisagreesWithTheChunksIsRefused) {
+    const fs::path store = import_to(pattern_volume({40, 300, 200}), "store_disagree");
+    StoreReader r(store);
+    std::string za;
+    {
+        std::ifstream in(store / "0" / ".zarray");
+        za.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    // More rows per chunk than written: every chunk then holds fewer bytes than the layout says.
+    const auto at = za.find(std::to_string(r.layout().chunk_rows) + ",");
+    ASSERT_NE(at, std::string::npos);
+    za.replace(at, std::to_string(r.layout().chunk_rows).size(), "33");
+    std::ofstream(store / "0" / ".zarray") << za;
+    // The chunk count no longer matches: refused at open.
+    expect_line([&] { StoreReader again(store); }, {"isowall.chunks"});
+}
+
+// A damaged chunk found while a frame reads it ends the process with its line (paged_voxels.h).
+TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    const Volume v = pattern_volume({64, 128, 64});
+    const fs::path store = import_to(v, "store_corrupt");
+    const std::string key = chunk_key(1, 0);
+    {
+        std::fstream f(store / key, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(40);
+        const char junk[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+        f.write(junk, sizeof junk);
+    }
+    const StoreLayout l = StoreReader(store).layout();
+    const std::size_t at =
+        std::size_t(l.chunk_rows) * l.row_bytes() + 5;  // a voxel in chunk (1, 0)
+    EXPECT_EXIT(
+        {
+            OpenedStore s = open_store(store, 64 << 20);
+            volatile std::byte b = s.volume.bytes()[at];
+            (void)b;
+            std::_Exit(0);
+        },
+        testing::ExitedWithCode(1), key);
+    // Truncated: the same.
+    fs::resize_file(store / key, 30);
+    EXPECT_EXIT(
+        {
+            OpenedStore s = open_store(store, 64 << 20);
+            volatile std::byte b = s.volume.bytes()[at];
+            (void)b;
+            std::_Exit(0);
+        },
+        testing::ExitedWithCode(1), key);
+}
+
+TEST(StoreDamage, ACapTooSmallForTheChunksIsOneLine) {
+    const fs::path store = import_to(pattern_volume({300, 260, 40}), "store_small_cap");
+    expect_line([&] { open_store(store, 1 << 20); }, {"--memory-limit", "at least"});
+}
+
+}  // namespace
+}  // namespace isowall::store
