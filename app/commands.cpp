@@ -295,12 +295,6 @@ void print_file_facts(const Volume& v) {
                 double(p.max.z));
 }
 
-// A store's reads (common/store/paged_voxels.h), when the volume is one.
-void print_paging(const OpenedVolume& ov) {
-    if (ov.pager)
-        std::printf("store: %s\n", store::paging_line(ov.pager->stats(), ov.pager->cap()).c_str());
-}
-
 }  // namespace
 
 int run_info(const InfoOptions& o) {

@@ -112,17 +112,18 @@ int run_import(const ImportCommand& o) {
             using T = decltype(zero);
             (void)MinMaxOctree<T>::load_or_build(ov.volume.view<T>(), src, &st);
         });
-        octree_note = st.cache_note.empty() ? "cached to " + st.cache_file.string()
-                                            : "not cached: " + st.cache_note;
+        std::error_code ec;
+        octree_note = !st.cache_file.empty() && std::filesystem::exists(st.cache_file, ec)
+                          ? "cached to " + st.cache_file.string()
+                          : "not cached: " + st.cache_note;
     }
     const double mib = 1024.0 * 1024.0;
     const store::StoreLayout& l = r.layout;
     std::printf(
-        "import: wrote %s  %dx%dx%d %s, %zu chunks of %dx%dx%d, %.1f MiB -> %.1f MiB "
+        "import: wrote %s  %dx%dx%d %s, %zu bricks of %d^3, %.1f MiB -> %.1f MiB "
         "(%.2f:1) in %.2f s (%.0f MiB/s)\n",
         out.c_str(), l.dims.x, l.dims.y, l.dims.z, std::string(type_name(l.type)).c_str(),
-        l.chunk_count(), l.dims.x, l.chunk_rows, l.chunk_slices, double(r.bytes_in) / mib,
-        double(r.bytes_out) / mib,
+        l.chunk_count(), l.brick(), double(r.bytes_in) / mib, double(r.bytes_out) / mib,
         double(r.bytes_in) / double(std::max<std::uint64_t>(r.bytes_out, 1)), write_s,
         double(r.bytes_in) / mib / std::max(write_s, 1e-9));
     std::printf("import: octree %s\n", octree_note.c_str());

@@ -115,4 +115,9 @@ void print_first_picture(const FrameResult& fr, double frame_at, double load_s, 
         frame_at + first->time_s, load_s, octree_s, first->time_s);
 }
 
+void print_paging(const OpenedVolume& ov) {
+    if (ov.pager)
+        std::printf("store: %s\n", store::paging_line(ov.pager->stats(), ov.pager->cap()).c_str());
+}
+
 }  // namespace isowall

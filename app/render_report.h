@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <string>
 
+#include "cli/volume_options.h"
 #include "common/core/image.h"
 #include "common/core/util.h"
 #include "common/core/view.h"
@@ -45,5 +46,8 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
 // `frame_at` seconds after it; `load_s` and `octree_s` of that went to the volume and its octree):
 // what a user waits before a picture, a cold volume's read included.
 void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s);
+
+// A store's reads (common/store/paged_voxels.h), when the volume is one; nothing otherwise.
+void print_paging(const OpenedVolume& ov);
 
 }  // namespace isowall

@@ -58,17 +58,38 @@ TEST(StoreFormat, ByteSizesParseAndNonsenseDoesNot) {
         EXPECT_FALSE(parse_byte_size(bad)) << bad;
 }
 
-TEST(StoreFormat, LayoutIsWholeRowsNearOneMebibyte) {
+TEST(StoreFormat, BricksAre32UnlessThatMakesTooManyFiles) {
     const StoreLayout small = layout_for({100, 90, 80}, VoxelType::u8, glm::vec3(1));
-    EXPECT_EQ(small.chunk_rows, 64);  // rows of 100 bytes: 64 x 64 rows is 400 KiB
+    EXPECT_EQ(small.brick(), 32);
+    EXPECT_EQ(small.grid(), glm::ivec3(4, 3, 3));  // edge bricks padded, as Zarr stores them
+    EXPECT_EQ(small.brick_bytes(), std::size_t(32 * 32 * 32));
     const StoreLayout big = layout_for({2048, 2048, 2048}, VoxelType::f32, glm::vec3(1));
-    EXPECT_EQ(big.chunk_rows, 8);  // rows of 8 KiB: 8 x 8 rows is 512 KiB
-    EXPECT_EQ(big.chunk_slices, big.chunk_rows);
-    // Edge chunks are short.
-    const StoreLayout l = layout_for({10, 70, 65}, VoxelType::u8, glm::vec3(1));
-    EXPECT_EQ(l.chunk_grid(), glm::ivec2(2, 2));
-    EXPECT_EQ(l.chunk_extent(1, 1), glm::ivec2(70 - 64, 65 - 64));
-    EXPECT_EQ(l.chunk_bytes(1, 1), std::size_t(6 * 1 * 10));
+    EXPECT_EQ(big.brick(), 64);  // 32 would make 262,144 chunk files
+    EXPECT_EQ(big.chunk_count(), std::size_t(32768));
+    EXPECT_EQ(big.brick_bytes() % 4096, 0u);  // a page multiple: the pager copies whole pages
+    for (std::size_t i : {std::size_t(0), std::size_t(5), std::size_t(35)})
+        EXPECT_EQ(small.brick_index(small.brick_at(i)), i);
+    EXPECT_EQ(chunk_key({3, 2, 1}), "0/1/2/3");
+}
+
+TEST(StoreFormat, BrickedViewIndexesEveryVoxelOnce) {
+    VolumeView<std::uint8_t> v;
+    v.dims = {37, 33, 34};
+    v.bricks = 4;
+    v.brick_grid = (v.dims + 15) >> 4;
+    std::vector<std::uint8_t> seen(std::size_t(3 * 3 * 3) << 12, 0);
+    for (int z = 0; z < v.dims.z; ++z)
+        for (int y = 0; y < v.dims.y; ++y)
+            for (int x = 0; x < v.dims.x; ++x) {
+                const std::size_t i = v.index(x, y, z);
+                ASSERT_LT(i, seen.size());
+                EXPECT_EQ(seen[i]++, 0) << x << " " << y << " " << z;
+            }
+    // Brick (1, 0, 0) starts after the whole first brick; inside a brick, x is fastest.
+    EXPECT_EQ(v.index(16, 0, 0), std::size_t(4096));
+    EXPECT_EQ(v.index(1, 0, 0), std::size_t(1));
+    EXPECT_EQ(v.index(0, 1, 0), std::size_t(16));
+    EXPECT_EQ(v.index(0, 0, 1), std::size_t(256));
 }
 
 TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
@@ -80,8 +101,7 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
     EXPECT_EQ(back.dims, l.dims);
     EXPECT_EQ(back.type, l.type);
     EXPECT_EQ(back.spacing, l.spacing);
-    EXPECT_EQ(back.chunk_rows, l.chunk_rows);
-    EXPECT_EQ(back.chunk_slices, l.chunk_slices);
+    EXPECT_EQ(back.brick_log2, l.brick_log2);
     EXPECT_EQ(back.value_min, -12);
     EXPECT_EQ(back.value_max, 900);
     EXPECT_EQ(back.source, "head.nrrd");
@@ -98,8 +118,9 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
     expect_line([&] { parse_layout("{", at, "s"); }, {"s", "0/.zarray", "JSON"});
     expect_line([&] { parse_layout(with(za, "\"<i2\"", "\">i2\""), at, "s"); }, {"dtype"});
     expect_line([&] { parse_layout(with(za, "\"zstd\"", "\"blosc\""), at, "s"); }, {"compressor"});
-    expect_line([&] { parse_layout(with(za, "33\n", "32\n"), at, "s"); }, {"chunks", "whole rows"});
-    expect_line([&] { parse_layout(za, with(at, "\"chunks\": 1", "\"chunks\": 7"), "s"); },
+    expect_line([&] { parse_layout(with(za, "32,", "24,"), at, "s"); }, {"chunks", "cubic"});
+    const std::string count = "\"chunks\": " + std::to_string(l.chunk_count());
+    expect_line([&] { parse_layout(za, with(at, count, "\"chunks\": 7"), "s"); },
                 {".zattrs", "isowall.chunks", "disagrees"});
     expect_line([&] { parse_layout(za, with(at, "\"format\": 1", "\"format\": 2"), "s"); },
                 {"isowall.format"});
@@ -122,13 +143,14 @@ TEST(StoreImport, EveryVoxelComesBackUnderACapThatForcesEvictions) {
     EXPECT_EQ(pv.dims(), v.dims());
     EXPECT_EQ(pv.spacing(), v.spacing());
     EXPECT_TRUE(pv.paged());
-    // Two threads, random voxels then a sweep: every byte as imported.
+    // Two threads, random voxels then a sweep: every voxel as imported.
+    const auto a = v.view<std::uint16_t>(), b = pv.view<std::uint16_t>();
+    ASSERT_TRUE(b.bricked());
     auto check = [&](unsigned seed, std::size_t* bad) {
         std::mt19937_64 rng(seed);
-        const auto a = v.bytes(), b = pv.bytes();
-        for (int i = 0; i < 1500; ++i) {  // each a refault, mostly: about 2 ms each
-            const std::size_t k = rng() % a.size();
-            if (a[k] != b[k]) ++*bad;
+        for (int i = 0; i < 4000; ++i) {
+            const int x = int(rng() % 300), y = int(rng() % 260), z = int(rng() % 200);
+            if (a.at(x, y, z) != b.at(x, y, z)) ++*bad;
         }
     };
     std::size_t bad1 = 0, bad2 = 0;
@@ -136,12 +158,21 @@ TEST(StoreImport, EveryVoxelComesBackUnderACapThatForcesEvictions) {
     t1.join();
     t2.join();
     EXPECT_EQ(bad1 + bad2, 0u);
-    EXPECT_EQ(std::memcmp(v.bytes().data(), pv.bytes().data(), v.bytes().size()), 0);
+    // Brick by brick (a sweep in x rows would cross ten bricks a row and thrash a 16-brick cap).
+    std::size_t bad = 0;
+    for (int bz = 0; bz < 200; bz += 32)
+        for (int by = 0; by < 260; by += 32)
+            for (int bx = 0; bx < 300; bx += 32)
+                for (int z = bz; z < std::min(bz + 32, 200); ++z)
+                    for (int y = by; y < std::min(by + 32, 260); ++y)
+                        for (int x = bx; x < std::min(bx + 32, 300); ++x)
+                            bad += a.at(x, y, z) != b.at(x, y, z);
+    EXPECT_EQ(bad, 0u);
     const PagingStats s = opened.pager->stats();
     EXPECT_GT(s.evictions, 0u);
     EXPECT_GT(s.refaults, 0u);
     EXPECT_LE(s.peak_bytes, cap);
-    EXPECT_GE(s.chunks_read, reader.layout().chunk_count());
+    EXPECT_GE(s.faults, reader.layout().chunk_count());
 }
 
 TEST(StoreImport, TheSurfaceFromAPagedStoreIsTheSurfaceFromMemory) {
@@ -180,7 +211,7 @@ TEST(StoreImport, AnExistingStoreIsKeptUnlessReplacedAndNeverHalfWritten) {
 
 TEST(StoreDamage, AMissingChunkIsRefusedAtOpenNamingIt) {
     const fs::path store = import_to(pattern_volume({40, 300, 200}), "store_missing");
-    const std::string key = chunk_key(1, 2);
+    const std::string key = chunk_key({1, 2, 0});
     fs::remove(store / key);
     expect_line([&] { StoreReader r(store); }, {store.string(), key, "missing"});
 }
@@ -193,10 +224,16 @@ TEST(StoreDamage, MetadataThatDisagreesWithTheChunksIsRefused) {
         std::ifstream in(store / "0" / ".zarray");
         za.assign(std::istreambuf_iterator<char>(in), {});
     }
-    // More rows per chunk than written: every chunk then holds fewer bytes than the layout says.
-    const auto at = za.find(std::to_string(r.layout().chunk_rows) + ",");
+    // Bricks of 16 instead of 32: eight times the chunks the store holds.
+    const auto at = za.find("32,");
     ASSERT_NE(at, std::string::npos);
-    za.replace(at, std::to_string(r.layout().chunk_rows).size(), "33");
+    za.replace(at, 2, "16");
+    const auto at2 = za.find("32,", at);
+    ASSERT_NE(at2, std::string::npos);
+    za.replace(at2, 2, "16");
+    const auto at3 = za.find("32\n", at2);
+    ASSERT_NE(at3, std::string::npos);
+    za.replace(at3, 2, "16");
     std::ofstream(store / "0" / ".zarray") << za;
     // The chunk count no longer matches: refused at open.
     expect_line([&] { StoreReader again(store); }, {"isowall.chunks"});
@@ -207,7 +244,7 @@ TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");
     const Volume v = pattern_volume({64, 128, 64});
     const fs::path store = import_to(v, "store_corrupt");
-    const std::string key = chunk_key(1, 0);
+    const std::string key = chunk_key({1, 0, 0});
     {
         std::fstream f(store / key, std::ios::in | std::ios::out | std::ios::binary);
         f.seekp(40);
@@ -215,8 +252,7 @@ TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
         f.write(junk, sizeof junk);
     }
     const StoreLayout l = StoreReader(store).layout();
-    const std::size_t at =
-        std::size_t(l.chunk_rows) * l.row_bytes() + 5;  // a voxel in chunk (1, 0)
+    const std::size_t at = l.brick_bytes() + 5;  // a voxel of brick (1, 0, 0)
     EXPECT_EXIT(
         {
             OpenedStore s = open_store(store, 64 << 20);
@@ -239,7 +275,7 @@ TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
 
 TEST(StoreDamage, ACapTooSmallForTheChunksIsOneLine) {
     const fs::path store = import_to(pattern_volume({300, 260, 40}), "store_small_cap");
-    expect_line([&] { open_store(store, 1 << 20); }, {"--memory-limit", "at least"});
+    expect_line([&] { open_store(store, 512 << 10); }, {"--memory-limit", "at least"});
 }
 
 }  // namespace

@@ -27,6 +27,11 @@ void emit_brick(const VolumeView<T>& v, glm::ivec3 b, glm::ivec3 e, double iso, 
     const InsideTest<T> is_inside(iso);
     for (int z = 0; z < n.z; ++z)
         for (int y = 0; y < n.y; ++y) {
+            if (v.bricked()) {
+                for (int x = 0; x < n.x; ++x)
+                    inside[z][y][x] = is_inside(v.at(b.x + x, b.y + y, b.z + z));
+                continue;
+            }
             const T* row = v.data + v.index(b.x, b.y + y, b.z + z);
             for (int x = 0; x < n.x; ++x) inside[z][y][x] = is_inside(row[x]);
         }

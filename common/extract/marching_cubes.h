@@ -72,6 +72,13 @@ inline UnitStrides unit_strides(const VolumeView<T>& v, int level) {
 // the unit must be complete (all eight corners inside the volume).
 template <class T>
 inline void meta_cell_corners(const VolumeView<T>& v, glm::ivec3 base, int level, double out[8]) {
+    if (v.bricked()) {
+        const int s = 1 << level;
+        for (int k = 0; k < 8; ++k)
+            out[k] = static_cast<double>(
+                v.at(base.x + s * (k & 1), base.y + s * ((k >> 1) & 1), base.z + s * (k >> 2)));
+        return;
+    }
     const UnitStrides d = unit_strides(v, level);
     const T* p = v.data + v.index(base.x, base.y, base.z);
     out[0] = static_cast<double>(p[0]);
@@ -96,6 +103,15 @@ inline void cell_corners(const VolumeView<T>& v, glm::ivec3 c, double out[8]) {
 template <class T>
 inline int meta_cell_case(const VolumeView<T>& v, glm::ivec3 base, int level,
                           const InsideTest<T>& inside) {
+    if (v.bricked()) {
+        const int s = 1 << level;
+        int c = 0;
+        for (int k = 0; k < 8; ++k)
+            c |= inside(
+                     v.at(base.x + s * (k & 1), base.y + s * ((k >> 1) & 1), base.z + s * (k >> 2)))
+                 << k;
+        return c;
+    }
     const UnitStrides d = unit_strides(v, level);
     const T* p = v.data + v.index(base.x, base.y, base.z);
     return inside(p[0]) | inside(p[d.x]) << 1 | inside(p[d.y]) << 2 | inside(p[d.y + d.x]) << 3 |
@@ -123,6 +139,15 @@ inline glm::vec3 gradient(const VolumeView<T>& v, glm::ivec3 p, glm::vec3 inv_st
         const std::size_t lo = has_lo ? i - step[a] : i, hi = has_hi ? i + step[a] : i;
         // A one-sided difference spans one voxel, not two.
         const float scale = (has_lo && has_hi) ? inv_step[a] : 2.0f * inv_step[a];
+        if (v.bricked()) {
+            glm::ivec3 l = p, h = p;
+            l[a] -= has_lo ? 1 : 0;
+            h[a] += has_hi ? 1 : 0;
+            g[a] = (static_cast<float>(v.at(h.x, h.y, h.z)) -
+                    static_cast<float>(v.at(l.x, l.y, l.z))) *
+                   scale;
+            continue;
+        }
         g[a] = (static_cast<float>(v.data[hi]) - static_cast<float>(v.data[lo])) * scale;
     }
     return g;

@@ -20,13 +20,14 @@ std::string mib(std::uint64_t bytes) {
 
 void add_facts(Volume& v, const StoreReader& r) {
     const StoreLayout& l = r.layout();
-    const double raw = double(l.dims.z) * double(l.dims.y) * double(l.row_bytes());
+    const double raw = double(l.chunk_count()) * double(l.brick_bytes());
     char text[160];
-    std::snprintf(text, sizeof text, "Zarr v2 (OME-Zarr 0.4), %zu chunks of %dx%dx%d, zstd %.2f:1",
-                  l.chunk_count(), l.dims.x, l.chunk_rows, l.chunk_slices,
+    std::snprintf(text, sizeof text,
+                  "Zarr v2 (OME-Zarr 0.4), %zu bricks of %d^3 voxels, 1 level, zstd %.2f:1",
+                  l.chunk_count(), l.brick(),
                   r.bytes_on_disk() ? raw / double(r.bytes_on_disk()) : 0.0);
     v.add_fact("store", text);
-    std::snprintf(text, sizeof text, "%.1f MiB of chunks (%.1f MiB of voxels)",
+    std::snprintf(text, sizeof text, "%.1f MiB of chunks (%.1f MiB of bricks)",
                   double(r.bytes_on_disk()) / (1024.0 * 1024.0), raw / (1024.0 * 1024.0));
     v.add_fact("on disk", text);
     if (!l.source.empty()) v.add_fact("imported from", l.source);
@@ -48,33 +49,21 @@ OpenedStore open_store(const fs::path& path, std::uint64_t cap_bytes) {
     } catch (const InputError&) {
         throw;
     } catch (const std::runtime_error& e) {
-        // No userfaultfd here: the whole volume, when it fits.
-        const std::uint64_t bytes =
-            std::uint64_t(l.dims.z) * std::uint64_t(l.dims.y) * l.row_bytes();
+        // No userfaultfd here: every brick at once, when they fit.
+        const std::uint64_t bytes = std::uint64_t(l.chunk_count()) * l.brick_bytes();
         if (bytes > cap_bytes)
             throw InputError(source, "--memory-limit",
                              std::string("paging needs userfaultfd (") + e.what() +
                                  "), and the voxels (" + mib(bytes) + ") pass the limit (" +
                                  mib(cap_bytes) + ")");
         std::vector<std::byte> all(bytes);
-        const glm::ivec2 grid = l.chunk_grid();
-        // Chunks of whole rows in C order: slab by slab, each slab's chunks interleave by slice.
-        for (int cz = 0; cz < grid.y; ++cz) {
-            const std::size_t slice = std::size_t(l.dims.y) * l.row_bytes();
-            for (int cy = 0; cy < grid.x; ++cy) {
-                std::vector<std::byte> c(l.chunk_bytes(cy, cz));
-                reader->read_chunk(cy, cz, c);
-                const glm::ivec2 ext = l.chunk_extent(cy, cz);
-                const std::size_t block = std::size_t(ext.x) * l.row_bytes();
-                for (int z = 0; z < ext.y; ++z)
-                    std::copy_n(c.data() + std::size_t(z) * block, block,
-                                all.data() + (std::size_t(cz) * l.chunk_slices + z) * slice +
-                                    std::size_t(cy) * l.chunk_rows * l.row_bytes());
-            }
-        }
+        for (std::size_t i = 0; i < l.chunk_count(); ++i)
+            reader->read_chunk(l.brick_at(i),
+                               std::span(all).subspan(i * l.brick_bytes(), l.brick_bytes()));
         out.volume = Volume(l.dims, l.type, l.spacing, std::move(all), source);
         out.how = std::string("read whole: no paging here (") + e.what() + ")";
     }
+    out.volume.set_bricks(l.brick_log2);
     out.volume.set_files({path / ".zattrs", path / "0" / ".zarray"});
     add_facts(out.volume, *reader);
     return out;

@@ -13,27 +13,13 @@ namespace isowall::store {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-glm::ivec2 StoreLayout::chunk_extent(int cy, int cz) const {
-    return {std::min(chunk_rows, dims.y - cy * chunk_rows),
-            std::min(chunk_slices, dims.z - cz * chunk_slices)};
-}
-
-std::size_t StoreLayout::chunk_bytes(int cy, int cz) const {
-    const glm::ivec2 e = chunk_extent(cy, cz);
-    return static_cast<std::size_t>(e.x) * static_cast<std::size_t>(e.y) * row_bytes();
-}
-
 StoreLayout layout_for(glm::ivec3 dims, VoxelType type, glm::vec3 spacing) {
-    constexpr double kTargetBytes = 1 << 20;
     StoreLayout l;
     l.dims = dims;
     l.type = type;
     l.spacing = spacing;
-    const double rows = kTargetBytes / static_cast<double>(l.row_bytes());
-    int c = 4;
-    while (c < 64 && double(2 * c) * double(2 * c) <= rows) c *= 2;
-    l.chunk_rows = c;
-    l.chunk_slices = c;
+    l.brick_log2 = 5;
+    if (l.chunk_count() > 65536) l.brick_log2 = 6;
     return l;
 }
 
@@ -96,7 +82,7 @@ std::string zarray_json(const StoreLayout& l) {
     const json j = {
         {"zarr_format", 2},
         {"shape", {l.dims.z, l.dims.y, l.dims.x}},
-        {"chunks", {l.chunk_slices, l.chunk_rows, l.dims.x}},
+        {"chunks", {l.brick(), l.brick(), l.brick()}},
         {"dtype", zarr_dtype(l.type)},
         {"compressor", {{"id", "zstd"}, {"level", l.zstd_level}, {"checksum", true}}},
         {"fill_value", 0},
@@ -151,11 +137,14 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     if (glm::any(glm::lessThan(l.dims, glm::ivec3(2))))
         bad(store, za + ": shape",
             "every side needs at least 2 voxels, got " + quote(shape.dump()));
-    l.chunk_slices = positive_int(chunks[0], store, za + ": chunks", kMaxSide);
-    l.chunk_rows = positive_int(chunks[1], store, za + ": chunks", kMaxSide);
-    if (positive_int(chunks[2], store, za + ": chunks", kMaxSide) != l.dims.x)
+    const int side = positive_int(chunks[0], store, za + ": chunks", kMaxSide);
+    l.brick_log2 = 0;
+    while ((1 << l.brick_log2) < side && l.brick_log2 < 8) ++l.brick_log2;
+    if ((1 << l.brick_log2) != side || side < 8 || side > 128 ||
+        positive_int(chunks[1], store, za + ": chunks", kMaxSide) != side ||
+        positive_int(chunks[2], store, za + ": chunks", kMaxSide) != side)
         bad(store, za + ": chunks",
-            "isowall reads chunks of whole rows (the last chunk size equal to shape's x), got " +
+            "isowall reads cubic chunks of 8 to 128 voxels a side, a power of two, got " +
                 quote(chunks.dump()));
     const json& dtype = member(a, "dtype", store, za);
     const auto type = dtype.is_string() ? parse_zarr_dtype(dtype.get<std::string>()) : std::nullopt;
@@ -208,8 +197,8 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     return l;
 }
 
-std::string chunk_key(int cy, int cz) {
-    return "0/" + std::to_string(cz) + "/" + std::to_string(cy) + "/0";
+std::string chunk_key(glm::ivec3 b) {
+    return "0/" + std::to_string(b.z) + "/" + std::to_string(b.y) + "/" + std::to_string(b.x);
 }
 
 fs::path store_path(const std::string& text) {

@@ -5,14 +5,14 @@
 //   STORE/.zgroup          {"zarr_format": 2}
 //   STORE/.zattrs          OME-Zarr "multiscales" (axes z, y, x; the spacing as a scale) and an
 //                          "isowall" block: format version, source, value range, chunk count
-//   STORE/0/.zarray        shape [z, y, x], chunks [cz, cy, x], dtype, zstd, dimension_separator /
-//   STORE/0/Z/Y/0          one chunk: cz slices of cy whole rows, zstd with its content checksum
+//   STORE/0/.zarray        shape [z, y, x], chunks [B, B, B], dtype, zstd, dimension_separator /
+//   STORE/0/Z/Y/X          one chunk: a cubic brick of B^3 voxels (edge bricks padded with
+//                          zeros, as Zarr stores them), zstd with its content checksum
 //
-// Why chunks of whole rows: the engine reads voxels through a pointer into one x-fastest array
-// (common/volume/volume.h: VolumeView), and the pager (paged_voxels.h) fills that array a span
-// of pages at a time on first touch. A span is a run of consecutive rows, so with whole-row chunks
-// it comes from one or two chunks; with cubic chunks a single 4 KiB page of a 1024-voxel row
-// would need 16 of them. The cost is read amplification along x, bounded by the row length.
+// Why cubic bricks: a surface passes near few of them, so a frame reads what its rays and its
+// propagation touch (the dissertation's 5.2.1: propagation has strong data locality). In memory
+// the voxels keep the same bricks (VolumeView's bricked layout), so a brick on disk is one span
+// of the pager (paged_voxels.h), decompressed straight into place.
 //
 // Every chunk is a zstd frame carrying its content checksum (XXH64): zstd checks it when the
 // chunk is decompressed, so a flipped bit is an error naming the chunk, never a voxel value.
@@ -34,28 +34,39 @@ struct StoreLayout {
     glm::ivec3 dims{0};  // voxels, x y z
     VoxelType type = VoxelType::u8;
     glm::vec3 spacing{1.0f};
-    int chunk_rows = 16;    // cy: rows of a chunk in y
-    int chunk_slices = 16;  // cz: slices of a chunk in z
+    int brick_log2 = 5;  // bricks of 2^brick_log2 voxels a side (the Zarr chunk)
     int zstd_level = 3;
     std::string source;                   // what was imported, for `info`
     double value_min = 0, value_max = 0;  // finite range of the voxels
 
-    glm::ivec2 chunk_grid() const {  // chunks in y and z
-        return {(dims.y + chunk_rows - 1) / chunk_rows, (dims.z + chunk_slices - 1) / chunk_slices};
-    }
+    int brick() const { return 1 << brick_log2; }
+    glm::ivec3 grid() const { return (dims + brick() - 1) >> brick_log2; }
     std::size_t chunk_count() const {
-        const glm::ivec2 g = chunk_grid();
-        return static_cast<std::size_t>(g.x) * static_cast<std::size_t>(g.y);
+        const glm::ivec3 g = grid();
+        return static_cast<std::size_t>(g.x) * static_cast<std::size_t>(g.y) *
+               static_cast<std::size_t>(g.z);
     }
-    std::size_t row_bytes() const { return static_cast<std::size_t>(dims.x) * voxel_size(type); }
-    // Rows of chunk (cy, cz) clamped at the volume's edge (edge chunks are short, as Zarr pads
-    // only on read; we write them short and read them short).
-    glm::ivec2 chunk_extent(int cy, int cz) const;
-    std::size_t chunk_bytes(int cy, int cz) const;
+    std::size_t brick_bytes() const {
+        return (std::size_t{1} << (3 * brick_log2)) * voxel_size(type);
+    }
+    // Brick b's place in the grid, x fastest (the bricks' order in memory).
+    std::size_t brick_index(glm::ivec3 b) const {
+        const glm::ivec3 g = grid();
+        return (static_cast<std::size_t>(b.z) * static_cast<std::size_t>(g.y) +
+                static_cast<std::size_t>(b.y)) *
+                   static_cast<std::size_t>(g.x) +
+               static_cast<std::size_t>(b.x);
+    }
+    glm::ivec3 brick_at(std::size_t i) const {
+        const glm::ivec3 g = grid();
+        const std::size_t gx = static_cast<std::size_t>(g.x), gy = static_cast<std::size_t>(g.y);
+        return {static_cast<int>(i % gx), static_cast<int>(i / gx % gy),
+                static_cast<int>(i / gx / gy)};
+    }
 };
 
-// The chunk shape for a volume: whole rows, cy = cz a power of two (4..64) that keeps a chunk
-// near 1 MiB, where zstd compresses well and a read is one disk request.
+// The brick side for a volume: 32 voxels (32 KiB to 256 KiB a brick: a page multiple, small
+// enough that a surface's bricks are few), 64 when 32 would make more than 65,536 chunk files.
 StoreLayout layout_for(glm::ivec3 dims, VoxelType type, glm::vec3 spacing);
 
 // Zarr's dtype for a voxel type ("|u1", "<i2", "<f4", ...), and back.
@@ -70,8 +81,8 @@ std::string zattrs_json(const StoreLayout& l);
 StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
                          const std::string& store);
 
-// "0/Z/Y/0": the chunk's key under the store (Zarr's "/" separator, C order z, y, x).
-std::string chunk_key(int cy, int cz);
+// "0/Z/Y/X": brick b's chunk key under the store (Zarr's "/" separator, C order z, y, x).
+std::string chunk_key(glm::ivec3 b);
 
 // A store's path as every part of isowall names it (the octree cache's key and file name depend on
 // it): normalised, without a trailing separator.

@@ -48,27 +48,24 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
         throw InputError(where, "store", "not a store (no .zattrs and 0/.zarray in the folder)");
     layout_ = parse_layout(read_text(store / "0" / ".zarray", where, "0/.zarray"),
                            read_text(store / ".zattrs", where, ".zattrs"), where);
-    const glm::ivec2 grid = layout_.chunk_grid();
-    for (int cz = 0; cz < grid.y; ++cz)
-        for (int cy = 0; cy < grid.x; ++cy) {
-            struct stat st {};
-            const fs::path f = store / chunk_key(cy, cz);
-            if (::stat(f.c_str(), &st) != 0)
-                throw InputError(where, chunk_key(cy, cz),
-                                 std::string("chunk missing: ") + std::strerror(errno));
-            if (!S_ISREG(st.st_mode) || st.st_size == 0)
-                throw InputError(where, chunk_key(cy, cz), "chunk is not a non-empty file");
-            bytes_on_disk_ += static_cast<std::uint64_t>(st.st_size);
-        }
+    const glm::ivec3 grid = layout_.grid();
+    for (int bz = 0; bz < grid.z; ++bz)
+        for (int by = 0; by < grid.y; ++by)
+            for (int bx = 0; bx < grid.x; ++bx) {
+                const std::string key = chunk_key({bx, by, bz});
+                struct stat st {};
+                if (::stat((store / key).c_str(), &st) != 0)
+                    throw InputError(where, key,
+                                     std::string("chunk missing: ") + std::strerror(errno));
+                if (!S_ISREG(st.st_mode) || st.st_size == 0)
+                    throw InputError(where, key, "chunk is not a non-empty file");
+                bytes_on_disk_ += static_cast<std::uint64_t>(st.st_size);
+            }
 }
 
-std::string StoreReader::chunk_name(int cy, int cz) const {
-    return (path_ / chunk_key(cy, cz)).string();
-}
-
-std::size_t StoreReader::read_chunk(int cy, int cz, std::span<std::byte> out) const {
-    const std::string where = path_.string(), key = chunk_key(cy, cz);
-    const std::size_t want = layout_.chunk_bytes(cy, cz);
+std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) const {
+    const std::string where = path_.string(), key = chunk_key(b);
+    const std::size_t want = layout_.brick_bytes();
     if (out.size() != want) throw InputError(where, key, "internal: wrong chunk buffer size");
     Fd f;
     f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC);

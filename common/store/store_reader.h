@@ -20,14 +20,11 @@ class StoreReader {
     // Compressed bytes of every chunk (what the store takes on disk, less its metadata).
     std::uint64_t bytes_on_disk() const { return bytes_on_disk_; }
 
-    // Decompresses chunk (cy, cz) into `out`, which holds exactly layout().chunk_bytes(cy, cz).
+    // Decompresses brick b's chunk into `out`, which holds exactly layout().brick_bytes().
     // A chunk that cannot be read, is not one zstd frame, fails its checksum or has another size
     // is an InputError naming the store and the chunk: garbage never becomes voxels. Returns the
     // bytes read from disk. Safe from any thread.
-    std::size_t read_chunk(int cy, int cz, std::span<std::byte> out) const;
-
-    // "STORE/0/Z/Y/0": a chunk's name in error lines.
-    std::string chunk_name(int cy, int cz) const;
+    std::size_t read_chunk(glm::ivec3 b, std::span<std::byte> out) const;
 
   private:
     std::filesystem::path path_;

@@ -94,110 +94,16 @@ struct TempDir {
     }
 };
 
-}  // namespace
-
-fs::path temporary_for(const fs::path& out) {
-    const fs::path abs = fs::absolute(out).lexically_normal();
-    const fs::path name = abs.has_filename() ? abs.filename() : abs.parent_path().filename();
-    const fs::path dir = abs.has_filename() ? abs.parent_path() : abs.parent_path().parent_path();
-    std::string hidden(1, '.');  // built in steps: GCC 12 warns falsely on "." + s + "..."
-    hidden.append(name.string()).append(".importing");
-    return dir / hidden;
-}
-
-ImportResult write_store(const Volume& volume, const fs::path& out, const ImportOptions& options) {
-    const std::string where = out.string();
+// The metadata, then the store into place: an old store moves aside first and goes only once
+// the new one is in.
+void commit(StoreLayout& layout, const Range& range, TempDir& tmp, const fs::path& out,
+            const std::string& where) {
     std::error_code ec;
-    if (fs::exists(out, ec) && !options.replace)
-        throw InputError(where, "--out", "exists; give --force to replace it");
-    if (fs::exists(out, ec) && !is_store(out))
-        throw InputError(where, "--out", "exists and is not a store; it is left alone");
-
-    StoreLayout layout = layout_for(volume.dims(), volume.type(), volume.spacing());
-    layout.source = volume.source();
-    layout.zstd_level = options.zstd_level;
-    const glm::ivec2 grid = layout.chunk_grid();
-
-    TempDir tmp{temporary_for(out)};
-    fs::remove_all(tmp.path, ec);  // what a stopped run left
-    for (int cz = 0; cz < grid.y; ++cz)
-        for (int cy = 0; cy < grid.x; ++cy) {
-            fs::create_directories(tmp.path / fs::path(chunk_key(cy, cz)).parent_path(), ec);
-            if (ec) throw InputError(where, "--out", "cannot make its folders: " + ec.message());
-        }
-
-    const std::span<const std::byte> all = volume.bytes();
-    const std::size_t slice_bytes = layout.row_bytes() * static_cast<std::size_t>(layout.dims.y);
-    const int threads = std::max(1, std::min(options.threads, grid.x));
-    ImportProgress progress;
-    progress.chunks_total = layout.chunk_count();
-    Range range;
-    std::mutex mu;
-    std::string failure;
-
-    for (int cz = 0; cz < grid.y; ++cz) {
-        // Chunk rows of this slab, split over the threads; each has its own buffers and context.
-        auto work = [&](int first, int last) {
-            ZSTD_CCtx* cctx = ZSTD_createCCtx();
-            ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, layout.zstd_level);
-            ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-            std::vector<std::byte> raw, packed;
-            try {
-                for (int cy = first; cy < last; ++cy) {
-                    const glm::ivec2 e = layout.chunk_extent(cy, cz);
-                    const std::size_t block = layout.row_bytes() * static_cast<std::size_t>(e.x);
-                    raw.resize(layout.chunk_bytes(cy, cz));
-                    for (int z = 0; z < e.y; ++z) {
-                        const std::size_t src =
-                            static_cast<std::size_t>(cz * layout.chunk_slices + z) * slice_bytes +
-                            static_cast<std::size_t>(cy * layout.chunk_rows) * layout.row_bytes();
-                        std::memcpy(raw.data() + static_cast<std::size_t>(z) * block,
-                                    all.data() + src, block);
-                    }
-                    packed.resize(ZSTD_compressBound(raw.size()));
-                    const std::size_t n =
-                        ZSTD_compress2(cctx, packed.data(), packed.size(), raw.data(), raw.size());
-                    if (ZSTD_isError(n))
-                        throw InputError(where, chunk_key(cy, cz),
-                                         std::string("zstd: ") + ZSTD_getErrorName(n));
-                    write_file(tmp.path / chunk_key(cy, cz), std::span(packed.data(), n), where,
-                               chunk_key(cy, cz));
-                    const Range r = range_of(raw, layout.type);
-                    std::lock_guard lock(mu);
-                    range.merge(r.min);
-                    range.merge(r.max);
-                    progress.chunks_done += 1;
-                    progress.bytes_in += raw.size();
-                    progress.bytes_out += n;
-                }
-            } catch (const std::exception& ex) {
-                std::lock_guard lock(mu);
-                if (failure.empty()) failure = ex.what();
-            }
-            ZSTD_freeCCtx(cctx);
-        };
-        std::vector<std::thread> pool;
-        for (int t = 1; t < threads; ++t)
-            pool.emplace_back(work, grid.x * t / threads, grid.x * (t + 1) / threads);
-        work(0, grid.x / threads);
-        for (auto& th : pool) th.join();
-        if (!failure.empty()) throw InputError::relayed(failure);
-        if (volume.mapped()) {
-            const std::size_t z0 = static_cast<std::size_t>(cz) * layout.chunk_slices;
-            const std::size_t z1 =
-                std::min<std::size_t>(z0 + layout.chunk_slices, std::size_t(layout.dims.z));
-            release_source_pages(all.data() + z0 * slice_bytes, all.data() + z1 * slice_bytes);
-        }
-        if (options.progress) options.progress(progress);
-    }
-    if (range.min > range.max) range.min = range.max = 0;  // no finite voxel
-    layout.value_min = range.min;
-    layout.value_max = range.max;
+    layout.value_min = range.min <= range.max ? range.min : 0;  // 0, 0: no finite voxel
+    layout.value_max = range.min <= range.max ? range.max : 0;
     write_text(tmp.path / ".zgroup", zgroup_json(), where, ".zgroup");
     write_text(tmp.path / "0" / ".zarray", zarray_json(layout), where, "0/.zarray");
     write_text(tmp.path / ".zattrs", zattrs_json(layout), where, ".zattrs");
-
-    // Into place: an old store moves aside first and goes only once the new one is in.
     fs::path old;
     if (fs::exists(out, ec)) {
         old = tmp.path;
@@ -211,7 +117,146 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         throw InputError(where, "--out", "cannot move the new store into place: " + ec.message());
     tmp.keep = true;
     if (!old.empty()) fs::remove_all(old, ec);
-    return {layout, progress.bytes_in, progress.bytes_out};
+}
+
+}  // namespace
+
+fs::path temporary_for(const fs::path& out) {
+    const fs::path abs = fs::absolute(out).lexically_normal();
+    const fs::path name = abs.has_filename() ? abs.filename() : abs.parent_path().filename();
+    const fs::path dir = abs.has_filename() ? abs.parent_path() : abs.parent_path().parent_path();
+    std::string hidden(1, '.');  // built in steps: GCC 12 warns falsely on "." + s + "..."
+    hidden.append(name.string()).append(".importing");
+    return dir / hidden;
+}
+
+namespace {
+
+// Brick b's voxels, gathered from the volume's rows into `raw` (zeros past the volume's edge, as
+// Zarr pads edge chunks); returns the range of the voxels that are in the volume.
+Range gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm::ivec3 b,
+                   std::vector<std::byte>& raw) {
+    const int side = l.brick();
+    const std::size_t size = voxel_size(l.type);
+    const std::size_t row_bytes = static_cast<std::size_t>(l.dims.x) * size;
+    const glm::ivec3 o = b * side;
+    const int nx = std::min(side, l.dims.x - o.x);
+    raw.assign(l.brick_bytes(), std::byte{0});
+    Range range;
+    for (int z = 0; z < std::min(side, l.dims.z - o.z); ++z)
+        for (int y = 0; y < std::min(side, l.dims.y - o.y); ++y) {
+            const std::size_t src =
+                ((static_cast<std::size_t>(o.z + z) * l.dims.y + (o.y + y)) * row_bytes +
+                 static_cast<std::size_t>(o.x) * size);
+            const std::size_t dst = (static_cast<std::size_t>(z) * side + y) * side * size;
+            std::memcpy(raw.data() + dst, all.data() + src, static_cast<std::size_t>(nx) * size);
+            const Range r = range_of(std::span(raw).subspan(dst, std::size_t(nx) * size), l.type);
+            range.merge(r.min);
+            range.merge(r.max);
+        }
+    return range;
+}
+
+// What the threads of one import share: the tallies, the value range, the first failure.
+struct Tally {
+    std::mutex mu;
+    ImportProgress progress;
+    Range range;
+    std::string failure;
+};
+
+// Compresses and writes the bricks of slab bz whose y is in [first, last); the first failure is
+// kept in `tally`.
+void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs::path& dir,
+                  const std::string& where, int bz, int first, int last, Tally& tally) {
+    ZSTD_CCtx* cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, l.zstd_level);
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+    std::vector<std::byte> raw, packed;
+    try {
+        for (int by = first; by < last; ++by)
+            for (int bx = 0; bx < l.grid().x; ++bx) {
+                const glm::ivec3 b(bx, by, bz);
+                const Range r = gather_brick(l, all, b, raw);
+                packed.resize(ZSTD_compressBound(raw.size()));
+                const std::size_t n =
+                    ZSTD_compress2(cctx, packed.data(), packed.size(), raw.data(), raw.size());
+                if (ZSTD_isError(n))
+                    throw InputError(where, chunk_key(b),
+                                     std::string("zstd: ") + ZSTD_getErrorName(n));
+                write_file(dir / chunk_key(b), std::span(packed.data(), n), where, chunk_key(b));
+                std::lock_guard lock(tally.mu);
+                tally.range.merge(r.min);
+                tally.range.merge(r.max);
+                tally.progress.chunks_done += 1;
+                tally.progress.bytes_in += raw.size();
+                tally.progress.bytes_out += n;
+            }
+    } catch (const std::exception& ex) {
+        std::lock_guard lock(tally.mu);
+        if (tally.failure.empty()) tally.failure = ex.what();
+    }
+    ZSTD_freeCCtx(cctx);
+}
+
+// The store's folders under `dir`: 0/Z/Y for each slab and row of bricks.
+void make_folders(const StoreLayout& l, const fs::path& dir, const std::string& where) {
+    const glm::ivec3 grid = l.grid();
+    std::error_code ec;
+    for (int bz = 0; bz < grid.z; ++bz)
+        for (int by = 0; by < grid.y; ++by) {
+            fs::create_directories(dir / fs::path(chunk_key({0, by, bz})).parent_path(), ec);
+            if (ec) throw InputError(where, "--out", "cannot make its folders: " + ec.message());
+        }
+}
+
+}  // namespace
+
+ImportResult write_store(const Volume& volume, const fs::path& out, const ImportOptions& options) {
+    const std::string where = out.string();
+    if (volume.bricks())
+        throw InputError(volume.source(), "source", "is a store already (copy its folder instead)");
+    std::error_code ec;
+    if (fs::exists(out, ec) && !options.replace)
+        throw InputError(where, "--out", "exists; give --force to replace it");
+    if (fs::exists(out, ec) && !is_store(out))
+        throw InputError(where, "--out", "exists and is not a store; it is left alone");
+
+    StoreLayout layout = layout_for(volume.dims(), volume.type(), volume.spacing());
+    layout.source = volume.source();
+    layout.zstd_level = options.zstd_level;
+    const glm::ivec3 grid = layout.grid();
+    TempDir tmp{temporary_for(out)};
+    fs::remove_all(tmp.path, ec);  // what a stopped run left
+    make_folders(layout, tmp.path, where);
+
+    const std::span<const std::byte> all = volume.bytes();
+    const std::size_t slice_bytes =
+        static_cast<std::size_t>(layout.dims.x) * layout.dims.y * voxel_size(layout.type);
+    const int threads = std::max(1, std::min(options.threads, grid.y));
+    Tally tally;
+    tally.progress.chunks_total = layout.chunk_count();
+    for (int bz = 0; bz < grid.z; ++bz) {
+        // The slab's rows of bricks split over the threads; each has its buffers and zstd context.
+        std::vector<std::thread> pool;
+        for (int t = 1; t < threads; ++t)
+            pool.emplace_back([&, t] {
+                write_bricks(layout, all, tmp.path, where, bz, grid.y * t / threads,
+                             grid.y * (t + 1) / threads, tally);
+            });
+        write_bricks(layout, all, tmp.path, where, bz, 0, grid.y / threads, tally);
+        for (auto& th : pool) th.join();
+        if (!tally.failure.empty()) throw InputError::relayed(tally.failure);
+        if (volume.mapped()) {
+            const std::size_t z0 = static_cast<std::size_t>(bz) * layout.brick();
+            const std::size_t z1 =
+                std::min<std::size_t>(z0 + layout.brick(), std::size_t(layout.dims.z));
+            release_source_pages(all.data() + z0 * slice_bytes, all.data() + z1 * slice_bytes);
+        }
+        if (options.progress) options.progress(tally.progress);
+    }
+    commit(layout, tally.range, tmp, out, where);
+    return {layout, tally.progress.bytes_in, tally.progress.bytes_out};
 }
 
 }  // namespace isowall::store

@@ -139,13 +139,15 @@ void slab_deltas(const VolumeView<T>& v, int bz, glm::ivec2 m, std::vector<float
                     const float hi = c01[k] + (c11[k] - c01[k]) * u;
                     edge[k] = lo + (hi - lo) * w;
                 }
-                const T* row = v.data + v.index(0, y0 + y, z0 + z);
+                // A bricked volume (a store's) is read voxel by voxel.
+                const T* row = v.bricked() ? nullptr : v.data + v.index(0, y0 + y, z0 + z);
                 for (int k = 0; k < m.x; ++k) {
                     const float a = edge[k], slope = (edge[k + 1] - a) * inv;
-                    const T* r = row + k * S;
+                    const T* r = row ? row + k * S : nullptr;
                     float worst = d[k];
                     for (int x = 0; x <= S; ++x) {
-                        const float e = std::abs(static_cast<float>(r[x]) -
+                        const T value = r ? r[x] : v.at(k * S + x, y0 + y, z0 + z);
+                        const float e = std::abs(static_cast<float>(value) -
                                                  (a + slope * static_cast<float>(x)));
                         if (e > worst || e != e) worst = e;  // NaN sticks
                     }

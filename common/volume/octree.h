@@ -198,12 +198,14 @@ FiniteRange MinMaxOctree<T>::build_leaves(const VolumeView<T>& v, ThreadBudget b
                     T lo = octree_key(v.at(x0, y0, z0)), hi = lo;
                     for (int z = z0; z <= z1; ++z)
                         for (int y = y0; y <= y1; ++y) {
-                            const T* row = v.data + v.index(0, y, z);
+                            // A bricked volume (a store's) is read voxel by voxel.
+                            const T* row = v.bricked() ? nullptr : v.data + v.index(0, y, z);
                             for (int x = x0; x <= x1; ++x) {
-                                lo = std::min(lo, octree_key(row[x]));
-                                hi = std::max(hi, octree_key(row[x]));
+                                const T value = row ? row[x] : v.at(x, y, z);
+                                lo = std::min(lo, octree_key(value));
+                                hi = std::max(hi, octree_key(value));
                                 if constexpr (std::is_floating_point_v<T>)
-                                    range->merge(static_cast<double>(row[x]));
+                                    range->merge(static_cast<double>(value));
                             }
                         }
                     const std::size_t i = 2 * shape_.node_index(0, {bx, by, bz});

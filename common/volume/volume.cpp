@@ -99,6 +99,7 @@ Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
       bytes_(bytes) {}
 
 void Volume::copy_to_huge_pages() {
+    if (bricks_) return;  // a store's bricks: a copy would read every one
     HugePageBuffer buffer(bytes_.size());
     std::copy(bytes_.begin(), bytes_.end(), buffer.bytes().begin());
     huge_ = std::move(buffer);

@@ -33,14 +33,29 @@ constexpr Endian host_endian() {
     return Endian::little;
 }  // x86-64 and aarch64 Linux
 
+// Voxels are x-fastest (`bricks` 0), or in cubic bricks of 2^bricks voxels a side, each brick
+// x-fastest inside and the bricks x-fastest in their grid (a store's voxels, paged in a brick at a
+// time: common/store/paged_voxels.h). Code that walks voxels with pointer strides checks
+// bricked() first and takes index() per voxel for a bricked volume.
 template <class T>
 struct VolumeView {
     const T* data = nullptr;
     glm::ivec3 dims{0};
     glm::vec3 spacing{1.0f};
+    int bricks = 0;            // log2 of the brick side; 0: one x-fastest array
+    glm::ivec3 brick_grid{0};  // bricks per axis, when bricked
 
+    bool bricked() const { return bricks != 0; }
     std::size_t index(int x, int y, int z) const {
-        return (static_cast<std::size_t>(z) * dims.y + y) * dims.x + x;
+        if (bricks == 0) return (static_cast<std::size_t>(z) * dims.y + y) * dims.x + x;
+        const int m = (1 << bricks) - 1;
+        const std::size_t brick =
+            (static_cast<std::size_t>(z >> bricks) * brick_grid.y + (y >> bricks)) * brick_grid.x +
+            (x >> bricks);
+        const std::size_t inner = (static_cast<std::size_t>(z & m) << (2 * bricks)) |
+                                  (static_cast<std::size_t>(y & m) << bricks) |
+                                  static_cast<std::size_t>(x & m);
+        return (brick << (3 * bricks)) | inner;
     }
     T at(int x, int y, int z) const { return data[index(x, y, z)]; }
     glm::ivec3 cell_dims() const { return glm::max(dims - 1, glm::ivec3(0)); }
@@ -86,6 +101,13 @@ class Volume {
     // scan them all behind the user's back).
     Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::shared_ptr<const void> keeper,
            std::span<const std::byte> bytes, std::string source);
+    // The voxels in cubic bricks of 2^log2_side (VolumeView); `bytes` must hold every brick of the
+    // grid that covers dims.
+    void set_bricks(int log2_side) { bricks_ = log2_side; }
+    int bricks() const { return bricks_; }
+    glm::ivec3 brick_grid() const {
+        return bricks_ ? (dims_ + (1 << bricks_) - 1) >> bricks_ : glm::ivec3(0);
+    }
 
     glm::ivec3 dims() const { return dims_; }
     glm::vec3 spacing() const { return spacing_; }
@@ -115,7 +137,7 @@ class Volume {
 
     template <class T>
     VolumeView<T> view() const {
-        return {reinterpret_cast<const T*>(bytes_.data()), dims_, spacing_};
+        return {reinterpret_cast<const T*>(bytes_.data()), dims_, spacing_, bricks_, brick_grid()};
     }
 
   private:
@@ -130,6 +152,7 @@ class Volume {
     std::vector<std::byte> owned_;
     HugePageBuffer huge_;
     std::shared_ptr<const void> keeper_;
+    int bricks_ = 0;
     std::span<const std::byte> bytes_;
 };
 
