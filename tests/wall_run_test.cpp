@@ -10,6 +10,7 @@
 #include "common/core/thread_budget.h"
 #include "common/core/util.h"
 #include "common/io/image_io.h"
+#include "common/volume/phantom.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
@@ -62,6 +63,44 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
             << log;
         EXPECT_NE(log.find("makespan"), std::string::npos) << log;
     }
+}
+
+// A store under a memory limit (issue 32): every rank pages its own bricks in; the mosaic is the
+// picture of the file the store was imported from.
+TEST(WallRun, AStoreUnderAMemoryLimitGivesTheMosaicOfItsFile) {
+    const auto dir = test::scratch_dir("wall_store");
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
+    {
+        const Volume v = make_phantom();
+        std::ofstream(dir / "phantom.raw", std::ios::binary)
+            .write(reinterpret_cast<const char*>(v.bytes().data()),
+                   static_cast<std::streamsize>(v.bytes().size()));
+    }
+    const std::string raw = " --dims 200 184 168 --type uint8";
+    const std::string store = (dir / "phantom.zarr").string();
+    ASSERT_EQ(run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() + "'" + raw +
+                      " -q --no-cache --out '" + store + "'",
+                  dir / "import.log"),
+              0)
+        << slurp(dir / "import.log");
+    ASSERT_EQ(
+        run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --volume '" + store +
+                "' --memory-limit 16M --iso 50 --out '" + (dir / "mosaic.png").string() + "'",
+            dir / "wall.log"),
+        0)
+        << slurp(dir / "wall.log");
+    EXPECT_NE(slurp(dir / "wall.log").find("in a store (paged, limit 16 MiB)"), std::string::npos)
+        << slurp(dir / "wall.log");
+    ASSERT_EQ(run(isowall_cmd() + "render --volume '" + (dir / "phantom.raw").string() + "'" + raw +
+                      " --iso 50 --size 320x240 -q --no-measure --out '" +
+                      (dir / "single.png").string() + "'",
+                  dir / "render.log"),
+              0)
+        << slurp(dir / "render.log");
+    const test::ImageComparison m = test::compare_images(
+        read_image(dir / "mosaic.png"), read_image(dir / "single.png"), kFromFiles);
+    EXPECT_GE(m.mask_iou, 0.999) << m;
+    EXPECT_GE(m.equal_share, 0.999) << m;
 }
 
 TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
