@@ -72,6 +72,28 @@ TEST_F(FullDisk, RenderAndExtractFailNamingTheFileAndLeaveNothing) {
     EXPECT_TRUE(fs::exists(disk_ / "small.png"));
 }
 
+// A store that does not fit (issue 32): noise does not compress, so 4 MiB of it fills the disk.
+TEST_F(FullDisk, AnImportFailsNamingTheStoreAndLeavesNothing) {
+    {
+        std::ofstream raw(dir_ / "noise.raw", std::ios::binary);
+        std::uint32_t x = 12345;
+        for (int i = 0; i < (4 << 20); ++i) {
+            x = x * 1664525u + 1013904223u;
+            raw.put(static_cast<char>(x >> 24));
+        }
+    }
+    const test::RunResult r = test::run_isowall(
+        dir_, "import noise.raw --dims 256 256 64 --type uint8 -q --no-cache --out '" +
+                  (disk_ / "noise.zarr").string() + "'");
+    SCOPED_TRACE("import");
+    EXPECT_NE(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.exit_code, 124) << "timed out";
+    EXPECT_EQ(test::count_of(r.err, "isowall: error:"), 1u) << r.err;
+    EXPECT_NE(r.err.find((disk_ / "noise.zarr").string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(disk_)) << "left on the disk: " << test::files_in(disk_).size();
+}
+
 TEST_F(FullDisk, TheWallsMosaicFailsNamingTheFileAndEveryRankEnds) {
     std::ofstream(dir_ / "big.toml") << "tiles = [2, 2]\ntile_size_px = [2000, 1500]\n";
     const fs::path log = dir_ / "wall.log";
