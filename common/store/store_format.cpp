@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/core/error.h"
+#include "common/volume/load_checks.h"
 
 namespace isowall::store {
 namespace fs = std::filesystem;
@@ -146,6 +147,16 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
         bad(store, za + ": chunks",
             "isowall reads cubic chunks of 8 to 128 voxels a side, a power of two, got " +
                 quote(chunks.dump()));
+    // The bricks' address space (paged_voxels.h reserves it whole) must fit this machine's
+    // 47-bit user space with room to spare: 64 TiB.
+    {
+        const glm::ivec3 g = (l.dims + side - 1) / side;
+        const auto bytes = checked_product({std::uint64_t(g.x), std::uint64_t(g.y),
+                                            std::uint64_t(g.z), std::uint64_t(side) * side * side,
+                                            8});
+        if (!bytes || *bytes > (std::uint64_t(1) << 46))
+            bad(store, za + ": shape", "larger than 64 TiB of voxels, got " + quote(shape.dump()));
+    }
     const json& dtype = member(a, "dtype", store, za);
     const auto type = dtype.is_string() ? parse_zarr_dtype(dtype.get<std::string>()) : std::nullopt;
     if (!type)
