@@ -150,10 +150,9 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     // The bricks' address space (paged_voxels.h reserves it whole) must fit this machine's
     // 47-bit user space with room to spare: 64 TiB.
     {
-        const glm::ivec3 g = (l.dims + side - 1) / side;
-        const auto bytes = checked_product({std::uint64_t(g.x), std::uint64_t(g.y),
-                                            std::uint64_t(g.z), std::uint64_t(side) * side * side,
-                                            8});
+        auto n = [&](int d) { return (std::uint64_t(d) + std::uint64_t(side) - 1) / side; };
+        const auto bytes = checked_product(
+            {n(l.dims.x), n(l.dims.y), n(l.dims.z), std::uint64_t(side) * side * side, 8});
         if (!bytes || *bytes > (std::uint64_t(1) << 46))
             bad(store, za + ": shape", "larger than 64 TiB of voxels, got " + quote(shape.dump()));
     }

@@ -40,7 +40,12 @@ struct StoreLayout {
     double value_min = 0, value_max = 0;  // finite range of the voxels
 
     int brick() const { return 1 << brick_log2; }
-    glm::ivec3 grid() const { return (dims + brick() - 1) >> brick_log2; }
+    glm::ivec3 grid() const {  // in 64 bits first: a side near 2^31 must not wrap
+        auto n = [&](int d) {
+            return static_cast<int>((std::int64_t{d} + brick() - 1) >> brick_log2);
+        };
+        return {n(dims.x), n(dims.y), n(dims.z)};
+    }
     std::size_t chunk_count() const {
         const glm::ivec3 g = grid();
         return static_cast<std::size_t>(g.x) * static_cast<std::size_t>(g.y) *

@@ -106,7 +106,11 @@ class Volume {
     void set_bricks(int log2_side) { bricks_ = log2_side; }
     int bricks() const { return bricks_; }
     glm::ivec3 brick_grid() const {
-        return bricks_ ? (dims_ + (1 << bricks_) - 1) >> bricks_ : glm::ivec3(0);
+        if (!bricks_) return glm::ivec3(0);
+        auto n = [&](int d) {
+            return static_cast<int>((std::int64_t{d} + (1 << bricks_) - 1) >> bricks_);
+        };
+        return {n(dims_.x), n(dims_.y), n(dims_.z)};
     }
 
     glm::ivec3 dims() const { return dims_; }
