@@ -34,7 +34,7 @@ struct PagingStats {
     std::uint64_t bytes_read = 0;  // compressed bytes read from disk
     std::uint64_t peak_bytes = 0;  // most bricks' bytes resident at once
     std::uint64_t resident_bytes = 0;
-    double fill_s = 0;  // time the pager's thread spent reading and installing bricks
+    double fill_s = 0;  // time the pager's threads spent reading and installing bricks
 };
 
 class PagedVoxels {
@@ -56,9 +56,9 @@ class PagedVoxels {
 
   private:
     struct State;
-    // The pager's thread: waits for faults, fills and installs their spans, keeps the cap.
+    // A pager thread: waits for faults, reads and installs their bricks, keeps the cap.
     void serve();
-    void install(std::size_t brick);
+    void install(std::size_t brick, const std::vector<std::byte>& buffer);
     void drop_to_cap(std::size_t keep);
 
     std::shared_ptr<const StoreReader> reader_;
