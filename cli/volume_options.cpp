@@ -89,9 +89,9 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         if (!o.memory_limit.empty()) {
             const auto parsed = store::parse_byte_size(o.memory_limit);
             if (!parsed)
-                throw InputError("--memory-limit", "value",
-                                 "expected a size such as 512M or 8G, got " +
-                                     quote(o.memory_limit));
+                throw InputError(
+                    "--memory-limit", "value",
+                    "expected a size such as 512M or 8G, got " + quote(o.memory_limit));
             cap = *parsed;
         }
         const std::filesystem::path path = store::store_path(o.path);

@@ -23,7 +23,7 @@ struct VolumeOptions {
     std::string cache_dir;
     bool no_cache = false;
     std::string huge_pages = "auto";  // auto, on, off (common/volume/huge_pages.h)
-    std::string memory_limit;          // a store's cap ("512M", "8G"); empty: the default share
+    std::string memory_limit;         // a store's cap ("512M", "8G"); empty: the default share
 };
 
 void add_volume_options(CLI::App& app, VolumeOptions& opts);

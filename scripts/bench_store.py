@@ -6,10 +6,11 @@ first picture and to 99% of the final pixels, the peak resident memory, and what
 The store is read once at the default memory limit and once at --limit (well under the volume).
 
 Usage: /usr/bin/python3 scripts/bench_store.py [--volume build/data/cthead_1024x1024x452.nhdr]
-           [--iso 600] [--limit 256M] [--runs 2] [--build build] [--out out/bench-store]
+           [--iso 600] [--limit 256M] [--runs 2] [--size 1600x1200] [--no-cold]
+           [--build build] [--out out/bench-store]
 
-Prints one table (markdown) and writes it to OUT/store.md. Without root the cold rows are
-skipped and say so. Errors: one line naming the option or the program, exit 1.
+Prints one table (markdown) and writes it to OUT/store.md. Without root, or with --no-cold, the
+cold rows are skipped and say so. Errors: one line naming the option or the program, exit 1.
 """
 import argparse
 import os
@@ -34,9 +35,16 @@ def parse_args(argv):
     ap.add_argument("--iso", type=float, default=600.0)
     ap.add_argument("--limit", default="256M")
     ap.add_argument("--runs", type=int, default=2)
+    ap.add_argument("--size", default="1600x1200")
+    ap.add_argument("--no-cold", action="store_true", help="warm runs only (no drop_caches)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out/bench-store"))
-    a = ap.parse_args(argv)
+    try:
+        a = ap.parse_args(argv)
+    except SystemExit as e:
+        if e.code == 0:
+            raise
+        sys.exit(1)
     if a.runs < 1:
         fail(f"--runs: expected at least 1, got {a.runs}")
     if not os.path.exists(a.volume):
@@ -62,7 +70,7 @@ def render(a, volume, extra, cold, cache_dir):
     if cold:
         drop_caches()
     png = os.path.join(a.out, "render.png")
-    cmd = [a.binary, "render", "--volume", volume, "--iso", str(a.iso), "--out", png,
+    cmd = [a.binary, "render", "--volume", volume, "--iso", str(a.iso), "--out", png, "--size", a.size,
            "--cache-dir", cache_dir] + extra
     t0 = time.monotonic()
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -99,21 +107,21 @@ def main(argv):
         fail(f"import: exit {p.returncode}: {p.stderr.strip()[:300]}")
     import_s = time.monotonic() - t0
     print(p.stdout.strip())
-    root = os.geteuid() == 0
+    cold_ok = os.geteuid() == 0 and not a.no_cold
     cases = [("file", a.volume, []), ("store, default limit", store, []),
              (f"store, --memory-limit {a.limit}", store, ["--memory-limit", a.limit])]
     rows = []
     for label, volume, extra in cases:
         render(a, volume, extra, False, cache_dir)  # the octree cache, the program's own pages
         for cold in (True, False):
-            if cold and not root:
+            if cold and not cold_ok:
                 rows.append((label, "cold", None))
                 continue
             runs = [render(a, volume, extra, cold, cache_dir) for _ in range(a.runs)]
             rows.append((label, "cold" if cold else "warm",
                          {k: median([r[k] for r in runs]) for k in runs[0]}))
     fmt = lambda v, f="%.3f": "-" if v is None else f % v  # noqa: E731
-    lines = [f"# {name}: file against store, default render (1600x1200), iso {a.iso:g}",
+    lines = [f"# {name}: file against store, default render ({a.size}), iso {a.iso:g}",
              "",
              f"Import took {import_s:.1f} s. Medians of {a.runs} runs; seconds, MiB.",
              "",
@@ -122,8 +130,8 @@ def main(argv):
              "|---|---|---|---|---|---|---|---|"]
     for label, cache, r in rows:
         if r is None:
-            lines.append(f"| {label} | {cache} | skipped: not root (no drop_caches) "
-                         "| | | | | |")
+            why = "--no-cold" if a.no_cold else "not root (no drop_caches)"
+            lines.append(f"| {label} | {cache} | skipped: {why} | | | | | |")
             continue
         lines.append(f"| {label} | {cache} | {fmt(r['first'])} | {fmt(r['c99'])} "
                      f"| {fmt(r['command'], '%.2f')} | {fmt(r['rss'], '%.0f')} "

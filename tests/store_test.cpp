@@ -239,6 +239,14 @@ TEST(StoreDamage, MetadataThatDisagreesWithTheChunksIsRefused) {
     expect_line([&] { StoreReader again(store); }, {"isowall.chunks"});
 }
 
+// Opens `store`, reads the byte at `at` (paging its brick in), and exits 0 if the read returns.
+[[noreturn]] void read_byte_and_exit(const fs::path& store, std::size_t at) {
+    OpenedStore s = open_store(store, 64 << 20);
+    volatile std::byte b = s.volume.bytes()[at];
+    (void)b;
+    std::_Exit(0);
+}
+
 // A damaged chunk found while a frame reads it ends the process with its line (paged_voxels.h).
 TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");
@@ -253,24 +261,10 @@ TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
     }
     const StoreLayout l = StoreReader(store).layout();
     const std::size_t at = l.brick_bytes() + 5;  // a voxel of brick (1, 0, 0)
-    EXPECT_EXIT(
-        {
-            OpenedStore s = open_store(store, 64 << 20);
-            volatile std::byte b = s.volume.bytes()[at];
-            (void)b;
-            std::_Exit(0);
-        },
-        testing::ExitedWithCode(1), key);
+    EXPECT_EXIT(read_byte_and_exit(store, at), testing::ExitedWithCode(1), key);
     // Truncated: the same.
     fs::resize_file(store / key, 30);
-    EXPECT_EXIT(
-        {
-            OpenedStore s = open_store(store, 64 << 20);
-            volatile std::byte b = s.volume.bytes()[at];
-            (void)b;
-            std::_Exit(0);
-        },
-        testing::ExitedWithCode(1), key);
+    EXPECT_EXIT(read_byte_and_exit(store, at), testing::ExitedWithCode(1), key);
 }
 
 TEST(StoreDamage, ACapTooSmallForTheChunksIsOneLine) {

@@ -117,13 +117,13 @@ std::string zattrs_json(const StoreLayout& l) {
     return j.dump(4) + "\n";
 }
 
-StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
-                         const std::string& store) {
+namespace {
+
+// The array's metadata (0/.zarray) into `l`: shape, cubic chunks, dtype, zstd, C order.
+void parse_zarray(std::string_view zarray, const std::string& store, StoreLayout& l) {
     constexpr long kMaxSide = 2147483647;
-    const std::string za = "0/.zarray", at = ".zattrs";
+    const std::string za = "0/.zarray";
     const json a = parse_json(zarray, store, za);
-    const json t = parse_json(zattrs, store, at);
-    StoreLayout l;
     if (member(a, "zarr_format", store, za) != 2)
         bad(store, za + ": zarr_format", "expected 2 (isowall reads Zarr v2 stores)");
     const json& shape = member(a, "shape", store, za);
@@ -171,7 +171,13 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
         bad(store, za + ": filters", "expected null, got " + quote(a["filters"].dump()));
     if (a.value("dimension_separator", ".") != "/")
         bad(store, za + ": dimension_separator", "expected \"/\"");
+}
 
+// The group's attributes (.zattrs) into `l`: isowall's block, checked against the array, and
+// the spacing from the OME-Zarr scale.
+void parse_zattrs(std::string_view zattrs, const std::string& store, StoreLayout& l) {
+    const std::string at = ".zattrs";
+    const json t = parse_json(zattrs, store, at);
     const json& iso = member(t, "isowall", store, at);
     if (!iso.is_object() || iso.value("format", 0) != kFormatVersion)
         bad(store, at + ": isowall.format",
@@ -204,6 +210,15 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     } catch (const std::exception&) {
         bad(store, at + ": multiscales", "expected a scale of three positive numbers for path 0");
     }
+}
+
+}  // namespace
+
+StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
+                         const std::string& store) {
+    StoreLayout l;
+    parse_zarray(zarray, store, l);
+    parse_zattrs(zattrs, store, l);
     return l;
 }
 

@@ -1,0 +1,67 @@
+#!/usr/bin/python3
+"""Tests of scripts/bench_store.py (issue 32): a quick warm run on the shared tooth imports it,
+reads it from the file, from the store and from the store under a small limit, and prints every
+figure of each warm row, with the store's reads and a peak within the limit; bad options give one
+line and status 1. Skips (status 77) without ../shared/data.
+
+Run: /usr/bin/python3 tests/bench_store_test.py BUILD_DIR   (CTest passes the path)
+"""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "bench_store.py")
+DATA = os.environ.get("ISOWALL_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+BUILD = None
+
+
+def bench(*args):
+    return subprocess.run([sys.executable, SCRIPT, "--build", BUILD, *args],
+                          capture_output=True, text=True, timeout=600)
+
+
+class BenchStore(unittest.TestCase):
+    def test_quick_warm_run_prints_every_figure(self):
+        with tempfile.TemporaryDirectory() as out:
+            r = bench("--volume", os.path.join(DATA, "tooth.nhdr"), "--iso", "620", "--runs", "1",
+                      "--size", "320x240", "--limit", "9M", "--no-cold", "--out", out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("import: wrote", r.stdout)
+            rows = [l for l in r.stdout.splitlines() if l.startswith("| ") and "warm" in l]
+            self.assertEqual(len(rows), 3, r.stdout)
+            for row in rows:
+                cells = [c.strip() for c in row.strip("|").split("|")]
+                for c in cells[2:6]:  # first picture, 99%, command, peak RSS
+                    self.assertRegex(c, r"^[0-9.]+$", row)
+            file_row, store_row, limited = rows
+            self.assertEqual([c.strip() for c in file_row.strip("|").split("|")][6], "-")
+            for row in (store_row, limited):
+                read, peak = [float(c) for c in row.strip("|").split("|")[6:8]]
+                self.assertGreater(read, 0)
+                self.assertGreater(peak, 0)
+            peak = float(limited.strip("|").split("|")[7])
+            self.assertLessEqual(peak, 9.0, limited)
+            self.assertEqual(r.stdout.count("skipped: --no-cold"), 3, r.stdout)
+            self.assertTrue(os.path.exists(os.path.join(out, "store.md")))
+
+    def test_bad_options_are_one_line(self):
+        for args, needle in ((["--runs", "0"], "--runs"),
+                             (["--volume", "/nonexistent/v.nhdr"], "--volume"),
+                             (["--runs", "x"], "--runs")):
+            r = bench(*args)
+            self.assertEqual(r.returncode, 1, (args, r.stderr))
+            lines = [l for l in r.stderr.splitlines() if "error" in l]
+            self.assertEqual(len(lines), 1, (args, r.stderr))
+            self.assertIn(needle, lines[0])
+
+
+if __name__ == "__main__":
+    BUILD = os.path.abspath(sys.argv.pop(1)) if len(sys.argv) > 1 else os.path.join(ROOT, "build")
+    if not os.path.exists(os.path.join(DATA, "tooth.nhdr")):
+        print(f"skip: no shared data at {DATA}")
+        sys.exit(77)
+    unittest.main()
