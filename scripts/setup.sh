@@ -14,7 +14,7 @@ PACKAGES=(
     libmeshoptimizer-dev libzstd-dev nlohmann-json3-dev libwebsocketpp-dev libasio-dev
     libembree-dev python3-vtk9
     libgdcm-dev libnifti2-dev libhdf5-dev
-    python3 python3-numpy python3-matplotlib
+    python3 python3-numpy python3-matplotlib python3-zarr
     libx11-dev libxext-dev xvfb xdotool x11-apps x11-utils iproute2
     nodejs chromium
 )

@@ -85,7 +85,9 @@ std::string zarray_json(const StoreLayout& l) {
         {"shape", {l.dims.z, l.dims.y, l.dims.x}},
         {"chunks", {l.brick(), l.brick(), l.brick()}},
         {"dtype", zarr_dtype(l.type)},
-        {"compressor", {{"id", "zstd"}, {"level", l.zstd_level}, {"checksum", true}}},
+        // No "checksum" key: numcodecs before 0.12 (Debian 12's 0.11) refuses the codec with it.
+        // The frames carry their checksums anyway, and every zstd decoder checks them.
+        {"compressor", {{"id", "zstd"}, {"level", l.zstd_level}}},
         {"fill_value", 0},
         {"order", "C"},
         {"filters", nullptr},
