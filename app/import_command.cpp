@@ -93,30 +93,31 @@ int run_import(const ImportCommand& o) {
     opts.zstd_level = o.level;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
-    Stopwatch sw;
-    const store::ImportResult r = store::write_store(ov.volume, out, opts);
-    bar.finish();
-    const double write_s = sw.seconds();
-
-    // The octree, from the voxels at hand, into the cache under the store's key: the first
-    // `--volume STORE` maps it instead of reading every chunk to build it.
-    std::string octree_note = "not cached (--no-cache)";
-    if (!vo.no_cache) {
+    // The store's own octree, from the voxels at hand, written into the store before it moves
+    // into place: `--volume STORE` maps it wherever the store lies, instead of reading every
+    // brick to build it.
+    std::string octree_note;
+    opts.before_commit = [&](const store::StoreLayout& layout, const std::filesystem::path& dir) {
         OctreeSource src;
         src.volume_path = out;
-        src.cache_dir = vo.cache_dir.empty() ? octree_cache::default_dir()
-                                             : std::filesystem::path(vo.cache_dir);
-        src.data_files = {out / ".zattrs", out / "0" / ".zarray"};
+        src.cache_dir = dir;  // not used: own_file names the file
+        src.own_file = store::octree_file(dir);
+        src.content_key = store::content_key(layout);
         OctreeStats st;
         dispatch_voxel_type(ov.volume.type(), [&](auto zero) {
             using T = decltype(zero);
             (void)MinMaxOctree<T>::load_or_build(ov.volume.view<T>(), src, &st);
         });
         std::error_code ec;
-        octree_note = !st.cache_file.empty() && std::filesystem::exists(st.cache_file, ec)
-                          ? "cached to " + st.cache_file.string()
-                          : "not cached: " + st.cache_note;
-    }
+        octree_note = std::filesystem::exists(src.own_file, ec)
+                          ? "written to " + store::octree_file(out).string()
+                          : "not written: " + st.cache_note;
+    };
+    Stopwatch sw;
+    const store::ImportResult r = store::write_store(ov.volume, out, opts);
+    bar.finish();
+    const double write_s = sw.seconds();
+
     const double mib = 1024.0 * 1024.0;
     const store::StoreLayout& l = r.layout;
     std::printf(

@@ -97,6 +97,7 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
     l.value_min = -12;
     l.value_max = 900;
     l.source = "head.nrrd";
+    l.id = new_store_id();
     const StoreLayout back = parse_layout(zarray_json(l), zattrs_json(l), "s");
     EXPECT_EQ(back.dims, l.dims);
     EXPECT_EQ(back.type, l.type);
@@ -105,6 +106,11 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
     EXPECT_EQ(back.value_min, -12);
     EXPECT_EQ(back.value_max, 900);
     EXPECT_EQ(back.source, "head.nrrd");
+    EXPECT_EQ(back.id, l.id);
+    EXPECT_EQ(content_key(back), content_key(l));
+    StoreLayout other = l;
+    other.id = new_store_id();
+    EXPECT_NE(content_key(other), content_key(l));  // a new import is new content
     for (VoxelType t : {VoxelType::u8, VoxelType::i8, VoxelType::u16, VoxelType::i16,
                         VoxelType::u32, VoxelType::i32, VoxelType::f32, VoxelType::f64})
         EXPECT_EQ(parse_zarr_dtype(zarr_dtype(t)), t);
@@ -124,6 +130,7 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
                 {".zattrs", "isowall.chunks", "disagrees"});
     expect_line([&] { parse_layout(za, with(at, "\"format\": 1", "\"format\": 2"), "s"); },
                 {"isowall.format"});
+    expect_line([&] { parse_layout(za, with(at, l.id, "not-hex-at-all!!"), "s"); }, {"isowall.id"});
     expect_line(
         [&] { parse_layout(with(za, "\"zarr_format\": 2", "\"zarr_format\": 3"), at, "s"); },
         {"zarr_format"});
@@ -186,6 +193,31 @@ TEST(StoreImport, TheSurfaceFromAPagedStoreIsTheSurfaceFromMemory) {
     EXPECT_EQ(got.triangle_count(), want.triangle_count());
     EXPECT_EQ(got.positions, want.positions);
     EXPECT_GT(opened.pager->stats().evictions, 0u);
+}
+
+// A store keeps its octree beside its bricks, keyed by its content: moved, it still maps it.
+TEST(StoreImport, TheOctreeLivesInTheStoreAndMovesWithIt) {
+    const Volume v = make_phantom({{90, 80, 70}, glm::vec3(1.0f)});
+    const fs::path store = import_to(v, "store_octree");
+    auto extract_stats = [](const fs::path& at) {
+        OpenedStore s = open_store(at, 64 << 20);
+        OctreeSource src;
+        src.volume_path = at;
+        src.cache_dir = at.parent_path() / "unused-cache";
+        OctreeStats st;
+        (void)make_surface_extractor(s.volume, src, &st);
+        return st;
+    };
+    const OctreeStats first = extract_stats(store);
+    EXPECT_FALSE(first.from_cache);  // write_store alone leaves no octree; the first open writes it
+    EXPECT_EQ(first.cache_file, octree_file(store));
+    EXPECT_TRUE(fs::exists(octree_file(store)));
+    const fs::path moved = store.parent_path() / "moved.zarr";
+    fs::rename(store, moved);
+    const OctreeStats second = extract_stats(moved);
+    EXPECT_TRUE(second.from_cache) << second.cache_note;
+    EXPECT_EQ(second.cache_file, octree_file(moved));
+    EXPECT_FALSE(fs::exists(store.parent_path() / "unused-cache"));
 }
 
 TEST(StoreImport, AnExistingStoreIsKeptUnlessReplacedAndNeverHalfWritten) {

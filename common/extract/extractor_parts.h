@@ -74,6 +74,10 @@ struct ExtractionData {
     static OctreeSource with_files(OctreeSource s, const Volume& v) {
         for (const auto& f : v.files())
             if (f != s.volume_path) s.data_files.push_back(f);
+        if (!v.own_octree().empty()) {
+            s.own_file = v.own_octree();
+            s.content_key = v.content_key();
+        }
         return s;
     }
 };

@@ -64,6 +64,7 @@ OpenedStore open_store(const fs::path& path, std::uint64_t cap_bytes) {
         out.how = std::string("read whole: no paging here (") + e.what() + ")";
     }
     out.volume.set_bricks(l.brick_log2);
+    out.volume.set_own_octree(octree_file(path), content_key(l));
     out.volume.set_files({path / ".zattrs", path / "0" / ".zarray"});
     add_facts(out.volume, *reader);
     return out;

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <random>
 
 #include <nlohmann/json.hpp>
 
@@ -111,6 +114,7 @@ std::string zattrs_json(const StoreLayout& l) {
                                       {"coordinateTransformations", json::array({scale})}}})}}})},
         {"isowall",
          {{"format", kFormatVersion},
+          {"id", l.id},
           {"source", l.source},
           {"value_min", l.value_min},
           {"value_max", l.value_max},
@@ -185,6 +189,9 @@ void parse_zattrs(std::string_view zattrs, const std::string& store, StoreLayout
         bad(store, at + ": isowall.format",
             "expected " + std::to_string(kFormatVersion) + " (a store isowall wrote)");
     l.source = iso.value("source", std::string());
+    l.id = iso.contains("id") && iso["id"].is_string() ? iso["id"].get<std::string>() : "";
+    if (l.id.size() != 16 || l.id.find_first_not_of("0123456789abcdef") != std::string::npos)
+        bad(store, at + ": isowall.id", "expected 16 hex digits, got " + quote(l.id));
     if (!iso.contains("value_min") || !iso["value_min"].is_number() || !iso.contains("value_max") ||
         !iso["value_max"].is_number())
         bad(store, at + ": isowall.value_min", "expected two numbers, value_min and value_max");
@@ -222,6 +229,26 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     parse_zarray(zarray, store, l);
     parse_zattrs(zattrs, store, l);
     return l;
+}
+
+fs::path octree_file(const fs::path& store) {
+    return store / "octree.isowall";
+}
+
+std::uint64_t content_key(const StoreLayout& l) {
+    std::uint64_t h = 14695981039346656037ull;  // FNV-1a
+    for (unsigned char c : l.id + "/" + zarray_json(l)) h = (h ^ c) * 1099511628211ull;
+    return h;
+}
+
+std::string new_store_id() {
+    std::random_device rd;
+    const std::uint64_t v =
+        (std::uint64_t(rd()) << 32) ^ rd() ^
+        std::uint64_t(std::chrono::steady_clock::now().time_since_epoch().count());
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(v));
+    return text;
 }
 
 std::string chunk_key(glm::ivec3 b) {

@@ -36,6 +36,7 @@ struct StoreLayout {
     glm::vec3 spacing{1.0f};
     int brick_log2 = 5;  // bricks of 2^brick_log2 voxels a side (the Zarr chunk)
     int zstd_level = 3;
+    std::string id;                       // 16 hex digits, new at each import: the content's key
     std::string source;                   // what was imported, for `info`
     double value_min = 0, value_max = 0;  // finite range of the voxels
 
@@ -85,6 +86,13 @@ std::string zattrs_json(const StoreLayout& l);
 // when they are not JSON, are not a store isowall wrote (or can read), or disagree.
 StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
                          const std::string& store);
+
+// The store's own octree (built by `import`, beside the array; Zarr readers pass over it), and
+// the key of the content it describes: from the store's id, so it holds wherever the store lies.
+std::filesystem::path octree_file(const std::filesystem::path& store);
+std::uint64_t content_key(const StoreLayout& l);
+// A fresh id for an import: 64 random bits as 16 hex digits.
+std::string new_store_id();
 
 // "0/Z/Y/X": brick b's chunk key under the store (Zarr's "/" separator, C order z, y, x).
 std::string chunk_key(glm::ivec3 b);

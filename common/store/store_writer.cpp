@@ -224,6 +224,7 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
 
     StoreLayout layout = layout_for(volume.dims(), volume.type(), volume.spacing());
     layout.source = volume.source();
+    layout.id = new_store_id();
     layout.zstd_level = options.zstd_level;
     const glm::ivec3 grid = layout.grid();
     TempDir tmp{temporary_for(out)};
@@ -255,6 +256,7 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         }
         if (options.progress) options.progress(tally.progress);
     }
+    if (options.before_commit) options.before_commit(layout, tmp.path);
     commit(layout, tally.range, tmp, out, where);
     return {layout, tally.progress.bytes_in, tally.progress.bytes_out};
 }

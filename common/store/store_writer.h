@@ -25,6 +25,10 @@ struct ImportOptions {
     int threads = 1;       // chunks compressed at once
     int zstd_level = 3;
     std::function<void(const ImportProgress&)> progress;  // after each slab of chunks
+    // Called with the layout and the temporary folder once every chunk is written, before the
+    // store moves into place: what else the store should hold (its octree) is then in it from
+    // the moment it exists.
+    std::function<void(const StoreLayout&, const std::filesystem::path&)> before_commit;
 };
 
 // Writes `volume` as a store at `out`. The store is built under a temporary name beside `out`

@@ -68,6 +68,12 @@ struct OctreeSource {
     // Every other file the voxels come from (a detached header's data file): the key covers each,
     // so data replaced behind an unchanged header is never served a stale octree.
     std::vector<std::filesystem::path> data_files{};
+    // A volume that carries its own octree (a store, common/store/open_store.h): the file, and
+    // the key of the content it was built from (the store's identity, not where it lies, so a
+    // moved or shared store keeps its octree). Empty/nullopt: the cache folder and the files'
+    // key above.
+    std::filesystem::path own_file{};
+    std::optional<std::uint64_t> content_key{};
 };
 
 struct OctreeStats {
@@ -280,8 +286,13 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
     if (src.volume_path.empty() || src.cache_dir.empty()) {
         st.cache_note = src.volume_path.empty() ? "generated volume, not cached" : "cache disabled";
-    } else if ((key = octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
-        file = octree_cache::file_for(src.cache_dir, src.volume_path);
+    } else if ((key = src.content_key
+                          ? std::optional(
+                                octree_cache::Key{static_cast<std::uint32_t>(voxel_type_of<T>()),
+                                                  v.dims, *src.content_key})
+                          : octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
+        file = src.own_file.empty() ? octree_cache::file_for(src.cache_dir, src.volume_path)
+                                    : src.own_file;
         st.cache_file = file;
         std::error_code ec;
         if (std::filesystem::exists(file, ec)) {

@@ -121,6 +121,14 @@ class Volume {
     // generated volume. The octree cache key covers each.
     const std::vector<std::filesystem::path>& files() const { return files_; }
     void set_files(std::vector<std::filesystem::path> files) { files_ = std::move(files); }
+    // Where a volume that carries its own octree keeps it, and the key of its content (a store:
+    // common/store/open_store.h); empty and 0 otherwise (the octree cache's folder and key).
+    const std::filesystem::path& own_octree() const { return own_octree_; }
+    std::uint64_t content_key() const { return content_key_; }
+    void set_own_octree(std::filesystem::path file, std::uint64_t content_key) {
+        own_octree_ = std::move(file);
+        content_key_ = content_key;
+    }
     const Orientation& orientation() const { return orientation_; }
     void set_orientation(const Orientation& o) { orientation_ = o; }
     const std::vector<VolumeFact>& facts() const { return facts_; }
@@ -150,6 +158,8 @@ class Volume {
     VoxelType type_ = VoxelType::u8;
     std::string source_;
     std::vector<std::filesystem::path> files_;
+    std::filesystem::path own_octree_;
+    std::uint64_t content_key_ = 0;
     Orientation orientation_;
     std::vector<VolumeFact> facts_;
     MappedFile file_;
