@@ -147,6 +147,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
+    if (ov.pager) setup.io_cpu_s = [pager = ov.pager] { return pager->stats().cpu_s; };
     std::optional<TileWindow> window;
     if (o.windows) {
         const int t = tile_of_rank(spec, comm.rank());

@@ -113,6 +113,7 @@ class TileRank {
             show_pending();
             std::optional<Message> m = inbox_.pop();
             trace_.switch_to(Stage::comm);
+            charge_io();
             if (!m) {
                 // snapshot requests only: answered below
             } else if (auto* v = std::get_if<ViewMsg>(&*m)) {
@@ -142,6 +143,14 @@ class TileRank {
     }
 
   private:
+    // What the volume's pager threads spent since the last charge, into the trace's io stage.
+    void charge_io() {
+        if (!setup_.io_cpu_s) return;
+        const double now = setup_.io_cpu_s();
+        trace_.charge(Stage::io, now - io_charged_s_);
+        io_charged_s_ = now;
+    }
+
     EngineOptions options() {
         EngineOptions opt = setup_.engine;
         // Every sample point: the measurement's shots want them; progress messages go out
@@ -320,6 +329,7 @@ class TileRank {
     std::vector<Shown> shows_;
     Stopwatch shown_clock_;
     double cpu0_ = 0, last_progress_s_ = -1;
+    double io_charged_s_ = 0;
     bool interrupted_ = false;
 };
 

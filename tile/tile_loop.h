@@ -6,6 +6,7 @@
 // progress point, lands helpers' results, answers snapshot requests from the frame being built,
 // and at quit sends its figures, trace and final image, then stays until the master releases it
 // (a helper's result may still be on its way to it).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ struct TileSetup {
     // Where the frame is shown as it builds (a window, a preview for the control window); each
     // is paced on its own (tile/frame_show.h).
     std::vector<FrameShow*> shows = {};
+    // CPU seconds so far of the threads that read the volume for this rank (a store's pager),
+    // charged to the trace's io stage; empty for a volume in memory.
+    std::function<double()> io_cpu_s = {};
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

@@ -25,6 +25,10 @@ TraceRecorder::TraceRecorder() {
     switch_to(Stage::setup);
 }
 
+void TraceRecorder::charge(Stage stage, double cpu_s) {
+    if (cpu_s > 0) spans_.push_back({static_cast<std::uint8_t>(stage), wall_now_s(), 0.0, cpu_s});
+}
+
 Stage TraceRecorder::switch_to(Stage stage) {
     const Stage left = current_;
     const double wall = wall_now_s(), cpu = thread_cpu_seconds();

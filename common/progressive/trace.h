@@ -21,9 +21,10 @@ struct TraceSpan {
 };
 
 // show: presenting the frame in a window or as a preview as it builds (not part of the emulated
-// busy time).
-inline constexpr const char* kTraceStages[] = {"intersection", "propagation", "render", "comm",
-                                               "idle",         "compose",     "setup",  "show"};
+// busy time). io: a store's pager threads reading bricks for this rank (common/store/
+// paged_voxels.h); charged as CPU without wall time, since they run beside the frame.
+inline constexpr const char* kTraceStages[] = {
+    "intersection", "propagation", "render", "comm", "idle", "compose", "setup", "show", "io"};
 enum class Stage : std::uint8_t {
     intersection,
     propagation,
@@ -32,7 +33,8 @@ enum class Stage : std::uint8_t {
     idle,
     compose,
     setup,
-    show
+    show,
+    io
 };
 
 double thread_cpu_seconds();
@@ -46,6 +48,9 @@ class TraceRecorder {
     Stage switch_to(Stage stage);
     // Ends the current span (the recorder can go on with switch_to).
     void close();
+    // Records CPU seconds spent by threads beside this one in `stage` (a store's pager: io) as a
+    // span of no wall time at now, without touching the open span.
+    void charge(Stage stage, double cpu_s);
     // Charges CPU seconds of the rank's other threads (the engine's workers) to the open span, so
     // that a span's cpu_s is the CPU the rank spent in it, on every thread.
     void add_cpu(double cpu_s) {

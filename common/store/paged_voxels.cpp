@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <deque>
 #include <mutex>
 #include <stdexcept>
@@ -35,6 +36,12 @@ std::string errno_text(const char* call) {
     const std::string line = "isowall: error: " + clip(what, 800) + "\n";
     [[maybe_unused]] const ssize_t n = ::write(2, line.data(), line.size());
     ::_exit(1);
+}
+
+double thread_cpu_s() {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 }  // namespace
@@ -193,6 +200,7 @@ void PagedVoxels::serve() {
             s.state[i] = State::kLoading;
         }
         const auto t0 = std::chrono::steady_clock::now();
+        const double cpu0 = thread_cpu_s();
         std::size_t read = 0;
         try {
             read = reader_->read_chunk(l.brick_at(i), buffer);
@@ -212,6 +220,7 @@ void PagedVoxels::serve() {
         s.seen[i] = 1;
         s.stats.bytes_read += read;
         s.stats.fill_s += dt;
+        s.stats.cpu_s += thread_cpu_s() - cpu0;
         s.stats.resident_bytes = s.resident_bytes;
         s.stats.peak_bytes = std::max(s.stats.peak_bytes, s.resident_bytes);
     }

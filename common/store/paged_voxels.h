@@ -35,6 +35,7 @@ struct PagingStats {
     std::uint64_t peak_bytes = 0;  // most bricks' bytes resident at once
     std::uint64_t resident_bytes = 0;
     double fill_s = 0;  // time the pager's threads spent reading and installing bricks
+    double cpu_s = 0;   // their CPU time (CLOCK_THREAD_CPUTIME_ID), for traces' io stage
 };
 
 class PagedVoxels {
