@@ -41,6 +41,8 @@ TEST(CliStore, ImportThenRenderUnderALimitDrawsThePictureOfTheFile) {
 
     const auto info = run_isowall(dir, "info --volume ph.zarr --cache-dir cache");
     ASSERT_EQ(info.exit_code, 0) << info.err;
+    if (info.out.find("read whole: no paging here") != std::string::npos)
+        GTEST_SKIP() << "no userfaultfd here: " << info.out;
     EXPECT_NE(info.out.find("in a store (paged"), std::string::npos) << info.out;
     EXPECT_NE(info.out.find("octree: mapped"), std::string::npos) << info.out;
     EXPECT_NE(info.out.find("store: Zarr v2 (OME-Zarr 0.4)"), std::string::npos) << info.out;

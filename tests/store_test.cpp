@@ -137,6 +137,8 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
 }
 
 TEST(StoreImport, EveryVoxelComesBackUnderACapThatForcesEvictions) {
+    if (const std::string why = paging_unavailable(); !why.empty())
+        GTEST_SKIP() << "no paging here (" << why << "): a store is read whole";
     const Volume v = pattern_volume({300, 260, 200});
     const fs::path store = import_to(v, "store_pattern");
     EXPECT_TRUE(is_store(store));
@@ -183,6 +185,8 @@ TEST(StoreImport, EveryVoxelComesBackUnderACapThatForcesEvictions) {
 }
 
 TEST(StoreImport, TheSurfaceFromAPagedStoreIsTheSurfaceFromMemory) {
+    if (const std::string why = paging_unavailable(); !why.empty())
+        GTEST_SKIP() << "no paging here (" << why << "): a store is read whole";
     const Volume v = make_phantom({{260, 230, 210}, glm::vec3(1.0f)});
     const fs::path store = import_to(v, "store_phantom");
     const StoreReader reader(store);
@@ -281,6 +285,8 @@ TEST(StoreDamage, MetadataThatDisagreesWithTheChunksIsRefused) {
 
 // A damaged chunk found while a frame reads it ends the process with its line (paged_voxels.h).
 TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
+    if (const std::string why = paging_unavailable(); !why.empty())
+        GTEST_SKIP() << "no paging here (" << why << "): a store is read whole";
     GTEST_FLAG_SET(death_test_style, "threadsafe");
     const Volume v = pattern_volume({64, 128, 64});
     const fs::path store = import_to(v, "store_corrupt");
@@ -300,6 +306,8 @@ TEST(StoreDamageDeathTest, ACorruptChunkEndsTheProcessNamingTheChunk) {
 }
 
 TEST(StoreDamage, ACapTooSmallForTheChunksIsOneLine) {
+    if (const std::string why = paging_unavailable(); !why.empty())
+        GTEST_SKIP() << "no paging here (" << why << "): a store is read whole";
     const fs::path store = import_to(pattern_volume({300, 260, 40}), "store_small_cap");
     expect_line([&] { open_store(store, 512 << 10); }, {"--memory-limit", "at least"});
 }

@@ -53,6 +53,8 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
         EXPECT_GE(m.equal_share, 0.999) << m;
         std::cout << "mosaic vs single view" << engine << ": " << m << "\n";
         const std::string log = slurp(dir / "wall.log");
+        if (log.find("read whole: no paging here") != std::string::npos)
+            GTEST_SKIP() << "no userfaultfd here: " << log;
         EXPECT_NE(log.find("rank  4 on "), std::string::npos) << log;
         EXPECT_NE(log.find("-> tile  3 (column 1, row 1)"), std::string::npos) << log;
         // --threads 0 (the default): each of the 5 ranks takes its share of this machine.

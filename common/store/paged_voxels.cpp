@@ -44,6 +44,14 @@ double thread_cpu_s() {
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+long open_userfaultfd() {
+    // UFFD_USER_MODE_ONLY lets a user without CAP_SYS_PTRACE page (kernels from 5.11); the voxels
+    // are only ever read from user space.
+    long fd = ::syscall(SYS_userfaultfd, O_CLOEXEC | O_NONBLOCK | UFFD_USER_MODE_ONLY);
+    if (fd < 0 && errno == EINVAL) fd = ::syscall(SYS_userfaultfd, O_CLOEXEC | O_NONBLOCK);
+    return fd;
+}
+
 }  // namespace
 
 // Two pager threads read faults from one userfaultfd: while one decompresses a brick, the other
@@ -76,10 +84,7 @@ PagedVoxels::PagedVoxels(std::shared_ptr<const StoreReader> reader, std::uint64_
     brick_bytes_ = l.brick_bytes();
     map_bytes_ = l.chunk_count() * brick_bytes_;
 
-    // UFFD_USER_MODE_ONLY lets a user without CAP_SYS_PTRACE page (kernels from 5.11); the voxels
-    // are only ever read from user space.
-    long fd = ::syscall(SYS_userfaultfd, O_CLOEXEC | O_NONBLOCK | UFFD_USER_MODE_ONLY);
-    if (fd < 0 && errno == EINVAL) fd = ::syscall(SYS_userfaultfd, O_CLOEXEC | O_NONBLOCK);
+    const long fd = open_userfaultfd();
     if (fd < 0) throw std::runtime_error(errno_text("userfaultfd"));
     uffd_ = static_cast<int>(fd);
     auto fail = [&](const std::string& why) {
@@ -224,6 +229,13 @@ void PagedVoxels::serve() {
         s.stats.resident_bytes = s.resident_bytes;
         s.stats.peak_bytes = std::max(s.stats.peak_bytes, s.resident_bytes);
     }
+}
+
+std::string paging_unavailable() {
+    const long fd = open_userfaultfd();
+    if (fd < 0) return errno_text("userfaultfd");
+    ::close(static_cast<int>(fd));
+    return "";
 }
 
 std::string paging_line(const PagingStats& s, std::uint64_t cap) {

@@ -70,6 +70,10 @@ class PagedVoxels {
     std::unique_ptr<State> state_;
 };
 
+// Empty when this process can page with userfaultfd; otherwise why not (an old kernel, a seccomp
+// filter such as a container's default one). Without it a store is read whole (open_store.h).
+std::string paging_unavailable();
+
 // A one-line summary of `s` for `render`: "bricks: 312 read (41.2 MiB from disk), ..."
 std::string paging_line(const PagingStats& s, std::uint64_t cap);
 
