@@ -84,8 +84,6 @@ int run_import(const ImportCommand& o) {
             throw InputError(o.out, "--out", "folder " + parent.string() + " does not exist");
     }
     OpenedVolume ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
-    if (ov.volume.paged() && std::filesystem::equivalent(*ov.file, out))
-        throw InputError(o.out, "--out", "is the store being imported");
 
     ProgressBar bar(o.quiet);
     store::ImportOptions opts;

@@ -80,6 +80,9 @@ TEST(CliStore, BadStoresAndOptionsAreOneLineEach) {
     expect_one_line_error(run_isowall(dir, "import nothing.nrrd --out x.zarr"), {"nothing.nrrd"});
     EXPECT_FALSE(fs::exists(dir / "x.zarr"));
     expect_one_line_error(run_isowall(dir, "import --out y.zarr"), {"source"});
+    expect_one_line_error(run_isowall(dir, "import ph.zarr --out copy.zarr"),
+                          {"ph.zarr", "a store already"});
+    EXPECT_FALSE(fs::exists(dir / "copy.zarr"));
 
     // A chunk flipped on disk: the frame that reads it ends with the chunk's line, no image.
     {
