@@ -91,6 +91,23 @@ void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
                         "X display of the control window (default $DISPLAY)");
 }
 
+// What each rank of a wall may use: its threads, and where it reads a store.
+void add_rank_options(CLI::App& wall_cmd, WallOptions& wall) {
+    wall_cmd
+        .add_option("--threads", wall.threads,
+                    "Threads each rank may use (octree build; rays and propagation). 0: its "
+                    "share of its node's cores (1 each when emulating a wall on one machine)")
+        ->transform(number_in({0, 1024, false, true}))
+        ->capture_default_str();
+    wall_cmd
+        .add_option("--bricks-from", wall.bricks_from,
+                    "Where tile ranks read a store (--volume STORE): auto, on their own host when "
+                    "they can see its folder, else from the master over MPI; master, always "
+                    "from the master")
+        ->check(CLI::IsMember({"auto", "master"}))
+        ->capture_default_str();
+}
+
 CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     auto* wall_cmd = app.add_subcommand(
         "wall",
@@ -122,12 +139,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
                      "Seconds the tile ranks may take to load the volume and start")
         ->transform(number_in(limits::kSeconds))
         ->capture_default_str();
-    wall_cmd
-        ->add_option("--threads", wall.threads,
-                     "Threads each rank may use (octree build; rays and propagation). 0: its "
-                     "share of its node's cores (1 each when emulating a wall on one machine)")
-        ->transform(number_in({0, 1024, false, true}))
-        ->capture_default_str();
+    add_rank_options(*wall_cmd, wall);
     wall_cmd->add_option("--trace", wall.trace,
                          "Write per-rank spans by stage with thread CPU time: PREFIX.json (Chrome "
                          "trace, opens in Perfetto) and PREFIX.csv; migrated jobs show as flows");

@@ -15,6 +15,7 @@
 #include "common/core/error.h"
 #include "common/core/util.h"
 #include "common/extract/surface_extractor.h"
+#include "common/store/open_store.h"
 #include "common/volume/phantom.h"
 #include "common/wall/control_layout.h"
 #include "common/wall/script.h"
@@ -24,6 +25,7 @@
 #include "master/wall_master.h"
 #include "render/renderer.h"
 #include "tile/preview_show.h"
+#include "tile/remote_store.h"
 #include "tile/tile_loop.h"
 #include "tile/tile_window.h"
 
@@ -97,6 +99,8 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     std::tie(mo.region_w, mo.region_h) = parse_region(o.region).value_or(std::pair{0, 0});
     mo.screen_box = to_engine_options(o.engine).screen_box;
     mo.measure = o.measure;
+    mo.store = in.volume->store;
+    mo.store_octree = in.volume->volume.own_octree();
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),
                       in.extractor->value_max());
     // Opened before the tiles load: a display that cannot open ends the job at once.
@@ -124,9 +128,33 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     return master.finish();
 }
 
+// A tile rank's volume: read on its own host, or, where the host cannot see the store given as
+// --volume (or with --bricks-from master), the master's store through `remote`.
+OpenedVolume open_tile_volume(const WallOptions& o, Comm& comm,
+                              std::optional<RemoteStore>& remote) {
+    const VolumeUse use{.copies_on_host = comm.ranks_on_host()};
+    const std::string& path = o.volume.path;
+    std::error_code ec;
+    if (path.empty() || (o.bricks_from != "master" && std::filesystem::exists(path, ec)))
+        return open_volume(o.volume, /*quiet=*/true, use);
+    remote.emplace(comm, o.timeout_s);
+    OpenedVolume ov;
+    ov.cache_dir = cache_dir(o.volume);
+    // The octree's copy lives in the cache folder (a temporary one with --no-cache).
+    const std::filesystem::path dir =
+        ov.cache_dir.empty() ? std::filesystem::temp_directory_path() : ov.cache_dir;
+    auto reader = remote->open(path, dir);
+    store::OpenedStore s =
+        store::open_store(reader, remote->octree_file(), memory_limit(o.volume, use));
+    ov.volume = std::move(s.volume);
+    ov.pager = std::move(s.pager);
+    ov.file = std::filesystem::path(path);
+    return ov;
+}
+
 int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
-    const OpenedVolume ov =
-        open_volume(o.volume, /*quiet=*/true, VolumeUse{.copies_on_host = comm.ranks_on_host()});
+    std::optional<RemoteStore> remote;
+    const OpenedVolume ov = open_tile_volume(o, comm, remote);
     auto extractor = open_extractor(ov, budget);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
     // thread, unless the user says otherwise: the work then stays on its core and in the frame
@@ -148,6 +176,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
     if (ov.pager) setup.io_cpu_s = [pager = ov.pager] { return pager->stats().cpu_s; };
+    if (remote) setup.remote_store = &*remote;
     std::optional<TileWindow> window;
     if (o.windows) {
         const int t = tile_of_rank(spec, comm.rank());

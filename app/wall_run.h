@@ -39,6 +39,10 @@ struct WallOptions {
     bool measure = false;           // emulated wall-wide correctness curves
     bool windows = false;           // each tile shows its frame in a window on its display
     bool region_clip = true;        // propagation stays within each job's region
+    // Where a tile rank reads a store given as --volume: "auto", from its own host when the
+    // folder is there, else from the master over the wall's messages; "master", always from the
+    // master (to try a cluster's set-up on one machine).
+    std::string bricks_from = "auto";
     // Threads each rank may use (the octree build, and the engine's threads casting and
     // propagating side by side): ranks share nodes, so this is the rank's budget, not the
     // machine's core count. 0: the rank's share of its node (rank_budget in wall_run.cpp).

@@ -74,6 +74,20 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
 
 }  // namespace
 
+std::uint64_t memory_limit(const VolumeOptions& o, VolumeUse use) {
+    if (o.memory_limit.empty()) return store::default_memory_limit(use.copies_on_host);
+    const auto parsed = store::parse_byte_size(o.memory_limit);
+    if (!parsed)
+        throw InputError("--memory-limit", "value",
+                         "expected a size such as 512M or 8G, got " + quote(o.memory_limit));
+    return *parsed;
+}
+
+std::filesystem::path cache_dir(const VolumeOptions& o) {
+    if (o.no_cache) return {};
+    return o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
+}
+
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     OpenedVolume out;
     Stopwatch sw;
@@ -85,19 +99,12 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     } else if (store::is_store(o.path)) {
         if (!o.dims.empty() || !o.type.empty())
             throw InputError(o.path, "--dims/--type", "a store carries its own size and type");
-        std::uint64_t cap = store::default_memory_limit(use.copies_on_host);
-        if (!o.memory_limit.empty()) {
-            const auto parsed = store::parse_byte_size(o.memory_limit);
-            if (!parsed)
-                throw InputError(
-                    "--memory-limit", "value",
-                    "expected a size such as 512M or 8G, got " + quote(o.memory_limit));
-            cap = *parsed;
-        }
+        const std::uint64_t cap = memory_limit(o, use);
         const std::filesystem::path path = store::store_path(o.path);
         store::OpenedStore opened = store::open_store(path, cap);
         out.volume = std::move(opened.volume);
         out.pager = std::move(opened.pager);
+        out.store = std::move(opened.reader);
         out.file = path;
         store_note = " (" + opened.how + ")";
     } else {
@@ -131,9 +138,7 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         }
     }
     out.load_s = sw.seconds();
-    if (out.file && !o.no_cache)
-        out.cache_dir =
-            o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
+    if (out.file) out.cache_dir = cache_dir(o);
     if (quiet) return out;
     const Volume& v = out.volume;
     const glm::ivec3 d = v.dims();

@@ -35,6 +35,8 @@ struct OpenedVolume {
     double load_s = 0;
     // A store's pager (common/store/paged_voxels.h), for what it read; null for other volumes.
     std::shared_ptr<const store::PagedVoxels> pager;
+    // A store's reader, for a wall master that sends chunks to ranks that cannot see the store.
+    std::shared_ptr<const store::StoreReader> store;
 };
 
 // Who holds the volume: `casts` when this process runs the engine over it (the master of a wall
@@ -45,6 +47,14 @@ struct VolumeUse {
     int copies_on_host = 1;
     bool one_frame = false;  // the process draws one frame (choose_huge_pages)
 };
+
+// A store's --memory-limit for this process: the option, or its share of the host's memory.
+// InputError naming --memory-limit when the value is not a size.
+std::uint64_t memory_limit(const VolumeOptions& opts, VolumeUse use);
+
+// The octree cache folder of `opts` (--cache-dir, $ISOWALL_CACHE_DIR, ~/.cache/isowall), or
+// empty with --no-cache.
+std::filesystem::path cache_dir(const VolumeOptions& opts);
 
 // Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,
 // and prints one line about it.

@@ -55,7 +55,10 @@ std::vector<Message> samples() {
             done,
             region,
             LandedMsg{9, 4},
-            preview};  // last, so the older seeds keep their names
+            preview,
+            StoreAskMsg{StorePart::chunk, 42},
+            StoreMetaMsg{true, R"({"zarr_format": 2})", R"({"isowall": {}})", 4096, 100},
+            StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}}};  // new last
 }
 
 }  // namespace

@@ -54,8 +54,7 @@ void WallMaster::handle(const Envelope& e) {
         t.host = h->host;
         t.threads = h->threads;
         (h->loaded ? t.hello : t.joined) = true;
-    } else if (std::holds_alternative<AliveMsg>(m)) {
-        // its message loop runs: heard is all it tells
+    } else if (std::holds_alternative<AliveMsg>(m)) {  // its loop runs: heard is all it tells
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
         if (p->generation == generation_)  // older generations: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);
@@ -74,6 +73,8 @@ void WallMaster::handle(const Envelope& e) {
             previews_[static_cast<std::size_t>(e.from)] = std::move(*pv);
             ++previews_taken_;
         }
+    } else if (auto* ask = std::get_if<StoreAskMsg>(&m)) {
+        store_sent_.add(e.from, answer_store_ask(*ask, o_.store.get(), o_.store_octree), comm_);
     } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
         raise_test_signal(o_.fault, FaultMoment::gather);
         t.result = std::move(*res);
@@ -391,6 +392,7 @@ void WallMaster::report(OutputFiles& batch) {
     if (o_.results_out) *o_.results_out = results;
     trace_.close();
     print_stage_table(stdout, trace_.spans(), results);
+    print_store_sent(stdout, store_sent_);
     if (!o_.trace.empty())
         write_wall_traces(batch, o_.trace, spec_, trace_.spans(), results, migrations_);
 }

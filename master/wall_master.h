@@ -17,6 +17,7 @@
 #include "common/wall/wall.h"
 #include "master/job_board.h"
 #include "master/mosaic.h"
+#include "master/store_server.h"
 #include "master/wall_report.h"
 
 namespace isowall {
@@ -42,6 +43,10 @@ struct MasterOptions {
     bool screen_box = true;  // the engine casts no ray outside the volume's screen box
     bool measure = false;    // tiles report emulated correctness curves
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
+    // The volume when it is a store (null otherwise), and its octree file: sent to a tile rank
+    // that asks because its host cannot see them (tile/remote_store.h).
+    std::shared_ptr<const store::StoreReader> store;
+    std::filesystem::path store_octree;
 };
 
 class WallMaster {
@@ -76,6 +81,7 @@ class WallMaster {
     // keeps a picture while a frame starts. previews_taken() grows with every preview kept.
     const std::vector<std::optional<PreviewMsg>>& previews() const { return previews_; }
     std::uint64_t previews_taken() const { return previews_taken_; }
+    const StoreSent& store_sent() const { return store_sent_; }
 
   private:
     struct TileState {
@@ -133,6 +139,7 @@ class WallMaster {
     std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on
     std::vector<std::optional<PreviewMsg>> previews_;  // by rank
     std::uint64_t previews_taken_ = 0;
+    StoreSent store_sent_;  // what tiles that cannot see the store were sent
 };
 
 }  // namespace isowall

@@ -6,6 +6,7 @@
 
 #include "common/core/wire_pieces.h"
 #include "protocol/protocol_jobs.h"
+#include "protocol/protocol_store.h"
 
 #include <cmath>
 #include <iterator>
@@ -272,6 +273,12 @@ const char* to_string(Tag tag) {
             return "region";
         case Tag::landed:
             return "landed";
+        case Tag::store_ask:
+            return "store_ask";
+        case Tag::store_meta:
+            return "store_meta";
+        case Tag::store_part:
+            return "store_part";
     }
     // A tag comes off the wire as any int32, so this is reachable.
     return "unknown";
@@ -309,9 +316,15 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_region(bytes);
         case Tag::landed:
             return job_wire::decode_landed(bytes);
+        case Tag::store_ask:
+            return store_wire::decode_store_ask(bytes);
+        case Tag::store_meta:
+            return store_wire::decode_store_meta(bytes);
+        case Tag::store_part:
+            return store_wire::decode_store_part(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
-                    ": unknown tag, expected 1..11 or 16..19");
+                    ": unknown tag, expected 1..14 or 16..19");
 }
 
 }  // namespace isowall

@@ -31,6 +31,9 @@ enum class Tag : std::int32_t {
     start = 9,        // master -> tile: the volume and its octree cache are ready; load them
     alive = 10,       // both ways, every kAliveIntervalS: the sender's message loop is running
     preview = 11,     // tile -> master (--control): a small copy of what the tile shows now
+    store_ask = 12,   // tile -> master: a part of the master's store (its host cannot see it)
+    store_meta = 13,  // master -> tile: the store's metadata (the answer to a meta ask)
+    store_part = 14,  // master -> tile: the store's octree piece or chunk that was asked for
     job = 16,         // master -> worker: fill a screen region of a tile (its own or another's)
     job_done = 17,    // worker -> master: the job's figures; the worker is free for the next
     region = 18,      // worker -> owner: colour and depth of a region it filled for the owner
@@ -133,6 +136,41 @@ struct PreviewMsg : Preview {
     static constexpr std::uint8_t kVersion = 1;
 };
 
+// A tile rank whose host cannot see the store given as --volume (a display node without the
+// shared file system) asks the master for it (tile/remote_bricks.h): first its metadata, then its
+// octree file in pieces, then, while frames run, the compressed chunks its pager needs. The
+// master reads them from its own copy and sends them as they are on disk; the tile checks each
+// chunk as if it had read it (checksum, size).
+enum class StorePart : std::uint8_t { meta = 0, octree = 1, chunk = 2 };
+inline constexpr std::uint64_t kOctreePieceBytes = std::uint64_t(16) << 20;
+// The most a store_part carries: a chunk of the largest brick (64^3 float64 voxels, 2 MiB) never
+// compresses past it, and an octree piece is kOctreePieceBytes.
+inline constexpr std::uint64_t kMaxStorePartBytes = std::uint64_t(32) << 20;
+
+struct StoreAskMsg {
+    static constexpr Tag kTag = Tag::store_ask;
+    static constexpr std::uint8_t kVersion = 1;
+    StorePart part = StorePart::meta;
+    std::uint64_t index = 0;  // the octree piece, or the chunk's brick (x fastest); 0 for meta
+};
+
+struct StoreMetaMsg {
+    static constexpr Tag kTag = Tag::store_meta;
+    static constexpr std::uint8_t kVersion = 1;
+    bool is_store = false;       // false: the master's volume is not a store, so it cannot be sent
+    std::string zarray, zattrs;  // the store's 0/.zarray and .zattrs, as on disk
+    std::uint64_t octree_bytes = 0;   // the size of its octree file (sent in pieces)
+    std::uint64_t bytes_on_disk = 0;  // its chunks' compressed bytes, for `info` lines
+};
+
+struct StorePartMsg {
+    static constexpr Tag kTag = Tag::store_part;
+    static constexpr std::uint8_t kVersion = 1;
+    StorePart part = StorePart::chunk;  // octree or chunk
+    std::uint64_t index = 0;
+    std::vector<std::byte> bytes;  // at most kMaxStorePartBytes
+};
+
 // Which ray-order levels of a region a job casts: the coarse levels (until about 1/16 of the
 // region's rays) or the rest. Coarse jobs of every tile go before fine jobs anywhere.
 enum class Band : std::uint8_t { coarse = 0, fine = 1 };
@@ -178,9 +216,10 @@ struct LandedMsg {
     std::uint32_t job = 0;
 };
 
-using Message = std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
-                             TileResultMsg, ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg,
-                             JobDoneMsg, RegionMsg, LandedMsg>;
+using Message =
+    std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg, TileResultMsg,
+                 ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg, JobDoneMsg, RegionMsg,
+                 LandedMsg, StoreAskMsg, StoreMetaMsg, StorePartMsg>;
 
 std::vector<std::byte> encode(const TileHelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -197,6 +236,9 @@ std::vector<std::byte> encode(const JobMsg& m);
 std::vector<std::byte> encode(const JobDoneMsg& m);
 std::vector<std::byte> encode(const RegionMsg& m);
 std::vector<std::byte> encode(const LandedMsg& m);
+std::vector<std::byte> encode(const StoreAskMsg& m);
+std::vector<std::byte> encode(const StoreMetaMsg& m);
+std::vector<std::byte> encode(const StorePartMsg& m);
 std::vector<std::byte> encode(const Message& m);
 Tag tag_of(const Message& m);
 

@@ -19,6 +19,7 @@
 
 #include "common/core/util.h"
 #include "common/io/image_io.h"
+#include "common/volume/phantom.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
@@ -47,12 +48,15 @@ std::string wall_args(const std::filesystem::path& dir, const std::string& mosai
 // The cluster's mpirun, as a script run on h1: the hostfile and agent come from netns_hosts.sh,
 // and both Open MPI's own channel (oob) and the ranks' messages (btl) use only the bridge's
 // subnet. No shared memory: ranks on one host talk over TCP too.
-std::string cluster_script(const std::filesystem::path& dir) {
-    std::string s = "set -eu\nexec mpirun --hostfile \"$ISOWALL_NETNS_HOSTFILE\"";
+// With `hide`, that folder is seen on h1 only (scripts/netns_agent.sh: ISOWALL_NETNS_HIDE).
+std::string cluster_script(const std::string& args, const std::filesystem::path& hide = {}) {
+    std::string s = "set -eu\n";
+    if (!hide.empty()) s += "export ISOWALL_NETNS_HIDE='" + hide.string() + "'\n";
+    s += "exec mpirun --hostfile \"$ISOWALL_NETNS_HOSTFILE\"";
     s += " --mca plm_rsh_agent \"$ISOWALL_NETNS_AGENT\"";
     s += " --mca oob_tcp_if_include \"$ISOWALL_NETNS_SUBNET\"";
     s += " --mca btl_tcp_if_include \"$ISOWALL_NETNS_SUBNET\" --mca btl tcp,self";
-    s += " --oversubscribe -np 5 " + isowall_cmd() + wall_args(dir, "cluster.png") + "\n";
+    s += " --oversubscribe -np 5 " + isowall_cmd() + args + "\n";
     return s;
 }
 
@@ -96,7 +100,7 @@ TEST(NetnsWall, TheTwoByTwoWallAcrossThreeNamespaceHostsGivesTheMosaicOfOneHost)
     if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
     const auto dir = test::scratch_dir("netns_wall");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
-    std::ofstream(dir / "cluster.sh") << cluster_script(dir);
+    std::ofstream(dir / "cluster.sh") << cluster_script(wall_args(dir, "cluster.png"));
 
     // Across hosts first: where this machine cannot make namespaces, the test skips at once.
     // h1 runs mpirun and holds the master and tile 0, h2 tiles 1-2, h3 tile 3.
@@ -138,6 +142,58 @@ TEST(NetnsWall, TheTwoByTwoWallAcrossThreeNamespaceHostsGivesTheMosaicOfOneHost)
     EXPECT_GE(m.equal_share, 0.999) << m;
     if (m.mask_iou < 0.999 || m.equal_share < 0.999)
         test::write_diff_images(dir, "netns_mosaic", cluster, one, kFromFiles);
+}
+
+// Issue 32, bricks over MPI: the store lies on h1's disk only (the display nodes h2 and h3 see an
+// empty folder there). The ranks on h2 and h3 get its metadata, octree and every chunk they touch
+// from the master; the mosaic is the one the same store gives on one host.
+TEST(NetnsWall, AStoreOnTheFirstHostOnlyGivesTheMosaicOfOneHost) {
+    if (::geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
+    if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
+    const auto dir = test::scratch_dir("netns_store");
+    std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
+    std::filesystem::create_directories(dir / "data");
+    {
+        const Volume v = make_phantom();
+        std::ofstream(dir / "phantom.raw", std::ios::binary)
+            .write(reinterpret_cast<const char*>(v.bytes().data()),
+                   static_cast<std::streamsize>(v.bytes().size()));
+    }
+    const std::string store = (dir / "data" / "phantom.zarr").string();
+    ASSERT_EQ(run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() +
+                      "' --dims 200 184 168 --type uint8 -q --out '" + store + "'",
+                  dir / "import.log"),
+              0)
+        << slurp(dir / "import.log");
+    // Each run's octree copies in a cache of its own, so the first run's cannot serve the second.
+    auto args = [&](const std::string& mosaic) {
+        return wall_args(dir, mosaic) + " --volume '" + store +
+               "' --iso 50 --memory-limit 16M --cache-dir '" +
+               (dir / ("cache-" + mosaic)).string() + "'";
+    };
+    std::ofstream(dir / "cluster.sh") << cluster_script(args("cluster.png"), dir / "data");
+    const std::string hosts = std::string(ISOWALL_SOURCE_DIR) + "/scripts/netns_hosts.sh";
+    const int rc = run("bash '" + hosts + "' --slots 2,2,1 --dir '" + (dir / "hosts").string() +
+                           "' -- bash '" + (dir / "cluster.sh").string() + "'",
+                       dir / "cluster.log", kGuardS);
+    const std::string log = slurp(dir / "cluster.log");
+    if (rc == kSkipCode && log.find("netns_hosts: skip:") != std::string::npos) GTEST_SKIP() << log;
+    ASSERT_EQ(rc, 0) << log;
+    // Ranks 2 and 3 on h2 and rank 4 on h3 asked; rank 1, on h1 with the master, read its disk.
+    EXPECT_NE(log.find("sent by the master to 3 rank(s)"), std::string::npos) << log;
+    ASSERT_EQ(run(mpirun(5) + args("one.png"), dir / "one.log", kGuardS), 0)
+        << slurp(dir / "one.log");
+    EXPECT_EQ(slurp(dir / "one.log").find("sent by the master"), std::string::npos);
+    const Image one = read_image(dir / "one.png");
+    const Image cluster = read_image(dir / "cluster.png");
+    ASSERT_EQ(cluster.width, one.width);
+    ASSERT_EQ(cluster.height, one.height);
+    const test::ImageComparison m = test::compare_images(cluster, one, kFromFiles);
+    std::cout << "store on h1 only vs one host: " << m << "\n";
+    EXPECT_GE(m.mask_iou, 0.999) << m;
+    EXPECT_GE(m.equal_share, 0.999) << m;
+    if (m.mask_iou < 0.999 || m.equal_share < 0.999)
+        test::write_diff_images(dir, "netns_store", cluster, one, kFromFiles);
 }
 
 }  // namespace

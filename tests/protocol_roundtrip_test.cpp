@@ -145,7 +145,10 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::region), "region");
     EXPECT_STREQ(to_string(Tag::landed), "landed");
     EXPECT_STREQ(to_string(static_cast<Tag>(0)), "unknown");
-    EXPECT_STREQ(to_string(static_cast<Tag>(12)), "unknown");
+    EXPECT_STREQ(to_string(Tag::store_ask), "store_ask");
+    EXPECT_STREQ(to_string(Tag::store_meta), "store_meta");
+    EXPECT_STREQ(to_string(Tag::store_part), "store_part");
+    EXPECT_STREQ(to_string(static_cast<Tag>(15)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(20)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }

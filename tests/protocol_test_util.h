@@ -105,6 +105,16 @@ inline bool operator==(const LandedMsg& a, const LandedMsg& b) {
     return a.generation == b.generation && a.job == b.job;
 }
 
+inline bool operator==(const StoreAskMsg& a, const StoreAskMsg& b) {
+    return a.part == b.part && a.index == b.index;
+}
+inline bool operator==(const StoreMetaMsg& a, const StoreMetaMsg& b) {
+    return a.is_store == b.is_store && a.zarray == b.zarray && a.zattrs == b.zattrs &&
+           a.octree_bytes == b.octree_bytes && a.bytes_on_disk == b.bytes_on_disk;
+}
+inline bool operator==(const StorePartMsg& a, const StorePartMsg& b) {
+    return a.part == b.part && a.index == b.index && a.bytes == b.bytes;
+}
 inline std::ostream& operator<<(std::ostream& os, const PixelRect& p) {
     return os << "PixelRect{" << p.x << ", " << p.y << ", " << p.width << "x" << p.height << "}";
 }
@@ -166,6 +176,17 @@ inline void PrintTo(const JobDoneMsg& m, std::ostream* os) {
 inline void PrintTo(const RegionMsg& m, std::ostream* os) {
     *os << "RegionMsg{generation " << m.generation << ", job " << m.job << ", rect " << m.rect
         << ", " << m.rgba.size() << " rgba bytes, " << m.depth.size() << " depths}";
+}
+inline void PrintTo(const StoreAskMsg& m, std::ostream* os) {
+    *os << "StoreAskMsg{part " << int(m.part) << ", index " << m.index << "}";
+}
+inline void PrintTo(const StoreMetaMsg& m, std::ostream* os) {
+    *os << "StoreMetaMsg{" << m.is_store << ", " << m.zarray.size() << "+" << m.zattrs.size()
+        << " bytes, octree " << m.octree_bytes << "}";
+}
+inline void PrintTo(const StorePartMsg& m, std::ostream* os) {
+    *os << "StorePartMsg{part " << int(m.part) << ", index " << m.index << ", " << m.bytes.size()
+        << " bytes}";
 }
 inline void PrintTo(const LandedMsg& m, std::ostream* os) {
     *os << "LandedMsg{generation " << m.generation << ", job " << m.job << "}";
@@ -288,6 +309,14 @@ struct Sample {
     Bytes bytes;
 };
 
+inline StoreMetaMsg sample_store_meta() {
+    return {true, R"({"zarr_format": 2})", R"({"isowall": {}})", 123456, 7890};
+}
+
+inline StorePartMsg sample_store_part() {
+    return {StorePart::octree, 3, {std::byte{1}, std::byte{2}, std::byte{0xff}}};
+}
+
 inline std::vector<Sample> samples() {
     return {{"hello", Tag::hello, encode(sample_hello())},
             {"view", Tag::view, encode(sample_view())},
@@ -303,7 +332,10 @@ inline std::vector<Sample> samples() {
             {"job", Tag::job, encode(sample_job())},
             {"job_done", Tag::job_done, encode(sample_job_done())},
             {"region", Tag::region, encode(sample_region())},
-            {"landed", Tag::landed, encode(LandedMsg{3, 4})}};
+            {"landed", Tag::landed, encode(LandedMsg{3, 4})},
+            {"store_ask", Tag::store_ask, encode(StoreAskMsg{StorePart::chunk, 77})},
+            {"store_meta", Tag::store_meta, encode(sample_store_meta())},
+            {"store_part", Tag::store_part, encode(sample_store_part())}};
 }
 
 // decode_message must throw a WireError whose text names the message and `field`.

@@ -11,6 +11,7 @@
 #include "common/core/pacer.h"
 #include "common/core/util.h"
 #include "common/progressive/trace.h"
+#include "tile/remote_store.h"
 #include "tile/tile_inbox.h"
 #include "tile/tile_jobs.h"
 
@@ -29,8 +30,10 @@ constexpr double kProgressIntervalS = 0.05;
 // that error, so the frame thread reports it.
 class Receiver {
   public:
-    Receiver(Comm& comm, TileInbox& inbox, double timeout_s)
-        : comm_(comm), inbox_(inbox), timeout_s_(timeout_s), thread_([this] { loop(); }) {}
+    Receiver(Comm& comm, TileInbox& inbox, double timeout_s, RemoteStore* store)
+        : comm_(comm), inbox_(inbox), timeout_s_(timeout_s), store_(store), thread_([this] {
+              loop();
+          }) {}
     ~Receiver() {
         ending_ = true;
         thread_.join();
@@ -58,6 +61,12 @@ class Receiver {
                 if (e->from == kMasterRank) master_heard.restart();
                 Message m = decode_message(e->tag, e->bytes);
                 if (std::holds_alternative<AliveMsg>(m) && e->from == kMasterRank) continue;
+                if (auto* part = std::get_if<StorePartMsg>(&m); part && e->from == kMasterRank) {
+                    if (!store_)
+                        throw WireError("a store_part message, and this rank reads its own store");
+                    store_->deliver(std::move(*part));
+                    continue;
+                }
                 // Region results come from helpers (tile ranks); everything else from the master.
                 const bool from_helper = std::holds_alternative<RegionMsg>(m);
                 if (from_helper == (e->from == kMasterRank))
@@ -67,7 +76,13 @@ class Receiver {
                 inbox_.push(std::move(m));
                 if (release) return;
             }
+        } catch (const std::exception& e) {
+            // A pager waiting for a chunk would wait for nothing: it ends with this line.
+            if (store_)
+                store_->fail(std::string("rank ") + std::to_string(comm_.rank()) + ": " + e.what());
+            inbox_.close(std::current_exception());
         } catch (...) {
+            if (store_) store_->fail("the communication thread ended");
             inbox_.close(std::current_exception());
         }
     }
@@ -86,6 +101,7 @@ class Receiver {
     Comm& comm_;
     TileInbox& inbox_;
     double timeout_s_;
+    RemoteStore* store_;
     std::atomic<bool> ending_{false};
     std::thread thread_;
 };
@@ -106,7 +122,7 @@ class TileRank {
             comm_, kMasterRank,
             TileHelloMsg{comm_.host(),
                          static_cast<std::uint32_t>(std::max(1, setup_.engine.threads)), true});
-        Receiver receiver(comm_, inbox_, setup_.timeout_s);
+        Receiver receiver(comm_, inbox_, setup_.timeout_s, setup_.remote_store);
         bool quit = false;
         for (;;) {
             trace_.switch_to(Stage::idle);

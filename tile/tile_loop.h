@@ -19,6 +19,8 @@
 
 namespace isowall {
 
+class RemoteStore;  // tile/remote_store.h
+
 struct TileSetup {
     SurfaceExtractor& extractor;
     Renderer& renderer;       // the tile's own frame
@@ -34,6 +36,8 @@ struct TileSetup {
     // CPU seconds so far of the threads that read the volume for this rank (a store's pager),
     // charged to the trace's io stage; empty for a volume in memory.
     std::function<double()> io_cpu_s = {};
+    // The store's chunks when this rank's host cannot see it: the master's answers go here.
+    RemoteStore* remote_store = nullptr;
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

@@ -36,11 +36,18 @@ void add_facts(Volume& v, const StoreReader& r) {
 }  // namespace
 
 OpenedStore open_store(const fs::path& path, std::uint64_t cap_bytes) {
-    auto reader = std::make_shared<const StoreReader>(path);
+    OpenedStore out =
+        open_store(std::make_shared<const StoreReader>(path), octree_file(path), cap_bytes);
+    out.volume.set_files({path / ".zattrs", path / "0" / ".zarray"});
+    return out;
+}
+
+OpenedStore open_store(std::shared_ptr<const StoreReader> reader, const fs::path& octree,
+                       std::uint64_t cap_bytes) {
     const StoreLayout& l = reader->layout();
     OpenedStore out;
     out.bytes_on_disk = reader->bytes_on_disk();
-    const std::string source = path.string();
+    const std::string source = reader->path().string();
     try {
         auto pager = std::make_shared<const PagedVoxels>(reader, cap_bytes);
         out.volume = Volume(l.dims, l.type, l.spacing, pager, pager->bytes(), source);
@@ -64,9 +71,9 @@ OpenedStore open_store(const fs::path& path, std::uint64_t cap_bytes) {
         out.how = std::string("read whole: no paging here (") + e.what() + ")";
     }
     out.volume.set_bricks(l.brick_log2);
-    out.volume.set_own_octree(octree_file(path), content_key(l));
-    out.volume.set_files({path / ".zattrs", path / "0" / ".zarray"});
+    out.volume.set_own_octree(octree, content_key(l));
     add_facts(out.volume, *reader);
+    out.reader = std::move(reader);
     return out;
 }
 

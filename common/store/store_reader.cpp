@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include <zstd.h>
@@ -46,8 +47,9 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
     const std::string where = store.string();
     if (!is_store(store))
         throw InputError(where, "store", "not a store (no .zattrs and 0/.zarray in the folder)");
-    layout_ = parse_layout(read_text(store / "0" / ".zarray", where, "0/.zarray"),
-                           read_text(store / ".zattrs", where, ".zattrs"), where);
+    zarray_ = read_text(store / "0" / ".zarray", where, "0/.zarray");
+    zattrs_ = read_text(store / ".zattrs", where, ".zattrs");
+    layout_ = parse_layout(zarray_, zattrs_, where);
     const glm::ivec3 grid = layout_.grid();
     for (int bz = 0; bz < grid.z; ++bz)
         for (int by = 0; by < grid.y; ++by)
@@ -63,10 +65,18 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
             }
 }
 
-std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) const {
+StoreReader::StoreReader(const std::string& name, const std::string& zarray,
+                         const std::string& zattrs, std::uint64_t bytes_on_disk, ChunkFetch fetch)
+    : path_(name),
+      zarray_(zarray),
+      zattrs_(zattrs),
+      layout_(parse_layout(zarray, zattrs, name)),
+      bytes_on_disk_(bytes_on_disk),
+      fetch_(std::move(fetch)) {}
+
+std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b) const {
     const std::string where = path_.string(), key = chunk_key(b);
-    const std::size_t want = layout_.brick_bytes();
-    if (out.size() != want) throw InputError(where, key, "internal: wrong chunk buffer size");
+    if (fetch_) throw InputError(where, key, "internal: the store is not read on this host");
     Fd f;
     f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC);
     if (f.fd < 0) throw InputError(where, key, std::string("cannot open: ") + std::strerror(errno));
@@ -75,7 +85,7 @@ std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) cons
         throw InputError(where, key, "chunk is not a file");
     // zstd never expands data by more than a small bound; a chunk larger than that is not ours.
     const std::size_t size = static_cast<std::size_t>(st.st_size);
-    if (size > ZSTD_compressBound(want) + 64)
+    if (size > ZSTD_compressBound(layout_.brick_bytes()) + 64)
         throw InputError(where, key, "chunk larger than its voxels could compress to");
     std::vector<std::byte> packed(size);
     std::size_t got = 0;
@@ -88,6 +98,17 @@ std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) cons
         got += static_cast<std::size_t>(n);
     }
     if (got != size) throw InputError(where, key, "chunk shorter than its size (truncated)");
+    return packed;
+}
+
+std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) const {
+    const std::string where = path_.string(), key = chunk_key(b);
+    const std::size_t want = layout_.brick_bytes();
+    if (out.size() != want) throw InputError(where, key, "internal: wrong chunk buffer size");
+    const std::vector<std::byte> packed = fetch_ ? fetch_(b) : read_packed(b);
+    const std::size_t size = packed.size();
+    if (size > ZSTD_compressBound(want) + 64)
+        throw InputError(where, key, "chunk larger than its voxels could compress to");
     const unsigned long long content = ZSTD_getFrameContentSize(packed.data(), size);
     if (content == ZSTD_CONTENTSIZE_ERROR)
         throw InputError(where, key, "not a zstd frame (a damaged or foreign chunk)");

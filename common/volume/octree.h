@@ -284,7 +284,9 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     std::filesystem::path file;
     std::vector<std::filesystem::path> sources{src.volume_path};
     sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
-    if (src.volume_path.empty() || src.cache_dir.empty()) {
+    // A volume's own octree (a store's) is part of the volume, not of the cache: it is used
+    // with the cache off too.
+    if (src.volume_path.empty() || (src.cache_dir.empty() && src.own_file.empty())) {
         st.cache_note = src.volume_path.empty() ? "generated volume, not cached" : "cache disabled";
     } else if ((key = src.content_key
                           ? std::optional(
