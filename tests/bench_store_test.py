@@ -35,18 +35,41 @@ class BenchStore(unittest.TestCase):
             self.assertEqual(len(rows), 3, r.stdout)
             for row in rows:
                 cells = [c.strip() for c in row.strip("|").split("|")]
-                for c in cells[2:6]:  # first picture, 99%, command, peak RSS
+                for c in cells[2:7]:  # first picture, C = 99%, 99% px, command, peak RSS
                     self.assertRegex(c, r"^[0-9.]+$", row)
             file_row, store_row, limited = rows
-            self.assertEqual([c.strip() for c in file_row.strip("|").split("|")][6], "-")
+            self.assertEqual([c.strip() for c in file_row.strip("|").split("|")][7], "-")
             for row in (store_row, limited):
-                read, peak = [float(c) for c in row.strip("|").split("|")[6:8]]
+                read, peak = [float(c) for c in row.strip("|").split("|")[7:9]]
                 self.assertGreater(read, 0)
                 self.assertGreater(peak, 0)
-            peak = float(limited.strip("|").split("|")[7])
+            peak = float(limited.strip("|").split("|")[8])
             self.assertLessEqual(peak, 9.0, limited)
             self.assertEqual(r.stdout.count("skipped: --no-cold"), 3, r.stdout)
             self.assertTrue(os.path.exists(os.path.join(out, "store.md")))
+            self.assertRegex(r.stdout, r"Import took [0-9.]+ s: [0-9]+ MB/s of the source")
+            self.assertRegex(r.stdout, r"warm time to C = 99%: store under 9M / file = [0-9.]+ "
+                                       r"\(target at most 1.5: (holds|missed)\)")
+
+    def test_a_store_made_before_and_a_reference_picture(self):
+        with tempfile.TemporaryDirectory() as out:
+            first = bench("--volume", os.path.join(DATA, "tooth.nhdr"), "--iso", "620", "--runs",
+                          "1", "--size", "160x120", "--no-cold", "--out", out)
+            self.assertEqual(first.returncode, 0, first.stderr)
+            # The default limit is 1/8 of the volume's 3.1 MB, and at least 16 MiB.
+            self.assertIn("--memory-limit 16M", first.stdout)
+            ref = os.path.join(out, "ref.png")
+            os.rename(os.path.join(out, "render.png"), ref)
+            again = bench("--volume", os.path.join(DATA, "tooth.nhdr"), "--iso", "620", "--runs",
+                          "1", "--size", "160x120", "--no-cold", "--no-file", "--store",
+                          os.path.join(out, "tooth.zarr"), "--reference", ref, "--out", out)
+            self.assertEqual(again.returncode, 0, again.stderr)
+            self.assertNotIn("Import took", again.stdout)
+            self.assertNotIn("| file |", again.stdout)
+            m = re.search(r"coverage IoU ([0-9.]+), ([0-9.]+)% of pixels within 1/255", again.stdout)
+            self.assertTrue(m, again.stdout)
+            self.assertEqual(float(m.group(1)), 1.0)
+            self.assertEqual(float(m.group(2)), 100.0)
 
     def test_bad_options_are_one_line(self):
         for args, needle in ((["--runs", "0"], "--runs"),
