@@ -91,26 +91,6 @@ int run_import(const ImportCommand& o) {
     opts.zstd_level = o.level;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
-    // The store's own octree, from the voxels at hand, written into the store before it moves
-    // into place: `--volume STORE` maps it wherever the store lies, instead of reading every
-    // brick to build it.
-    std::string octree_note;
-    opts.before_commit = [&](const store::StoreLayout& layout, const std::filesystem::path& dir) {
-        OctreeSource src;
-        src.volume_path = out;
-        src.cache_dir = dir;  // not used: own_file names the file
-        src.own_file = store::octree_file(dir);
-        src.content_key = store::content_key(layout);
-        OctreeStats st;
-        dispatch_voxel_type(ov.volume.type(), [&](auto zero) {
-            using T = decltype(zero);
-            (void)MinMaxOctree<T>::load_or_build(ov.volume.view<T>(), src, &st);
-        });
-        std::error_code ec;
-        octree_note = std::filesystem::exists(src.own_file, ec)
-                          ? "written to " + store::octree_file(out).string()
-                          : "not written: " + st.cache_note;
-    };
     Stopwatch sw;
     const store::ImportResult r = store::write_store(ov.volume, out, opts);
     bar.finish();
@@ -125,7 +105,9 @@ int run_import(const ImportCommand& o) {
         l.chunk_count(), l.brick(), double(r.bytes_in) / mib, double(r.bytes_out) / mib,
         double(r.bytes_in) / double(std::max<std::uint64_t>(r.bytes_out, 1)), write_s,
         double(r.bytes_in) / mib / std::max(write_s, 1e-9));
-    std::printf("import: octree %s\n", octree_note.c_str());
+    std::printf("import: octree %s\n",
+                r.octree_note.empty() ? ("written to " + store::octree_file(out).string()).c_str()
+                                      : ("not written: " + r.octree_note).c_str());
     return 0;
 }
 

@@ -212,10 +212,25 @@ TEST(StoreImport, TheOctreeLivesInTheStoreAndMovesWithIt) {
         (void)make_surface_extractor(s.volume, src, &st);
         return st;
     };
+    // write_store built it from the slabs it read, node for node the octree of the whole volume.
+    ASSERT_TRUE(fs::exists(octree_file(store)));
     const OctreeStats first = extract_stats(store);
-    EXPECT_FALSE(first.from_cache);  // write_store alone leaves no octree; the first open writes it
+    EXPECT_TRUE(first.from_cache) << first.cache_note;
     EXPECT_EQ(first.cache_file, octree_file(store));
-    EXPECT_TRUE(fs::exists(octree_file(store)));
+    {
+        OpenedStore s = open_store(store, 64 << 20);
+        OctreeSource src;
+        src.volume_path = store;
+        src.own_file = octree_file(store);
+        src.content_key = s.volume.content_key();
+        const auto mapped = MinMaxOctree<std::uint8_t>::load_or_build(
+            s.volume.view<std::uint8_t>(), src, nullptr);
+        const auto whole = MinMaxOctree<std::uint8_t>::build(v.view<std::uint8_t>());
+        ASSERT_EQ(mapped.nodes().size(), whole.nodes().size());
+        EXPECT_TRUE(std::equal(mapped.nodes().begin(), mapped.nodes().end(), whole.nodes().begin()));
+        EXPECT_EQ(mapped.finite_range().min, whole.finite_range().min);
+        EXPECT_EQ(mapped.finite_range().max, whole.finite_range().max);
+    }
     const fs::path moved = store.parent_path() / "moved.zarr";
     fs::rename(store, moved);
     const OctreeStats second = extract_stats(moved);

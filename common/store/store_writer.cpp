@@ -16,6 +16,7 @@
 #include <zstd.h>
 
 #include "common/core/error.h"
+#include "common/store/slab_octree.h"
 
 namespace isowall::store {
 namespace fs = std::filesystem;
@@ -237,7 +238,10 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
     const int threads = std::max(1, std::min(options.threads, grid.y));
     Tally tally;
     tally.progress.chunks_total = layout.chunk_count();
+    const std::unique_ptr<SlabOctree> octree = options.octree ? make_slab_octree(volume) : nullptr;
+    FiniteRange finite;
     for (int bz = 0; bz < grid.z; ++bz) {
+        const int z0 = bz * layout.brick(), z1 = std::min(z0 + layout.brick(), layout.dims.z);
         // The slab's rows of bricks split over the threads; each has its buffers and zstd context.
         std::vector<std::thread> pool;
         for (int t = 1; t < threads; ++t)
@@ -248,17 +252,20 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         write_bricks(layout, all, tmp.path, where, bz, 0, grid.y / threads, tally);
         for (auto& th : pool) th.join();
         if (!tally.failure.empty()) throw InputError::relayed(tally.failure);
-        if (volume.mapped()) {
-            const std::size_t z0 = static_cast<std::size_t>(bz) * layout.brick();
-            const std::size_t z1 =
-                std::min<std::size_t>(z0 + layout.brick(), std::size_t(layout.dims.z));
-            release_source_pages(all.data() + z0 * slice_bytes, all.data() + z1 * slice_bytes);
-        }
+        // The slab's voxels are at hand: its leaves of the octree now, not in a second pass.
+        if (octree) finite.merge(octree->add_slab(z0, z1, threads));
+        if (volume.mapped())
+            release_source_pages(all.data() + std::size_t(z0) * slice_bytes,
+                                 all.data() + std::size_t(z1) * slice_bytes);
         if (options.progress) options.progress(tally.progress);
     }
+    ImportResult result{layout, tally.progress.bytes_in, tally.progress.bytes_out, {}};
+    if (octree)
+        result.octree_note = octree->write(octree_file(tmp.path), content_key(layout), finite);
     if (options.before_commit) options.before_commit(layout, tmp.path);
     commit(layout, tally.range, tmp, out, where);
-    return {layout, tally.progress.bytes_in, tally.progress.bytes_out};
+    result.layout = layout;
+    return result;
 }
 
 }  // namespace isowall::store

@@ -18,6 +18,8 @@ struct ImportProgress {
 struct ImportResult {
     StoreLayout layout;
     std::uint64_t bytes_in = 0, bytes_out = 0;
+    // Empty when the store's octree was written (octree_file(out)); else why it was not.
+    std::string octree_note;
 };
 
 struct ImportOptions {
@@ -25,9 +27,12 @@ struct ImportOptions {
     int threads = 1;       // chunks compressed at once
     int zstd_level = 3;
     std::function<void(const ImportProgress&)> progress;  // after each slab of chunks
+    // The store's octree, built from the slabs as they are read (common/store/slab_octree.h)
+    // and written into the store before it moves into place: `--volume STORE` maps it wherever
+    // the store lies instead of reading every brick to build it.
+    bool octree = true;
     // Called with the layout and the temporary folder once every chunk is written, before the
-    // store moves into place: what else the store should hold (its octree) is then in it from
-    // the moment it exists.
+    // store moves into place (tests: a stop at that moment).
     std::function<void(const StoreLayout&, const std::filesystem::path&)> before_commit;
 };
 

@@ -124,6 +124,14 @@ class MinMaxOctree {
                                       OctreeStats* stats,
                                       ThreadBudget budget = ThreadBudget::hardware());
 
+    // Built while the volume is walked slab by slab in z (a store's import reads each slab once):
+    // start(), then leaf_slab() for each slab of voxel slices [z0, z1) whose cells start there
+    // (it reads slice z1 too), from any thread for disjoint slabs whose ends are multiples of
+    // kLeafCells, then finish() with the merged ranges.
+    static MinMaxOctree start(glm::ivec3 cell_dims);
+    FiniteRange leaf_slab(const VolumeView<T>& v, int z0, int z1);
+    void finish(const FiniteRange& finite);
+
     const OctreeShape& shape() const { return shape_; }
     int level_count() const { return static_cast<int>(shape_.levels.size()); }
     T min(int level, glm::ivec3 n) const { return nodes_[2 * shape_.node_index(level, n)]; }
@@ -142,6 +150,8 @@ class MinMaxOctree {
 
   private:
     FiniteRange build_leaves(const VolumeView<T>& v, ThreadBudget budget);
+    // Leaf rows [bz0, bz1): their nodes, and the finite range of their voxels (floats only).
+    FiniteRange leaf_rows(const VolumeView<T>& v, int bz0, int bz1);
     void build_upper_levels();
 
     OctreeShape shape_;
@@ -189,50 +199,83 @@ std::filesystem::path default_dir();
 // independent; they are split over the budget (the build runs once per volume), each slab
 // keeping its own finite range, merged at the end.
 template <class T>
-FiniteRange MinMaxOctree<T>::build_leaves(const VolumeView<T>& v, ThreadBudget budget) {
+FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1) {
     T* nodes = owned_.data();
     const auto& leaf = shape_.levels[0];
     constexpr int B = OctreeShape::kLeafCells;
-    auto leaf_rows = [&](int bz0, int bz1, FiniteRange* range) {
-        for (int bz = bz0; bz < bz1; ++bz)
-            for (int by = 0; by < leaf.dims.y; ++by)
-                for (int bx = 0; bx < leaf.dims.x; ++bx) {
-                    const int x0 = bx * B, y0 = by * B, z0 = bz * B;
-                    const int x1 = std::min(x0 + B, v.dims.x - 1);
-                    const int y1 = std::min(y0 + B, v.dims.y - 1);
-                    const int z1 = std::min(z0 + B, v.dims.z - 1);
-                    T lo = octree_key(v.at(x0, y0, z0)), hi = lo;
-                    for (int z = z0; z <= z1; ++z)
-                        for (int y = y0; y <= y1; ++y) {
-                            // A bricked volume (a store's) is read voxel by voxel.
-                            const T* row = v.bricked() ? nullptr : v.data + v.index(0, y, z);
-                            for (int x = x0; x <= x1; ++x) {
-                                const T value = row ? row[x] : v.at(x, y, z);
-                                lo = std::min(lo, octree_key(value));
-                                hi = std::max(hi, octree_key(value));
-                                if constexpr (std::is_floating_point_v<T>)
-                                    range->merge(static_cast<double>(value));
-                            }
+    FiniteRange range;
+    for (int bz = bz0; bz < bz1; ++bz)
+        for (int by = 0; by < leaf.dims.y; ++by)
+            for (int bx = 0; bx < leaf.dims.x; ++bx) {
+                const int x0 = bx * B, y0 = by * B, z0 = bz * B;
+                const int x1 = std::min(x0 + B, v.dims.x - 1);
+                const int y1 = std::min(y0 + B, v.dims.y - 1);
+                const int z1 = std::min(z0 + B, v.dims.z - 1);
+                T lo = octree_key(v.at(x0, y0, z0)), hi = lo;
+                for (int z = z0; z <= z1; ++z)
+                    for (int y = y0; y <= y1; ++y) {
+                        // A bricked volume (a store's) is read voxel by voxel.
+                        const T* row = v.bricked() ? nullptr : v.data + v.index(0, y, z);
+                        for (int x = x0; x <= x1; ++x) {
+                            const T value = row ? row[x] : v.at(x, y, z);
+                            lo = std::min(lo, octree_key(value));
+                            hi = std::max(hi, octree_key(value));
+                            if constexpr (std::is_floating_point_v<T>)
+                                range.merge(static_cast<double>(value));
                         }
-                    const std::size_t i = 2 * shape_.node_index(0, {bx, by, bz});
-                    nodes[i] = lo;
-                    nodes[i + 1] = hi;
-                }
-    };
+                    }
+                const std::size_t i = 2 * shape_.node_index(0, {bx, by, bz});
+                nodes[i] = lo;
+                nodes[i + 1] = hi;
+            }
+    return range;
+}
+
+template <class T>
+FiniteRange MinMaxOctree<T>::build_leaves(const VolumeView<T>& v, ThreadBudget budget) {
+    const auto& leaf = shape_.levels[0];
     const int threads = std::max(1, std::min(budget.usable(), leaf.dims.z));
     std::vector<FiniteRange> ranges(static_cast<std::size_t>(threads));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t)
-        pool.emplace_back(leaf_rows, leaf.dims.z * t / threads, leaf.dims.z * (t + 1) / threads,
-                          &ranges[static_cast<std::size_t>(t)]);
-    leaf_rows(0, leaf.dims.z / threads, &ranges[0]);
+        pool.emplace_back([&, t] {
+            ranges[static_cast<std::size_t>(t)] =
+                leaf_rows(v, leaf.dims.z * t / threads, leaf.dims.z * (t + 1) / threads);
+        });
+    ranges[0] = leaf_rows(v, 0, leaf.dims.z / threads);
     for (auto& th : pool) th.join();
     FiniteRange all;
     for (const FiniteRange& r : ranges) all.merge(r);
     return all;
 }
 
-// Upper levels: reduce the (up to) eight children of each node.
+template <class T>
+MinMaxOctree<T> MinMaxOctree<T>::start(glm::ivec3 cell_dims) {
+    MinMaxOctree o;
+    o.shape_ = OctreeShape::for_cells(cell_dims);
+    o.owned_.resize(2 * o.shape_.node_count);
+    return o;
+}
+
+template <class T>
+FiniteRange MinMaxOctree<T>::leaf_slab(const VolumeView<T>& v, int z0, int z1) {
+    const int rows = shape_.levels[0].dims.z;
+    const int first = z0 / OctreeShape::kLeafCells;
+    const int last = std::min(rows, (z1 + OctreeShape::kLeafCells - 1) / OctreeShape::kLeafCells);
+    return first < last ? leaf_rows(v, first, last) : FiniteRange{};
+}
+
+template <class T>
+void MinMaxOctree<T>::finish(const FiniteRange& finite) {
+    build_upper_levels();
+    nodes_ = owned_;
+    finite_ = finite;
+    if constexpr (!std::is_floating_point_v<T>) {
+        finite_.merge(static_cast<double>(value_min()));
+        finite_.merge(static_cast<double>(value_max()));
+    }
+}
+
 template <class T>
 void MinMaxOctree<T>::build_upper_levels() {
     T* nodes = owned_.data();
@@ -265,13 +308,7 @@ MinMaxOctree<T> MinMaxOctree<T>::build(const VolumeView<T>& v, ThreadBudget budg
     MinMaxOctree o;
     o.shape_ = OctreeShape::for_cells(v.cell_dims());
     o.owned_.resize(2 * o.shape_.node_count);
-    o.finite_ = o.build_leaves(v, budget);
-    o.build_upper_levels();
-    o.nodes_ = o.owned_;
-    if constexpr (!std::is_floating_point_v<T>) {
-        o.finite_.merge(static_cast<double>(o.value_min()));
-        o.finite_.merge(static_cast<double>(o.value_max()));
-    }
+    o.finish(o.build_leaves(v, budget));
     return o;
 }
 
