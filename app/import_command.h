@@ -14,7 +14,7 @@ struct ImportCommand {
     std::string source;
     std::string out;
     bool force = false;
-    int level = 3;
+    int level = 1;
     bool quiet = false;
 };
 

@@ -223,11 +223,12 @@ TEST(StoreImport, TheOctreeLivesInTheStoreAndMovesWithIt) {
         src.volume_path = store;
         src.own_file = octree_file(store);
         src.content_key = s.volume.content_key();
-        const auto mapped = MinMaxOctree<std::uint8_t>::load_or_build(
-            s.volume.view<std::uint8_t>(), src, nullptr);
+        const auto mapped =
+            MinMaxOctree<std::uint8_t>::load_or_build(s.volume.view<std::uint8_t>(), src, nullptr);
         const auto whole = MinMaxOctree<std::uint8_t>::build(v.view<std::uint8_t>());
         ASSERT_EQ(mapped.nodes().size(), whole.nodes().size());
-        EXPECT_TRUE(std::equal(mapped.nodes().begin(), mapped.nodes().end(), whole.nodes().begin()));
+        EXPECT_TRUE(
+            std::equal(mapped.nodes().begin(), mapped.nodes().end(), whole.nodes().begin()));
         EXPECT_EQ(mapped.finite_range().min, whole.finite_range().min);
         EXPECT_EQ(mapped.finite_range().max, whole.finite_range().max);
     }

@@ -35,11 +35,13 @@ class SlabOctreeOf : public SlabOctree {
         const octree_cache::Key key{static_cast<std::uint32_t>(voxel_type_of<T>()), view_.dims,
                                     content_key};
         std::string why;
-        if (!octree_cache::write(file, key, std::as_bytes(octree_.nodes()),
-                                 octree_.finite_range(), &why))
+        if (!octree_cache::write(file, key, std::as_bytes(octree_.nodes()), octree_.finite_range(),
+                                 &why))
             return why.empty() ? "cannot write it" : why;
         return {};
     }
+
+    FiniteRange range() const override { return octree_.finite_range(); }
 
   private:
     VolumeView<T> view_;

@@ -21,6 +21,8 @@ class SlabOctree {
     // `--volume STORE` maps). Returns an empty string, or why the file was not written.
     virtual std::string write(const std::filesystem::path& file, std::uint64_t content_key,
                               const FiniteRange& finite) = 0;
+    // After write(): the range of the volume's finite voxels.
+    virtual FiniteRange range() const = 0;
 };
 
 // For `volume`, which must outlive it and be walked in rows (not bricked).

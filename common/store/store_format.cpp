@@ -171,6 +171,10 @@ void parse_zarray(std::string_view zarray, const std::string& store, StoreLayout
     const json& comp = member(a, "compressor", store, za);
     if (!comp.is_object() || comp.value("id", "") != "zstd")
         bad(store, za + ": compressor", "expected zstd, got " + quote(comp.dump()));
+    // The level the chunks were written with (any reads them): kept, so that the layout read back
+    // is the layout written, and its content key the same.
+    if (comp.contains("level") && comp["level"].is_number_integer())
+        l.zstd_level = comp["level"].get<int>();
     if (a.value("order", "C") != "C")
         bad(store, za + ": order", "expected \"C\", got " + quote(a["order"].dump()));
     if (a.contains("filters") && !a["filters"].is_null())

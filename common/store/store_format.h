@@ -35,7 +35,7 @@ struct StoreLayout {
     VoxelType type = VoxelType::u8;
     glm::vec3 spacing{1.0f};
     int brick_log2 = 5;  // bricks of 2^brick_log2 voxels a side (the Zarr chunk)
-    int zstd_level = 3;
+    int zstd_level = 1;
     std::string id;                       // 16 hex digits, new at each import: the content's key
     std::string source;                   // what was imported, for `info`
     double value_min = 0, value_max = 0;  // finite range of the voxels

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -85,6 +86,19 @@ void release_source_pages(const std::byte* begin, const std::byte* end) {
     if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_DONTNEED);
 }
 
+// Reads [begin, end) of a memory-mapped source into memory and maps it, in one call rather than
+// a fault a page (MADV_POPULATE_READ, Linux 5.14; older kernels fault the pages in as read).
+void populate_source_pages(const std::byte* begin, const std::byte* end) {
+#ifdef MADV_POPULATE_READ
+    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto b = reinterpret_cast<std::uintptr_t>(begin) / page * page;
+    const auto e = reinterpret_cast<std::uintptr_t>(end);
+    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_READ);
+#else
+    (void)begin, (void)end;
+#endif
+}
+
 struct TempDir {
     fs::path path;
     bool keep = false;
@@ -133,29 +147,47 @@ fs::path temporary_for(const fs::path& out) {
 
 namespace {
 
+struct Gathered {
+    Range range;        // of the voxels in the volume (with want_range)
+    bool zero = false;  // every voxel 0: `raw` was not filled
+};
+
 // Brick b's voxels, gathered from the volume's rows into `raw` (zeros past the volume's edge, as
-// Zarr pads edge chunks); returns the range of the voxels that are in the volume.
-Range gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm::ivec3 b,
-                   std::vector<std::byte>& raw) {
+// Zarr pads edge chunks); with `want_range`, also the range of the voxels that are in the volume
+// (the octree gives it otherwise). Rows of zeros are not copied until a row that is not zero
+// comes: a brick of air costs a read of its rows, not a copy.
+Gathered gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm::ivec3 b,
+                      std::vector<std::byte>& raw, bool want_range) {
     const int side = l.brick();
     const std::size_t size = voxel_size(l.type);
     const std::size_t row_bytes = static_cast<std::size_t>(l.dims.x) * size;
     const glm::ivec3 o = b * side;
-    const int nx = std::min(side, l.dims.x - o.x);
-    raw.assign(l.brick_bytes(), std::byte{0});
-    Range range;
+    const std::size_t n = static_cast<std::size_t>(std::min(side, l.dims.x - o.x)) * size;
+    const bool edge = glm::any(glm::greaterThan(o + side, l.dims));
+    raw.resize(l.brick_bytes());
+    static constexpr std::byte kZeros[64 * 8] = {};  // a row of the largest brick
+    // With want_range every row is copied and measured; without, rows of zeros are skipped.
+    Gathered g{{}, !want_range};
+    if (!g.zero && edge) std::memset(raw.data(), 0, raw.size());
     for (int z = 0; z < std::min(side, l.dims.z - o.z); ++z)
         for (int y = 0; y < std::min(side, l.dims.y - o.y); ++y) {
-            const std::size_t src =
+            const std::byte* from =
+                all.data() +
                 ((static_cast<std::size_t>(o.z + z) * l.dims.y + (o.y + y)) * row_bytes +
                  static_cast<std::size_t>(o.x) * size);
             const std::size_t dst = (static_cast<std::size_t>(z) * side + y) * side * size;
-            std::memcpy(raw.data() + dst, all.data() + src, static_cast<std::size_t>(nx) * size);
-            const Range r = range_of(std::span(raw).subspan(dst, std::size_t(nx) * size), l.type);
-            range.merge(r.min);
-            range.merge(r.max);
+            if (g.zero) {
+                if (std::memcmp(from, kZeros, n) == 0) continue;
+                g.zero = false;  // the rows before were zeros, and so is the padding
+                std::memset(raw.data(), 0, edge ? raw.size() : dst);
+            }
+            std::memcpy(raw.data() + dst, from, n);
+            if (!want_range) continue;
+            const Range r = range_of(std::span(raw).subspan(dst, n), l.type);
+            g.range.merge(r.min);
+            g.range.merge(r.max);
         }
-    return range;
+    return g;
 }
 
 // What the threads of one import share: the tallies, the value range, the first failure.
@@ -166,31 +198,44 @@ struct Tally {
     std::string failure;
 };
 
-// Compresses and writes the bricks of slab bz whose y is in [first, last); the first failure is
+// Compresses and writes rows of bricks of slab bz, taking the next row from `next_row` until none
+// is left (rows of air go fast, so threads take rows as they come free); the first failure is
 // kept in `tally`.
 void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs::path& dir,
-                  const std::string& where, int bz, int first, int last, Tally& tally) {
+                  const std::string& where, int bz, std::atomic<int>& next_row, Tally& tally,
+                  bool want_range) {
     ZSTD_CCtx* cctx = ZSTD_createCCtx();
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, l.zstd_level);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-    std::vector<std::byte> raw, packed;
+    std::vector<std::byte> raw, packed, zero_frame;
+    const std::vector<std::byte> zeros(l.brick_bytes());
+    auto compress = [&](std::vector<std::byte>& to, const std::vector<std::byte>& from,
+                        glm::ivec3 b) {
+        to.resize(ZSTD_compressBound(from.size()));
+        const std::size_t n = ZSTD_compress2(cctx, to.data(), to.size(), from.data(), from.size());
+        if (ZSTD_isError(n))
+            throw InputError(where, chunk_key(b), std::string("zstd: ") + ZSTD_getErrorName(n));
+        to.resize(n);
+    };
     try {
-        for (int by = first; by < last; ++by)
+        for (int by = next_row++; by < l.grid().y; by = next_row++)
             for (int bx = 0; bx < l.grid().x; ++bx) {
                 const glm::ivec3 b(bx, by, bz);
-                const Range r = gather_brick(l, all, b, raw);
-                packed.resize(ZSTD_compressBound(raw.size()));
-                const std::size_t n =
-                    ZSTD_compress2(cctx, packed.data(), packed.size(), raw.data(), raw.size());
-                if (ZSTD_isError(n))
-                    throw InputError(where, chunk_key(b),
-                                     std::string("zstd: ") + ZSTD_getErrorName(n));
-                write_file(dir / chunk_key(b), std::span(packed.data(), n), where, chunk_key(b));
+                const Gathered g = gather_brick(l, all, b, raw, want_range);
+                const Range& r = g.range;
+                // Bricks of nothing but zeros (air around a scan: three in four of the 4x CT
+                // head's) all compress to one frame: it is made once and written again.
+                const bool zero = g.zero;
+                if (zero && zero_frame.empty()) compress(zero_frame, zeros, b);
+                if (!zero) compress(packed, raw, b);
+                const std::vector<std::byte>& frame = zero ? zero_frame : packed;
+                const std::size_t n = frame.size();
+                write_file(dir / chunk_key(b), frame, where, chunk_key(b));
                 std::lock_guard lock(tally.mu);
                 tally.range.merge(r.min);
                 tally.range.merge(r.max);
                 tally.progress.chunks_done += 1;
-                tally.progress.bytes_in += raw.size();
+                tally.progress.bytes_in += l.brick_bytes();
                 tally.progress.bytes_out += n;
             }
     } catch (const std::exception& ex) {
@@ -240,16 +285,33 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
     tally.progress.chunks_total = layout.chunk_count();
     const std::unique_ptr<SlabOctree> octree = options.octree ? make_slab_octree(volume) : nullptr;
     FiniteRange finite;
+    std::thread reading;
+    struct Join {
+        std::thread& t;
+        ~Join() {
+            if (t.joinable()) t.join();
+        }
+    } join_reading{reading};
+    if (volume.mapped())
+        populate_source_pages(
+            all.data(),
+            all.data() + std::min<std::size_t>(all.size(), layout.brick() * slice_bytes));
     for (int bz = 0; bz < grid.z; ++bz) {
         const int z0 = bz * layout.brick(), z1 = std::min(z0 + layout.brick(), layout.dims.z);
+        // The next slab is read from disk while this one is compressed.
+        if (reading.joinable()) reading.join();
+        if (volume.mapped() && z1 < layout.dims.z) {
+            const int z2 = std::min(z1 + layout.brick(), layout.dims.z);
+            reading = std::thread(populate_source_pages, all.data() + std::size_t(z1) * slice_bytes,
+                                  all.data() + std::size_t(z2) * slice_bytes);
+        }
         // The slab's rows of bricks split over the threads; each has its buffers and zstd context.
         std::vector<std::thread> pool;
+        std::atomic<int> next_row{0};
         for (int t = 1; t < threads; ++t)
-            pool.emplace_back([&, t] {
-                write_bricks(layout, all, tmp.path, where, bz, grid.y * t / threads,
-                             grid.y * (t + 1) / threads, tally);
-            });
-        write_bricks(layout, all, tmp.path, where, bz, 0, grid.y / threads, tally);
+            pool.emplace_back(
+                [&] { write_bricks(layout, all, tmp.path, where, bz, next_row, tally, !octree); });
+        write_bricks(layout, all, tmp.path, where, bz, next_row, tally, !octree);
         for (auto& th : pool) th.join();
         if (!tally.failure.empty()) throw InputError::relayed(tally.failure);
         // The slab's voxels are at hand: its leaves of the octree now, not in a second pass.
@@ -260,8 +322,11 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         if (options.progress) options.progress(tally.progress);
     }
     ImportResult result{layout, tally.progress.bytes_in, tally.progress.bytes_out, {}};
-    if (octree)
+    if (octree) {
         result.octree_note = octree->write(octree_file(tmp.path), content_key(layout), finite);
+        const FiniteRange r = octree->range();
+        if (r.any) tally.range.merge(r.min), tally.range.merge(r.max);
+    }
     if (options.before_commit) options.before_commit(layout, tmp.path);
     commit(layout, tally.range, tmp, out, where);
     result.layout = layout;

@@ -25,7 +25,7 @@ struct ImportResult {
 struct ImportOptions {
     bool replace = false;  // an existing store at `out` is replaced (else it is an error)
     int threads = 1;       // chunks compressed at once
-    int zstd_level = 3;
+    int zstd_level = 1;
     std::function<void(const ImportProgress&)> progress;  // after each slab of chunks
     // The store's octree, built from the slabs as they are read (common/store/slab_octree.h)
     // and written into the store before it moves into place: `--volume STORE` maps it wherever

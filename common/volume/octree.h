@@ -198,36 +198,54 @@ std::filesystem::path default_dir();
 // Leaves: a brick of B cells spans B+1 voxels per axis (cells share their faces). Leaf slabs are
 // independent; they are split over the budget (the build runs once per volume), each slab
 // keeping its own finite range, merged at the end.
+// Leaf (bx, by, bz) covers voxels [4b, 4b + 4] on each axis (clipped): neighbours share a face.
+// For a row of leaves, the 25 voxel rows its y and z windows hold are merged element by element
+// (loops the compiler vectorises), then the x windows are taken of the merged row. A bricked
+// volume (a store's) is read voxel by voxel through the same merge.
 template <class T>
 FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1) {
     T* nodes = owned_.data();
     const auto& leaf = shape_.levels[0];
     constexpr int B = OctreeShape::kLeafCells;
     FiniteRange range;
+    const auto nx = static_cast<std::size_t>(v.dims.x);
+    std::vector<T> lo(nx), hi(nx), brick_row(v.bricked() ? nx : 0);
     for (int bz = bz0; bz < bz1; ++bz)
-        for (int by = 0; by < leaf.dims.y; ++by)
-            for (int bx = 0; bx < leaf.dims.x; ++bx) {
-                const int x0 = bx * B, y0 = by * B, z0 = bz * B;
-                const int x1 = std::min(x0 + B, v.dims.x - 1);
-                const int y1 = std::min(y0 + B, v.dims.y - 1);
-                const int z1 = std::min(z0 + B, v.dims.z - 1);
-                T lo = octree_key(v.at(x0, y0, z0)), hi = lo;
-                for (int z = z0; z <= z1; ++z)
-                    for (int y = y0; y <= y1; ++y) {
-                        // A bricked volume (a store's) is read voxel by voxel.
-                        const T* row = v.bricked() ? nullptr : v.data + v.index(0, y, z);
-                        for (int x = x0; x <= x1; ++x) {
-                            const T value = row ? row[x] : v.at(x, y, z);
-                            lo = std::min(lo, octree_key(value));
-                            hi = std::max(hi, octree_key(value));
-                            if constexpr (std::is_floating_point_v<T>)
-                                range.merge(static_cast<double>(value));
-                        }
+        for (int by = 0; by < leaf.dims.y; ++by) {
+            const int z0 = bz * B, z1 = std::min(z0 + B, v.dims.z - 1);
+            const int y0 = by * B, y1 = std::min(y0 + B, v.dims.y - 1);
+            bool first = true;
+            for (int z = z0; z <= z1; ++z)
+                for (int y = y0; y <= y1; ++y, first = false) {
+                    const T* row = v.data + (v.bricked() ? 0 : v.index(0, y, z));
+                    if (v.bricked()) {
+                        for (std::size_t x = 0; x < nx; ++x) brick_row[x] = v.at(int(x), y, z);
+                        row = brick_row.data();
                     }
-                const std::size_t i = 2 * shape_.node_index(0, {bx, by, bz});
-                nodes[i] = lo;
-                nodes[i + 1] = hi;
+                    if constexpr (std::is_floating_point_v<T>)
+                        for (std::size_t x = 0; x < nx; ++x) range.merge(double(row[x]));
+                    if (first) {
+                        for (std::size_t x = 0; x < nx; ++x) lo[x] = hi[x] = octree_key(row[x]);
+                        continue;
+                    }
+                    for (std::size_t x = 0; x < nx; ++x) {
+                        lo[x] = std::min(lo[x], octree_key(row[x]));
+                        hi[x] = std::max(hi[x], octree_key(row[x]));
+                    }
+                }
+            T* n = nodes + 2 * shape_.node_index(0, {0, by, bz});
+            for (int bx = 0; bx < leaf.dims.x; ++bx) {
+                const auto x0 = static_cast<std::size_t>(bx * B);
+                const std::size_t x1 = std::min(x0 + B, nx - 1);
+                T l = lo[x0], h = hi[x0];
+                for (std::size_t x = x0 + 1; x <= x1; ++x) {
+                    l = std::min(l, lo[x]);
+                    h = std::max(h, hi[x]);
+                }
+                n[2 * bx] = l;
+                n[2 * bx + 1] = h;
             }
+        }
     return range;
 }
 
