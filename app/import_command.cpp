@@ -59,7 +59,9 @@ CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
     add_volume_options(*c, o.volume);
     c->add_option("--out,-o", o.out, "The store folder to write")->required();
     c->add_flag("--force", o.force, "Replace a store already at --out");
-    c->add_option("--level", o.level, "zstd level, 1 (fastest) to 19 (smallest). Default: 1 (3 makes the 4x CT head 6% smaller and its import 10% slower)")
+    c->add_option("--level", o.level,
+                  "zstd level, 1 (fastest) to 19 (smallest). Default: 1 (3 makes the 4x CT head "
+                  "6% smaller and its import 10% slower)")
         ->transform(number_in({1, 19, false, true}));
     c->add_flag("--quiet,-q", o.quiet, "No progress bar");
     return c;
