@@ -23,6 +23,7 @@ line naming the option or the program, exit 1.
 import argparse
 import os
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -163,16 +164,23 @@ def median(values):
 
 
 def import_store(a, store, cache_dir, cold_ok):
-    """Imports a.volume (cold when allowed); (seconds, the import's line, disk MB/s or None)."""
+    """Imports a.volume (cold when allowed); (seconds, the import's line, disk MB/s or None).
+    The disk is read once before and once after the import, and the faster read counts (a
+    virtual disk's speed varies with what its host holds), so the ratio is not flattered."""
     disk = disk_read_rate(data_file(a.volume)) if cold_ok else None
+    if os.path.isdir(store):
+        shutil.rmtree(store)  # removing a store is not importing one
     if cold_ok:
         drop_caches()
     t0 = time.monotonic()
-    p = subprocess.run([a.binary, "import", a.volume, "--out", store, "--force", "-q",
+    p = subprocess.run([a.binary, "import", a.volume, "--out", store, "-q",
                         "--cache-dir", cache_dir], capture_output=True, text=True)
     if p.returncode != 0:
         fail(f"import: exit {p.returncode}: {p.stderr.strip()[:300]}")
-    return time.monotonic() - t0, p.stdout.strip(), disk
+    seconds = time.monotonic() - t0
+    if disk:
+        disk = max(disk, disk_read_rate(data_file(a.volume)))
+    return seconds, p.stdout.strip(), disk
 
 
 def measure_cases(a, cases, cold_ok, cache_dir):
@@ -236,7 +244,8 @@ def main(argv):
         rate = source_bytes(a.volume) / import_s / 1e6
         note = f"Import took {import_s:.1f} s: {rate:.0f} MB/s of the source"
         if disk:
-            note += (f"; the disk reads the source file at {disk:.0f} MB/s (cold, sequential), "
+            note += (f"; the disk reads the source file at {disk:.0f} MB/s (cold, sequential, the "
+                     f"faster of a read before and one after), "
                      f"ratio {rate / disk:.2f} (target at least 0.5: "
                      f"{'holds' if rate >= 0.5 * disk else 'missed'})")
         notes.append(note + ".")

@@ -118,7 +118,8 @@ std::string zattrs_json(const StoreLayout& l) {
           {"source", l.source},
           {"value_min", l.value_min},
           {"value_max", l.value_max},
-          {"chunks", l.chunk_count()}}},
+          {"chunks", l.chunk_count()},
+          {"bytes", l.bytes}}},
     };
     return j.dump(4) + "\n";
 }
@@ -206,6 +207,13 @@ void parse_zattrs(std::string_view zattrs, const std::string& store, StoreLayout
         bad(store, at + ": isowall.chunks",
             "disagrees with 0/.zarray (which makes " + std::to_string(l.chunk_count()) +
                 " chunks of its shape), got " + quote(iso.value("chunks", json()).dump()));
+    // Stores of the first imports did not record their bytes: then the reader counts them.
+    if (iso.contains("bytes")) {
+        if (!iso["bytes"].is_number_unsigned())
+            bad(store, at + ": isowall.bytes",
+                "expected a byte count, got " + quote(iso["bytes"].dump()));
+        l.bytes = iso["bytes"].get<std::uint64_t>();
+    }
     // The spacing: the first dataset's scale transform, z y x.
     try {
         const json& s = t.at("multiscales")

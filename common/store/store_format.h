@@ -39,6 +39,7 @@ struct StoreLayout {
     std::string id;                       // 16 hex digits, new at each import: the content's key
     std::string source;                   // what was imported, for `info`
     double value_min = 0, value_max = 0;  // finite range of the voxels
+    std::uint64_t bytes = 0;  // the chunks' compressed bytes, as written (0: not recorded)
 
     int brick() const { return 1 << brick_log2; }
     glm::ivec3 grid() const {  // in 64 bits first: a side near 2^31 must not wrap

@@ -46,6 +46,8 @@ class StoreReader {
     std::size_t read_chunk(glm::ivec3 b, std::span<std::byte> out) const;
 
   private:
+    void check_chunks(const std::filesystem::path& store, const std::string& where);
+
     std::filesystem::path path_;
     std::string zarray_, zattrs_;
     StoreLayout layout_;

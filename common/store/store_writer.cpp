@@ -328,6 +328,7 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         if (r.any) tally.range.merge(r.min), tally.range.merge(r.max);
     }
     if (options.before_commit) options.before_commit(layout, tmp.path);
+    layout.bytes = tally.progress.bytes_out;
     commit(layout, tally.range, tmp, out, where);
     result.layout = layout;
     return result;
