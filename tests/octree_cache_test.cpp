@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "common/volume/mapped_file.h"
 #include "common/volume/octree.h"
 #include "common/volume/volume.h"
 #include "tests/test_util.h"
@@ -194,6 +195,38 @@ void scattered_nonfinite(std::vector<float>& v, glm::ivec3) {
 void all_nan_but_one(std::vector<float>& v, glm::ivec3 d) {
     std::fill(v.begin(), v.end(), std::nanf(""));
     v[at(d, 3, 4, 5)] = 42.0f;
+}
+
+// A store's octree past 256 MiB is checked on a background thread while the first frame runs
+// (octree_cache::check_in_background): a sound one lets the program go on; a damaged one ends it
+// with one line naming the file and status 1, however far the program has got.
+TEST(OctreeCache, ABackgroundCheckPassesASoundOctreeAndEndsTheProgramOnADamagedOne) {
+    const fs::path dir = test::scratch_dir("octree_background");
+    const octree_cache::Key key{7, kDims, 42};
+    std::vector<std::byte> nodes(4096);
+    for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = std::byte(i * 31);
+    FiniteRange range;
+    range.merge(1.0);
+    range.merge(9.0);
+    const fs::path file = dir / "octree.isowall";
+    ASSERT_TRUE(octree_cache::write(file, key, nodes, range, nullptr));
+    auto sound = std::make_shared<const MappedFile>(file);
+    // Sound: the check ends quietly when its guard goes.
+    octree_cache::check_in_background(sound, file, nodes.size()).reset();
+    sound.reset();
+
+    // One node byte flipped: match sees it only when asked to check the content ...
+    {
+        std::fstream f(file, std::ios::binary | std::ios::in | std::ios::out);
+        f.seekp(128 + 1000);
+        f.put('\x7f');
+    }
+    const auto damaged = std::make_shared<const MappedFile>(file);
+    EXPECT_FALSE(octree_cache::match(*damaged, key, nodes.size(), nullptr));
+    EXPECT_TRUE(octree_cache::match(*damaged, key, nodes.size(), nullptr, false));
+    // ... and the background check ends the program, naming the file.
+    EXPECT_EXIT(octree_cache::check_in_background(damaged, file, nodes.size()).reset(),
+                ::testing::ExitedWithCode(1), "octree.isowall: the octree is damaged");
 }
 
 TEST(OctreeNonFinite, NanIsBelowEveryIsovalueAndTheRangeIsFinite) {

@@ -158,6 +158,7 @@ class MinMaxOctree {
     std::span<const T> nodes_;  // (min, max) per node, in node_index order
     std::vector<T> owned_;
     std::shared_ptr<MappedFile> mapped_;
+    std::shared_ptr<void> check_;  // the background check of a store's octree, while it runs
     FiniteRange finite_;
 };
 
@@ -186,8 +187,17 @@ struct Hit {
 // The node bytes of a cache file whose header matches `key` and whose nodes and value range match
 // their checksum;
 // nullopt (and `why`: stale, truncated or damaged) otherwise.
+// With `check_content` false, the nodes' checksum is left to check_in_background.
 std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
-                         std::string* why);
+                         std::string* why, bool check_content = true);
+// Checks the nodes' checksum of a matched `file` on a thread of idle priority while the program
+// goes on (a store's octree is a gigabyte for a 30 GB volume: read and summed before the first
+// ray, it held the first picture back by seconds). On a mismatch it prints one line naming
+// `path` and ends the process with status 1. The returned guard waits for the check when it goes.
+inline constexpr std::uintmax_t kBackgroundCheckBytes = std::uintmax_t(256) << 20;
+std::shared_ptr<void> check_in_background(std::shared_ptr<const MappedFile> file,
+                                          const std::filesystem::path& path,
+                                          std::size_t node_bytes);
 // Writes header + nodes to a temporary file and renames it into place (atomic for readers).
 bool write(const std::filesystem::path& file, const Key& key, std::span<const std::byte> nodes,
            const FiniteRange& range, std::string* why);
@@ -354,13 +364,21 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
         std::error_code ec;
         if (std::filesystem::exists(file, ec)) {
             try {
-                auto mapped = std::make_shared<MappedFile>(file, true);
+                // A store's octree (own_file) past kBackgroundCheckBytes is mapped as it is read
+                // and checked in the background: it may be a gigabyte. Others are read and
+                // checked at once.
+                const bool own = !src.own_file.empty() &&
+                                 std::filesystem::file_size(file, ec) > octree_cache::kBackgroundCheckBytes;
+                auto mapped = std::make_shared<MappedFile>(file, !own);
                 const OctreeShape shape = OctreeShape::for_cells(v.cell_dims());
                 const std::size_t count = 2 * shape.node_count;
-                if (auto hit =
-                        octree_cache::match(*mapped, *key, count * sizeof(T), &st.cache_note)) {
+                if (auto hit = octree_cache::match(*mapped, *key, count * sizeof(T), &st.cache_note,
+                                                   !own)) {
                     MinMaxOctree o;
                     o.shape_ = shape;
+                    if (own)
+                        o.check_ =
+                            octree_cache::check_in_background(mapped, file, count * sizeof(T));
                     o.mapped_ = std::move(mapped);
                     o.nodes_ = {reinterpret_cast<const T*>(hit->nodes.data()), count};
                     o.finite_ = hit->range;

@@ -1,5 +1,6 @@
 #include "common/volume/octree.h"
 
+#include <sched.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <cstddef>
@@ -9,6 +10,7 @@
 #include <functional>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "common/core/output_files.h"
 
@@ -141,7 +143,7 @@ std::filesystem::path file_for(const std::filesystem::path& cache_dir,
 }
 
 std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
-                         std::string* why) {
+                         std::string* why, bool check_content) {
     const Header want = header_for(key, node_bytes);
     Header have{};
     if (file.size() >= sizeof(Header)) std::memcpy(&have, file.bytes().data(), sizeof(Header));
@@ -158,12 +160,51 @@ std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t nod
     if (have.has_finite) range.merge(have.finite_min), range.merge(have.finite_max);
     const bool range_ok = (have.has_finite != 0) == range.any && have.has_finite <= 1;
     const std::uint64_t sum =
-        content_checksum(nodes, have.finite_min, have.finite_max, have.has_finite);
+        check_content ? content_checksum(nodes, have.finite_min, have.finite_max, have.has_finite)
+                      : have.content_checksum;
     if (sum != have.content_checksum || !range_ok) {
         if (why) *why = "cache file is damaged (checksum mismatch), rebuilt";
         return std::nullopt;
     }
     return Hit{nodes, range};
+}
+
+namespace {
+
+// The content check of a mapped octree, on a thread of idle priority (it runs on cores the frame
+// leaves free). Joined when the octree goes: a program never ends with its octree unchecked.
+struct BackgroundCheck {
+    std::thread thread;
+    ~BackgroundCheck() { thread.join(); }
+};
+
+void check_content(const MappedFile& file, const std::filesystem::path& path,
+                   std::size_t node_bytes) {
+    sched_param param{};
+    ::sched_setscheduler(0, SCHED_IDLE, &param);  // this thread only (Linux)
+    Header have{};
+    std::memcpy(&have, file.bytes().data(), sizeof(Header));
+    const auto nodes = file.bytes().subspan(kNodeOffset, node_bytes);
+    if (content_checksum(nodes, have.finite_min, have.finite_max, have.has_finite) ==
+        have.content_checksum)
+        return;
+    // A damaged octree would hide surface: the program ends here, as on a damaged chunk.
+    const std::string line = "isowall: error: " + path.string() +
+                             ": the octree is damaged (checksum mismatch); delete it and open "
+                             "the volume again to rebuild it\n";
+    [[maybe_unused]] const ssize_t n = ::write(2, line.data(), line.size());
+    ::_exit(1);
+}
+
+}  // namespace
+
+std::shared_ptr<void> check_in_background(std::shared_ptr<const MappedFile> file,
+                                          const std::filesystem::path& path,
+                                          std::size_t node_bytes) {
+    auto check = std::make_shared<BackgroundCheck>();
+    check->thread = std::thread(
+        [file = std::move(file), path, node_bytes] { check_content(*file, path, node_bytes); });
+    return check;
 }
 
 bool write(const std::filesystem::path& file, const Key& key, std::span<const std::byte> nodes,
