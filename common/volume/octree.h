@@ -124,10 +124,9 @@ class MinMaxOctree {
                                       OctreeStats* stats,
                                       ThreadBudget budget = ThreadBudget::hardware());
 
-    // Built while the volume is walked slab by slab in z (a store's import reads each slab once):
-    // start(), then leaf_slab() for each slab of voxel slices [z0, z1) whose cells start there
-    // (it reads slice z1 too), from any thread for disjoint slabs whose ends are multiples of
-    // kLeafCells, then finish() with the merged ranges.
+    // Built slab by slab in z (a store's import reads each slab once): start(), leaf_slab() for
+    // each slab of slices [z0, z1) (ends multiples of kLeafCells; it reads slice z1 too; disjoint
+    // slabs from any thread), then finish() with the merged ranges.
     static MinMaxOctree start(glm::ivec3 cell_dims);
     FiniteRange leaf_slab(const VolumeView<T>& v, int z0, int z1);
     void finish(const FiniteRange& finite);
@@ -190,10 +189,9 @@ struct Hit {
 // With `check_content` false, the nodes' checksum is left to check_in_background.
 std::optional<Hit> match(const MappedFile& file, const Key& key, std::size_t node_bytes,
                          std::string* why, bool check_content = true);
-// Checks the nodes' checksum of a matched `file` on a thread of idle priority while the program
-// goes on (a store's octree is a gigabyte for a 30 GB volume: read and summed before the first
-// ray, it held the first picture back by seconds). On a mismatch it prints one line naming
-// `path` and ends the process with status 1. The returned guard waits for the check when it goes.
+// Checks the nodes' checksum of a matched `file` on an idle-priority thread while the program goes
+// on (a 30 GB store's octree is a gigabyte); on a mismatch prints one line naming `path` and ends
+// the process (status 1). The returned guard waits for the check when it goes.
 inline constexpr std::uintmax_t kBackgroundCheckBytes = std::uintmax_t(256) << 20;
 std::shared_ptr<void> check_in_background(std::shared_ptr<const MappedFile> file,
                                           const std::filesystem::path& path,
@@ -208,10 +206,9 @@ std::filesystem::path default_dir();
 // Leaves: a brick of B cells spans B+1 voxels per axis (cells share their faces). Leaf slabs are
 // independent; they are split over the budget (the build runs once per volume), each slab
 // keeping its own finite range, merged at the end.
-// Leaf (bx, by, bz) covers voxels [4b, 4b + 4] on each axis (clipped): neighbours share a face.
-// For a row of leaves, the 25 voxel rows its y and z windows hold are merged element by element
-// (loops the compiler vectorises), then the x windows are taken of the merged row. A bricked
-// volume (a store's) is read voxel by voxel through the same merge.
+// Leaf (bx, by, bz) covers voxels [4b, 4b + 4] on each axis (clipped). For a row of leaves the 25
+// voxel rows of its y and z windows are merged element by element (vectorised loops), then the x
+// windows are taken; a bricked volume (a store's) is read voxel by voxel into the same merge.
 template <class T>
 FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1) {
     T* nodes = owned_.data();
@@ -364,11 +361,10 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
         std::error_code ec;
         if (std::filesystem::exists(file, ec)) {
             try {
-                // A store's octree (own_file) past kBackgroundCheckBytes is mapped as it is read
-                // and checked in the background: it may be a gigabyte. Others are read and
-                // checked at once.
-                const bool own = !src.own_file.empty() &&
-                                 std::filesystem::file_size(file, ec) > octree_cache::kBackgroundCheckBytes;
+                // A store's octree past kBackgroundCheckBytes is mapped as it is read and
+                // checked in the background; others are read and checked at once.
+                const bool own = !src.own_file.empty() && std::filesystem::file_size(file, ec) >
+                                                              octree_cache::kBackgroundCheckBytes;
                 auto mapped = std::make_shared<MappedFile>(file, !own);
                 const OctreeShape shape = OctreeShape::for_cells(v.cell_dims());
                 const std::size_t count = 2 * shape.node_count;
