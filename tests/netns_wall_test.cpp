@@ -95,6 +95,22 @@ std::string namespaces_left(const std::filesystem::path& map) {
     return left;
 }
 
+// cluster.png against one.png in `dir`. Not bit-identical in general: with balancing, which rank
+// casts which region depends on timing, and so do a few sub-pixel triangles (the README's
+// balanced-versus-static rule). On a miss the difference images are written as `name`.
+void expect_same_mosaic(const std::filesystem::path& dir, const std::string& name) {
+    const Image one = read_image(dir / "one.png");
+    const Image cluster = read_image(dir / "cluster.png");
+    ASSERT_EQ(cluster.width, one.width);
+    ASSERT_EQ(cluster.height, one.height);
+    const test::ImageComparison m = test::compare_images(cluster, one, kFromFiles);
+    std::cout << name << ": three hosts vs one: " << m << "\n";
+    EXPECT_GE(m.mask_iou, 0.999) << m;
+    EXPECT_GE(m.equal_share, 0.999) << m;
+    if (m.mask_iou < 0.999 || m.equal_share < 0.999)
+        test::write_diff_images(dir, name, cluster, one, kFromFiles);
+}
+
 TEST(NetnsWall, TheTwoByTwoWallAcrossThreeNamespaceHostsGivesTheMosaicOfOneHost) {
     if (::geteuid() != 0) GTEST_SKIP() << "network namespaces need root";
     if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
@@ -130,18 +146,7 @@ TEST(NetnsWall, TheTwoByTwoWallAcrossThreeNamespaceHostsGivesTheMosaicOfOneHost)
     for (const auto& [rank, host] : hosts_of_ranks(slurp(dir / "one.log"))) one_host.insert(host);
     EXPECT_EQ(one_host.size(), 1u) << slurp(dir / "one.log");
 
-    const Image one = read_image(dir / "one.png");
-    const Image cluster = read_image(dir / "cluster.png");
-    ASSERT_EQ(cluster.width, one.width);
-    ASSERT_EQ(cluster.height, one.height);
-    // Not bit-identical in general: with balancing, which rank casts which region depends on
-    // timing, and so do a few sub-pixel triangles (the README's balanced-versus-static rule).
-    const test::ImageComparison m = test::compare_images(cluster, one, kFromFiles);
-    std::cout << "three hosts vs one: " << m << "\n";
-    EXPECT_GE(m.mask_iou, 0.999) << m;
-    EXPECT_GE(m.equal_share, 0.999) << m;
-    if (m.mask_iou < 0.999 || m.equal_share < 0.999)
-        test::write_diff_images(dir, "netns_mosaic", cluster, one, kFromFiles);
+    expect_same_mosaic(dir, "netns_mosaic");
 }
 
 // Issue 32, bricks over MPI: the store lies on h1's disk only (the display nodes h2 and h3 see an
@@ -184,16 +189,7 @@ TEST(NetnsWall, AStoreOnTheFirstHostOnlyGivesTheMosaicOfOneHost) {
     ASSERT_EQ(run(mpirun(5) + args("one.png"), dir / "one.log", kGuardS), 0)
         << slurp(dir / "one.log");
     EXPECT_EQ(slurp(dir / "one.log").find("sent by the master"), std::string::npos);
-    const Image one = read_image(dir / "one.png");
-    const Image cluster = read_image(dir / "cluster.png");
-    ASSERT_EQ(cluster.width, one.width);
-    ASSERT_EQ(cluster.height, one.height);
-    const test::ImageComparison m = test::compare_images(cluster, one, kFromFiles);
-    std::cout << "store on h1 only vs one host: " << m << "\n";
-    EXPECT_GE(m.mask_iou, 0.999) << m;
-    EXPECT_GE(m.equal_share, 0.999) << m;
-    if (m.mask_iou < 0.999 || m.equal_share < 0.999)
-        test::write_diff_images(dir, "netns_store", cluster, one, kFromFiles);
+    expect_same_mosaic(dir, "netns_store");
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "common/store/open_store.h"
 #include "common/store/store_writer.h"
 #include "master/store_server.h"
+#include "tests/store_test_util.h"
 #include "tests/test_util.h"
 #include "tile/remote_store.h"
 
@@ -22,15 +23,7 @@ namespace isowall {
 namespace {
 namespace fs = std::filesystem;
 
-Volume pattern_volume(glm::ivec3 dims) {
-    std::vector<std::byte> bytes(std::size_t(dims.x) * dims.y * dims.z * 2);
-    auto* p = reinterpret_cast<std::uint16_t*>(bytes.data());
-    for (int z = 0; z < dims.z; ++z)
-        for (int y = 0; y < dims.y; ++y)
-            for (int x = 0; x < dims.x; ++x)
-                *p++ = static_cast<std::uint16_t>(x * 7 + y * 131 + z * 1031);
-    return Volume(dims, VoxelType::u16, {1.0f, 0.5f, 2.0f}, std::move(bytes), "pattern");
-}
+using test::pattern_volume;
 
 // A store with an octree file beside its bricks, as `isowall import` leaves it; this one is only
 // bytes, of more than one piece, since the test copies it and never maps it.

@@ -12,22 +12,14 @@
 #include "common/store/open_store.h"
 #include "common/store/store_writer.h"
 #include "common/volume/phantom.h"
+#include "tests/store_test_util.h"
 #include "tests/test_util.h"
 
 namespace isowall::store {
 namespace {
 namespace fs = std::filesystem;
 
-// A volume whose every voxel says where it is, so a voxel from the wrong place shows.
-Volume pattern_volume(glm::ivec3 dims) {
-    std::vector<std::byte> bytes(std::size_t(dims.x) * dims.y * dims.z * 2);
-    auto* p = reinterpret_cast<std::uint16_t*>(bytes.data());
-    for (int z = 0; z < dims.z; ++z)
-        for (int y = 0; y < dims.y; ++y)
-            for (int x = 0; x < dims.x; ++x)
-                *p++ = static_cast<std::uint16_t>(x * 7 + y * 131 + z * 1031);
-    return Volume(dims, VoxelType::u16, {1.0f, 0.5f, 2.0f}, std::move(bytes), "pattern");
-}
+using test::pattern_volume;
 
 fs::path import_to(const Volume& v, const std::string& name) {
     const fs::path dir = test::scratch_dir(name);

@@ -1,0 +1,21 @@
+#pragma once
+// Shared by the store tests (store_test.cpp, remote_store_test.cpp).
+#include <cstdint>
+#include <vector>
+
+#include "common/volume/volume.h"
+
+namespace isowall::test {
+
+// A 16-bit volume whose every voxel says where it is, so a voxel from the wrong place shows.
+inline Volume pattern_volume(glm::ivec3 dims) {
+    std::vector<std::byte> bytes(std::size_t(dims.x) * dims.y * dims.z * 2);
+    auto* p = reinterpret_cast<std::uint16_t*>(bytes.data());
+    for (int z = 0; z < dims.z; ++z)
+        for (int y = 0; y < dims.y; ++y)
+            for (int x = 0; x < dims.x; ++x)
+                *p++ = static_cast<std::uint16_t>(x * 7 + y * 131 + z * 1031);
+    return Volume(dims, VoxelType::u16, {1.0f, 0.5f, 2.0f}, std::move(bytes), "pattern");
+}
+
+}  // namespace isowall::test
