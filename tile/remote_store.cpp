@@ -102,9 +102,12 @@ std::vector<std::byte> RemoteStore::chunk(glm::ivec3 b) {
     const std::uint64_t index = layout_.brick_index(b);
     std::unique_lock lock(mutex_);
     if (failed_) throw std::runtime_error(*failed_);
-    const bool asked = waiting_.count(index) > 0;
-    auto& slot = waiting_[index];
-    if (!asked) send_message(comm_, kMasterRank, StoreAskMsg{StorePart::chunk, index});
+    // The pager asks once a brick (a brick loading is not asked for again), so each slot has one
+    // waiter, which erases it.
+    const auto [it, fresh] = waiting_.try_emplace(index);
+    if (!fresh) throw std::logic_error("chunk " + store::chunk_key(b) + " asked for twice at once");
+    auto& slot = it->second;
+    send_message(comm_, kMasterRank, StoreAskMsg{StorePart::chunk, index});
     const bool came = arrived_.wait_for(lock, std::chrono::duration<double>(timeout_s_),
                                         [&] { return slot.has_value() || failed_; });
     if (failed_ || !came) waiting_.erase(index);

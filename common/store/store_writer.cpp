@@ -208,7 +208,6 @@ void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, l.zstd_level);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
     std::vector<std::byte> raw, packed, zero_frame;
-    const std::vector<std::byte> zeros(l.brick_bytes());
     auto compress = [&](std::vector<std::byte>& to, const std::vector<std::byte>& from,
                         glm::ivec3 b) {
         to.resize(ZSTD_compressBound(from.size()));
@@ -222,18 +221,19 @@ void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs
             for (int bx = 0; bx < l.grid().x; ++bx) {
                 const glm::ivec3 b(bx, by, bz);
                 const Gathered g = gather_brick(l, all, b, raw, want_range);
-                const Range& r = g.range;
                 // Bricks of nothing but zeros (air around a scan: three in four of the 4x CT
                 // head's) all compress to one frame: it is made once and written again.
-                const bool zero = g.zero;
-                if (zero && zero_frame.empty()) compress(zero_frame, zeros, b);
-                if (!zero) compress(packed, raw, b);
-                const std::vector<std::byte>& frame = zero ? zero_frame : packed;
+                if (g.zero && zero_frame.empty()) {
+                    raw.assign(l.brick_bytes(), std::byte{0});
+                    compress(zero_frame, raw, b);
+                }
+                if (!g.zero) compress(packed, raw, b);
+                const std::vector<std::byte>& frame = g.zero ? zero_frame : packed;
                 const std::size_t n = frame.size();
                 write_file(dir / chunk_key(b), frame, where, chunk_key(b));
                 std::lock_guard lock(tally.mu);
-                tally.range.merge(r.min);
-                tally.range.merge(r.max);
+                tally.range.merge(g.range.min);
+                tally.range.merge(g.range.max);
                 tally.progress.chunks_done += 1;
                 tally.progress.bytes_in += l.brick_bytes();
                 tally.progress.bytes_out += n;
