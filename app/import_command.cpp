@@ -85,6 +85,7 @@ int run_import(const ImportCommand& o) {
         if (!std::filesystem::is_directory(parent, ec))
             throw InputError(o.out, "--out", "folder " + parent.string() + " does not exist");
     }
+    Stopwatch sw;  // from the open: a format decoded into memory reads its file there
     OpenedVolume ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
 
     ProgressBar bar(o.quiet);
@@ -93,7 +94,6 @@ int run_import(const ImportCommand& o) {
     opts.zstd_level = o.level;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
-    Stopwatch sw;
     const store::ImportResult r = store::write_store(ov.volume, out, opts);
     bar.finish();
     const double write_s = sw.seconds();

@@ -108,7 +108,8 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         out.file = path;
         store_note = " (" + opened.how + ")";
     } else {
-        out.volume = formats::read_volume(o.path, raw_spec(o));
+        // A volume not cast (import) streams its file itself, at the disk's pace.
+        out.volume = formats::read_volume(o.path, raw_spec(o), use.casts);
         out.file = std::filesystem::path(o.path);
         if (!o.memory_limit.empty())
             throw InputError("--memory-limit", "value",

@@ -9,12 +9,19 @@ source file, in the same run.
 
 Usage: /usr/bin/python3 scripts/bench_store.py [--volume build/data/cthead_1024x1024x452.nhdr]
            [--iso 600] [--limit 1/8 | 256M] [--runs 2] [--size 1600x1200] [--no-cold]
-           [--no-file] [--store STORE] [--reference PNG] [--build build] [--out out/bench-store]
+           [--no-file] [--store STORE] [--reference PNG] [--disk-mbps N] [--build build]
+           [--out out/bench-store]
 
 --no-file leaves out the file rows (a volume past this machine's memory cannot be read whole);
 --store uses a store made before instead of importing (no import figures); --reference compares
 the store's picture under the limit with a picture made elsewhere (e.g. the in-memory render of a
 smaller copy, same view and size): coverage IoU and the share of pixels within 1/255.
+
+--disk-mbps N emulates a disk that reads N MB/s (root: a cgroup's block-I/O read throttle on the
+disk that holds the volume, for this script and every program it runs, the disk-rate measure
+included). A virtual disk whose host caches it reads at 0.4-3.9 GB/s from one run to the next;
+a workstation's NVMe reads 2-3 GB/s, a SATA SSD 0.5 GB/s, a cluster's file system per node less.
+The figures of every path are taken at the same rate, so their ratios are those of that disk.
 
 Prints one table (markdown), the import line and the issue's ratios, and writes them to
 OUT/store.md. Without root, or with --no-cold, the cold rows are skipped and say so. Errors: one
@@ -49,6 +56,7 @@ def parse_args(argv):
     ap.add_argument("--no-file", action="store_true", help="no rows read from the file")
     ap.add_argument("--store", help="a store made before (skips the import)")
     ap.add_argument("--reference", help="a PNG to compare the store's picture with")
+    ap.add_argument("--disk-mbps", type=float, help="emulate a disk that reads this many MB/s")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out/bench-store"))
     try:
@@ -65,6 +73,10 @@ def parse_args(argv):
         fail(f"--store: {a.store}: no such folder")
     if a.reference and not os.path.exists(a.reference):
         fail(f"--reference: {a.reference}: no such file")
+    if a.disk_mbps is not None and a.disk_mbps <= 0:
+        fail(f"--disk-mbps: expected a rate above 0, got {a.disk_mbps:g}")
+    if a.disk_mbps and os.geteuid() != 0:
+        fail("--disk-mbps: needs root (a cgroup's block-I/O throttle)")
     m = re.fullmatch(r"1/([0-9]+)", a.limit)
     if m:
         if int(m.group(1)) < 1:
@@ -74,6 +86,45 @@ def parse_args(argv):
     if not os.access(a.binary, os.X_OK):
         fail(f"--build: {a.binary}: not built (run scripts/setup.sh)")
     return a
+
+
+def whole_disk(dev):
+    """'major:minor' of the disk that holds device number `dev` (a partition's parent: the
+    throttle applies to whole disks)."""
+    node = os.path.realpath(f"/sys/dev/block/{os.major(dev)}:{os.minor(dev)}")
+    if os.path.exists(os.path.join(node, "partition")):
+        node = os.path.dirname(node)
+    with open(os.path.join(node, "dev")) as f:
+        return f.read().strip()
+
+
+def throttle_reads(paths, mbps):
+    """Moves this process (and so every program it starts) into a cgroup whose reads from the
+    disks holding `paths` are throttled to `mbps` MB/s each; returns the cgroup's folder."""
+    disks = sorted({whole_disk(os.stat(p).st_dev) for p in paths})
+    rate = int(mbps * 1e6)
+    for root, knob, form in (("/sys/fs/cgroup/blkio", "blkio.throttle.read_bps_device", "{} {}"),
+                             ("/sys/fs/cgroup", "io.max", "{} rbps={}")):
+        if os.path.exists(os.path.join(root, "cgroup.procs")) and (
+                root != "/sys/fs/cgroup" or os.path.exists(os.path.join(root, "cgroup.controllers"))):
+            group = os.path.join(root, f"isowall-bench-{os.getpid()}")
+            os.makedirs(group, exist_ok=True)
+            try:
+                for disk in disks:
+                    with open(os.path.join(group, knob), "w") as f:
+                        f.write(form.format(disk, rate) + "\n")
+                with open(os.path.join(group, "cgroup.procs"), "w") as f:
+                    f.write(str(os.getpid()))
+            except OSError as e:
+                fail(f"--disk-mbps: {os.path.join(group, knob)}: {e.strerror}")
+            return group
+    fail("--disk-mbps: no block-I/O cgroup here (neither cgroup v1 blkio nor v2 io)")
+
+
+def leave_cgroup(group):
+    with open(os.path.join(os.path.dirname(group), "cgroup.procs"), "w") as f:
+        f.write(str(os.getpid()))
+    os.rmdir(group)
 
 
 def drop_caches():
@@ -236,6 +287,15 @@ def main(argv):
     name = os.path.basename(a.volume).split(".")[0]
     cold_ok = os.geteuid() == 0 and not a.no_cold
     notes = []
+    group = throttle_reads([data_file(a.volume), a.out], a.disk_mbps) if a.disk_mbps else None
+    try:
+        run(a, name, cache_dir, cold_ok, notes)
+    finally:
+        if group:
+            leave_cgroup(group)
+
+
+def run(a, name, cache_dir, cold_ok, notes):
     store = a.store
     if not store:
         store = os.path.join(a.out, name + ".zarr")
@@ -258,6 +318,9 @@ def main(argv):
         notes.append(f"The picture under {a.limit} against {a.reference}: coverage IoU {iou:.5f}, "
                      f"{100 * close:.2f}% of pixels within 1/255.")
     lines = [f"# {name}: file against store, default render ({a.size}), iso {a.iso:g}", ""]
+    if a.disk_mbps:
+        lines += [f"Disk emulated at {a.disk_mbps:g} MB/s (a block-I/O read throttle on every "
+                  "program this benchmark runs).", ""]
     lines += [n + "\n" for n in notes]
     lines += [f"Medians of {a.runs} runs; seconds, MiB.", ""] + table(a, rows) + [""]
     lines += ratios(a, rows)

@@ -62,9 +62,9 @@ Volume hdf5(const fs::path& file, const std::string& dataset) {
                          [&] { return read_hdf5(file, dataset); });
 }
 
-Volume read_file(const fs::path& p, const std::string& name) {
+Volume read_file(const fs::path& p, const std::string& name, bool populate) {
     const std::string n = lower(name);
-    if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return load_nrrd(p);
+    if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return load_nrrd(p, populate);
     if (ends_with(n, ".nii") || ends_with(n, ".nii.gz") || ends_with(n, ".hdr") ||
         ends_with(n, ".img") || ends_with(n, ".img.gz"))
         return read_nifti(p);
@@ -79,8 +79,8 @@ Volume read_file(const fs::path& p, const std::string& name) {
 
 }  // namespace
 
-Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw) {
-    if (raw) return load_raw(path, *raw);
+Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, bool populate) {
+    if (raw) return load_raw(path, *raw, populate);
     const fs::path p(path);
     std::error_code ec;
     if (fs::is_directory(p, ec)) return is_tiff_folder(p) ? read_tiff_stack(p) : dicom(p);
@@ -91,7 +91,7 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw) {
         if (is_hdf5_name(file)) return hdf5(file, path.substr(colon + 1));
     }
     check_regular_file(p, path, "file");
-    return read_file(p, p.filename().string());
+    return read_file(p, p.filename().string(), populate);
 }
 
 }  // namespace isowall::formats

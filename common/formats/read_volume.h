@@ -15,6 +15,8 @@
 
 namespace isowall::formats {
 
-Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw);
+// populate: as load_raw's (common/volume/volume.h), for the formats that map their file.
+Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw,
+                   bool populate = true);
 
 }  // namespace isowall::formats

@@ -191,7 +191,7 @@ std::vector<std::byte> decode(Encoding e, std::span<const std::byte> data, const
 
 }  // namespace
 
-Volume load_nrrd(const fs::path& path) {
+Volume load_nrrd(const fs::path& path, bool populate) {
     const std::string where = path.string();
     check_regular_file(path, where, "file");
     MappedFile header_file(path);
@@ -205,7 +205,7 @@ Volume load_nrrd(const fs::path& path) {
     if (text.data_file) {
         data_path = data_path_of(path, *text.data_file);
         check_regular_file(data_path, where, "data file");
-        data_file = MappedFile(data_path, true);
+        data_file = MappedFile(data_path, populate);
     } else {
         if (!text.data_offset)
             throw InputError(where, "header",

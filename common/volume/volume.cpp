@@ -155,7 +155,7 @@ int to_teem_type(VoxelType t) {
 
 }  // namespace
 
-Volume load_raw(const fs::path& path, const RawSpec& spec) {
+Volume load_raw(const fs::path& path, const RawSpec& spec, bool populate) {
     const std::string where = path.string();
     check_dims(where, "--dims", spec.dims, spec.type);
     check_regular_file(path, where, "file");
@@ -163,7 +163,7 @@ Volume load_raw(const fs::path& path, const RawSpec& spec) {
         if (std::string p = spacing_problem(spec.spacing[i], spec.dims[i], i); !p.empty())
             throw InputError(where, "--spacing", p);
     const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
-    MappedFile file(path, true);
+    MappedFile file(path, populate);
     check_size(where, file.size(), spec.header_bytes, need);
     Volume volume;
     if (spec.endian == host_endian() || voxel_size(spec.type) == 1) {

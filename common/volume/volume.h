@@ -224,12 +224,15 @@ struct RawSpec {
 
 // Headerless voxels, x fastest. The file must be a regular file holding exactly
 // header_bytes + voxels * size bytes.
-Volume load_raw(const std::filesystem::path& path, const RawSpec& spec);
+// populate (here and in load_nrrd): a mapped file is read into the page cache at once when it
+// fits in half the memory, so the first frame does not wait on the disk ray by ray; false: mapped
+// only (a reader that streams the file in its own order, as `isowall import`).
+Volume load_raw(const std::filesystem::path& path, const RawSpec& spec, bool populate = true);
 // NRRD: Teem parses the header text; we locate the data (one regular data file, line and byte
 // skips checked against its size) and decode it: raw, gzip, bzip2, ascii, hex, each with the
 // exact count the header gives. Raw data in host byte order is memory-mapped, everything else
 // decoded into memory. Every failure is an InputError naming the file and the field.
-Volume load_nrrd(const std::filesystem::path& path);
+Volume load_nrrd(const std::filesystem::path& path, bool populate = true);
 // Picks the loader by extension (.nrrd/.nhdr -> NRRD, anything else needs a RawSpec).
 Volume load_volume(const std::filesystem::path& path, const std::optional<RawSpec>& raw);
 
