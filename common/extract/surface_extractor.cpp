@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "common/extract/extractor_parts.h"
+#include "common/volume/surface_bricks.h"
 
 namespace isowall {
 namespace {
@@ -44,6 +45,11 @@ class TypedExtractor final : public SurfaceExtractor {
             std::isfinite(levels.error_px) ? &data_.lod_table().errors : nullptr;
         frame_.begin(iso, ResolutionMap(levels, data_.view.spacing, cells, errors), cells);
         for (ExtractWorker<T>& w : workers_) w.begin_frame(frame_);
+        const Volume& v = data_.volume;
+        if (v.wants_brick_hint() && iso != hinted_iso_) {
+            v.hint_bricks(surface_bricks(data_.octree, v.bricks(), v.brick_grid(), iso));
+            hinted_iso_ = iso;
+        }
     }
     double iso() const override { return frame_.iso; }
     const LodTable& prepare_lod_errors() const override { return data_.lod_table(); }
@@ -88,6 +94,7 @@ class TypedExtractor final : public SurfaceExtractor {
     const ExtractionData<T>& data_;
     FrameState frame_;
     std::vector<ExtractWorker<T>> workers_;  // at least one
+    double hinted_iso_ = std::nan("");       // the isovalue a paged volume was last hinted at
 };
 
 }  // namespace

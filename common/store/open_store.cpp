@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
+#include <string_view>
 
 #include "common/core/error.h"
 #include "common/volume/huge_pages.h"
@@ -33,6 +35,13 @@ void add_facts(Volume& v, const StoreReader& r) {
     if (!l.source.empty()) v.add_fact("imported from", l.source);
 }
 
+// Read-ahead is on unless ISOWALL_READ_AHEAD=off (a study's switch: scripts/bench_store.py
+// measures a cold frame with and without it).
+bool read_ahead_wanted() {
+    const char* v = std::getenv("ISOWALL_READ_AHEAD");
+    return !(v && std::string_view(v) == "off");
+}
+
 }  // namespace
 
 OpenedStore open_store(const fs::path& path, std::uint64_t cap_bytes) {
@@ -49,8 +58,10 @@ OpenedStore open_store(std::shared_ptr<const StoreReader> reader, const fs::path
     out.bytes_on_disk = reader->bytes_on_disk();
     const std::string source = reader->path().string();
     try {
-        auto pager = std::make_shared<const PagedVoxels>(reader, cap_bytes);
+        auto pager = std::make_shared<const PagedVoxels>(reader, cap_bytes, read_ahead_wanted());
         out.volume = Volume(l.dims, l.type, l.spacing, pager, pager->bytes(), source);
+        out.volume.set_brick_hint(
+            [p = pager.get()](std::vector<std::uint8_t> wanted) { p->want(std::move(wanted)); });
         out.pager = std::move(pager);
         out.how = "paged, limit " + mib(cap_bytes);
     } catch (const InputError&) {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -61,10 +62,16 @@ long open_userfaultfd() {
 struct PagedVoxels::State {
     static constexpr std::uint8_t kAbsent = 0, kLoading = 1, kResident = 2;
     static constexpr int kThreads = 2;
-    std::mutex mu;                    // guards everything below but the buffers
-    std::vector<std::uint8_t> state;  // per brick: kAbsent, kLoading, kResident
-    std::vector<std::uint8_t> seen;   // per brick: read at least once
-    std::deque<std::size_t> fifo;     // resident bricks, oldest first
+    std::mutex mu;                     // guards everything below but the buffers
+    std::vector<std::uint8_t> state;   // per brick: kAbsent, kLoading, kResident
+    std::vector<std::uint8_t> seen;    // per brick: read at least once
+    std::deque<std::size_t> fifo;      // resident bricks, oldest first
+    std::vector<std::uint8_t> hinted;  // per brick: queued for read-ahead once
+    std::vector<std::uint8_t> wanted;  // per brick: on the surface (want()); empty: none known
+    std::vector<std::size_t> ahead;    // bricks to read ahead, newest last
+    std::condition_variable ahead_cv;
+    bool stopping = false;
+    std::thread ahead_thread;
     std::uint64_t resident_bytes = 0;
     PagingStats stats;
     std::vector<std::thread> threads;
@@ -74,7 +81,8 @@ std::uint64_t PagedVoxels::min_cap(const StoreLayout& l) {
     return 16 * static_cast<std::uint64_t>(l.brick_bytes());
 }
 
-PagedVoxels::PagedVoxels(std::shared_ptr<const StoreReader> reader, std::uint64_t cap_bytes)
+PagedVoxels::PagedVoxels(std::shared_ptr<const StoreReader> reader, std::uint64_t cap_bytes,
+                         bool read_ahead)
     : reader_(std::move(reader)), cap_(cap_bytes), state_(std::make_unique<State>()) {
     const StoreLayout& l = reader_->layout();
     if (cap_ < min_cap(l))
@@ -111,16 +119,30 @@ PagedVoxels::PagedVoxels(std::shared_ptr<const StoreReader> reader, std::uint64_
     State& s = *state_;
     s.state.assign(l.chunk_count(), State::kAbsent);
     s.seen.assign(l.chunk_count(), 0);
+    // Hinting 0 marks every brick as queued already: no read-ahead.
+    s.hinted.assign(l.chunk_count(), read_ahead ? 0 : 1);
     for (int t = 0; t < State::kThreads; ++t) s.threads.emplace_back([this] { serve(); });
+    if (read_ahead) s.ahead_thread = std::thread([this] { this->read_ahead(); });
 }
 
 PagedVoxels::~PagedVoxels() {
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(stop_fd_, &one, sizeof(one));
     for (auto& t : state_->threads) t.join();
+    {
+        std::lock_guard lock(state_->mu);
+        state_->stopping = true;
+    }
+    state_->ahead_cv.notify_all();
+    if (state_->ahead_thread.joinable()) state_->ahead_thread.join();
     ::munmap(base_, map_bytes_);
     ::close(uffd_);
     ::close(stop_fd_);
+}
+
+void PagedVoxels::want(std::vector<std::uint8_t> bricks) const {
+    std::lock_guard lock(state_->mu);
+    if (bricks.size() == state_->state.size()) state_->wanted = std::move(bricks);
 }
 
 PagingStats PagedVoxels::stats() const {
@@ -145,6 +167,46 @@ void PagedVoxels::drop_to_cap(std::size_t keep) {
         s.state[old] = State::kAbsent;
         s.resident_bytes -= brick_bytes_;
         s.stats.evictions += 1;
+    }
+}
+
+// Queues the face neighbours of brick `i` that were never read nor queued. Called with the
+// state's lock held. The queue keeps the newest 1,024: hints that old no longer lead a front.
+void PagedVoxels::hint_neighbours(std::size_t i) {
+    State& s = *state_;
+    const StoreLayout& l = reader_->layout();
+    const glm::ivec3 g = l.grid(), b = l.brick_at(i);
+    static constexpr int kSteps[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                         {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+    bool any = false;
+    for (const auto& d : kSteps) {
+        const glm::ivec3 n = b + glm::ivec3(d[0], d[1], d[2]);
+        if (n.x < 0 || n.y < 0 || n.z < 0 || n.x >= g.x || n.y >= g.y || n.z >= g.z) continue;
+        const std::size_t j = l.brick_index(n);
+        if (s.hinted[j] || s.seen[j] || s.wanted.size() <= j || !s.wanted[j]) continue;
+        s.hinted[j] = 1;
+        s.ahead.push_back(j);
+        any = true;
+    }
+    constexpr std::size_t kMost = 1024;
+    if (s.ahead.size() > kMost) s.ahead.erase(s.ahead.begin(), s.ahead.end() - kMost);
+    if (any) s.ahead_cv.notify_one();
+}
+
+void PagedVoxels::read_ahead() {
+    State& s = *state_;
+    const StoreLayout& l = reader_->layout();
+    std::unique_lock lock(s.mu);
+    for (;;) {
+        s.ahead_cv.wait(lock, [&] { return s.stopping || !s.ahead.empty(); });
+        if (s.stopping) return;
+        const std::size_t j = s.ahead.back();  // the newest: nearest the work going on now
+        s.ahead.pop_back();
+        if (s.seen[j]) continue;  // touched meanwhile
+        s.stats.hinted += 1;
+        lock.unlock();
+        reader_->prefetch(l.brick_at(j));
+        lock.lock();
     }
 }
 
@@ -203,6 +265,7 @@ void PagedVoxels::serve() {
                 continue;
             }
             s.state[i] = State::kLoading;
+            if (!s.seen[i]) hint_neighbours(i);
         }
         const auto t0 = std::chrono::steady_clock::now();
         const double cpu0 = thread_cpu_s();
@@ -243,11 +306,11 @@ std::string paging_line(const PagingStats& s, std::uint64_t cap) {
     char line[320];
     std::snprintf(line, sizeof line,
                   "bricks: %llu read (%.1f MiB from disk), %llu read again, %llu dropped; peak "
-                  "%.1f MiB of the %.0f MiB limit; %.3f s reading",
+                  "%.1f MiB of the %.0f MiB limit; %.3f s reading; %llu chunks read ahead",
                   static_cast<unsigned long long>(s.faults), double(s.bytes_read) / mib,
                   static_cast<unsigned long long>(s.refaults),
                   static_cast<unsigned long long>(s.evictions), double(s.peak_bytes) / mib,
-                  double(cap) / mib, s.fill_s);
+                  double(cap) / mib, s.fill_s, static_cast<unsigned long long>(s.hinted));
     return line;
 }
 

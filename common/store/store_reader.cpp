@@ -124,6 +124,13 @@ std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b) const {
     return packed;
 }
 
+void StoreReader::prefetch(glm::ivec3 b) const {
+    if (fetch_) return;
+    Fd f;
+    f.fd = ::open((path_ / chunk_key(b)).c_str(), O_RDONLY | O_CLOEXEC);
+    if (f.fd >= 0) ::posix_fadvise(f.fd, 0, 0, POSIX_FADV_WILLNEED);
+}
+
 std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) const {
     const std::string where = path_.string(), key = chunk_key(b);
     const std::size_t want = layout_.brick_bytes();

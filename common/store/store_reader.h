@@ -45,6 +45,11 @@ class StoreReader {
     // bytes read from disk. Safe from any thread.
     std::size_t read_chunk(glm::ivec3 b, std::span<std::byte> out) const;
 
+    // Asks the kernel to start reading brick b's chunk into the page cache and returns at once
+    // (read-ahead: a later read_chunk then finds it in memory). Errors are left to that read;
+    // nothing for a store read elsewhere.
+    void prefetch(glm::ivec3 b) const;
+
   private:
     void check_chunks(const std::filesystem::path& store, const std::string& where);
 

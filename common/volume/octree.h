@@ -348,7 +348,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
     // A volume's own octree (a store's) is part of the volume, not of the cache: it is used
     // with the cache off too.
-    if (src.volume_path.empty() || (src.cache_dir.empty() && src.own_file.empty())) {
+    if (src.own_file.empty() && (src.volume_path.empty() || src.cache_dir.empty())) {
         st.cache_note = src.volume_path.empty() ? "generated volume, not cached" : "cache disabled";
     } else if ((key = src.content_key
                           ? std::optional(

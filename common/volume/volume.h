@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -104,6 +105,15 @@ class Volume {
     // The voxels in cubic bricks of 2^log2_side (VolumeView); `bytes` must hold every brick of the
     // grid that covers dims.
     void set_bricks(int log2_side) { bricks_ = log2_side; }
+    // Which bricks a frame may touch (one byte per brick of brick_grid(), x fastest: 1 where the
+    // surface at the frame's isovalue may pass), for a paged volume's read-ahead; the extractor
+    // tells it at each frame's start. A volume without the hook ignores it.
+    using BrickHint = std::function<void(std::vector<std::uint8_t>)>;
+    void set_brick_hint(BrickHint hint) { brick_hint_ = std::move(hint); }
+    bool wants_brick_hint() const { return static_cast<bool>(brick_hint_); }
+    void hint_bricks(std::vector<std::uint8_t> wanted) const {
+        if (brick_hint_) brick_hint_(std::move(wanted));
+    }
     int bricks() const { return bricks_; }
     glm::ivec3 brick_grid() const {
         if (!bricks_) return glm::ivec3(0);
@@ -166,6 +176,7 @@ class Volume {
     std::vector<std::byte> owned_;
     HugePageBuffer huge_;
     std::shared_ptr<const void> keeper_;
+    BrickHint brick_hint_;
     int bricks_ = 0;
     std::span<const std::byte> bytes_;
 };
