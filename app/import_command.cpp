@@ -63,6 +63,11 @@ CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
                   "zstd level, 1 (fastest) to 19 (smallest). Default: 1 (3 makes the 4x CT head "
                   "6% smaller and its import 10% slower)")
         ->transform(number_in({1, 19, false, true}));
+    c->add_option("--levels", o.levels,
+                  "Levels of the multiscale pyramid, each every other voxel of the one below "
+                  "(what napari and neuroglancer show first). Default: down to one brick a side; "
+                  "1: full resolution only")
+        ->transform(number_in({1, 12, false, true}));
     c->add_flag("--quiet,-q", o.quiet, "No progress bar");
     return c;
 }
@@ -92,6 +97,7 @@ int run_import(const ImportCommand& o) {
     store::ImportOptions opts;
     opts.replace = o.force;
     opts.zstd_level = o.level;
+    opts.levels = o.levels;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
     const store::ImportResult r = store::write_store(ov.volume, out, opts);
@@ -99,14 +105,15 @@ int run_import(const ImportCommand& o) {
     const double write_s = sw.seconds();
 
     const double mib = 1024.0 * 1024.0;
+    const double source = double(ov.volume.bytes().size());  // the voxels, all levels from them
     const store::StoreLayout& l = r.layout;
     std::printf(
-        "import: wrote %s  %dx%dx%d %s, %zu bricks of %d^3, %.1f MiB -> %.1f MiB "
+        "import: wrote %s  %dx%dx%d %s, %zu bricks of %d^3 (%d level%s), %.1f MiB -> %.1f MiB "
         "(%.2f:1) in %.2f s (%.0f MiB/s)\n",
         out.c_str(), l.dims.x, l.dims.y, l.dims.z, std::string(type_name(l.type)).c_str(),
-        l.chunk_count(), l.brick(), double(r.bytes_in) / mib, double(r.bytes_out) / mib,
-        double(r.bytes_in) / double(std::max<std::uint64_t>(r.bytes_out, 1)), write_s,
-        double(r.bytes_in) / mib / std::max(write_s, 1e-9));
+        l.chunk_count(), l.brick(), l.levels, l.levels == 1 ? "" : "s", source / mib,
+        double(r.bytes_out) / mib, source / double(std::max<std::uint64_t>(r.bytes_out, 1)),
+        write_s, source / mib / std::max(write_s, 1e-9));
     std::printf("import: octree %s\n",
                 r.octree_note.empty() ? ("written to " + store::octree_file(out).string()).c_str()
                                       : ("not written: " + r.octree_note).c_str());

@@ -15,6 +15,7 @@ struct ImportCommand {
     std::string out;
     bool force = false;
     int level = 1;
+    int levels = 0;  // 0: down to one brick a side (store::levels_for)
     bool quiet = false;
 };
 

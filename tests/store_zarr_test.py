@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """A store that `isowall import` writes opens in zarr-python (Debian's python3-zarr, with its
-numcodecs) voxel for voxel: the point of writing Zarr is that users' other tools read it. Three
+numcodecs) voxel for voxel, every level of its multiscale pyramid too: the point of writing Zarr is that users' other tools read it. Three
 volumes: float32 and int16 noise of sides that are not multiples of a brick (the padded edge
 bricks must crop away), and the shared tooth (uint16) when ../shared/data is there. The
 OME-Zarr attributes carry the axes and the spacing as a scale.
@@ -44,8 +44,18 @@ class StoreInZarr(unittest.TestCase):
         self.assertTrue(np.array_equal(a[:], want))
         ms = g.attrs["multiscales"][0]
         self.assertEqual([x["name"] for x in ms["axes"]], ["z", "y", "x"])
-        scale = ms["datasets"][0]["coordinateTransformations"][0]["scale"]
-        self.assertEqual(scale, list(reversed(spacing)) if spacing else [1.0, 1.0, 1.0])
+        base = list(reversed(spacing)) if spacing else [1.0, 1.0, 1.0]
+        # Every level of the pyramid, as OME-Zarr lists it: every 2^k-th voxel, its scale 2^k
+        # times level 0's, down to a level that fits one chunk a side.
+        self.assertGreater(len(ms["datasets"]), 1)
+        for k, d in enumerate(ms["datasets"]):
+            step = 2 ** k
+            self.assertEqual(d["path"], str(k))
+            self.assertEqual(d["coordinateTransformations"][0]["scale"],
+                             [x * step for x in base])
+            self.assertTrue(np.array_equal(g[d["path"]][:], want[::step, ::step, ::step]),
+                            f"level {k}")
+        self.assertLessEqual(max(g[str(len(ms["datasets"]) - 1)].shape), 32)
 
     def test_noise_with_padded_edges(self):
         rng = np.random.default_rng(7)

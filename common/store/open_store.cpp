@@ -25,11 +25,11 @@ void add_facts(Volume& v, const StoreReader& r) {
     const double raw = double(l.chunk_count()) * double(l.brick_bytes());
     char text[160];
     std::snprintf(text, sizeof text,
-                  "Zarr v2 (OME-Zarr 0.4), %zu bricks of %d^3 voxels, 1 level, zstd %.2f:1",
-                  l.chunk_count(), l.brick(),
+                  "Zarr v2 (OME-Zarr 0.4), %zu bricks of %d^3 voxels, %d level%s, zstd %.2f:1",
+                  l.chunk_count(), l.brick(), l.levels, l.levels == 1 ? "" : "s",
                   r.bytes_on_disk() ? raw / double(r.bytes_on_disk()) : 0.0);
     v.add_fact("store", text);
-    std::snprintf(text, sizeof text, "%.1f MiB of chunks (%.1f MiB of bricks)",
+    std::snprintf(text, sizeof text, "%.1f MiB of level 0's chunks (%.1f MiB of bricks)",
                   double(r.bytes_on_disk()) / (1024.0 * 1024.0), raw / (1024.0 * 1024.0));
     v.add_fact("on disk", text);
     if (!l.source.empty()) v.add_fact("imported from", l.source);

@@ -103,15 +103,18 @@ std::string zattrs_json(const StoreLayout& l) {
     const json axes = json::array({{{"name", "z"}, {"type", "space"}},
                                    {{"name", "y"}, {"type", "space"}},
                                    {{"name", "x"}, {"type", "space"}}});
-    const json scale = {{"type", "scale"}, {"scale", {l.spacing.z, l.spacing.y, l.spacing.x}}};
+    json datasets = json::array();
+    for (int k = 0; k < l.levels; ++k) {
+        const glm::vec3 s = l.level(k).spacing;
+        const json scale = {{"type", "scale"}, {"scale", {s.z, s.y, s.x}}};
+        datasets.push_back(
+            {{"path", std::to_string(k)}, {"coordinateTransformations", json::array({scale})}});
+    }
     const json j = {
-        {"multiscales",
-         json::array({{{"version", "0.4"},
-                       {"name", fs::path(l.source).filename().string()},
-                       {"axes", axes},
-                       {"datasets",
-                        json::array({{{"path", "0"},
-                                      {"coordinateTransformations", json::array({scale})}}})}}})},
+        {"multiscales", json::array({{{"version", "0.4"},
+                                      {"name", fs::path(l.source).filename().string()},
+                                      {"axes", axes},
+                                      {"datasets", datasets}}})},
         {"isowall",
          {{"format", kFormatVersion},
           {"id", l.id},
@@ -119,17 +122,18 @@ std::string zattrs_json(const StoreLayout& l) {
           {"value_min", l.value_min},
           {"value_max", l.value_max},
           {"chunks", l.chunk_count()},
-          {"bytes", l.bytes}}},
+          {"bytes", l.bytes},
+          {"levels", l.levels}}},
     };
     return j.dump(4) + "\n";
 }
 
 namespace {
 
-// The array's metadata (0/.zarray) into `l`: shape, cubic chunks, dtype, zstd, C order.
-void parse_zarray(std::string_view zarray, const std::string& store, StoreLayout& l) {
+// An array's metadata (K/.zarray, `za`) into `l`: shape, cubic chunks, dtype, zstd, C order.
+void parse_zarray(std::string_view zarray, const std::string& store, StoreLayout& l,
+                  const std::string& za = "0/.zarray") {
     constexpr long kMaxSide = 2147483647;
-    const std::string za = "0/.zarray";
     const json a = parse_json(zarray, store, za);
     if (member(a, "zarr_format", store, za) != 2)
         bad(store, za + ": zarr_format", "expected 2 (isowall reads Zarr v2 stores)");
@@ -214,6 +218,17 @@ void parse_zattrs(std::string_view zattrs, const std::string& store, StoreLayout
                 "expected a byte count, got " + quote(iso["bytes"].dump()));
         l.bytes = iso["bytes"].get<std::uint64_t>();
     }
+    // Levels past 0 (stores without the field have level 0 only); their arrays are checked by
+    // the reader (store_reader.cpp), each against l.level(k).
+    if (iso.contains("levels")) {
+        const json& n = iso["levels"];
+        if (!n.is_number_unsigned() || n.get<std::uint64_t>() < 1 || n.get<std::uint64_t>() > 12 ||
+            n.get<int>() > levels_for(l.dims, l.brick_log2))
+            bad(store, at + ": isowall.levels",
+                "expected 1 to " + std::to_string(levels_for(l.dims, l.brick_log2)) +
+                    " for this shape, got " + quote(n.dump()));
+        l.levels = n.get<int>();
+    }
     // The spacing: the first dataset's scale transform, z y x.
     try {
         const json& s = t.at("multiscales")
@@ -243,6 +258,20 @@ StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
     return l;
 }
 
+void check_level(std::string_view zarray, const StoreLayout& l, int k, const std::string& store) {
+    const std::string za = std::to_string(k) + "/.zarray";
+    StoreLayout got;
+    parse_zarray(zarray, store, got, za);
+    const StoreLayout want = l.level(k);
+    if (got.dims != want.dims)
+        bad(store, za + ": shape",
+            "expected [" + std::to_string(want.dims.z) + ", " + std::to_string(want.dims.y) + ", " +
+                std::to_string(want.dims.x) + "] (every " + std::to_string(1 << k) +
+                "th voxel of level 0)");
+    if (got.brick_log2 != l.brick_log2 || got.type != l.type)
+        bad(store, za + ": chunks", "expected the chunks and dtype of 0/.zarray");
+}
+
 fs::path octree_file(const fs::path& store) {
     return store / "octree.isowall";
 }
@@ -263,8 +292,17 @@ std::string new_store_id() {
     return text;
 }
 
-std::string chunk_key(glm::ivec3 b) {
-    return "0/" + std::to_string(b.z) + "/" + std::to_string(b.y) + "/" + std::to_string(b.x);
+std::string chunk_key(glm::ivec3 b, int level) {
+    return std::to_string(level) + "/" + std::to_string(b.z) + "/" + std::to_string(b.y) + "/" +
+           std::to_string(b.x);
+}
+
+int levels_for(glm::ivec3 dims, int brick_log2) {
+    int levels = 1;
+    while (levels < 12 &&
+           (std::max({dims.x, dims.y, dims.z}) - 1) >> (levels - 1) >= (1 << brick_log2))
+        ++levels;
+    return levels;
 }
 
 fs::path store_path(const std::string& text) {

@@ -52,6 +52,10 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
     zarray_ = read_text(store / "0" / ".zarray", where, "0/.zarray");
     zattrs_ = read_text(store / ".zattrs", where, ".zattrs");
     layout_ = parse_layout(zarray_, zattrs_, where);
+    for (int k = 1; k < layout_.levels; ++k) {
+        const std::string key = std::to_string(k) + "/.zarray";
+        check_level(read_text(store / key, where, key), layout_, k, where);
+    }
     check_chunks(store, where);
 }
 
@@ -59,24 +63,7 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
 // chunk: a store of 120,000 chunks opens in a few milliseconds). Their sizes are summed only for
 // a store that did not record them.
 void StoreReader::check_chunks(const fs::path& store, const std::string& where) {
-    const glm::ivec3 grid = layout_.grid();
-    std::vector<char> seen(static_cast<std::size_t>(grid.x));
-    for (int bz = 0; bz < grid.z; ++bz)
-        for (int by = 0; by < grid.y; ++by) {
-            std::fill(seen.begin(), seen.end(), 0);
-            const fs::path row = store / fs::path(chunk_key({0, by, bz})).parent_path();
-            std::error_code ec;
-            for (fs::directory_iterator it(row, ec), end; !ec && it != end; it.increment(ec)) {
-                const std::string name = it->path().filename().string();
-                char* stop = nullptr;
-                const long x = std::strtol(name.c_str(), &stop, 10);
-                if (*stop == '\0' && !name.empty() && x >= 0 && x < grid.x && !it->is_directory(ec))
-                    seen[static_cast<std::size_t>(x)] = 1;
-            }
-            for (int bx = 0; bx < grid.x; ++bx)
-                if (!seen[static_cast<std::size_t>(bx)])
-                    throw InputError(where, chunk_key({bx, by, bz}), "chunk missing: no such file");
-        }
+    for (int k = 0; k < layout_.levels; ++k) check_level_chunks(store, where, k);
     bytes_on_disk_ = layout_.bytes;
     if (bytes_on_disk_ != 0) return;
     for (std::size_t i = 0; i < layout_.chunk_count(); ++i) {
@@ -88,6 +75,28 @@ void StoreReader::check_chunks(const fs::path& store, const std::string& where) 
     }
 }
 
+void StoreReader::check_level_chunks(const fs::path& store, const std::string& where, int k) {
+    const glm::ivec3 grid = layout_.level(k).grid();
+    std::vector<char> seen(static_cast<std::size_t>(grid.x));
+    for (int bz = 0; bz < grid.z; ++bz)
+        for (int by = 0; by < grid.y; ++by) {
+            std::fill(seen.begin(), seen.end(), 0);
+            const fs::path row = store / fs::path(chunk_key({0, by, bz}, k)).parent_path();
+            std::error_code ec;
+            for (fs::directory_iterator it(row, ec), end; !ec && it != end; it.increment(ec)) {
+                const std::string name = it->path().filename().string();
+                char* stop = nullptr;
+                const long x = std::strtol(name.c_str(), &stop, 10);
+                if (*stop == '\0' && !name.empty() && x >= 0 && x < grid.x && !it->is_directory(ec))
+                    seen[static_cast<std::size_t>(x)] = 1;
+            }
+            for (int bx = 0; bx < grid.x; ++bx)
+                if (!seen[static_cast<std::size_t>(bx)])
+                    throw InputError(where, chunk_key({bx, by, bz}, k),
+                                     "chunk missing: no such file");
+        }
+}
+
 StoreReader::StoreReader(const std::string& name, const std::string& zarray,
                          const std::string& zattrs, std::uint64_t bytes_on_disk, ChunkFetch fetch)
     : path_(name),
@@ -97,8 +106,8 @@ StoreReader::StoreReader(const std::string& name, const std::string& zarray,
       bytes_on_disk_(bytes_on_disk),
       fetch_(std::move(fetch)) {}
 
-std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b) const {
-    const std::string where = path_.string(), key = chunk_key(b);
+std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b, int level) const {
+    const std::string where = path_.string(), key = chunk_key(b, level);
     if (fetch_) throw InputError(where, key, "internal: the store is not read on this host");
     Fd f;
     f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC);
@@ -131,11 +140,13 @@ void StoreReader::prefetch(glm::ivec3 b) const {
     if (f.fd >= 0) ::posix_fadvise(f.fd, 0, 0, POSIX_FADV_WILLNEED);
 }
 
-std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out) const {
-    const std::string where = path_.string(), key = chunk_key(b);
+std::size_t StoreReader::read_chunk(glm::ivec3 b, std::span<std::byte> out, int level) const {
+    const std::string where = path_.string(), key = chunk_key(b, level);
     const std::size_t want = layout_.brick_bytes();
     if (out.size() != want) throw InputError(where, key, "internal: wrong chunk buffer size");
-    const std::vector<std::byte> packed = fetch_ ? fetch_(b) : read_packed(b);
+    if (level < 0 || level >= layout_.levels || (level > 0 && fetch_))
+        throw InputError(where, key, "internal: no such level here");
+    const std::vector<std::byte> packed = fetch_ ? fetch_(b) : read_packed(b, level);
     const std::size_t size = packed.size();
     if (size > ZSTD_compressBound(want) + 64)
         throw InputError(where, key, "chunk larger than its voxels could compress to");

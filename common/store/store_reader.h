@@ -37,13 +37,14 @@ class StoreReader {
     // Brick b's chunk as it is on disk (compressed), for a reader elsewhere. InputError naming
     // the store and chunk when it cannot be read or is larger than its voxels could compress to.
     // Only for a store read here.
-    std::vector<std::byte> read_packed(glm::ivec3 b) const;
+    std::vector<std::byte> read_packed(glm::ivec3 b, int level = 0) const;
 
     // Decompresses brick b's chunk into `out`, which holds exactly layout().brick_bytes().
     // A chunk that cannot be read, is not one zstd frame, fails its checksum or has another size
     // is an InputError naming the store and the chunk: garbage never becomes voxels. Returns the
     // bytes read from disk. Safe from any thread.
-    std::size_t read_chunk(glm::ivec3 b, std::span<std::byte> out) const;
+    // Level k > 0 (layout().level(k)) only for a store read here.
+    std::size_t read_chunk(glm::ivec3 b, std::span<std::byte> out, int level = 0) const;
 
     // Asks the kernel to start reading brick b's chunk into the page cache and returns at once
     // (read-ahead: a later read_chunk then finds it in memory). Errors are left to that read;
@@ -52,6 +53,7 @@ class StoreReader {
 
   private:
     void check_chunks(const std::filesystem::path& store, const std::string& where);
+    void check_level_chunks(const std::filesystem::path& store, const std::string& where, int k);
 
     std::filesystem::path path_;
     std::string zarray_, zattrs_;

@@ -17,6 +17,8 @@
 #include <zstd.h>
 
 #include "common/core/error.h"
+#include "common/store/pyramid.h"
+#include "common/store/source_pages.h"
 #include "common/store/slab_octree.h"
 
 namespace isowall::store {
@@ -77,28 +79,6 @@ void write_text(const fs::path& file, const std::string& text, const std::string
     write_file(file, std::as_bytes(std::span(text.data(), text.size())), store, key);
 }
 
-// Lets the kernel drop a memory-mapped source's pages of [begin, end) from this process, so an
-// import's resident memory stays at a slab, not the volume (they are re-read if touched again).
-void release_source_pages(const std::byte* begin, const std::byte* end) {
-    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    const auto b = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) / page * page;
-    const auto e = reinterpret_cast<std::uintptr_t>(end) / page * page;
-    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_DONTNEED);
-}
-
-// Reads [begin, end) of a memory-mapped source into memory and maps it, in one call rather than
-// a fault a page (MADV_POPULATE_READ, Linux 5.14; older kernels fault the pages in as read).
-void populate_source_pages(const std::byte* begin, const std::byte* end) {
-#ifdef MADV_POPULATE_READ
-    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
-    const auto b = reinterpret_cast<std::uintptr_t>(begin) / page * page;
-    const auto e = reinterpret_cast<std::uintptr_t>(end);
-    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_READ);
-#else
-    (void)begin, (void)end;
-#endif
-}
-
 struct TempDir {
     fs::path path;
     bool keep = false;
@@ -117,7 +97,10 @@ void commit(StoreLayout& layout, const Range& range, TempDir& tmp, const fs::pat
     layout.value_min = range.min <= range.max ? range.min : 0;  // 0, 0: no finite voxel
     layout.value_max = range.min <= range.max ? range.max : 0;
     write_text(tmp.path / ".zgroup", zgroup_json(), where, ".zgroup");
-    write_text(tmp.path / "0" / ".zarray", zarray_json(layout), where, "0/.zarray");
+    for (int k = 0; k < layout.levels; ++k) {
+        const std::string key = std::to_string(k) + "/.zarray";
+        write_text(tmp.path / key, zarray_json(layout.level(k)), where, key);
+    }
     write_text(tmp.path / ".zattrs", zattrs_json(layout), where, ".zattrs");
     fs::path old;
     if (fs::exists(out, ec)) {
@@ -156,8 +139,9 @@ struct Gathered {
 // Zarr pads edge chunks); with `want_range`, also the range of the voxels that are in the volume
 // (the octree gives it otherwise). Rows of zeros are not copied until a row that is not zero
 // comes: a brick of air costs a read of its rows, not a copy.
-Gathered gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm::ivec3 b,
-                      std::vector<std::byte>& raw, bool want_range) {
+// `all` holds the volume's rows from z_base on (a level's slab: pyramid.h).
+Gathered gather_brick(const StoreLayout& l, std::span<const std::byte> all, int z_base,
+                      glm::ivec3 b, std::vector<std::byte>& raw, bool want_range) {
     const int side = l.brick();
     const std::size_t size = voxel_size(l.type);
     const std::size_t row_bytes = static_cast<std::size_t>(l.dims.x) * size;
@@ -173,7 +157,7 @@ Gathered gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm:
         for (int y = 0; y < std::min(side, l.dims.y - o.y); ++y) {
             const std::byte* from =
                 all.data() +
-                ((static_cast<std::size_t>(o.z + z) * l.dims.y + (o.y + y)) * row_bytes +
+                ((static_cast<std::size_t>(o.z + z - z_base) * l.dims.y + (o.y + y)) * row_bytes +
                  static_cast<std::size_t>(o.x) * size);
             const std::size_t dst = (static_cast<std::size_t>(z) * side + y) * side * size;
             if (g.zero) {
@@ -194,16 +178,27 @@ Gathered gather_brick(const StoreLayout& l, std::span<const std::byte> all, glm:
 struct Tally {
     std::mutex mu;
     ImportProgress progress;
+    std::uint64_t level0_bytes = 0;
     Range range;
     std::string failure;
 };
 
-// Compresses and writes rows of bricks of slab bz, taking the next row from `next_row` until none
+// Which slab of which level write_bricks writes, from which voxels: `all` holds the level's rows
+// from z_base on.
+struct SlabJob {
+    const StoreLayout& l;  // the level's layout
+    int level;
+    std::span<const std::byte> all;
+    int z_base;
+    int bz;
+};
+
+// Compresses and writes rows of bricks of a slab, taking the next row from `next_row` until none
 // is left (rows of air go fast, so threads take rows as they come free); the first failure is
 // kept in `tally`.
-void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs::path& dir,
-                  const std::string& where, int bz, std::atomic<int>& next_row, Tally& tally,
-                  bool want_range) {
+void write_bricks(const SlabJob& job, const fs::path& dir, const std::string& where,
+                  std::atomic<int>& next_row, Tally& tally, bool want_range) {
+    const StoreLayout& l = job.l;
     ZSTD_CCtx* cctx = ZSTD_createCCtx();
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, l.zstd_level);
     ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
@@ -219,8 +214,8 @@ void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs
     try {
         for (int by = next_row++; by < l.grid().y; by = next_row++)
             for (int bx = 0; bx < l.grid().x; ++bx) {
-                const glm::ivec3 b(bx, by, bz);
-                const Gathered g = gather_brick(l, all, b, raw, want_range);
+                const glm::ivec3 b(bx, by, job.bz);
+                const Gathered g = gather_brick(l, job.all, job.z_base, b, raw, want_range);
                 // Bricks of nothing but zeros (air around a scan: three in four of the 4x CT
                 // head's) all compress to one frame: it is made once and written again.
                 if (g.zero && zero_frame.empty()) {
@@ -230,8 +225,10 @@ void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs
                 if (!g.zero) compress(packed, raw, b);
                 const std::vector<std::byte>& frame = g.zero ? zero_frame : packed;
                 const std::size_t n = frame.size();
-                write_file(dir / chunk_key(b), frame, where, chunk_key(b));
+                const std::string key = chunk_key(b, job.level);
+                write_file(dir / key, frame, where, key);
                 std::lock_guard lock(tally.mu);
+                if (job.level == 0) tally.level0_bytes += n;
                 tally.range.merge(g.range.min);
                 tally.range.merge(g.range.max);
                 tally.progress.chunks_done += 1;
@@ -245,16 +242,67 @@ void write_bricks(const StoreLayout& l, std::span<const std::byte> all, const fs
     ZSTD_freeCCtx(cctx);
 }
 
-// The store's folders under `dir`: 0/Z/Y for each slab and row of bricks.
+// The store's folders under `dir`: K/Z/Y for each level, slab and row of bricks.
 void make_folders(const StoreLayout& l, const fs::path& dir, const std::string& where) {
-    const glm::ivec3 grid = l.grid();
     std::error_code ec;
-    for (int bz = 0; bz < grid.z; ++bz)
-        for (int by = 0; by < grid.y; ++by) {
-            fs::create_directories(dir / fs::path(chunk_key({0, by, bz})).parent_path(), ec);
-            if (ec) throw InputError(where, "--out", "cannot make its folders: " + ec.message());
-        }
+    for (int k = 0; k < l.levels; ++k) {
+        const glm::ivec3 grid = l.level(k).grid();
+        for (int bz = 0; bz < grid.z; ++bz)
+            for (int by = 0; by < grid.y; ++by) {
+                fs::create_directories(dir / fs::path(chunk_key({0, by, bz}, k)).parent_path(), ec);
+                if (ec)
+                    throw InputError(where, "--out", "cannot make its folders: " + ec.message());
+            }
+    }
 }
+
+// Compresses and writes one slab over `threads` threads; throws the first failure.
+void write_slab(const SlabJob& job, int threads, const fs::path& dir, const std::string& where,
+                Tally& tally, bool want_range) {
+    std::vector<std::thread> pool;
+    std::atomic<int> next_row{0};
+    for (int t = 1; t < threads; ++t)
+        pool.emplace_back([&] { write_bricks(job, dir, where, next_row, tally, want_range); });
+    write_bricks(job, dir, where, next_row, tally, want_range);
+    for (auto& th : pool) th.join();
+    if (!tally.failure.empty()) throw InputError::relayed(tally.failure);
+}
+
+// Level k >= 1 of the pyramid (store_format.h): every 2^k-th voxel of the level-0 slabs as they
+// pass, gathered into a slab of the level's own bricks and written when it is full. Memory: a
+// slab of level 1 is a quarter of one of level 0, and the levels above it add a third of that.
+class LevelSlab {
+  public:
+    LevelSlab(const StoreLayout& level0, int k)
+        : k_(k),
+          l_(level0.level(k)),
+          plane_(std::size_t(l_.dims.x) * l_.dims.y * voxel_size(l_.type)),
+          rows_(plane_ * std::size_t(l_.brick())) {}
+
+    // Takes level-0 rows [z0, z1) of `all` (the whole level-0 volume); writes each slab filled.
+    void add(std::span<const std::byte> all, glm::ivec3 dims0, int z0, int z1, int threads,
+             const fs::path& dir, const std::string& where, Tally& tally) {
+        const std::size_t plane0 = std::size_t(dims0.x) * dims0.y * voxel_size(l_.type);
+        const int step = 1 << k_;
+        for (int z = (z0 + step - 1) / step * step; z < z1; z += step) {
+            const int zk = z >> k_;
+            decimate_plane(all.subspan(std::size_t(z) * plane0, plane0), dims0, l_.type, k_,
+                           l_.dims, rows_.data() + std::size_t(zk - bz_ * l_.brick()) * plane_);
+            if (zk == (bz_ + 1) * l_.brick() - 1 || zk == l_.dims.z - 1) {
+                write_slab({l_, k_, rows_, bz_ * l_.brick(), bz_}, threads, dir, where, tally,
+                           false);
+                ++bz_;
+            }
+        }
+    }
+
+  private:
+    int k_;
+    StoreLayout l_;
+    std::size_t plane_;  // bytes of one z plane of the level
+    std::vector<std::byte> rows_;
+    int bz_ = 0;  // the level's slab being filled
+};
 
 }  // namespace
 
@@ -272,6 +320,9 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
     layout.source = volume.source();
     layout.id = new_store_id();
     layout.zstd_level = options.zstd_level;
+    layout.levels = options.levels > 0
+                        ? std::min(options.levels, levels_for(layout.dims, layout.brick_log2))
+                        : levels_for(layout.dims, layout.brick_log2);
     const glm::ivec3 grid = layout.grid();
     TempDir tmp{temporary_for(out)};
     fs::remove_all(tmp.path, ec);  // what a stopped run left
@@ -282,7 +333,10 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         static_cast<std::size_t>(layout.dims.x) * layout.dims.y * voxel_size(layout.type);
     const int threads = std::max(1, std::min(options.threads, grid.y));
     Tally tally;
-    tally.progress.chunks_total = layout.chunk_count();
+    for (int k = 0; k < layout.levels; ++k)
+        tally.progress.chunks_total += layout.level(k).chunk_count();
+    std::vector<LevelSlab> pyramid;
+    for (int k = 1; k < layout.levels; ++k) pyramid.emplace_back(layout, k);
     const std::unique_ptr<SlabOctree> octree = options.octree ? make_slab_octree(volume) : nullptr;
     FiniteRange finite;
     std::thread reading;
@@ -306,14 +360,9 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
                                   all.data() + std::size_t(z2) * slice_bytes);
         }
         // The slab's rows of bricks split over the threads; each has its buffers and zstd context.
-        std::vector<std::thread> pool;
-        std::atomic<int> next_row{0};
-        for (int t = 1; t < threads; ++t)
-            pool.emplace_back(
-                [&] { write_bricks(layout, all, tmp.path, where, bz, next_row, tally, !octree); });
-        write_bricks(layout, all, tmp.path, where, bz, next_row, tally, !octree);
-        for (auto& th : pool) th.join();
-        if (!tally.failure.empty()) throw InputError::relayed(tally.failure);
+        write_slab({layout, 0, all, 0, bz}, threads, tmp.path, where, tally, !octree);
+        for (LevelSlab& level : pyramid)
+            level.add(all, layout.dims, z0, z1, threads, tmp.path, where, tally);
         // The slab's voxels are at hand: its leaves of the octree now, not in a second pass.
         if (octree) finite.merge(octree->add_slab(z0, z1, threads));
         if (volume.mapped())
@@ -328,7 +377,7 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
         if (r.any) tally.range.merge(r.min), tally.range.merge(r.max);
     }
     if (options.before_commit) options.before_commit(layout, tmp.path);
-    layout.bytes = tally.progress.bytes_out;
+    layout.bytes = tally.level0_bytes;
     commit(layout, tally.range, tmp, out, where);
     result.layout = layout;
     return result;

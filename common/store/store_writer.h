@@ -26,6 +26,7 @@ struct ImportOptions {
     bool replace = false;  // an existing store at `out` is replaced (else it is an error)
     int threads = 1;       // chunks compressed at once
     int zstd_level = 1;
+    int levels = 0;  // of the multiscale pyramid (store_format.h); 0: levels_for(), 1: none
     std::function<void(const ImportProgress&)> progress;  // after each slab of chunks
     // The store's octree, built from the slabs as they are read (common/store/slab_octree.h)
     // and written into the store before it moves into place: `--volume STORE` maps it wherever
