@@ -188,7 +188,13 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
         preview.emplace(comm, preview_max_side(spec));
         setup.shows.push_back(&*preview);
     }
-    return run_tile(comm, setup);
+    const int status = run_tile(comm, setup);
+    // A study's figure (--measure): what this rank's pager read, to weigh one cache per host
+    // against one per rank (docs/volumes.md).
+    if (ov.pager && o.measure)
+        std::printf("rank %d store: %s\n", comm.rank(),
+                    store::paging_line(ov.pager->stats(), ov.pager->cap()).c_str());
+    return status;
 }
 
 // A tile waits for the master's start (the volume is loaded and its octree cached, so the tile
