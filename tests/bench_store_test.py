@@ -71,8 +71,26 @@ class BenchStore(unittest.TestCase):
             self.assertEqual(float(m.group(1)), 1.0)
             self.assertEqual(float(m.group(2)), 100.0)
 
+    def test_an_emulated_disk_throttles_the_run_and_leaves_no_cgroup(self):
+        if os.geteuid() != 0:
+            self.skipTest("--disk-mbps needs root")
+        if not (os.path.exists("/sys/fs/cgroup/blkio/cgroup.procs")
+                or os.path.exists("/sys/fs/cgroup/cgroup.controllers")):
+            self.skipTest("no block-I/O cgroup here")
+        with tempfile.TemporaryDirectory() as out:
+            r = bench("--volume", os.path.join(DATA, "tooth.nhdr"), "--iso", "620", "--runs", "1",
+                      "--size", "160x120", "--no-cold", "--no-file", "--disk-mbps", "2000",
+                      "--out", out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("Disk emulated at 2000 MB/s", r.stdout)
+        for root in ("/sys/fs/cgroup/blkio", "/sys/fs/cgroup"):
+            if os.path.isdir(root):
+                left = [d for d in os.listdir(root) if d.startswith("isowall-bench-")]
+                self.assertEqual(left, [], root)
+
     def test_bad_options_are_one_line(self):
         for args, needle in ((["--runs", "0"], "--runs"),
+                             (["--disk-mbps", "0"], "--disk-mbps"),
                              (["--volume", "/nonexistent/v.nhdr"], "--volume"),
                              (["--runs", "x"], "--runs")):
             r = bench(*args)
