@@ -73,6 +73,13 @@ def parse_args(argv):
         fail(f"--store: {a.store}: no such folder")
     if a.reference and not os.path.exists(a.reference):
         fail(f"--reference: {a.reference}: no such file")
+    if a.reference:
+        try:  # checked now, not after the runs: a python3 without them would lose every figure
+            import numpy  # noqa: F401
+            import matplotlib.image  # noqa: F401
+        except ImportError as e:
+            fail(f"--reference: needs numpy and matplotlib ({e.name} is missing from "
+                 f"{sys.executable}; run /usr/bin/python3, Debian's python3-matplotlib)")
     if a.disk_mbps is not None and a.disk_mbps <= 0:
         fail(f"--disk-mbps: expected a rate above 0, got {a.disk_mbps:g}")
     if a.disk_mbps and os.geteuid() != 0:

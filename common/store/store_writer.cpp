@@ -18,8 +18,8 @@
 
 #include "common/core/error.h"
 #include "common/store/pyramid.h"
-#include "common/store/source_pages.h"
 #include "common/store/slab_octree.h"
+#include "common/store/source_pages.h"
 
 namespace isowall::store {
 namespace fs = std::filesystem;
