@@ -15,14 +15,7 @@ namespace isowall::store {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path import_to(const Volume& v, const std::string& name, int levels = 0) {
-    const fs::path dir = test::scratch_dir(name);
-    ImportOptions o;
-    o.threads = 2;
-    o.levels = levels;
-    write_store(v, dir / "store", o);
-    return dir / "store";
-}
+using test::import_to;
 
 std::string read_text(const fs::path& f) {
     std::ifstream in(f);

@@ -18,13 +18,7 @@ namespace isowall::store {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path import_to(const Volume& v, const std::string& name) {
-    const fs::path dir = test::scratch_dir(name);
-    ImportOptions o;
-    o.threads = 2;
-    write_store(v, dir / "store", o);
-    return dir / "store";
-}
+using test::import_to;
 
 // Waits (at most 20 s: a loaded machine) until the pager has hinted `n` chunks. The faults are
 // counted just after the brick wakes its reader, so they are waited for too.

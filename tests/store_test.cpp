@@ -19,15 +19,9 @@ namespace isowall::store {
 namespace {
 namespace fs = std::filesystem;
 
-using test::pattern_volume;
+using test::import_to;
 
-fs::path import_to(const Volume& v, const std::string& name) {
-    const fs::path dir = test::scratch_dir(name);
-    ImportOptions o;
-    o.threads = 2;
-    write_store(v, dir / "store", o);
-    return dir / "store";
-}
+using test::pattern_volume;
 
 void expect_line(const std::function<void()>& f, std::initializer_list<std::string> mentions) {
     try {

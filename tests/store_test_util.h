@@ -3,7 +3,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/store/store_writer.h"
 #include "common/volume/volume.h"
+#include "tests/test_util.h"
 
 namespace isowall::test {
 
@@ -16,6 +18,17 @@ inline Volume pattern_volume(glm::ivec3 dims) {
             for (int x = 0; x < dims.x; ++x)
                 *p++ = static_cast<std::uint16_t>(x * 7 + y * 131 + z * 1031);
     return Volume(dims, VoxelType::u16, {1.0f, 0.5f, 2.0f}, std::move(bytes), "pattern");
+}
+
+// `v` imported as a store in a fresh scratch folder `name` (two threads; `levels` as
+// ImportOptions'); returns the store's path.
+inline std::filesystem::path import_to(const Volume& v, const std::string& name, int levels = 0) {
+    const std::filesystem::path dir = scratch_dir(name);
+    store::ImportOptions o;
+    o.threads = 2;
+    o.levels = levels;
+    store::write_store(v, dir / "store", o);
+    return dir / "store";
 }
 
 }  // namespace isowall::test
