@@ -6,22 +6,28 @@
 // first cell and level, and marking a meta-cell of 4^3 cells costs one write, not 64.
 //
 // Each level's grid is paged by bricks of 8^3 units: a table with one page number per brick
-// (4 bytes per 512 units: 31 MB for the cells of 2048x2048x936, an eighth of that per level up),
-// made when a frame first uses the level, and a page of 512 group ids for each brick that holds a
-// taken unit. A lookup is two loads and no hash. Pages come from a pool kept across frames, and a
-// new frame forgets only the bricks the last one touched, where a bit per cell would clear 490 MB
-// at 2048^2 x 936 and a hash would cost a probe per cell.
+// (4 bytes per 512 units: 31 MB for the cells of 2048x2048x936, 245 MB for 4096x4096x1872, an
+// eighth of that per level up), made when a frame first uses the level, and a page of 512 group
+// ids for each brick that holds a taken unit. The table holds page + 1, so that 0 is "no page"
+// and a new table is calloc's zero pages: the kernel maps them as the frame first writes them,
+// where filling a table with a free mark wrote all of it before the first ray (0.3-0.45 s at
+// 4096x4096x1872) and kept it resident. A lookup is two loads and no hash. Pages come from a pool
+// kept across frames, and a new frame forgets only the bricks the last one touched, where a bit per
+// cell would clear 490 MB at 2048^2 x 936 and a hash would cost a probe per cell.
 //
 // Threads: insert(), contains() and group_of() may run on any number of threads at once (the
 // workers of one frame). A unit is claimed by a compare-and-swap of its slot, so exactly one
 // insert of it returns true; a brick's page is added under a lock (once per brick), published by
 // a release store of its number that readers acquire. reset() runs alone, between frames.
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <vector>
 
 #include <glm/common.hpp>
@@ -47,7 +53,7 @@ class VisitedCells {
             for (Grid& g : grids_) g = Grid{};
         } else {
             for (Grid& g : grids_) {
-                for (const std::size_t b : g.touched) g.pages[b] = kFree;
+                for (const std::size_t b : g.touched) g.pages[b] = kNoPage;
                 g.touched.clear();
             }
         }
@@ -80,17 +86,17 @@ class VisitedCells {
         const glm::ivec3 u = c >> level;
         const std::size_t b = g.brick(u);
         std::atomic_ref<std::uint32_t> page_ref(g.pages[b]);
-        std::uint32_t page = page_ref.load(std::memory_order_acquire);
-        if (page == kFree) {
+        std::uint32_t entry = page_ref.load(std::memory_order_acquire);
+        if (entry == kNoPage) {
             const std::lock_guard<std::mutex> lock(grow_);
-            page = page_ref.load(std::memory_order_relaxed);
-            if (page == kFree) {
-                page = take_page();
+            entry = page_ref.load(std::memory_order_relaxed);
+            if (entry == kNoPage) {
+                entry = take_page() + 1;
                 g.touched.push_back(b);
-                page_ref.store(page, std::memory_order_release);
+                page_ref.store(entry, std::memory_order_release);
             }
         }
-        std::atomic_ref<std::uint32_t> id(page_at(page)[local(u)]);
+        std::atomic_ref<std::uint32_t> id(page_at(entry - 1)[local(u)]);
         std::uint32_t expected = kFree;
         return id.compare_exchange_strong(expected, group, std::memory_order_acq_rel);
     }
@@ -112,9 +118,23 @@ class VisitedCells {
     static constexpr std::size_t kChunkPages = 1024;
     static constexpr std::size_t kChunks = 16384;
 
+    static constexpr std::uint32_t kNoPage = 0;  // in a table: the brick has no page
+
+    // A table of zeros from calloc: large ones come as untouched zero pages.
+    struct Table {
+        struct Free {
+            void operator()(std::uint32_t* p) const { std::free(p); }
+        };
+        std::unique_ptr<std::uint32_t[], Free> entries;
+        std::size_t size = 0;
+        bool empty() const { return size == 0; }
+        std::uint32_t& operator[](std::size_t i) { return entries[i]; }
+        const std::uint32_t& operator[](std::size_t i) const { return entries[i]; }
+    };
+
     struct Grid {
         glm::ivec3 bricks{0};
-        std::vector<std::uint32_t> pages;  // per brick: its page in the pool, or kFree
+        Table pages;                       // per brick: its page in the pool + 1, or kNoPage
         std::vector<std::size_t> touched;  // bricks with a page, to forget at reset
         std::size_t brick(glm::ivec3 u) const {
             const glm::ivec3 b = u >> kLog2;
@@ -130,9 +150,13 @@ class VisitedCells {
     void make(Grid& g, int level) const {
         const int side = kSide << level;  // cells a brick of this level spans
         g.bricks = (glm::max(dims_, glm::ivec3(0)) + side - 1) / side;
-        g.pages.assign(static_cast<std::size_t>(g.bricks.x) * static_cast<std::size_t>(g.bricks.y) *
-                           static_cast<std::size_t>(g.bricks.z),
-                       kFree);
+        const std::size_t n = static_cast<std::size_t>(g.bricks.x) *
+                              static_cast<std::size_t>(g.bricks.y) *
+                              static_cast<std::size_t>(g.bricks.z);
+        auto* p = static_cast<std::uint32_t*>(std::calloc(std::max<std::size_t>(n, 1), 4));
+        if (!p) throw std::bad_alloc();
+        g.pages.entries.reset(p);
+        g.pages.size = n;
     }
     Page& page_at(std::uint32_t page) const {
         return chunks_[page / kChunkPages][page % kChunkPages];
@@ -155,10 +179,10 @@ class VisitedCells {
         const glm::ivec3 u = c >> level;
         // atomic_ref needs a non-const object; the load does not write.
         auto& entry = const_cast<std::uint32_t&>(g.pages[g.brick(u)]);
-        const std::uint32_t page =
+        const std::uint32_t page_plus_1 =
             std::atomic_ref<std::uint32_t>(entry).load(std::memory_order_acquire);
-        if (page == kFree) return kFree;
-        return std::atomic_ref<std::uint32_t>(page_at(page)[local(u)])
+        if (page_plus_1 == kNoPage) return kFree;
+        return std::atomic_ref<std::uint32_t>(page_at(page_plus_1 - 1)[local(u)])
             .load(std::memory_order_acquire);
     }
 
