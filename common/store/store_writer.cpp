@@ -232,7 +232,7 @@ void write_bricks(const SlabJob& job, const fs::path& dir, const std::string& wh
                 tally.range.merge(g.range.min);
                 tally.range.merge(g.range.max);
                 tally.progress.chunks_done += 1;
-                tally.progress.bytes_in += l.brick_bytes();
+                if (job.level == 0) tally.progress.bytes_in += l.brick_bytes();
                 tally.progress.bytes_out += n;
             }
     } catch (const std::exception& ex) {

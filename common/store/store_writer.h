@@ -11,8 +11,8 @@ namespace isowall::store {
 
 struct ImportProgress {
     std::size_t chunks_done = 0, chunks_total = 0;
-    std::uint64_t bytes_in = 0;   // voxel bytes compressed so far
-    std::uint64_t bytes_out = 0;  // chunk bytes written so far
+    std::uint64_t bytes_in = 0;   // level 0's voxel bytes compressed so far (the source's pace)
+    std::uint64_t bytes_out = 0;  // chunk bytes written so far, every level
 };
 
 struct ImportResult {
