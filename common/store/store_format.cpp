@@ -266,8 +266,8 @@ void check_level(std::string_view zarray, const StoreLayout& l, int k, const std
     if (got.dims != want.dims)
         bad(store, za + ": shape",
             "expected [" + std::to_string(want.dims.z) + ", " + std::to_string(want.dims.y) + ", " +
-                std::to_string(want.dims.x) + "] (every " + std::to_string(1 << k) +
-                "th voxel of level 0)");
+                std::to_string(want.dims.x) + "] (level 0's shape halved " + std::to_string(k) +
+                " times, rounded up)");
     if (got.brick_log2 != l.brick_log2 || got.type != l.type)
         bad(store, za + ": chunks", "expected the chunks and dtype of 0/.zarray");
 }
