@@ -67,6 +67,10 @@ def parse_args(argv):
         sys.exit(1)
     if a.runs < 1:
         fail(f"--runs: expected at least 1, got {a.runs}")
+    if a.disk_mbps is not None and a.disk_mbps <= 0:
+        fail(f"--disk-mbps: expected a rate above 0, got {a.disk_mbps:g}")
+    if a.disk_mbps and os.geteuid() != 0:
+        fail("--disk-mbps: needs root (a cgroup's block-I/O throttle)")
     if not os.path.exists(a.volume):
         fail(f"--volume: {a.volume}: no such file (scripts/resample_volume.py makes the copies)")
     if a.store and not os.path.isdir(a.store):
@@ -80,10 +84,6 @@ def parse_args(argv):
         except ImportError as e:
             fail(f"--reference: needs numpy and matplotlib ({e.name} is missing from "
                  f"{sys.executable}; run /usr/bin/python3, Debian's python3-matplotlib)")
-    if a.disk_mbps is not None and a.disk_mbps <= 0:
-        fail(f"--disk-mbps: expected a rate above 0, got {a.disk_mbps:g}")
-    if a.disk_mbps and os.geteuid() != 0:
-        fail("--disk-mbps: needs root (a cgroup's block-I/O throttle)")
     m = re.fullmatch(r"1/([0-9]+)", a.limit)
     if m:
         if int(m.group(1)) < 1:
