@@ -9,10 +9,14 @@ namespace {
 template <class T>
 class SlabOctreeOf : public SlabOctree {
   public:
-    explicit SlabOctreeOf(const Volume& v)
-        : view_(v.view<T>()), octree_(MinMaxOctree<T>::start(view_.cell_dims())) {}
+    explicit SlabOctreeOf(glm::ivec3 dims)
+        : dims_(dims), octree_(MinMaxOctree<T>::start(glm::max(dims - 1, glm::ivec3(0)))) {}
 
-    FiniteRange add_slab(int z0, int z1, int threads) override {
+    FiniteRange add_slab(std::span<const std::byte> planes, int z0, int z1,
+                         int threads) override {
+        VolumeView<T> view;
+        view.data = reinterpret_cast<const T*>(planes.data());
+        view.dims = dims_;
         constexpr int B = OctreeShape::kLeafCells;
         threads = std::max(1, std::min(threads, (z1 - z0) / B));
         std::vector<FiniteRange> ranges(static_cast<std::size_t>(threads));
@@ -20,9 +24,9 @@ class SlabOctreeOf : public SlabOctree {
         std::vector<std::thread> pool;
         for (int t = 1; t < threads; ++t)
             pool.emplace_back([&, t] {
-                ranges[static_cast<std::size_t>(t)] = octree_.leaf_slab(view_, cut(t), cut(t + 1));
+                ranges[static_cast<std::size_t>(t)] = octree_.leaf_slab(view, cut(t), cut(t + 1), z0);
             });
-        ranges[0] = octree_.leaf_slab(view_, z0, cut(1));
+        ranges[0] = octree_.leaf_slab(view, z0, cut(1), z0);
         for (auto& th : pool) th.join();
         FiniteRange all;
         for (const FiniteRange& r : ranges) all.merge(r);
@@ -32,7 +36,7 @@ class SlabOctreeOf : public SlabOctree {
     std::string write(const std::filesystem::path& file, std::uint64_t content_key,
                       const FiniteRange& finite) override {
         octree_.finish(finite);
-        const octree_cache::Key key{static_cast<std::uint32_t>(voxel_type_of<T>()), view_.dims,
+        const octree_cache::Key key{static_cast<std::uint32_t>(voxel_type_of<T>()), dims_,
                                     content_key};
         std::string why;
         if (!octree_cache::write(file, key, std::as_bytes(octree_.nodes()), octree_.finite_range(),
@@ -44,15 +48,15 @@ class SlabOctreeOf : public SlabOctree {
     FiniteRange range() const override { return octree_.finite_range(); }
 
   private:
-    VolumeView<T> view_;
+    glm::ivec3 dims_;
     MinMaxOctree<T> octree_;
 };
 
 }  // namespace
 
-std::unique_ptr<SlabOctree> make_slab_octree(const Volume& volume) {
-    return dispatch_voxel_type(volume.type(), [&](auto zero) -> std::unique_ptr<SlabOctree> {
-        return std::make_unique<SlabOctreeOf<decltype(zero)>>(volume);
+std::unique_ptr<SlabOctree> make_slab_octree(glm::ivec3 dims, VoxelType type) {
+    return dispatch_voxel_type(type, [&](auto zero) -> std::unique_ptr<SlabOctree> {
+        return std::make_unique<SlabOctreeOf<decltype(zero)>>(dims);
     });
 }
 

@@ -3,6 +3,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 
 namespace isowall::store {
@@ -27,6 +28,29 @@ void populate_source_pages(const std::byte* begin, const std::byte* end) {
 #else
     (void)begin, (void)end;
 #endif
+}
+
+}  // namespace isowall::store
+
+namespace isowall::store {
+
+VolumePlanes::VolumePlanes(const Volume& volume) : v_(volume) {}
+
+VolumePlanes::~VolumePlanes() {
+    if (reading_.joinable()) reading_.join();
+    if (v_.mapped()) release_source_pages(at(released_), at(v_.dims().z));
+}
+
+std::span<const std::byte> VolumePlanes::planes(int z0, int z1) {
+    if (reading_.joinable()) reading_.join();
+    if (v_.mapped()) {
+        if (z0 > released_) release_source_pages(at(released_), at(z0)), released_ = z0;
+        // This slab is read now if the thread has not read it; the next one on the thread.
+        populate_source_pages(at(z0), at(z1));
+        const int z2 = std::min(z1 + (z1 - z0), v_.dims().z);
+        if (z1 < z2) reading_ = std::thread(populate_source_pages, at(z1), at(z2));
+    }
+    return {at(z0), std::size_t(z1 - z0) * plane_bytes()};
 }
 
 }  // namespace isowall::store

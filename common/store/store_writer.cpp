@@ -279,14 +279,15 @@ class LevelSlab {
           plane_(std::size_t(l_.dims.x) * l_.dims.y * voxel_size(l_.type)),
           rows_(plane_ * std::size_t(l_.brick())) {}
 
-    // Takes level-0 rows [z0, z1) of `all` (the whole level-0 volume); writes each slab filled.
-    void add(std::span<const std::byte> all, glm::ivec3 dims0, int z0, int z1, int threads,
+    // Takes level-0 planes [z0, z1) of `planes` (which holds the level-0 planes from z0 on);
+    // writes each slab filled.
+    void add(std::span<const std::byte> planes, glm::ivec3 dims0, int z0, int z1, int threads,
              const fs::path& dir, const std::string& where, Tally& tally) {
         const std::size_t plane0 = std::size_t(dims0.x) * dims0.y * voxel_size(l_.type);
         const int step = 1 << k_;
         for (int z = (z0 + step - 1) / step * step; z < z1; z += step) {
             const int zk = z >> k_;
-            decimate_plane(all.subspan(std::size_t(z) * plane0, plane0), dims0, l_.type, k_,
+            decimate_plane(planes.subspan(std::size_t(z - z0) * plane0, plane0), dims0, l_.type, k_,
                            l_.dims, rows_.data() + std::size_t(zk - bz_ * l_.brick()) * plane_);
             if (zk == (bz_ + 1) * l_.brick() - 1 || zk == l_.dims.z - 1) {
                 write_slab({l_, k_, rows_, bz_ * l_.brick(), bz_}, threads, dir, where, tally,
@@ -307,17 +308,22 @@ class LevelSlab {
 }  // namespace
 
 ImportResult write_store(const Volume& volume, const fs::path& out, const ImportOptions& options) {
-    const std::string where = out.string();
     if (volume.bricks())
         throw InputError(volume.source(), "source", "is a store already (copy its folder instead)");
+    VolumePlanes planes(volume);
+    return write_store(planes, out, options);
+}
+
+ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportOptions& options) {
+    const std::string where = out.string();
     std::error_code ec;
     if (fs::exists(out, ec) && !options.replace)
         throw InputError(where, "--out", "exists; give --force to replace it");
     if (fs::exists(out, ec) && !is_store(out))
         throw InputError(where, "--out", "exists and is not a store; it is left alone");
 
-    StoreLayout layout = layout_for(volume.dims(), volume.type(), volume.spacing());
-    layout.source = volume.source();
+    StoreLayout layout = layout_for(source.dims(), source.type(), source.spacing());
+    layout.source = source.source();
     layout.id = new_store_id();
     layout.zstd_level = options.zstd_level;
     layout.levels = options.levels > 0
@@ -328,46 +334,26 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
     fs::remove_all(tmp.path, ec);  // what a stopped run left
     make_folders(layout, tmp.path, where);
 
-    const std::span<const std::byte> all = volume.bytes();
-    const std::size_t slice_bytes =
-        static_cast<std::size_t>(layout.dims.x) * layout.dims.y * voxel_size(layout.type);
     const int threads = std::max(1, std::min(options.threads, grid.y));
     Tally tally;
     for (int k = 0; k < layout.levels; ++k)
         tally.progress.chunks_total += layout.level(k).chunk_count();
     std::vector<LevelSlab> pyramid;
     for (int k = 1; k < layout.levels; ++k) pyramid.emplace_back(layout, k);
-    const std::unique_ptr<SlabOctree> octree = options.octree ? make_slab_octree(volume) : nullptr;
+    const std::unique_ptr<SlabOctree> octree =
+        options.octree ? make_slab_octree(layout.dims, layout.type) : nullptr;
     FiniteRange finite;
-    std::thread reading;
-    struct Join {
-        std::thread& t;
-        ~Join() {
-            if (t.joinable()) t.join();
-        }
-    } join_reading{reading};
-    if (volume.mapped())
-        populate_source_pages(
-            all.data(),
-            all.data() + std::min<std::size_t>(all.size(), layout.brick() * slice_bytes));
     for (int bz = 0; bz < grid.z; ++bz) {
         const int z0 = bz * layout.brick(), z1 = std::min(z0 + layout.brick(), layout.dims.z);
-        // The next slab is read from disk while this one is compressed.
-        if (reading.joinable()) reading.join();
-        if (volume.mapped() && z1 < layout.dims.z) {
-            const int z2 = std::min(z1 + layout.brick(), layout.dims.z);
-            reading = std::thread(populate_source_pages, all.data() + std::size_t(z1) * slice_bytes,
-                                  all.data() + std::size_t(z2) * slice_bytes);
-        }
+        // The slab's planes and the next one's first, which the octree's last leaves reach.
+        const std::span<const std::byte> planes =
+            source.planes(z0, std::min(z1 + 1, layout.dims.z));
         // The slab's rows of bricks split over the threads; each has its buffers and zstd context.
-        write_slab({layout, 0, all, 0, bz}, threads, tmp.path, where, tally, !octree);
+        write_slab({layout, 0, planes, z0, bz}, threads, tmp.path, where, tally, !octree);
         for (LevelSlab& level : pyramid)
-            level.add(all, layout.dims, z0, z1, threads, tmp.path, where, tally);
+            level.add(planes, layout.dims, z0, z1, threads, tmp.path, where, tally);
         // The slab's voxels are at hand: its leaves of the octree now, not in a second pass.
-        if (octree) finite.merge(octree->add_slab(z0, z1, threads));
-        if (volume.mapped())
-            release_source_pages(all.data() + std::size_t(z0) * slice_bytes,
-                                 all.data() + std::size_t(z1) * slice_bytes);
+        if (octree) finite.merge(octree->add_slab(planes, z0, z1, threads));
         if (options.progress) options.progress(tally.progress);
     }
     ImportResult result{layout, tally.progress.bytes_in, tally.progress.bytes_out, {}};

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "common/store/store_format.h"
+#include "common/volume/plane_source.h"
 #include "common/volume/volume.h"
 
 namespace isowall::store {
@@ -44,6 +45,10 @@ struct ImportOptions {
 // (a full or read-only disk, an existing `out`) are InputErrors naming `out`; the temporary is
 // removed.
 ImportResult write_store(const Volume& volume, const std::filesystem::path& out,
+                         const ImportOptions& options);
+// The same from planes read in z order (common/volume/plane_source.h): a slab of them, and one
+// plane more, at a time. A source's InputError ends the import as any other failure does.
+ImportResult write_store(PlaneSource& source, const std::filesystem::path& out,
                          const ImportOptions& options);
 
 // Where write_store builds the store before renaming it (".NAME.importing" beside it).

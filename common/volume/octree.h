@@ -128,7 +128,8 @@ class MinMaxOctree {
     // each slab of slices [z0, z1) (ends multiples of kLeafCells; it reads slice z1 too; disjoint
     // slabs from any thread), then finish() with the merged ranges.
     static MinMaxOctree start(glm::ivec3 cell_dims);
-    FiniteRange leaf_slab(const VolumeView<T>& v, int z0, int z1);
+    // `v.data` may hold only the planes from z_base on (a slab a streamed import decoded).
+    FiniteRange leaf_slab(const VolumeView<T>& v, int z0, int z1, int z_base = 0);
     void finish(const FiniteRange& finite);
 
     const OctreeShape& shape() const { return shape_; }
@@ -150,7 +151,7 @@ class MinMaxOctree {
   private:
     FiniteRange build_leaves(const VolumeView<T>& v, ThreadBudget budget);
     // Leaf rows [bz0, bz1): their nodes, and the finite range of their voxels (floats only).
-    FiniteRange leaf_rows(const VolumeView<T>& v, int bz0, int bz1);
+    FiniteRange leaf_rows(const VolumeView<T>& v, int bz0, int bz1, int z_base = 0);
     void build_upper_levels();
 
     OctreeShape shape_;
@@ -210,7 +211,7 @@ std::filesystem::path default_dir();
 // voxel rows of its y and z windows are merged element by element (vectorised loops), then the x
 // windows are taken; a bricked volume (a store's) is read voxel by voxel into the same merge.
 template <class T>
-FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1) {
+FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1, int z_base) {
     T* nodes = owned_.data();
     const auto& leaf = shape_.levels[0];
     constexpr int B = OctreeShape::kLeafCells;
@@ -224,7 +225,7 @@ FiniteRange MinMaxOctree<T>::leaf_rows(const VolumeView<T>& v, int bz0, int bz1)
             bool first = true;
             for (int z = z0; z <= z1; ++z)
                 for (int y = y0; y <= y1; ++y, first = false) {
-                    const T* row = v.data + (v.bricked() ? 0 : v.index(0, y, z));
+                    const T* row = v.data + (v.bricked() ? 0 : v.index(0, y, z - z_base));
                     if (v.bricked()) {
                         for (std::size_t x = 0; x < nx; ++x) brick_row[x] = v.at(int(x), y, z);
                         row = brick_row.data();
@@ -283,11 +284,11 @@ MinMaxOctree<T> MinMaxOctree<T>::start(glm::ivec3 cell_dims) {
 }
 
 template <class T>
-FiniteRange MinMaxOctree<T>::leaf_slab(const VolumeView<T>& v, int z0, int z1) {
+FiniteRange MinMaxOctree<T>::leaf_slab(const VolumeView<T>& v, int z0, int z1, int z_base) {
     const int rows = shape_.levels[0].dims.z;
     const int first = z0 / OctreeShape::kLeafCells;
     const int last = std::min(rows, (z1 + OctreeShape::kLeafCells - 1) / OctreeShape::kLeafCells);
-    return first < last ? leaf_rows(v, first, last) : FiniteRange{};
+    return first < last ? leaf_rows(v, first, last, z_base) : FiniteRange{};
 }
 
 template <class T>

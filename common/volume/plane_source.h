@@ -1,0 +1,64 @@
+#pragma once
+// A volume's planes in z order, a slab at a time: what `isowall import` reads its source through,
+// so that a volume larger than memory is never held whole. A memory-mapped file hands out views
+// of its map (common/store/source_pages.h); a format decoded by a library hands out planes it
+// decodes into a buffer of a slab (common/formats/plane_stack.h).
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "common/volume/volume.h"
+
+namespace isowall {
+
+class PlaneSource {
+  public:
+    virtual ~PlaneSource() = default;
+    virtual glm::ivec3 dims() const = 0;
+    virtual VoxelType type() const = 0;
+    virtual glm::vec3 spacing() const = 0;
+    virtual const std::string& source() const = 0;  // the file or folder, for errors and the store
+    // Planes [z0, z1) (x fastest), valid until the next call. Calls come in z order: each call's
+    // z0 is at least the last one's z0 and at most its z1 (a slab may ask again for the plane the
+    // last one ended on: a leaf of the octree spans its slab's last plane and the next one's
+    // first). Errors are InputErrors naming the source.
+    virtual std::span<const std::byte> planes(int z0, int z1) = 0;
+
+    std::size_t plane_bytes() const {
+        return static_cast<std::size_t>(dims().x) * dims().y * voxel_size(type());
+    }
+};
+
+// Planes decoded into a buffer by `decode(z0, z1, to)`, which is called with z0 rising from 0,
+// each call starting where the last one ended, so a decoder may stream its file once. Planes a
+// call asks for again are kept from the last call, whose end a call never comes before; the
+// buffer holds the largest call's planes.
+class DecodedPlanes final : public PlaneSource {
+  public:
+    using Decode = std::function<void(int z0, int z1, std::byte* to)>;
+    DecodedPlanes(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::string source,
+                  Decode decode);
+    glm::ivec3 dims() const override { return dims_; }
+    VoxelType type() const override { return type_; }
+    glm::vec3 spacing() const override { return spacing_; }
+    const std::string& source() const override { return source_; }
+    std::span<const std::byte> planes(int z0, int z1) override;
+    // The most bytes the buffer held at once (tests: memory stays at a slab).
+    std::size_t peak_bytes() const { return peak_; }
+
+  private:
+    glm::ivec3 dims_;
+    VoxelType type_;
+    glm::vec3 spacing_;
+    std::string source_;
+    Decode decode_;
+    std::vector<std::byte> buffer_;
+    int z0_ = 0, z1_ = 0;  // the planes in buffer_
+    std::size_t peak_ = 0;
+};
+
+}  // namespace isowall
