@@ -10,6 +10,7 @@
 #include "common/core/error.h"
 #include "common/core/util.h"
 #include "common/store/store_writer.h"
+#include "common/volume/load_checks.h"
 #include "common/volume/octree.h"
 
 namespace isowall {
@@ -91,7 +92,11 @@ int run_import(const ImportCommand& o) {
             throw InputError(o.out, "--out", "folder " + parent.string() + " does not exist");
     }
     Stopwatch sw;  // from the open: a format decoded into memory reads its file there
-    OpenedVolume ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
+    // Formats a library decodes stream a slab of planes at a time; raw data and raw NRRD are
+    // mapped and streamed from the map; the rest (bzip2, hex, ascii NRRD) are decoded whole.
+    std::unique_ptr<PlaneSource> planes = open_planes(vo);
+    OpenedVolume ov;
+    if (!planes) ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
 
     ProgressBar bar(o.quiet);
     store::ImportOptions opts;
@@ -100,13 +105,14 @@ int run_import(const ImportCommand& o) {
     opts.levels = o.levels;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
-    const store::ImportResult r = store::write_store(ov.volume, out, opts);
+    const store::ImportResult r =
+        planes ? store::write_store(*planes, out, opts) : store::write_store(ov.volume, out, opts);
     bar.finish();
     const double write_s = sw.seconds();
 
     const double mib = 1024.0 * 1024.0;
-    const double source = double(ov.volume.bytes().size());  // the voxels, all levels from them
     const store::StoreLayout& l = r.layout;
+    const double source = double(voxel_bytes(l.dims, l.type));  // the voxels, all levels from them
     std::printf(
         "import: wrote %s  %dx%dx%d %s, %zu bricks of %d^3 (%d level%s), %.1f MiB -> %.1f MiB "
         "(%.2f:1) in %.2f s (%.0f MiB/s)\n",
@@ -117,6 +123,10 @@ int run_import(const ImportCommand& o) {
     std::printf("import: octree %s\n",
                 r.octree_note.empty() ? ("written to " + store::octree_file(out).string()).c_str()
                                       : ("not written: " + r.octree_note).c_str());
+    const char* how = planes               ? "decoded a slab of planes at a time"
+                      : ov.volume.mapped() ? "read a slab at a time from the file's memory map"
+                                           : "decoded whole first";
+    std::printf("import: source %s; peak resident memory %.0f MiB\n", how, peak_rss_mib());
     return 0;
 }
 

@@ -88,6 +88,14 @@ std::filesystem::path cache_dir(const VolumeOptions& o) {
     return o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
 }
 
+std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
+    if (o.path.empty() || store::is_store(o.path)) return nullptr;
+    if (!o.memory_limit.empty())
+        throw InputError("--memory-limit", "value",
+                         "applies to a store (`isowall import`), not to " + quote(o.path));
+    return formats::open_planes(o.path, raw_spec(o));
+}
+
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     OpenedVolume out;
     Stopwatch sw;

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/store/paged_voxels.h"
+#include "common/volume/plane_source.h"
 #include "common/volume/volume.h"
 
 namespace isowall {
@@ -59,5 +60,9 @@ std::filesystem::path cache_dir(const VolumeOptions& opts);
 // Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,
 // and prints one line about it.
 OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false, VolumeUse use = {});
+
+// The volume's planes for `isowall import` to stream (common/formats/read_volume.h: open_planes),
+// or null where open_volume serves (the phantom, a store, raw data and raw NRRD it maps).
+std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& opts);
 
 }  // namespace isowall

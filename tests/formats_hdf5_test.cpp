@@ -10,6 +10,7 @@
 #include "common/formats/read_volume.h"
 #include "common/formats/readers.h"
 #include "tests/formats_more_util.h"
+#include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -108,6 +109,8 @@ void expect_round_trip(const std::string& name, hid_t file_type, hid_t memory_ty
     ASSERT_EQ(v.files().size(), 1u);
     EXPECT_EQ(v.files()[0], file);
     EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0) << "a handle left open";
+    // Streamed from a child process, a hyperslab of planes at a time.
+    test::expect_streams_alike(file.string() + ":/volume");
 }
 
 TEST(FormatsHdf5, EveryVoxelTypeInBothByteOrdersAndLayouts) {

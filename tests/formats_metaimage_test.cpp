@@ -9,6 +9,7 @@
 
 #include "common/formats/readers.h"
 #include "tests/formats_more_util.h"
+#include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -91,6 +92,7 @@ void expect_mhd_and_mha(const std::string& name) {
     EXPECT_EQ(mhd.files(), (std::vector<fs::path>{dir / "v.mhd", dir / "v.raw"}));
     EXPECT_EQ(test::fact(mhd, "format"), "MetaImage");
     EXPECT_FALSE(mhd.orientation().known);
+    test::expect_streams_alike((dir / "v.mhd").string());
 
     const auto bytes = test::as_bytes(test::test_voxels<T>());
     write_file(dir / "v.mha", header(t, "", "LOCAL", true) + big_endian_of<T>(bytes));
@@ -98,6 +100,7 @@ void expect_mhd_and_mha(const std::string& name) {
     test::expect_test_volume<T>(mha);
     EXPECT_EQ(mha.spacing(), glm::vec3(1.0f));
     EXPECT_EQ(mha.files(), std::vector<fs::path>{dir / "v.mha"});
+    test::expect_streams_alike((dir / "v.mha").string());  // swapped a slab at a time
 }
 
 TEST(FormatsMetaImage, EveryTypeDetachedAndLocalInBothByteOrders) {
@@ -117,6 +120,7 @@ TEST(FormatsMetaImage, CompressedLocalAndDetached) {
     write_file(dir / "z.mha", header(VoxelType::f32, "CompressedData = True\n", "LOCAL") +
                                   zlib_of(raw_of<float>()));
     test::expect_test_volume<float>(formats::read_metaimage(dir / "z.mha"));
+    test::expect_streams_alike((dir / "z.mha").string());  // inflated a slab at a time
     // .mhd: CompressedDataSize is the size of the .zraw beside it.
     const std::string packed = zlib_of(raw_of<std::int16_t>());
     write_file(dir / "z.mhd", header(VoxelType::i16,
@@ -127,6 +131,7 @@ TEST(FormatsMetaImage, CompressedLocalAndDetached) {
     const Volume v = formats::read_metaimage(dir / "z.mhd");
     test::expect_test_volume<std::int16_t>(v);
     EXPECT_EQ(test::fact(v, "compression"), "zlib");
+    test::expect_streams_alike((dir / "z.mhd").string());
     write_file(dir / "z.zraw", packed + "x");
     expect_input_error([&] { formats::read_metaimage(dir / "z.mhd"); }, (dir / "z.zraw").string(),
                        "size", "longer");

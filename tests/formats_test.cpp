@@ -24,6 +24,7 @@
 #include "common/formats/dicom_lengths.h"
 #include "common/formats/read_volume.h"
 #include "common/formats/voxel_ops.h"
+#include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
 
 namespace isowall::test {
@@ -72,6 +73,8 @@ TEST(FormatsDicom, TheScannersSeriesEqualsItsRawTwin) {
     EXPECT_EQ(v.files().size(), 120u);
     EXPECT_TRUE(v.orientation().known);
     EXPECT_EQ(formats::orientation_letters(v.orientation().axes), "LPS");
+    // What `import` streams: decoded in a child process, slice by slice, handed over a pipe.
+    test::expect_streams_alike((*dir / "mrhead_t1_dicom").string());
 }
 
 TEST(FormatsDicom, OneFileOfTheSeriesReadsTheWholeSeries) {
@@ -112,6 +115,7 @@ TEST(FormatsDicom, JpegLsAndJpeg2000SeriesEqualTheRawTwin) {
             reencoded_series(*dir / "mrhead_t1_dicom", gdcm::TransferSyntax(ts), uid);
         const Volume v = read_volume(series.string(), std::nullopt);
         expect_same_voxels(v, raw);
+        test::expect_streams_alike(series.string());
         std::string syntax;
         for (const VolumeFact& f : v.facts())
             if (f.name == "transfer syntax") syntax = f.value;
@@ -243,6 +247,7 @@ TEST(FormatsNifti, EngineAndHeptaneEqualTheirRawTwins) {
         const Volume v = read_volume((*dir / (name + ".nii.gz")).string(), std::nullopt);
         expect_same_voxels(v, twin(name));
         EXPECT_EQ(v.spacing(), glm::vec3(1.0f)) << name;
+        test::expect_streams_alike((*dir / (name + ".nii.gz")).string());  // a gzip stream
     }
 }
 
@@ -286,6 +291,10 @@ TEST(FormatsNifti, AnIntegerScaleWidensOnlyAsFarAsTheValuesNeed) {
     const Volume v = read_volume(write_nifti(dir / "ct.nii", 1, -1024).string(), std::nullopt);
     EXPECT_EQ(v.type(), VoxelType::i16);
     EXPECT_EQ(v.view<std::int16_t>().at(12, 12, 12), 200 - 1024);
+    // A stream chooses its type before a voxel: from uint8's range, -1024..-769 is int16 too.
+    const auto planes = formats::open_planes((dir / "ct.nii").string(), std::nullopt);
+    EXPECT_EQ(planes->type(), VoxelType::i16);
+    test::expect_planes_equal(*planes, v);
 }
 
 TEST(FormatsNifti, ANanScaleIsNamed) {

@@ -8,6 +8,7 @@
 #include "common/formats/read_volume.h"
 #include "common/formats/readers.h"
 #include "tests/formats_more_util.h"
+#include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -81,6 +82,7 @@ void expect_multipage(const std::string& name) {
     EXPECT_EQ(test::fact(v, "spacing from"), "none in the file (1 1 1)");
     EXPECT_FALSE(v.orientation().known);
     EXPECT_EQ(v.files(), std::vector<fs::path>{file});
+    test::expect_streams_alike(file.string());  // what `import` streams, a slab at a time
 }
 
 TEST(FormatsTiff, MultiPageOfEveryType) {
@@ -110,6 +112,7 @@ TEST(FormatsTiff, FolderOfSlicesInNaturalOrder) {
     // --volume's choice agrees: a folder with TIFF slices (and a note) is a TIFF stack.
     const Volume front_door = formats::read_volume(dir.string(), std::nullopt);
     EXPECT_EQ(front_door.files(), want);
+    test::expect_streams_alike(dir.string());
 }
 
 TEST(FormatsTiff, ImageJSpacingFromDescriptionAndResolution) {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <gdcmDirectory.h>
+#include <gdcmImageHelper.h>
 #include <gdcmImageReader.h>
 #include <gdcmScanner.h>
 #include <gdcmTrace.h>
@@ -19,6 +20,7 @@
 #include "common/core/error.h"
 #include "common/formats/dicom_lengths.h"
 #include "common/formats/dicom_slices.h"
+#include "common/formats/plane_stack.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
 #include "common/volume/load_checks.h"
@@ -202,6 +204,7 @@ struct SlicePixels {
     Scaling scaling;
     std::string transfer_syntax;
     std::vector<std::byte> bytes;
+    std::pair<double, double> stored_range;  // what BitsStored and PixelRepresentation allow
 };
 
 // One slice's pixels, decoded, of the type of the series' first slice when `expected` is set.
@@ -242,18 +245,50 @@ SlicePixels read_slice(const SliceHeader& h, const std::optional<VoxelType>& exp
     if (img.GetDimension(0) != unsigned(h.columns) || img.GetDimension(1) != unsigned(h.rows) ||
         img.GetBufferLength() != need)
         throw wrong_size(img.GetBufferLength());
+    const int bits = std::clamp(int(pf.GetBitsStored()), 1, int(voxel_size(*type) * 8));
+    const bool is_signed = pf.GetPixelRepresentation() == 1;
+    const double span = std::ldexp(1.0, bits);
     SlicePixels out{*type,
                     {img.GetSlope(), img.GetIntercept()},
                     transfer_syntax_text(img.GetTransferSyntax()),
-                    std::vector<std::byte>(need)};
+                    std::vector<std::byte>(need),
+                    is_signed ? std::pair{-span / 2, span / 2 - 1} : std::pair{0.0, span - 1}};
     if (!img.GetBuffer(reinterpret_cast<char*>(out.bytes.data())))
         throw InputError(f, "PixelData", "GDCM could not decode the pixels");
     return out;
 }
 
+// A slice's scaling as GDCM's image reader will apply it (its rules for which modalities a
+// Rescale applies to), from the header alone.
+Scaling gdcm_scaling(const std::string& f) {
+    gdcm::Reader reader;
+    reader.SetFileName(f.c_str());
+    if (!reader.ReadUpToTag(kPixelData))
+        throw InputError(f, "DICOM", "GDCM cannot read its header (a damaged file)");
+    const std::vector<double> is =
+        gdcm::ImageHelper::GetRescaleInterceptSlopeValue(reader.GetFile());
+    return is.size() == 2 ? Scaling{is[1], is[0]} : Scaling{};
+}
+
+// What the stack's reads share: the slices in order, and the first one's pixels, decoded to learn
+// the series' type (kept for the first read).
+struct SeriesSlices {
+    std::vector<SliceHeader> headers;  // in slice order
+    std::vector<Scaling> scalings;     // each slice's, from its header
+    bool per_slice = false;            // slices scaled each its own way: float32 values
+    std::optional<SlicePixels> first;
+};
+
 }  // namespace
 
-Volume read_dicom(const fs::path& path) {
+// The series' name in errors: the folder, or the folder of the file named.
+std::string series_where(const fs::path& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) return path.string();
+    return path.parent_path().empty() ? std::string(".") : path.parent_path().string();
+}
+
+PlaneStack dicom_planes(const fs::path& path) {
     gdcm::Trace::SetWarning(false);  // its warnings go to stderr; ours is the one line
     gdcm::Trace::SetError(false);
     std::error_code ec;
@@ -262,54 +297,40 @@ Volume read_dicom(const fs::path& path) {
     gdcm::Scanner scanner;
     const std::map<std::string, Series> all = scan_series(dir, scanner);
     const auto& [uid, series] = choose_series(all, path, folder ? "" : path.string(), scanner);
-    const std::string where = folder ? path.string() : dir.string();
+    const std::string where = series_where(path);
     std::vector<SliceHeader> headers;
     for (const std::string& f : series.files) headers.push_back(slice_header(f, scanner));
     const SliceOrder order = order_slices(headers, where);
-    const SliceHeader& first = headers[order.order.front()];
     const std::vector<double> ps =
         numbers(trimmed(scanner.GetValue(series.files.front().c_str(), kPixelSpacing)));
     if (ps.size() != 2)
         throw InputError(series.files.front(), "PixelSpacing", "missing or not two numbers");
-    Decoded d;
-    d.spacing = {float(ps[1]), float(ps[0]), float(order.spacing)};  // PixelSpacing: row, column
-    std::vector<Scaling> scalings;
-    std::string syntax;
-    for (std::size_t k = 0; k < order.order.size(); ++k) {
-        const SliceHeader& h = headers[order.order[k]];
-        SlicePixels p = read_slice(h, k == 0 ? std::nullopt : std::optional(d.type));
-        if (k == 0) {
-            d.type = p.type;
-            d.dims = checked_dims(
-                where, "Rows/Columns",
-                std::vector<std::uint64_t>{std::uint64_t(h.columns), std::uint64_t(h.rows),
-                                           std::uint64_t(headers.size())},
-                d.type);
-            check_fits_memory(voxel_bytes(d.dims, d.type), where, "Rows/Columns");
-            d.bytes.reserve(voxel_bytes(d.dims, d.type));
-            syntax = p.transfer_syntax;
-        }
-        d.bytes.insert(d.bytes.end(), p.bytes.begin(), p.bytes.end());
-        scalings.push_back(p.scaling);
+    auto slices = std::make_shared<SeriesSlices>();
+    for (const std::size_t k : order.order) {
+        slices->headers.push_back(headers[k]);
+        slices->scalings.push_back(gdcm_scaling(headers[k].file));
     }
-    const bool one_scaling = std::all_of(scalings.begin(), scalings.end(), [&](const Scaling& s) {
-        return s.slope == scalings[0].slope && s.intercept == scalings[0].intercept;
+    const SliceHeader& first = slices->headers.front();
+    slices->first = read_slice(first, std::nullopt);
+    const std::vector<Scaling>& sc = slices->scalings;
+    slices->per_slice = !std::all_of(sc.begin(), sc.end(), [&](const Scaling& s) {
+        return s.slope == sc[0].slope && s.intercept == sc[0].intercept;
     });
-    if (one_scaling) {
-        d.scaling = scalings[0];
-    } else {
-        // Some scanners scale each slice to its own range: each slice to float32 by its own.
-        const std::size_t slice_bytes = d.bytes.size() / scalings.size();
-        std::vector<std::byte> values;
-        for (std::size_t k = 0; k < scalings.size(); ++k) {
-            const std::vector<std::byte> v = to_float32(
-                std::span(d.bytes).subspan(k * slice_bytes, slice_bytes), d.type, scalings[k]);
-            values.insert(values.end(), v.begin(), v.end());
-        }
-        d.bytes = std::move(values);
-        d.type = VoxelType::f32;
+
+    PlaneStack stack;
+    Decoded& d = stack.head;
+    d.spacing = {float(ps[1]), float(ps[0]), float(order.spacing)};  // PixelSpacing: row, column
+    d.type = slices->per_slice ? VoxelType::f32 : slices->first->type;
+    d.dims = checked_dims(
+        where, "Rows/Columns",
+        std::vector<std::uint64_t>{std::uint64_t(first.columns), std::uint64_t(first.rows),
+                                   std::uint64_t(headers.size())},
+        d.type);
+    if (slices->per_slice)
         d.facts.push_back({"scaling", "RescaleSlope/Intercept per slice (applied: float32)"});
-    }
+    else
+        d.scaling = slices->first->scaling;
+    stack.declared_range = slices->first->stored_range;
     d.orientation.axes =
         glm::mat3(glm::vec3(first.row), glm::vec3(first.column), glm::vec3(order.normal));
     d.orientation.origin = glm::vec3(first.position);
@@ -320,8 +341,35 @@ Volume read_dicom(const fs::path& path) {
     d.facts.push_back({"series", series_label(uid, series)});
     d.facts.push_back({"slices", std::to_string(headers.size()) + ", " +
                                      std::to_string(order.spacing) + " mm apart"});
-    d.facts.push_back({"transfer syntax", syntax});
-    return finish_volume(std::move(d), where, "RescaleSlope");
+    d.facts.push_back({"transfer syntax", slices->first->transfer_syntax});
+    stack.size_field = "Rows/Columns";
+    stack.scaling_field = "RescaleSlope";
+    const VoxelType stored = slices->first->type;
+    const Scaling one = d.scaling;
+    stack.read = [slices, stored, one](int z0, int z1, std::byte* to) {
+        for (int z = z0; z < z1; ++z) {
+            const SliceHeader& h = slices->headers[std::size_t(z)];
+            SlicePixels p = z == 0 && slices->first ? std::move(*slices->first)
+                                                    : read_slice(h, std::optional(stored));
+            if (z == 0) slices->first.reset();
+            const std::size_t n = p.bytes.size() / voxel_size(stored);
+            if (slices->per_slice) {
+                const std::vector<std::byte> v = to_float32(p.bytes, stored, p.scaling);
+                std::memcpy(to + std::size_t(z - z0) * n * 4, v.data(), v.size());
+                continue;
+            }
+            // The series' one scaling was read from the headers; the pixels' must agree.
+            if (p.scaling.slope != one.slope || p.scaling.intercept != one.intercept)
+                throw InputError(h.file, "RescaleSlope",
+                                 "differs between the slice's header and its image");
+            std::memcpy(to + std::size_t(z - z0) * p.bytes.size(), p.bytes.data(), p.bytes.size());
+        }
+    };
+    return stack;
+}
+
+Volume read_dicom(const fs::path& path) {
+    return read_whole(dicom_planes(path), series_where(path));
 }
 
 }  // namespace isowall::formats

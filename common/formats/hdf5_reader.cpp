@@ -14,6 +14,7 @@
 
 #include "common/core/error.h"
 #include "common/core/number.h"
+#include "common/formats/plane_stack.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
 #include "common/volume/load_checks.h"
@@ -239,30 +240,54 @@ glm::vec3 dataset_spacing(hid_t ds, const std::string& where, std::vector<Volume
     return glm::vec3(1.0f);
 }
 
+// The open file and dataset the stack's reads share.
+struct OpenDataset {
+    Handle file, dataset;
+};
+
 }  // namespace
 
-Volume read_hdf5(const fs::path& file, const std::string& dataset) {
+PlaneStack hdf5_planes(const fs::path& file, const std::string& dataset) {
     const std::string where = file.string();
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // libhdf5's stack dumps; ours is the one line
-    const Handle f = open_file(file, where);
+    Handle f = open_file(file, where);
     const std::string name = dataset.empty() ? only_dataset(f.get(), where) : dataset;
-    const Handle ds = open_dataset(f.get(), name, where);
-    const Handle dtype(H5Dget_type(ds.get()), H5Tclose);
+    Handle dset = open_dataset(f.get(), name, where);
+    auto open = std::make_shared<OpenDataset>(OpenDataset{std::move(f), std::move(dset)});
+    const hid_t ds = open->dataset.get();
+    const Handle dtype(H5Dget_type(ds), H5Tclose);
     if (!dtype.valid()) throw InputError(where, "type", "libhdf5 cannot read the type of " + name);
-    Decoded d;
+    PlaneStack stack;
+    Decoded& d = stack.head;
     d.type = voxel_type_of(dtype.get(), name, where);
-    d.dims = dataset_dims(ds.get(), d.type, name, where);
-    check_filters(ds.get(), where);
+    d.dims = dataset_dims(ds, d.type, name, where);
+    check_filters(ds, where);
     d.facts.push_back({"dataset", name});
-    d.spacing = dataset_spacing(ds.get(), where, d.facts);
-    d.bytes = allocate_voxels(voxel_bytes(d.dims, d.type), where, "dims");
-    if (H5Dread(ds.get(), native_type(d.type), H5S_ALL, H5S_ALL, H5P_DEFAULT, d.bytes.data()) < 0)
-        throw InputError(
-            where, "data",
-            "libhdf5 cannot read the voxels of " + name + " (the file is damaged or cut short)");
+    d.spacing = dataset_spacing(ds, where, d.facts);
     d.format = "HDF5";
     d.files = {file};
-    return finish_volume(std::move(d), where, "scaling");
+    stack.size_field = "dims";
+    // Each call reads its planes as one hyperslab (z y x in the file's C order).
+    const glm::ivec3 dims = d.dims;
+    const hid_t mem_type = native_type(d.type);
+    stack.read = [open, dims, mem_type, where, name](int z0, int z1, std::byte* to) {
+        const hsize_t start[3] = {hsize_t(z0), 0, 0};
+        const hsize_t count[3] = {hsize_t(z1 - z0), hsize_t(dims.y), hsize_t(dims.x)};
+        Handle space(H5Dget_space(open->dataset.get()), H5Sclose);
+        Handle mem(H5Screate_simple(3, count, nullptr), H5Sclose);
+        if (!space.valid() || !mem.valid() ||
+            H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0 ||
+            H5Dread(open->dataset.get(), mem_type, mem.get(), space.get(), H5P_DEFAULT, to) < 0)
+            throw InputError(where, "data",
+                             "libhdf5 cannot read the voxels of " + name + " (slices " +
+                                 std::to_string(z0) + " to " + std::to_string(z1 - 1) +
+                                 "; the file is damaged or cut short)");
+    };
+    return stack;
+}
+
+Volume read_hdf5(const fs::path& file, const std::string& dataset) {
+    return read_whole(hdf5_planes(file, dataset), file.string());
 }
 
 }  // namespace isowall::formats

@@ -13,17 +13,7 @@
 
 #include "common/core/error.h"
 #include "common/core/wire.h"
-
-#if defined(__SANITIZE_ADDRESS__)
-#define ISOWALL_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define ISOWALL_ASAN 1
-#endif
-#endif
-#ifdef ISOWALL_ASAN
-#include <sanitizer/common_interface_defs.h>
-#endif
+#include "common/formats/child_process.h"
 
 namespace isowall::formats {
 namespace {
@@ -39,45 +29,9 @@ std::size_t voxels_offset(std::size_t header_bytes) {
     return (8 + header_bytes + kVoxelsAlign - 1) / kVoxelsAlign * kVoxelsAlign;
 }
 
-// A file descriptor closed with its owner.
-class Fd {
-  public:
-    explicit Fd(int fd = -1) : fd_(fd) {}
-    Fd(const Fd&) = delete;
-    Fd& operator=(const Fd&) = delete;
-    ~Fd() { reset(); }
-    int get() const { return fd_; }
-    void reset() {
-        if (fd_ >= 0) ::close(fd_);
-        fd_ = -1;
-    }
-
-  private:
-    int fd_;
-};
-
-bool write_all(int fd, const void* data, std::size_t n) {
-    const auto* p = static_cast<const char*>(data);
-    while (n > 0) {
-        const ssize_t w = ::write(fd, p, n);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) return false;
-        p += w;
-        n -= std::size_t(w);
-    }
-    return true;
-}
-
 // The child's whole life: read, write the volume (or the error's line) and leave.
 [[noreturn]] void child(const std::function<Volume()>& read, int data_fd, int error_fd) {
-    // A crash ends the child by its signal: handlers the parent installed (a fuzzer's, which would
-    // report the parent's input as its own finding) are not the child's to run, nor is a
-    // sanitizer's death callback (libFuzzer's writes the input as a crash of its own).
-    for (const int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP})
-        std::signal(sig, SIG_DFL);
-#ifdef ISOWALL_ASAN
-    __sanitizer_set_death_callback(nullptr);
-#endif
+    become_child();
     char kind = 'E';
     std::string line;
     try {
@@ -102,31 +56,6 @@ bool write_all(int fd, const void* data, std::size_t n) {
     write_all(error_fd, &kind, 1);
     write_all(error_fd, line.data(), line.size());
     ::_exit(1);
-}
-
-// Everything the child writes to `fd` until it closes it, or until `deadline` (then false).
-bool read_until_closed(int fd, Clock::time_point deadline, std::string& out) {
-    char buf[4096];
-    for (;;) {
-        const auto left =
-            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-        if (left.count() <= 0) return false;
-        pollfd p{fd, POLLIN, 0};
-        const int r = ::poll(&p, 1, int(std::min<long long>(left.count(), 1000)));
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) continue;
-        const ssize_t n = ::read(fd, buf, sizeof buf);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return true;
-        if (out.size() < 4096) out.append(buf, std::size_t(n));
-    }
-}
-
-int wait_for(pid_t pid) {
-    int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    return status;
 }
 
 }  // namespace
@@ -213,20 +142,8 @@ Volume read_isolated(const std::string& where, const std::string& decoder,
                              std::to_string(limit.count() / 1000) + " s: it was ended");
     }
     const int status = wait_for(pid);
-    if (WIFSIGNALED(status))
-        throw InputError(where, "data",
-                         decoder + " failed on this data and ended (signal " +
-                             std::to_string(WTERMSIG(status)) + ", " +
-                             ::strsignal(WTERMSIG(status)) +
-                             "): the file is damaged or of a kind it cannot decode");
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        if (message.size() > 1 && message[0] == 'I') throw InputError::relayed(message.substr(1));
-        if (message.size() > 1) throw std::runtime_error(message.substr(1));
-        throw InputError(where, "data",
-                         decoder + " failed on this data (exit status " +
-                             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
-                             "): the file is damaged or of a kind it cannot decode");
-    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        child_failed(where, decoder, status, message);
     MappedFile file("/proc/self/fd/" + std::to_string(data.get()));
     const std::span<const std::byte> all = file.bytes();
     std::uint64_t length = 0;

@@ -12,6 +12,7 @@
 #include <cctype>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -26,7 +27,9 @@
 #include "common/core/number.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
+#include "common/volume/inflate_stream.h"
 #include "common/volume/load_checks.h"
+#include "common/volume/mapped_file.h"
 
 namespace isowall::formats {
 namespace fs = std::filesystem;
@@ -301,49 +304,6 @@ DataPlace data_place(const Keys& k, const fs::path& header, std::uint64_t voxel_
     return p;
 }
 
-std::vector<std::byte> read_bytes(const fs::path& file, std::uint64_t offset, std::uint64_t count,
-                                  const std::string& where, const std::string& field) {
-    std::vector<std::byte> bytes = allocate_voxels(count, where, field);
-    std::ifstream in(file, std::ios::binary);
-    in.seekg(std::streamoff(offset));
-    if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(count)))
-        throw InputError(
-            file.string(), "data",
-            "cannot read " + std::to_string(count) + " bytes at byte " + std::to_string(offset));
-    return bytes;
-}
-
-// Inflates zlib (or gzip) data into exactly `need` bytes; a stream that ends early, runs long,
-// or leaves bytes after its end is damaged.
-std::vector<std::byte> inflated(const std::vector<std::byte>& packed, std::uint64_t need,
-                                const std::string& where) {
-    std::vector<std::byte> out = allocate_voxels(need, where, "DimSize");
-    z_stream z{};
-    if (inflateInit2(&z, 15 + 32) != Z_OK) throw InputError(where, "CompressedData", "no zlib");
-    const std::unique_ptr<z_stream, int (*)(z_stream*)> end(&z, inflateEnd);
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(packed.data()));
-    z.next_out = reinterpret_cast<Bytef*>(out.data());
-    std::uint64_t in_left = packed.size(), out_left = need;
-    int rc = Z_OK;
-    while (rc == Z_OK) {
-        const uInt in_step = uInt(std::min<std::uint64_t>(in_left, UINT_MAX));
-        const uInt out_step = uInt(std::min<std::uint64_t>(out_left, UINT_MAX));
-        z.avail_in = in_step;
-        z.avail_out = out_step;
-        rc = inflate(&z, Z_NO_FLUSH);
-        in_left -= in_step - z.avail_in;
-        out_left -= out_step - z.avail_out;
-        if (rc == Z_OK && in_step == z.avail_in && out_step == z.avail_out) rc = Z_BUF_ERROR;
-    }
-    if (rc != Z_STREAM_END || out_left != 0 || in_left != 0)
-        throw InputError(
-            where, "CompressedData",
-            rc != Z_STREAM_END && rc != Z_BUF_ERROR
-                ? std::string("zlib data is corrupt: ") + (z.msg ? z.msg : "")
-                : "the zlib data does not inflate to exactly " + std::to_string(need) + " bytes");
-    return out;
-}
-
 // MetaIO writes both byte-order keys and reads either; two that disagree leave no answer.
 bool big_endian(const Keys& k) {
     const auto element = k.boolean("ElementByteOrderMSB");
@@ -355,7 +315,7 @@ bool big_endian(const Keys& k) {
 
 }  // namespace
 
-Volume read_metaimage(const fs::path& path) {
+PlaneStack metaimage_planes(const fs::path& path) {
     const std::string where = path.string();
     check_regular_file(path, where, "file");
     std::string head(kMaxHeaderBytes, '\0');
@@ -366,25 +326,41 @@ Volume read_metaimage(const fs::path& path) {
     const Keys k(split_lines(head, whole, where), where);
 
     check_image_keys(k);
-    Decoded d;
+    PlaneStack stack;
+    Decoded& d = stack.head;
     d.type = element_type(k);
     d.dims = dim_size(k, d.type);
     take_geometry(k, d);
     const std::uint64_t need = voxel_bytes(d.dims, d.type);
     const DataPlace place = data_place(k, path, need);
-    if (place.compressed) {
-        const auto packed =
-            read_bytes(place.file, place.offset, place.stored, where, "CompressedDataSize");
-        d.bytes = inflated(packed, need, where);
-    } else {
-        d.bytes = read_bytes(place.file, place.offset, need, where, "DimSize");
-    }
-    if (big_endian(k) != (host_endian() == Endian::big)) swap_bytes(d.bytes, voxel_size(d.type));
+    const bool swap = big_endian(k) != (host_endian() == Endian::big);
     d.format = "MetaImage";
     d.files = {path};
     if (place.file != path) d.files.push_back(place.file);
     if (place.compressed) d.facts.push_back({"compression", "zlib"});
-    return finish_volume(std::move(d), where, "scaling");
+    stack.size_field = "DimSize";
+    // The data file is mapped, not read: a slab of planes is copied (or inflated) at a time.
+    auto file = std::make_shared<MappedFile>(place.file, false);
+    const std::span<const std::byte> data =
+        file->bytes().subspan(place.offset, place.compressed ? place.stored : need);
+    std::shared_ptr<InflateStream> inflate;
+    if (place.compressed)
+        inflate = std::make_shared<InflateStream>(data, need, where, "CompressedData");
+    const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+    const std::size_t size = voxel_size(d.type);
+    stack.read = [file, data, inflate, plane, size, swap](int z0, int z1, std::byte* to) {
+        const std::size_t n = plane * std::size_t(z1 - z0);
+        if (inflate)
+            inflate->read(to, n);
+        else
+            std::memcpy(to, data.data() + plane * std::size_t(z0), n);
+        if (swap) swap_bytes({to, n}, size);
+    };
+    return stack;
+}
+
+Volume read_metaimage(const fs::path& path) {
+    return read_whole(metaimage_planes(path), path.string());
 }
 
 }  // namespace isowall::formats

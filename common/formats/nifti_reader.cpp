@@ -15,6 +15,7 @@
 #include <nifti2_io.h>
 
 #include "common/core/error.h"
+#include "common/formats/plane_stack.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
 #include "common/volume/load_checks.h"
@@ -161,14 +162,25 @@ void take_geometry(const nifti_image& n, const std::string& where, Decoded& d) {
     d.facts.push_back({"orientation from", which});
 }
 
+// The open image file and the header niftilib read, shared by the stack's reads.
+struct OpenImage {
+    NiftiPtr n;
+    znzFile fp = nullptr;
+    ~OpenImage() {
+        if (fp) znzclose(fp);
+    }
+};
+
 }  // namespace
 
-Volume read_nifti(const fs::path& path) {
+PlaneStack nifti_planes(const fs::path& path) {
     const std::string where = path.string();
     nifti_set_debug_level(0);
     const QuietStderr quiet;
     const Scaling scaling = header_scaling(path, where);
-    NiftiPtr n(nifti_image_read(path.c_str(), 0));
+    auto image = std::make_shared<OpenImage>();
+    image->n.reset(nifti_image_read(path.c_str(), 0));
+    const nifti_image* n = image->n.get();
     if (!n) throw InputError(where, "header", "not a NIfTI file niftilib reads");
     for (int a = 4; a <= n->dim[0] && a < 8; ++a)
         if (n->dim[a] > 1)
@@ -186,19 +198,11 @@ Volume read_nifti(const fs::path& path) {
     const std::uint64_t sizes[3] = {std::uint64_t(std::max<int64_t>(n->nx, 0)),
                                     std::uint64_t(std::max<int64_t>(n->ny, 0)),
                                     std::uint64_t(std::max<int64_t>(n->nz, 0))};
-    Decoded d;
+    PlaneStack stack;
+    Decoded& d = stack.head;
     d.dims = checked_dims(where, "dim", sizes, *type);
     d.type = *type;
-    check_fits_memory(voxel_bytes(d.dims, d.type), where, "dim");
     check_data_present(*n, voxel_bytes(d.dims, d.type), where);
-    if (nifti_image_load(n.get()) != 0 || !n->data)
-        throw InputError(where, "data",
-                         "the voxels could not be read (the file is shorter than its header "
-                         "says, or its compression is damaged)");
-    const auto* data = static_cast<const std::byte*>(n->data);
-    d.bytes.assign(data, data + voxel_bytes(d.dims, d.type));
-    n->data = nullptr;
-    std::free(const_cast<std::byte*>(data));
     take_geometry(*n, where, d);
     d.scaling = scaling;
     d.format = n->nifti_type >= NIFTI_FTYPE_NIFTI2_1  ? "NIfTI-2"
@@ -208,7 +212,34 @@ Volume read_nifti(const fs::path& path) {
     if (std::string(n->iname) != n->fname) d.files.emplace_back(n->iname);
     if (n->descrip[0])
         d.facts.push_back({"description", std::string(n->descrip, strnlen(n->descrip, 80))});
-    return finish_volume(std::move(d), where, "scl_slope");
+    stack.scaling_field = "scl_slope";
+    stack.size_field = "dim";
+    // The image file is streamed once, in order (a gzip stream cannot seek back cheaply);
+    // niftilib's buffer read swaps the bytes of a file of the other byte order.
+    const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+    stack.read = [image, plane, where](int z0, int z1, std::byte* to) {
+        const QuietStderr quiet;
+        nifti_image* n = image->n.get();
+        if (!image->fp) {
+            image->fp = znzopen(n->iname, "rb", nifti_is_gzfile(n->iname));
+            if (znz_isnull(image->fp) ||
+                znzseek(image->fp, std::max<int64_t>(n->iname_offset, 0), SEEK_SET) < 0)
+                throw InputError(where, "data",
+                                 "cannot open the image file " + quote_bounded(n->iname));
+        }
+        const auto want = static_cast<int64_t>(plane * std::size_t(z1 - z0));
+        if (nifti_read_buffer(image->fp, to, want, n) != want)
+            throw InputError(where, "data",
+                             "the voxels of slices " + std::to_string(z0) + " to " +
+                                 std::to_string(z1 - 1) +
+                                 " could not be read (the file is shorter than its header "
+                                 "says, or its compression is damaged)");
+    };
+    return stack;
+}
+
+Volume read_nifti(const fs::path& path) {
+    return read_whole(nifti_planes(path), path.string());
 }
 
 }  // namespace isowall::formats

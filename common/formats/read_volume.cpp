@@ -9,6 +9,8 @@
 #include "common/core/error.h"
 #include "common/formats/dicom_lengths.h"
 #include "common/formats/isolated_read.h"
+#include "common/formats/isolated_stream.h"
+#include "common/formats/plane_stack.h"
 #include "common/formats/readers.h"
 #include "common/volume/load_checks.h"
 
@@ -62,6 +64,16 @@ Volume hdf5(const fs::path& file, const std::string& dataset) {
                          [&] { return read_hdf5(file, dataset); });
 }
 
+// DICOM and HDF5 streamed from a child process (isolated_read.h) as it decodes them.
+std::unique_ptr<PlaneSource> dicom_stream(const fs::path& p) {
+    return stream_isolated(p.string(), "the DICOM decoder (GDCM)", [&] { return dicom_planes(p); });
+}
+
+std::unique_ptr<PlaneSource> hdf5_stream(const fs::path& file, const std::string& dataset) {
+    return stream_isolated(file.string(), "the HDF5 library (libhdf5)",
+                           [&] { return hdf5_planes(file, dataset); });
+}
+
 Volume read_file(const fs::path& p, const std::string& name, bool populate) {
     const std::string n = lower(name);
     if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return load_nrrd(p, populate);
@@ -77,7 +89,40 @@ Volume read_file(const fs::path& p, const std::string& name, bool populate) {
                      "name or content); for headerless data give --dims X Y Z and --type T");
 }
 
+std::unique_ptr<PlaneSource> streamed(PlaneStack stack, const fs::path& p) {
+    return stream_planes(std::move(stack), p.string());
+}
+
+std::unique_ptr<PlaneSource> file_planes(const fs::path& p, const std::string& name) {
+    const std::string n = lower(name);
+    if (ends_with(n, ".nrrd") || ends_with(n, ".nhdr")) return nrrd_planes(p);
+    if (ends_with(n, ".nii") || ends_with(n, ".nii.gz") || ends_with(n, ".hdr") ||
+        ends_with(n, ".img") || ends_with(n, ".img.gz"))
+        return streamed(nifti_planes(p), p);
+    if (ends_with(n, ".mhd") || ends_with(n, ".mha")) return streamed(metaimage_planes(p), p);
+    if (is_hdf5_name(n)) return hdf5_stream(p, "");
+    if (ends_with(n, ".tif") || ends_with(n, ".tiff")) return streamed(tiff_planes(p), p);
+    if (ends_with(n, ".dcm") || has_dicom_magic(p)) return dicom_stream(p);
+    return nullptr;  // read_volume names what it is not
+}
+
 }  // namespace
+
+std::unique_ptr<PlaneSource> open_planes(const std::string& path,
+                                         const std::optional<RawSpec>& raw) {
+    if (raw) return nullptr;
+    const fs::path p(path);
+    std::error_code ec;
+    if (fs::is_directory(p, ec))
+        return is_tiff_folder(p) ? streamed(tiff_planes(p), p) : dicom_stream(p);
+    const std::size_t colon = path.rfind(":/");
+    if (colon != std::string::npos && !fs::exists(p, ec)) {
+        const std::string file = path.substr(0, colon);
+        if (is_hdf5_name(file)) return hdf5_stream(file, path.substr(colon + 1));
+    }
+    check_regular_file(p, path, "file");
+    return file_planes(p, p.filename().string());
+}
 
 Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, bool populate) {
     if (raw) return load_raw(path, *raw, populate);

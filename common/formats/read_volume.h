@@ -8,9 +8,11 @@
 //   .dcm, or DICM at byte 128    the DICOM series the file belongs to
 //   .nrrd .nhdr                  NRRD (common/volume/volume.h: load_nrrd)
 //   anything else                headerless raw, with `raw` (--dims, --type)
+#include <memory>
 #include <optional>
 #include <string>
 
+#include "common/volume/plane_source.h"
 #include "common/volume/volume.h"
 
 namespace isowall::formats {
@@ -18,5 +20,13 @@ namespace isowall::formats {
 // populate: as load_raw's (common/volume/volume.h), for the formats that map their file.
 Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw,
                    bool populate = true);
+
+// The planes of the volume read_volume gives, for `isowall import` to stream a slab at a time:
+// TIFF stacks, NIfTI, MetaImage, DICOM series and HDF5 datasets (their readers' plane stacks,
+// plane_stack.h; DICOM and HDF5 decoded in a child process as read_volume does), and gzip or
+// other-endian NRRD (nrrd_planes). Null for what read_volume maps without decoding (raw, raw
+// NRRD), and for bzip2, hex and ascii NRRD, which are decoded whole.
+std::unique_ptr<PlaneSource> open_planes(const std::string& path,
+                                         const std::optional<RawSpec>& raw);
 
 }  // namespace isowall::formats

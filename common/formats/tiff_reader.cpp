@@ -13,6 +13,7 @@
 
 #include "common/core/error.h"
 #include "common/core/number.h"
+#include "common/formats/plane_stack.h"
 #include "common/formats/readers.h"
 #include "common/formats/voxel_ops.h"
 #include "common/io/oiio_module.h"
@@ -210,27 +211,31 @@ void check_count(std::size_t slices, const std::string& where, const std::string
                          std::to_string(slices) + " slice(s); a volume needs at least 2");
 }
 
-Decoded allocate_stack(const Slice& first, std::uint64_t slices, const std::string& where,
+// The stack's description once every slice has been checked (a bad slice costs no allocation).
+Decoded describe_stack(const Slice& first, std::uint64_t slices, const std::string& where,
                        const std::string& field) {
     Decoded d;
     d.type = first.type;
     const std::uint64_t sizes[3] = {std::uint64_t(first.width), std::uint64_t(first.height),
                                     slices};
     d.dims = checked_dims(where, field, sizes, d.type);
-    d.bytes = allocate_voxels(voxel_bytes(d.dims, d.type), where, field);
     return d;
 }
 
-void read_slice(const Input& in, int page, int z, Decoded& d, const std::string& where) {
-    const std::size_t slice_bytes = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+void read_slice(const Input& in, int page, std::byte* to, oiio::Sample sample,
+                const std::string& where) {
     std::string error;
-    if (!in.read(page, sample_of(d.type), d.bytes.data() + slice_bytes * z, error))
+    if (!in.read(page, sample, to, error))
         throw InputError(where, "page " + std::to_string(page),
                          "OpenImageIO cannot decode it: " + error);
 }
 
-Decoded read_pages(const fs::path& file, const std::string& where) {
-    const auto in = open_tiff(file, where);
+std::size_t slice_bytes(const Decoded& d) {
+    return std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+}
+
+PlaneStack read_pages(const fs::path& file, const std::string& where) {
+    std::shared_ptr<const Input> in = open_tiff(file, where);
     const int pages = in->page_count();
     const oiio::PageInfo spec0 = in->spec(0);
     check_imagej_stack(spec0, pages, where);
@@ -244,18 +249,23 @@ Decoded read_pages(const fs::path& file, const std::string& where) {
                 where, field,
                 describe(s) + ", but page 0 is " + describe(first) + "; every slice must match");
     }
-    Decoded d = allocate_stack(first, std::uint64_t(pages), where, "pages");
-    for (int p = 0; p < pages; ++p) read_slice(*in, p, p, d, where);
-    d.spacing = stack_spacing(spec0, d.facts);
-    d.files = {file};
-    return d;
+    PlaneStack stack{describe_stack(first, std::uint64_t(pages), where, "pages"), {}, {}};
+    stack.size_field = "pages";
+    stack.head.spacing = stack_spacing(spec0, stack.head.facts);
+    stack.head.files = {file};
+    const std::size_t bytes = slice_bytes(stack.head);
+    const oiio::Sample sample = sample_of(first.type);
+    stack.read = [in, bytes, sample, where](int z0, int z1, std::byte* to) {
+        for (int p = z0; p < z1; ++p)
+            read_slice(*in, p, to + bytes * std::size_t(p - z0), sample, where);
+    };
+    return stack;
 }
 
-// The folder's slices, each opened and checked before the stack is allocated (a bad slice costs
-// no allocation), then each opened again to read: a folder may hold more slices than a process
-// may keep open.
-Decoded read_folder(const fs::path& dir, const std::string& where) {
-    const std::vector<fs::path> files = slice_files(dir);
+// The folder's slices, each opened and checked before any is read, then each opened again to
+// read: a folder may hold more slices than a process may keep open.
+PlaneStack read_folder(const fs::path& dir, const std::string& where) {
+    std::vector<fs::path> files = slice_files(dir);
     check_count(files.size(), where, "slices");
     Slice first;
     oiio::PageInfo spec0;
@@ -275,24 +285,37 @@ Decoded read_folder(const fs::path& dir, const std::string& where) {
                                  "; every slice must match");
         }
     }
-    Decoded d = allocate_stack(first, files.size(), where, "slices");
-    for (std::size_t z = 0; z < files.size(); ++z)
-        read_slice(*open_tiff(files[z], files[z].string()), 0, int(z), d, files[z].string());
-    d.spacing = stack_spacing(spec0, d.facts);
-    d.files = files;
-    return d;
+    PlaneStack stack{describe_stack(first, files.size(), where, "slices"), {}, {}};
+    stack.size_field = "slices";
+    stack.head.spacing = stack_spacing(spec0, stack.head.facts);
+    stack.head.files = files;
+    const std::size_t bytes = slice_bytes(stack.head);
+    const oiio::Sample sample = sample_of(first.type);
+    stack.read = [files, bytes, sample](int z0, int z1, std::byte* to) {
+        for (int z = z0; z < z1; ++z) {
+            const std::string at = files[std::size_t(z)].string();
+            read_slice(*open_tiff(files[std::size_t(z)], at), 0, to + bytes * std::size_t(z - z0),
+                       sample, at);
+        }
+    };
+    return stack;
 }
 
 }  // namespace
 
-Volume read_tiff_stack(const fs::path& path) {
+PlaneStack tiff_planes(const fs::path& path) {
     const std::string where = path.string();
     std::error_code ec;
-    Decoded d = fs::is_directory(path, ec) ? read_folder(path, where) : read_pages(path, where);
+    PlaneStack s = fs::is_directory(path, ec) ? read_folder(path, where) : read_pages(path, where);
+    Decoded& d = s.head;
     d.format = "TIFF";
     d.facts.push_back({"slices", std::to_string(d.dims.z) +
                                      (d.files.size() > 1 ? " files" : " pages of one file")});
-    return finish_volume(std::move(d), where, "scaling");
+    return s;
+}
+
+Volume read_tiff_stack(const fs::path& path) {
+    return read_whole(tiff_planes(path), path.string());
 }
 
 }  // namespace isowall::formats

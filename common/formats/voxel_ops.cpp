@@ -35,17 +35,22 @@ std::optional<VoxelType> smallest_integer_type(double lo, double hi) {
     return std::nullopt;
 }
 
-// Every stored value through the scaling into Out.
+// Every stored value through the scaling into Out, at `out`.
 template <class In, class Out>
-std::vector<std::byte> scaled(std::span<const std::byte> bytes, Scaling s) {
+void scale_to(std::span<const std::byte> bytes, Scaling s, std::byte* out) {
     const std::size_t n = bytes.size() / sizeof(In);
-    std::vector<std::byte> out(n * sizeof(Out));
     for (std::size_t i = 0; i < n; ++i) {
         In v;
         std::memcpy(&v, bytes.data() + i * sizeof(In), sizeof(In));
         const Out o = static_cast<Out>(s.slope * double(v) + s.intercept);
-        std::memcpy(out.data() + i * sizeof(Out), &o, sizeof(Out));
+        std::memcpy(out + i * sizeof(Out), &o, sizeof(Out));
     }
+}
+
+template <class In, class Out>
+std::vector<std::byte> scaled(std::span<const std::byte> bytes, Scaling s) {
+    std::vector<std::byte> out(bytes.size() / sizeof(In) * sizeof(Out));
+    scale_to<In, Out>(bytes, s, out.data());
     return out;
 }
 
@@ -81,18 +86,46 @@ ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling
         throw InputError(where, field, "a scaling slope of 0 makes every voxel the same value");
     if (s.identity()) return {std::move(bytes), type};
     const bool integral = std::trunc(s.slope) == s.slope && std::trunc(s.intercept) == s.intercept;
-    VoxelType out = type == VoxelType::f64 ? VoxelType::f64 : VoxelType::f32;
-    if (integral && is_integer_type(type)) {
-        const auto [lo, hi] =
-            dispatch_voxel_type(type, [&](auto t) { return value_range<decltype(t)>(bytes); });
-        const double a = s.slope * lo + s.intercept, b = s.slope * hi + s.intercept;
-        if (const auto t = smallest_integer_type(std::min(a, b), std::max(a, b))) out = *t;
-    }
+    const auto [lo, hi] =
+        integral && is_integer_type(type)
+            ? dispatch_voxel_type(type, [&](auto t) { return value_range<decltype(t)>(bytes); })
+            : std::pair<double, double>{0, 0};
+    const VoxelType out = scaled_type(type, s, lo, hi);
     std::vector<std::byte> result = dispatch_voxel_type(type, [&](auto in) {
         return dispatch_voxel_type(
             out, [&](auto o) { return scaled<decltype(in), decltype(o)>(bytes, s); });
     });
     return {std::move(result), out};
+}
+
+VoxelType scaled_type(VoxelType type, Scaling s, double lo, double hi) {
+    if (s.identity()) return type;
+    const bool integral = std::trunc(s.slope) == s.slope && std::trunc(s.intercept) == s.intercept;
+    if (integral && is_integer_type(type)) {
+        const double a = s.slope * lo + s.intercept, b = s.slope * hi + s.intercept;
+        if (const auto t = smallest_integer_type(std::min(a, b), std::max(a, b))) return *t;
+    }
+    return type == VoxelType::f64 ? VoxelType::f64 : VoxelType::f32;
+}
+
+void scale_into(std::span<const std::byte> in, VoxelType type, Scaling s, VoxelType out_type,
+                std::byte* out) {
+    dispatch_voxel_type(type, [&](auto i) {
+        dispatch_voxel_type(out_type,
+                            [&](auto o) { scale_to<decltype(i), decltype(o)>(in, s, out); });
+    });
+}
+
+void mirror_rows(std::span<std::byte> bytes, int width, VoxelType type) {
+    const std::size_t size = voxel_size(type);
+    const std::size_t row = static_cast<std::size_t>(width) * size;
+    const std::size_t rows = bytes.size() / std::max<std::size_t>(row, 1);
+    for (std::size_t r = 0; r < rows; ++r) {
+        std::byte* p = bytes.data() + r * row;
+        for (int a = 0, b = width - 1; a < b; ++a, --b)
+            std::swap_ranges(p + std::size_t(a) * size, p + std::size_t(a + 1) * size,
+                             p + std::size_t(b) * size);
+    }
 }
 
 std::vector<std::byte> to_float32(std::span<const std::byte> bytes, VoxelType type, Scaling s) {
@@ -103,15 +136,7 @@ std::vector<std::byte> to_float32(std::span<const std::byte> bytes, VoxelType ty
 void make_rotation(std::vector<std::byte>& bytes, glm::ivec3 dims, VoxelType type,
                    glm::vec3 spacing, Orientation& o) {
     if (glm::determinant(o.axes) >= 0) return;
-    const std::size_t size = voxel_size(type);
-    const std::size_t row = static_cast<std::size_t>(dims.x) * size;
-    const std::size_t rows = bytes.size() / std::max<std::size_t>(row, 1);
-    for (std::size_t r = 0; r < rows; ++r) {
-        std::byte* p = bytes.data() + r * row;
-        for (int a = 0, b = dims.x - 1; a < b; ++a, --b)
-            std::swap_ranges(p + std::size_t(a) * size, p + std::size_t(a + 1) * size,
-                             p + std::size_t(b) * size);
-    }
+    mirror_rows(bytes, dims.x, type);
     o.origin += o.axes[0] * (spacing.x * float(dims.x - 1));
     o.axes[0] = -o.axes[0];
 }

@@ -32,6 +32,15 @@ struct ScaledVoxels {
 ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling s,
                            const std::string& where, const std::string& field);
 
+// The type apply_scaling gives stored voxels of `type` whose values lie in [lo, hi] (a streamed
+// read decides it before any voxel is read, from the range the file declares or the type's).
+VoxelType scaled_type(VoxelType type, Scaling s, double lo, double hi);
+// Stored voxels of `type` through the scaling into `out_type` at `out`.
+void scale_into(std::span<const std::byte> in, VoxelType type, Scaling s, VoxelType out_type,
+                std::byte* out);
+// Reverses x in each row of `width` voxels of `type` (make_rotation's mirror, a plane at a time).
+void mirror_rows(std::span<std::byte> bytes, int width, VoxelType type);
+
 // Every voxel of `type` in `bytes` as slope * stored + intercept in float32, whatever the scaling.
 std::vector<std::byte> to_float32(std::span<const std::byte> bytes, VoxelType type, Scaling s);
 

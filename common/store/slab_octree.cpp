@@ -12,8 +12,7 @@ class SlabOctreeOf : public SlabOctree {
     explicit SlabOctreeOf(glm::ivec3 dims)
         : dims_(dims), octree_(MinMaxOctree<T>::start(glm::max(dims - 1, glm::ivec3(0)))) {}
 
-    FiniteRange add_slab(std::span<const std::byte> planes, int z0, int z1,
-                         int threads) override {
+    FiniteRange add_slab(std::span<const std::byte> planes, int z0, int z1, int threads) override {
         VolumeView<T> view;
         view.data = reinterpret_cast<const T*>(planes.data());
         view.dims = dims_;
@@ -24,7 +23,8 @@ class SlabOctreeOf : public SlabOctree {
         std::vector<std::thread> pool;
         for (int t = 1; t < threads; ++t)
             pool.emplace_back([&, t] {
-                ranges[static_cast<std::size_t>(t)] = octree_.leaf_slab(view, cut(t), cut(t + 1), z0);
+                ranges[static_cast<std::size_t>(t)] =
+                    octree_.leaf_slab(view, cut(t), cut(t + 1), z0);
             });
         ranges[0] = octree_.leaf_slab(view, z0, cut(1), z0);
         for (auto& th : pool) th.join();

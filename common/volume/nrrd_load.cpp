@@ -2,12 +2,15 @@
 // and we locate and decode the data (nrrd_decode.h), so every size and skip is checked by us.
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 #include "common/core/error.h"
+#include "common/volume/inflate_stream.h"
 #include "common/volume/load_checks.h"
 #include "common/volume/nrrd_decode.h"
 #include "common/volume/nrrd_header.h"
+#include "common/volume/plane_source.h"
 #include "common/volume/teem_util.h"
 #include "common/volume/volume.h"
 
@@ -191,44 +194,90 @@ std::vector<std::byte> decode(Encoding e, std::span<const std::byte> data, const
 
 }  // namespace
 
-Volume load_nrrd(const fs::path& path, bool populate) {
+namespace {
+
+// A NRRD file's header read and its data located (the data file mapped, not read).
+struct NrrdData {
+    NrrdInfo info;
+    fs::path data_path;
+    MappedFile file;
+    std::size_t offset = 0;
+    std::uint64_t need = 0;
+};
+
+NrrdData locate(const fs::path& path, bool populate) {
     const std::string where = path.string();
     check_regular_file(path, where, "file");
     MappedFile header_file(path);
     const NrrdHeaderText text = split_nrrd_header(header_file.bytes(), where);
-    const NrrdInfo info = parse_info(text, where);
-    const std::uint64_t need = voxel_bytes(info.dims, info.type);
-
-    fs::path data_path = path;
-    MappedFile data_file;
-    std::size_t offset = 0;
+    NrrdData d;
+    d.info = parse_info(text, where);
+    d.need = voxel_bytes(d.info.dims, d.info.type);
+    d.data_path = path;
     if (text.data_file) {
-        data_path = data_path_of(path, *text.data_file);
-        check_regular_file(data_path, where, "data file");
-        data_file = MappedFile(data_path, populate);
+        d.data_path = data_path_of(path, *text.data_file);
+        check_regular_file(d.data_path, where, "data file");
+        d.file = MappedFile(d.data_path, populate);
     } else {
         if (!text.data_offset)
             throw InputError(where, "header",
                              "no blank line ends the header and no data file is named");
-        data_file = std::move(header_file);
-        offset = *text.data_offset;
+        d.file = std::move(header_file);
+        d.offset = *text.data_offset;
     }
-    const std::string data_where = data_path.string();
-    offset = data_start(data_file.bytes(), offset, text, info, need, where, data_where);
-    const auto data = data_file.bytes().subspan(offset);
+    d.offset =
+        data_start(d.file.bytes(), d.offset, text, d.info, d.need, where, d.data_path.string());
+    if (d.info.encoding == Encoding::raw)
+        check_size(d.data_path.string(), d.file.size(), d.offset, d.need);
+    return d;
+}
+
+std::vector<fs::path> files_of(const fs::path& path, const NrrdData& d) {
+    std::vector<fs::path> files{path};
+    if (d.data_path != path) files.push_back(d.data_path);
+    return files;
+}
+
+}  // namespace
+
+Volume load_nrrd(const fs::path& path, bool populate) {
+    const std::string where = path.string();
+    NrrdData d = locate(path, populate);
+    const NrrdInfo& info = d.info;
+    const std::vector<fs::path> files = files_of(path, d);
     Volume volume;
-    if (info.encoding == Encoding::raw) check_size(data_where, data_file.size(), offset, need);
     if (info.encoding == Encoding::raw && info.host_order) {
-        volume = Volume(info.dims, info.type, info.spacing, std::move(data_file), offset, where);
+        volume = Volume(info.dims, info.type, info.spacing, std::move(d.file), d.offset, where);
     } else {
-        std::vector<std::byte> bytes = decode(info.encoding, data, info, need, data_where);
+        std::vector<std::byte> bytes = decode(info.encoding, d.file.bytes().subspan(d.offset), info,
+                                              d.need, d.data_path.string());
         if (!info.host_order) swap_bytes(bytes, voxel_size(info.type));
         volume = Volume(info.dims, info.type, info.spacing, std::move(bytes), where);
     }
-    std::vector<fs::path> files{path};
-    if (data_path != path) files.push_back(data_path);
-    volume.set_files(std::move(files));
+    volume.set_files(files);
     return volume;
+}
+
+std::unique_ptr<PlaneSource> nrrd_planes(const fs::path& path) {
+    auto d = std::make_shared<NrrdData>(locate(path, false));
+    const NrrdInfo& info = d->info;
+    const bool gzip = info.encoding == Encoding::gzip;
+    if (!gzip && !(info.encoding == Encoding::raw && !info.host_order)) return nullptr;
+    const std::size_t plane = std::size_t(info.dims.x) * info.dims.y * voxel_size(info.type);
+    std::shared_ptr<InflateStream> inflate;
+    if (gzip)
+        inflate = std::make_shared<InflateStream>(d->file.bytes().subspan(d->offset), d->need,
+                                                  d->data_path.string(), "data");
+    auto decode = [d, inflate, plane](int z0, int z1, std::byte* to) {
+        const std::size_t n = plane * std::size_t(z1 - z0);
+        if (inflate)
+            inflate->read(to, n);
+        else
+            std::memcpy(to, d->file.bytes().data() + d->offset + plane * std::size_t(z0), n);
+        if (!d->info.host_order) swap_bytes({to, n}, voxel_size(d->info.type));
+    };
+    return std::make_unique<DecodedPlanes>(info.dims, info.type, info.spacing, path.string(),
+                                           std::move(decode));
 }
 
 }  // namespace isowall

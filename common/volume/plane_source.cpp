@@ -5,8 +5,8 @@
 
 namespace isowall {
 
-DecodedPlanes::DecodedPlanes(glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
-                             std::string source, Decode decode)
+DecodedPlanes::DecodedPlanes(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::string source,
+                             Decode decode)
     : dims_(dims),
       type_(type),
       spacing_(spacing),

@@ -4,7 +4,9 @@
 // of its map (common/store/source_pages.h); a format decoded by a library hands out planes it
 // decodes into a buffer of a slab (common/formats/plane_stack.h).
 #include <cstddef>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -60,5 +62,10 @@ class DecodedPlanes final : public PlaneSource {
     int z0_ = 0, z1_ = 0;  // the planes in buffer_
     std::size_t peak_ = 0;
 };
+
+// The planes of a NRRD file whose data is not mapped as it is (load_nrrd copies it): gzip, inflated
+// a slab at a time, and raw data of the other byte order. Null for raw data in host order (map it:
+// load_nrrd) and for bzip2, hex and ascii, which are decoded whole.
+std::unique_ptr<PlaneSource> nrrd_planes(const std::filesystem::path& path);
 
 }  // namespace isowall

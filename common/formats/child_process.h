@@ -1,0 +1,48 @@
+#pragma once
+// What a reader in a child process (isolated_read.h) and its parent share: descriptors closed with
+// their owner, whole writes, a wait, and the one error a child's failure becomes.
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+#include <utility>
+
+namespace isowall::formats {
+
+// A file descriptor closed with its owner.
+class Fd {
+  public:
+    explicit Fd(int fd = -1) : fd_(fd) {}
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    ~Fd() { reset(); }
+    int get() const { return fd_; }
+    void reset();
+    int release() { return std::exchange(fd_, -1); }  // the caller owns it now
+
+  private:
+    int fd_;
+};
+
+// All of `n` bytes to `fd` (false on an error or a closed reader).
+bool write_all(int fd, const void* data, std::size_t n);
+
+// Everything the child writes to `fd` until it closes it (the first 4 KiB kept in `out`), or
+// until `deadline` (then false).
+bool read_until_closed(int fd, std::chrono::steady_clock::time_point deadline, std::string& out);
+
+// waitpid through EINTR; the status.
+int wait_for(pid_t pid);
+
+// What a child does first: a crash ends it by its signal. Handlers the parent installed (a
+// fuzzer's, which would report the parent's input as its own finding) are not the child's to run,
+// nor is a sanitizer's death callback (libFuzzer's writes the input as a crash of its own).
+void become_child();
+
+// The error a child that did not exit 0 means: the InputError it relayed in `message` ('I' and
+// its line), another error's line, or its signal or exit status, naming `where` and `decoder`.
+[[noreturn]] void child_failed(const std::string& where, const std::string& decoder, int status,
+                               const std::string& message);
+
+}  // namespace isowall::formats
