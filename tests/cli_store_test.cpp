@@ -3,7 +3,12 @@
 // store or option is one line naming it.
 #include <gtest/gtest.h>
 
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <vector>
 
 #include "common/volume/phantom.h"
 #include "tests/cli_util.h"
@@ -98,6 +103,63 @@ TEST(CliStore, BadStoresAndOptionsAreOneLineEach) {
     fs::remove(dir / "ph.zarr/0/1/1/0");
     expect_one_line_error(run_isowall(dir, "info --volume ph.zarr --no-cache"),
                           {"ph.zarr", "0/1/1/0", "missing"});
+}
+
+// The peak resident memory `import` prints, in MiB (-1 when it prints none).
+double peak_mib(const std::string& out) {
+    const std::size_t at = out.find("peak resident memory ");
+    return at == std::string::npos ? -1 : std::stod(out.substr(at + 21));
+}
+
+// A gzip NRRD of `n` x `n` x `depth` uint8 voxels (a few smooth waves), written a plane at a time.
+void write_gzip_nrrd(const fs::path& p, int n, int depth) {
+    std::ofstream out(p, std::ios::binary);
+    out << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << n << " " << n << " " << depth
+        << "\nencoding: gzip\n\n";
+    z_stream z{};
+    ASSERT_EQ(deflateInit2(&z, 1, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY), Z_OK);
+    std::vector<unsigned char> plane(std::size_t(n) * n), packed(1 << 20);
+    for (int k = 0; k < depth; ++k) {
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                plane[std::size_t(y) * n + x] = static_cast<unsigned char>(
+                    128 + 40 * (std::sin(x / 23.0) + std::cos(y / 17.0) + std::sin(k / 29.0)));
+        z.next_in = plane.data();
+        z.avail_in = uInt(plane.size());
+        do {
+            z.next_out = packed.data();
+            z.avail_out = uInt(packed.size());
+            deflate(&z, k + 1 == depth ? Z_FINISH : Z_NO_FLUSH);
+            out.write(reinterpret_cast<const char*>(packed.data()),
+                      std::streamsize(packed.size() - z.avail_out));
+        } while (z.avail_out == 0);
+    }
+    deflateEnd(&z);
+}
+
+// A format decoded by a library (here gzip NRRD; every reader's planes are checked against its
+// whole read in the formats tests) streams into the store: the import's memory grows by a slab
+// of planes, not by the volume. The phantom's mapped import gives the process's own size.
+TEST(CliStore, AGzipVolumeImportsASlabAtATimeInBoundedMemory) {
+    const fs::path dir = test::scratch_dir("cli_store_stream");
+    phantom_raw(dir);
+    const auto small =
+        run_isowall(dir, std::string("import phantom.raw") + kRawOptions + " --out ph.zarr -q");
+    ASSERT_EQ(small.exit_code, 0) << small.err;
+    write_gzip_nrrd(dir / "big.nrrd", 512, 384);  // 96 MiB of voxels
+    const auto big = run_isowall(dir, "import big.nrrd --out big.zarr -q");
+    ASSERT_EQ(big.exit_code, 0) << big.err;
+    EXPECT_NE(big.out.find("import: wrote big.zarr  512x512x384 uint8"), std::string::npos)
+        << big.out;
+    EXPECT_NE(big.out.find("source decoded a slab of planes at a time"), std::string::npos)
+        << big.out;
+    const double base = peak_mib(small.out), peak = peak_mib(big.out);
+    ASSERT_GT(base, 0) << small.out;
+    std::printf(
+        "import peak resident memory: %.0f MiB for 96 MiB of gzip NRRD, %.0f MiB for "
+        "the 6 MiB phantom mapped\n",
+        peak, base);
+    EXPECT_LT(peak - base, 48) << "the import held more than half the volume";
 }
 
 }  // namespace
