@@ -214,6 +214,9 @@ PlaneStack nifti_planes(const fs::path& path) {
         d.facts.push_back({"description", std::string(n->descrip, strnlen(n->descrip, 80))});
     stack.scaling_field = "scl_slope";
     stack.size_field = "dim";
+    // niftilib's reads run with stderr pointed away (QuietStderr): on a thread beside the
+    // import's, that would swallow its progress bar.
+    stack.read_ahead = false;
     // The image file is streamed once, in order (a gzip stream cannot seek back cheaply);
     // niftilib's buffer read swaps the bytes of a file of the other byte order.
     const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);

@@ -68,6 +68,7 @@ std::unique_ptr<PlaneSource> stream_planes(PlaneStack stack, const std::string& 
     // the integer type chosen from it.
     const bool check_range = !d.scaling.identity() && stack.declared_range &&
                              *stack.declared_range != type_range(d.type);
+    const bool ahead = stack.read_ahead;
     auto decode = [stack = std::move(stack), out, mirror, plane, check_range, where,
                    stored = std::vector<std::byte>()](int z0, int z1, std::byte* to) mutable {
         const Decoded& h = stack.head;
@@ -82,7 +83,7 @@ std::unique_ptr<PlaneSource> stream_planes(PlaneStack stack, const std::string& 
         }
         if (mirror) mirror_rows(planes, h.dims.x, out);
     };
-    return std::make_unique<DecodedPlanes>(d.dims, out, d.spacing, where, std::move(decode));
+    return std::make_unique<DecodedPlanes>(d.dims, out, d.spacing, where, std::move(decode), ahead);
 }
 
 }  // namespace isowall::formats

@@ -25,6 +25,9 @@ struct PlaneStack {
     std::optional<std::pair<double, double>> declared_range;
     std::string scaling_field = "scaling";  // the field a bad scaling is reported under
     std::string size_field = "size";        // the field a volume too large for memory is
+    // Whether the stream may decode the next slab on a thread of its own while the last one is
+    // written (DecodedPlanes); off for a decoder that must run where it was opened.
+    bool read_ahead = true;
 };
 
 // Every plane, then the reader's usual end (finish_volume): the volume read_volume gives.

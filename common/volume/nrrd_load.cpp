@@ -258,7 +258,7 @@ Volume load_nrrd(const fs::path& path, bool populate) {
     return volume;
 }
 
-std::unique_ptr<PlaneSource> nrrd_planes(const fs::path& path) {
+std::unique_ptr<PlaneSource> nrrd_planes(const fs::path& path, bool read_ahead) {
     auto d = std::make_shared<NrrdData>(locate(path, false));
     const NrrdInfo& info = d->info;
     const bool gzip = info.encoding == Encoding::gzip;
@@ -277,7 +277,7 @@ std::unique_ptr<PlaneSource> nrrd_planes(const fs::path& path) {
         if (!d->info.host_order) swap_bytes({to, n}, voxel_size(d->info.type));
     };
     return std::make_unique<DecodedPlanes>(info.dims, info.type, info.spacing, path.string(),
-                                           std::move(decode));
+                                           std::move(decode), read_ahead);
 }
 
 }  // namespace isowall

@@ -4,11 +4,13 @@
 // of its map (common/store/source_pages.h); a format decoded by a library hands out planes it
 // decodes into a buffer of a slab (common/formats/plane_stack.h).
 #include <cstddef>
+#include <exception>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -36,14 +38,19 @@ class PlaneSource {
 };
 
 // Planes decoded into a buffer by `decode(z0, z1, to)`, which is called with z0 rising from 0,
-// each call starting where the last one ended, so a decoder may stream its file once. Planes a
-// call asks for again are kept from the last call, whose end a call never comes before; the
-// buffer holds the largest call's planes.
+// each call starting where the last one ended (one call at a time, not always on one thread), so
+// a decoder may stream its file once. Planes a call asks for again are kept from the last call,
+// whose end a call never comes before. With `read_ahead`, as many planes as a call asked for are
+// decoded after it on a thread of their own while the caller works on them: the buffer holds two
+// calls' planes. A decoder's error on that thread is thrown by the next call.
 class DecodedPlanes final : public PlaneSource {
   public:
     using Decode = std::function<void(int z0, int z1, std::byte* to)>;
     DecodedPlanes(glm::ivec3 dims, VoxelType type, glm::vec3 spacing, std::string source,
-                  Decode decode);
+                  Decode decode, bool read_ahead = true);
+    ~DecodedPlanes() override;
+    DecodedPlanes(const DecodedPlanes&) = delete;
+    DecodedPlanes& operator=(const DecodedPlanes&) = delete;
     glm::ivec3 dims() const override { return dims_; }
     VoxelType type() const override { return type_; }
     glm::vec3 spacing() const override { return spacing_; }
@@ -53,19 +60,26 @@ class DecodedPlanes final : public PlaneSource {
     std::size_t peak_bytes() const { return peak_; }
 
   private:
+    void finish_ahead();  // waits for the planes read ahead; throws the decoder's error
     glm::ivec3 dims_;
     VoxelType type_;
     glm::vec3 spacing_;
     std::string source_;
     Decode decode_;
-    std::vector<std::byte> buffer_;
-    int z0_ = 0, z1_ = 0;  // the planes in buffer_
+    bool read_ahead_;
+    std::vector<std::byte> buffer_;  // planes [z0_, have_), then those read ahead
+    int z0_ = 0, z1_ = 0;            // the last call's planes
+    int have_ = 0;                   // planes decoded
+    std::thread ahead_;              // decoding [have_, ahead_end_)
+    int ahead_end_ = 0;
+    std::exception_ptr ahead_error_;
     std::size_t peak_ = 0;
 };
 
 // The planes of a NRRD file whose data is not mapped as it is (load_nrrd copies it): gzip, inflated
 // a slab at a time, and raw data of the other byte order. Null for raw data in host order (map it:
 // load_nrrd) and for bzip2, hex and ascii, which are decoded whole.
-std::unique_ptr<PlaneSource> nrrd_planes(const std::filesystem::path& path);
+// `read_ahead` as DecodedPlanes'.
+std::unique_ptr<PlaneSource> nrrd_planes(const std::filesystem::path& path, bool read_ahead = true);
 
 }  // namespace isowall
