@@ -124,11 +124,10 @@ class MinMaxOctree {
                                       OctreeStats* stats,
                                       ThreadBudget budget = ThreadBudget::hardware());
 
-    // Built slab by slab in z (a store's import reads each slab once): start(), leaf_slab() for
-    // each slab of slices [z0, z1) (ends multiples of kLeafCells; it reads slice z1 too; disjoint
-    // slabs from any thread), then finish() with the merged ranges.
+    // Built slab by slab in z (an import): start(), leaf_slab() for each slab of slices [z0, z1)
+    // (ends multiples of kLeafCells; it reads slice z1 too; v.data may start at plane z_base;
+    // disjoint slabs from any thread), then finish() with the merged ranges.
     static MinMaxOctree start(glm::ivec3 cell_dims);
-    // `v.data` may hold only the planes from z_base on (a slab a streamed import decoded).
     FiniteRange leaf_slab(const VolumeView<T>& v, int z0, int z1, int z_base = 0);
     void finish(const FiniteRange& finite);
 
