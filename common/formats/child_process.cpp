@@ -75,6 +75,26 @@ void become_child() {
 #endif
 }
 
+void run_child(int error_fd, const std::function<std::string()>& work) {
+    become_child();
+    char kind = 'E';
+    std::string line;
+    try {
+        line = work();
+        if (line.empty()) ::_exit(0);
+    } catch (const InputError& e) {
+        kind = 'I';
+        line = e.what();
+    } catch (const std::exception& e) {
+        line = e.what();
+    } catch (...) {
+        line = "an unknown error";
+    }
+    write_all(error_fd, &kind, 1);
+    write_all(error_fd, line.data(), line.size());
+    ::_exit(1);
+}
+
 void child_failed(const std::string& where, const std::string& decoder, int status,
                   const std::string& message) {
     if (WIFSIGNALED(status))

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <utility>
 
@@ -39,6 +40,12 @@ int wait_for(pid_t pid);
 // fuzzer's, which would report the parent's input as its own finding) are not the child's to run,
 // nor is a sanitizer's death callback (libFuzzer's writes the input as a crash of its own).
 void become_child();
+
+// A child's whole life after become_child(): `work` runs; when it returns an empty string the
+// child leaves with status 0, else with 1 after writing to `error_fd` 'E' and the line it
+// returned. An InputError it throws is written as 'I' and its line (child_failed relays it as it
+// is), any other exception as 'E' and its message. Never returns.
+[[noreturn]] void run_child(int error_fd, const std::function<std::string()>& work);
 
 // The error a child that did not exit 0 means: the InputError it relayed in `message` ('I' and
 // its line), another error's line, or its signal or exit status, naming `where` and `decoder`.

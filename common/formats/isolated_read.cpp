@@ -31,10 +31,7 @@ std::size_t voxels_offset(std::size_t header_bytes) {
 
 // The child's whole life: read, write the volume (or the error's line) and leave.
 [[noreturn]] void child(const std::function<Volume()>& read, int data_fd, int error_fd) {
-    become_child();
-    char kind = 'E';
-    std::string line;
-    try {
+    run_child(error_fd, [&]() -> std::string {
         const Volume v = read();
         const std::vector<std::byte> header = encode_volume_header(v);
         const std::uint64_t length = header.size();
@@ -43,30 +40,36 @@ std::size_t voxels_offset(std::size_t header_bytes) {
         if (write_all(data_fd, &length, 8) && write_all(data_fd, header.data(), header.size()) &&
             write_all(data_fd, pad.data(), pad.size()) &&
             write_all(data_fd, voxels.data(), voxels.size()))
-            ::_exit(0);
-        line = std::string("cannot hand the volume over: ") + std::strerror(errno);
-    } catch (const InputError& e) {
-        kind = 'I';
-        line = e.what();
-    } catch (const std::exception& e) {
-        line = e.what();
-    } catch (...) {
-        line = "an unknown error";
-    }
-    write_all(error_fd, &kind, 1);
-    write_all(error_fd, line.data(), line.size());
-    ::_exit(1);
+            return {};
+        return std::string("cannot hand the volume over: ") + std::strerror(errno);
+    });
 }
 
 }  // namespace
 
+void put_shape(MessageWriter& w, const VolumeShape& s) {
+    w.put(s.dims.x);
+    w.put(s.dims.y);
+    w.put(s.dims.z);
+    w.put(static_cast<std::uint8_t>(s.type));
+    w.put(s.spacing);
+}
+
+VolumeShape get_shape(MessageReader& r) {
+    VolumeShape s;
+    s.dims.x = r.get<int>();
+    s.dims.y = r.get<int>();
+    s.dims.z = r.get<int>();
+    const auto type = r.get<std::uint8_t>();
+    if (type > static_cast<std::uint8_t>(VoxelType::f64)) r.fail("voxel type out of range");
+    s.type = static_cast<VoxelType>(type);
+    s.spacing = r.get_vec3();
+    return s;
+}
+
 std::vector<std::byte> encode_volume_header(const Volume& v) {
     MessageWriter w(kHeaderVersion);
-    w.put(v.dims().x);
-    w.put(v.dims().y);
-    w.put(v.dims().z);
-    w.put(static_cast<std::uint8_t>(v.type()));
-    w.put(v.spacing());
+    put_shape(w, {v.dims(), v.type(), v.spacing()});
     w.put_string(v.source());
     w.put(static_cast<std::uint64_t>(v.files().size()));
     for (const auto& f : v.files()) w.put_string(f.string());
@@ -84,13 +87,7 @@ std::vector<std::byte> encode_volume_header(const Volume& v) {
 
 Volume decode_volume(std::span<const std::byte> header, MappedFile file, std::size_t offset) {
     MessageReader r(header, kHeaderVersion, "volume from the reader");
-    glm::ivec3 dims;
-    dims.x = r.get<int>();
-    dims.y = r.get<int>();
-    dims.z = r.get<int>();
-    const auto type = r.get<std::uint8_t>();
-    if (type > static_cast<std::uint8_t>(VoxelType::f64)) r.fail("voxel type out of range");
-    const glm::vec3 spacing = r.get_vec3();
+    const auto [dims, type, spacing] = get_shape(r);
     std::string source = r.get_string();
     std::vector<std::filesystem::path> files(r.get_count(8));
     for (auto& f : files) f = r.get_string();
@@ -105,12 +102,11 @@ Volume decode_volume(std::span<const std::byte> header, MappedFile file, std::si
     }
     r.finish();
     if (glm::any(glm::lessThan(dims, glm::ivec3(1)))) r.fail("dims not positive");
-    const std::size_t size = voxel_size(static_cast<VoxelType>(type));
+    const std::size_t size = voxel_size(type);
     const std::size_t room = offset <= file.size() ? file.size() - offset : 0;
     if (std::size_t(dims.x) > room / size / std::size_t(dims.y) / std::size_t(dims.z))
         throw std::runtime_error("the reader's voxels are cut short");
-    Volume v(dims, static_cast<VoxelType>(type), spacing, std::move(file), offset,
-             std::move(source));
+    Volume v(dims, type, spacing, std::move(file), offset, std::move(source));
     v.set_files(std::move(files));
     v.set_orientation(o);
     for (VolumeFact& f : facts) v.add_fact(std::move(f.name), std::move(f.value));

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "common/core/wire.h"
 #include "common/volume/volume.h"
 
 namespace isowall::formats {
@@ -27,6 +28,16 @@ std::vector<std::byte> encode_volume_header(const Volume& v);
 // WireError (common/core/wire.h) on a malformed header, std::runtime_error when `file` is too
 // short for the voxels.
 Volume decode_volume(std::span<const std::byte> header, MappedFile file, std::size_t offset);
+
+// The dims, type and spacing at the start of the description above, and of a streamed child's
+// (isolated_stream.h): written, then read back with the type's range checked (a WireError).
+struct VolumeShape {
+    glm::ivec3 dims{0};
+    VoxelType type = VoxelType::u8;
+    glm::vec3 spacing{1.0f};
+};
+void put_shape(MessageWriter& w, const VolumeShape& s);
+VolumeShape get_shape(MessageReader& r);
 
 // How long a child may read before it is ended (a decoder looping on a crafted file).
 inline constexpr std::chrono::seconds kIsolatedReadLimit{600};

@@ -24,41 +24,25 @@ constexpr std::size_t kChildSlabBytes = std::size_t{16} << 20;  // what the chil
 // The child's whole life: open the stack, write the description and every plane, and leave.
 [[noreturn]] void child(const std::string& where, const std::function<PlaneStack()>& open,
                         int data_fd, int error_fd) {
-    become_child();
-    char kind = 'E';
-    std::string line;
-    try {
+    run_child(error_fd, [&]() -> std::string {
         const std::unique_ptr<PlaneSource> src = stream_planes(open(), where);
         MessageWriter w(kPlanesVersion);
-        w.put(src->dims().x);
-        w.put(src->dims().y);
-        w.put(src->dims().z);
-        w.put(static_cast<std::uint8_t>(src->type()));
-        w.put(src->spacing());
+        put_shape(w, {src->dims(), src->type(), src->spacing()});
         const std::vector<std::byte> header = w.take();
         const std::uint64_t length = header.size();
         bool ok =
             write_all(data_fd, &length, 8) && write_all(data_fd, header.data(), header.size());
         const int depth = src->dims().z;
-        const int step = int(std::clamp<std::size_t>(
-            kChildSlabBytes / std::max<std::size_t>(src->plane_bytes(), 1), 1, std::size_t(depth)));
+        const std::size_t per_plane = std::max<std::size_t>(src->plane_bytes(), 1);
+        const int step =
+            int(std::clamp<std::size_t>(kChildSlabBytes / per_plane, 1, std::size_t(depth)));
         for (int z = 0; ok && z < depth; z += step) {
             const std::span<const std::byte> planes = src->planes(z, std::min(z + step, depth));
             ok = write_all(data_fd, planes.data(), planes.size());
         }
-        if (ok) ::_exit(0);
-        line = std::string("cannot hand the planes over: ") + std::strerror(errno);
-    } catch (const InputError& e) {
-        kind = 'I';
-        line = e.what();
-    } catch (const std::exception& e) {
-        line = e.what();
-    } catch (...) {
-        line = "an unknown error";
-    }
-    write_all(error_fd, &kind, 1);
-    write_all(error_fd, line.data(), line.size());
-    ::_exit(1);
+        return ok ? std::string()
+                  : std::string("cannot hand the planes over: ") + std::strerror(errno);
+    });
 }
 
 // The parent's end of a child: its pipes, and its end (reaped, or killed when dropped early).
@@ -151,19 +135,12 @@ std::unique_ptr<PlaneSource> stream_isolated(const std::string& where, const std
     std::vector<std::byte> header(length);
     c->read(header.data(), header.size());
     MessageReader r(header, kPlanesVersion, "planes from the reader");
-    glm::ivec3 dims;
-    dims.x = r.get<int>();
-    dims.y = r.get<int>();
-    dims.z = r.get<int>();
-    const auto type = r.get<std::uint8_t>();
-    if (type > static_cast<std::uint8_t>(VoxelType::f64)) r.fail("voxel type out of range");
-    const glm::vec3 spacing = r.get_vec3();
+    const auto [dims, type, spacing] = get_shape(r);
     r.finish();
     if (glm::any(glm::lessThan(dims, glm::ivec3(1)))) r.fail("dims not positive");
-    const std::size_t plane = std::size_t(dims.x) * dims.y * voxel_size(VoxelType(type));
+    const std::size_t plane = std::size_t(dims.x) * dims.y * voxel_size(type);
     return std::make_unique<DecodedPlanes>(
-        dims, VoxelType(type), spacing, where,
-        [c, plane, depth = dims.z](int z0, int z1, std::byte* to) {
+        dims, type, spacing, where, [c, plane, depth = dims.z](int z0, int z1, std::byte* to) {
             c->read(to, plane * std::size_t(z1 - z0));
             if (z1 == depth) c->end(false);
         });
