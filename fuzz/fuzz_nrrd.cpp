@@ -1,7 +1,8 @@
 // Harness: the NRRD loader (common/volume/volume.cpp through Teem). The loader takes a path, so
 // the bytes go to files in a per-process folder: everything before a line "@data.raw" is in.nrrd,
 // everything after it data.raw beside it (for "data file: data.raw" headers). A volume that loads
-// must hold exactly dims x voxel size bytes, every one readable.
+// must hold exactly dims x voxel size bytes, every one readable; so must its planes streamed as
+// `import` reads them (nrrd_planes).
 //
 // regressions/nrrd holds one input of each class the loader crashed or hung on before its fix,
 // named by class: ascii-* (Teem's ascii reader smashed the stack on a long token), devzero-*
@@ -20,6 +21,7 @@
 #include <string_view>
 
 #include "common/core/error.h"
+#include "common/volume/plane_source.h"
 #include "common/volume/volume.h"
 #include "fuzz/fuzz_check.h"
 
@@ -67,6 +69,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::uint64_t sum = 0;  // read every byte, so a short mapping or buffer shows under ASan
         for (const std::byte b : v.bytes()) sum += static_cast<std::uint64_t>(b);
         check(sum <= 255u * v.bytes().size(), "bytes are bytes");
+    } catch (const isowall::InputError&) {
+    }
+    // The same file streamed as `import` reads it (gzip inflated a slab at a time): every plane
+    // readable, or an InputError, whichever slab finds the fault.
+    try {
+        const auto planes = isowall::nrrd_planes(folder() / "in.nrrd");
+        if (!planes) return 0;
+        const int depth = planes->dims().z;
+        std::uint64_t sum = 0;
+        for (int z = 0; z < depth; z += 3) {
+            const int z1 = std::min(z + 4, depth);
+            const auto got = planes->planes(z, z1);
+            check(got.size() == planes->plane_bytes() * std::size_t(z1 - z),
+                  "a call holds its planes");
+            for (const std::byte b : got) sum += static_cast<std::uint64_t>(b);
+            if (z1 == depth) break;
+        }
+        check(sum < ~std::uint64_t{0}, "bytes are bytes");
     } catch (const isowall::InputError&) {
     }
     return 0;
