@@ -162,5 +162,19 @@ TEST(CliStore, AGzipVolumeImportsASlabAtATimeInBoundedMemory) {
     EXPECT_LT(peak - base, 48) << "the import held more than half the volume";
 }
 
+// A source that fails part-way through a streamed import (gzip cut short: the planes of the first
+// slabs decode, a later one cannot) is one line naming the file; no store and no temporary folder
+// are left.
+TEST(CliStore, ASourceThatFailsMidStreamLeavesNoStore) {
+    const fs::path dir = test::scratch_dir("cli_store_stream_fail");
+    write_gzip_nrrd(dir / "whole.nrrd", 128, 160);
+    const std::string whole = slurp(dir / "whole.nrrd");
+    std::ofstream(dir / "cut.nrrd", std::ios::binary) << whole.substr(0, whole.size() * 3 / 4);
+    const auto r = run_isowall(dir, "import cut.nrrd --out cut.zarr -q");
+    expect_one_line_error(r, {"cut.nrrd", "data", "ends early"});
+    EXPECT_FALSE(fs::exists(dir / "cut.zarr"));
+    EXPECT_FALSE(fs::exists(dir / ".cut.zarr.importing"));
+}
+
 }  // namespace
 }  // namespace isowall
