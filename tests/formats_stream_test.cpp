@@ -232,19 +232,24 @@ TEST(PlaneStream, AChildThatFailsMidStreamIsOneLineAndADroppedStreamEndsIt) {
     test::expect_input_error(
         [&] { read_all(*formats::stream_isolated("scan.h5", "a test reader", failing_at(30, 1))); },
         "scan.h5", "data", "signal 6");
-    // A stream dropped after its first slab ends its child at once, not after it finishes.
+    // A stream dropped after its first slab ends its child at once, even while its read-ahead
+    // waits on the child: planes of 8 MiB, so the child hands over two at a time and then takes
+    // 60 s for the next two.
+    const glm::ivec3 big{2048, 2048, 6};
+    const std::vector<std::byte> big_all = pattern(big);
     const auto t0 = std::chrono::steady_clock::now();
     {
         auto slow = formats::stream_isolated("scan.h5", "a test reader", [&] {
-            formats::PlaneStack s = stack_of(all, dims, {}, std::nullopt);
+            formats::PlaneStack s = stack_of(big_all, big, {}, std::nullopt);
             auto read = s.read;
             s.read = [read](int z0, int z1, std::byte* to) {
-                if (z0 > 0) std::this_thread::sleep_for(std::chrono::seconds(60));
+                if (z0 >= 2) std::this_thread::sleep_for(std::chrono::seconds(60));
                 read(z0, z1, to);
             };
             return s;
         });
-        slow->planes(0, 1);
+        slow->planes(0, 2);  // and planes 2-3 are read ahead, from a child that sleeps
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
     EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30));
 }

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -84,6 +85,11 @@ class Child {
         }
     }
 
+    // Ends the child now (the planes are dropped before their end); the destructor reaps it.
+    void kill() {
+        if (!reaped_) ::kill(pid_, SIGKILL);
+    }
+
     // Waits for the child to leave; `early`: the planes stopped short of the last.
     void end(bool early) {
         std::string message;
@@ -100,7 +106,7 @@ class Child {
     Fd data_, errors_;
     std::string where_, decoder_;
     std::chrono::milliseconds quiet_;
-    bool reaped_ = false;
+    std::atomic<bool> reaped_{false};
 };
 
 }  // namespace
@@ -139,11 +145,15 @@ std::unique_ptr<PlaneSource> stream_isolated(const std::string& where, const std
     r.finish();
     if (glm::any(glm::lessThan(dims, glm::ivec3(1)))) r.fail("dims not positive");
     const std::size_t plane = std::size_t(dims.x) * dims.y * voxel_size(type);
-    return std::make_unique<DecodedPlanes>(
+    auto planes = std::make_unique<DecodedPlanes>(
         dims, type, spacing, where, [c, plane, depth = dims.z](int z0, int z1, std::byte* to) {
             c->read(to, plane * std::size_t(z1 - z0));
             if (z1 == depth) c->end(false);
         });
+    // Dropped early (an import that failed elsewhere), the planes end the child, so that a read
+    // ahead waiting on it returns at once rather than when the child writes or goes quiet.
+    planes->set_cancel([c] { c->kill(); });
+    return planes;
 }
 
 }  // namespace isowall::formats

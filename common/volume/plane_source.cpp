@@ -17,7 +17,9 @@ DecodedPlanes::DecodedPlanes(glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
       read_ahead_(read_ahead) {}
 
 DecodedPlanes::~DecodedPlanes() {
-    if (ahead_.joinable()) ahead_.join();
+    if (!ahead_.joinable()) return;
+    if (cancel_ && have_ < dims_.z) cancel_();
+    ahead_.join();
 }
 
 void DecodedPlanes::finish_ahead() {

@@ -58,6 +58,10 @@ class DecodedPlanes final : public PlaneSource {
     std::span<const std::byte> planes(int z0, int z1) override;
     // The most bytes the buffer held at once (tests: memory stays at a slab).
     std::size_t peak_bytes() const { return peak_; }
+    // What makes a decode under way return early (with an error) when the planes are dropped
+    // before their end: a decoder waiting on another process ends it. Called by the destructor
+    // before it waits for the read-ahead thread.
+    void set_cancel(std::function<void()> cancel) { cancel_ = std::move(cancel); }
 
   private:
     void finish_ahead();  // waits for the planes read ahead; throws the decoder's error
@@ -73,6 +77,7 @@ class DecodedPlanes final : public PlaneSource {
     std::thread ahead_;              // decoding [have_, ahead_end_)
     int ahead_end_ = 0;
     std::exception_ptr ahead_error_;
+    std::function<void()> cancel_;
     std::size_t peak_ = 0;
 };
 
