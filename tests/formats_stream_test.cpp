@@ -14,6 +14,7 @@
 #include "common/core/error.h"
 #include "common/formats/isolated_stream.h"
 #include "common/formats/plane_stack.h"
+#include "common/formats/read_volume.h"
 #include "common/store/source_pages.h"
 #include "common/store/store_format.h"
 #include "common/store/store_writer.h"
@@ -128,7 +129,7 @@ void write(const fs::path& p, const std::string& text) {
     std::ofstream(p, std::ios::binary) << text;
 }
 
-TEST(PlaneStream, GzipAndOtherEndianNrrdStreamAndRawNrrdIsMapped) {
+TEST(PlaneStream, GzipAndOtherEndianNrrdAndRawStreamAndHostOrderIsMapped) {
     const fs::path dir = test::scratch_dir("stream_nrrd");
     const glm::ivec3 dims{9, 7, 11};
     const std::vector<std::byte> all = pattern(dims);
@@ -143,6 +144,20 @@ TEST(PlaneStream, GzipAndOtherEndianNrrdStreamAndRawNrrdIsMapped) {
     test::expect_streams_alike((dir / "gz.nrrd").string());
     test::expect_streams_alike((dir / "big.nrrd").string());
     test::expect_streams_alike((dir / "raw.nrrd").string(), false);
+    // Headerless raw of the other byte order streams too (swapped a slab at a time); in host
+    // order it is mapped.
+    write(dir / "big.raw",
+          "HEAD" + std::string(reinterpret_cast<const char*>(big.data()), big.size()));
+    RawSpec spec;
+    spec.dims = dims;
+    spec.type = VoxelType::u16;
+    spec.endian = Endian::big;
+    spec.header_bytes = 4;
+    const auto raw_stream = formats::open_planes((dir / "big.raw").string(), spec);
+    ASSERT_TRUE(raw_stream);
+    test::expect_planes_equal(*raw_stream, formats::read_volume((dir / "big.raw").string(), spec));
+    spec.endian = Endian::little;
+    EXPECT_FALSE(formats::open_planes((dir / "big.raw").string(), spec));
     // A gzip stream cut short fails on the slab that needs the missing bytes, naming the file.
     const std::string packed = gzip_of(all);
     write(dir / "cut.nrrd",

@@ -110,7 +110,7 @@ std::unique_ptr<PlaneSource> file_planes(const fs::path& p, const std::string& n
 
 std::unique_ptr<PlaneSource> open_planes(const std::string& path,
                                          const std::optional<RawSpec>& raw) {
-    if (raw) return nullptr;
+    if (raw) return raw_planes(path, *raw);
     const fs::path p(path);
     std::error_code ec;
     if (fs::is_directory(p, ec))

@@ -24,8 +24,8 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw,
 // The planes of the volume read_volume gives, for `isowall import` to stream a slab at a time:
 // TIFF stacks, NIfTI, MetaImage, DICOM series and HDF5 datasets (their readers' plane stacks,
 // plane_stack.h; DICOM and HDF5 decoded in a child process as read_volume does), and gzip or
-// other-endian NRRD (nrrd_planes). Null for what read_volume maps without decoding (raw, raw
-// NRRD), and for bzip2, hex and ascii NRRD, which are decoded whole.
+// other-endian NRRD and raw (nrrd_planes, raw_planes). Null for what read_volume maps without
+// decoding (raw and raw NRRD in host order), and for bzip2, hex and ascii NRRD, decoded whole.
 std::unique_ptr<PlaneSource> open_planes(const std::string& path,
                                          const std::optional<RawSpec>& raw);
 

@@ -84,6 +84,10 @@ class DecodedPlanes final : public PlaneSource {
 // The planes of a NRRD file whose data is not mapped as it is (load_nrrd copies it): gzip, inflated
 // a slab at a time, and raw data of the other byte order. Null for raw data in host order (map it:
 // load_nrrd) and for bzip2, hex and ascii, which are decoded whole.
+// The planes of a raw file of the other byte order (load_raw copies it), swapped a slab at a
+// time; null for one in host order (map it: load_raw). The spec is checked as load_raw checks it.
+std::unique_ptr<PlaneSource> raw_planes(const std::filesystem::path& path, const RawSpec& spec);
+
 // `read_ahead` as DecodedPlanes'.
 std::unique_ptr<PlaneSource> nrrd_planes(const std::filesystem::path& path, bool read_ahead = true);
 

@@ -10,6 +10,7 @@
 
 #include "common/core/error.h"
 #include "common/volume/load_checks.h"
+#include "common/volume/plane_source.h"
 #include "common/volume/teem_util.h"
 
 namespace isowall {
@@ -155,16 +156,41 @@ int to_teem_type(VoxelType t) {
 
 }  // namespace
 
-Volume load_raw(const fs::path& path, const RawSpec& spec, bool populate) {
+namespace {
+
+// A raw file checked against its spec and mapped.
+MappedFile checked_raw(const fs::path& path, const RawSpec& spec, bool populate) {
     const std::string where = path.string();
     check_dims(where, "--dims", spec.dims, spec.type);
     check_regular_file(path, where, "file");
     for (int i = 0; i < 3; ++i)
         if (std::string p = spacing_problem(spec.spacing[i], spec.dims[i], i); !p.empty())
             throw InputError(where, "--spacing", p);
-    const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
     MappedFile file(path, populate);
-    check_size(where, file.size(), spec.header_bytes, need);
+    check_size(where, file.size(), spec.header_bytes, voxel_bytes(spec.dims, spec.type));
+    return file;
+}
+
+}  // namespace
+
+std::unique_ptr<PlaneSource> raw_planes(const fs::path& path, const RawSpec& spec) {
+    if (spec.endian == host_endian() || voxel_size(spec.type) == 1) return nullptr;
+    auto file = std::make_shared<MappedFile>(checked_raw(path, spec, false));
+    const std::size_t plane = std::size_t(spec.dims.x) * spec.dims.y * voxel_size(spec.type);
+    const std::size_t at = spec.header_bytes, size = voxel_size(spec.type);
+    return std::make_unique<DecodedPlanes>(
+        spec.dims, spec.type, spec.spacing, path.string(),
+        [file, plane, at, size](int z0, int z1, std::byte* to) {
+            const std::size_t n = plane * std::size_t(z1 - z0);
+            std::memcpy(to, file->bytes().data() + at + plane * std::size_t(z0), n);
+            swap_bytes({to, n}, size);
+        });
+}
+
+Volume load_raw(const fs::path& path, const RawSpec& spec, bool populate) {
+    const std::string where = path.string();
+    MappedFile file = checked_raw(path, spec, populate);
+    const std::uint64_t need = voxel_bytes(spec.dims, spec.type);
     Volume volume;
     if (spec.endian == host_endian() || voxel_size(spec.type) == 1) {
         volume =
