@@ -54,7 +54,8 @@ CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
     auto* c = app.add_subcommand(
         "import",
         "Write a volume as a store (Zarr v2 with OME-Zarr metadata, zstd chunks with "
-        "checksums) that --volume then reads on first touch, under --memory-limit");
+        "checksums) that --volume then reads on first touch, under --memory-limit. The source, "
+        "in any format --volume reads, is read a slab at a time, never whole");
     c->add_option("source", o.source,
                   "The volume to import: any file or folder --volume reads (or give --volume)");
     add_volume_options(*c, o.volume);
