@@ -69,6 +69,8 @@ std::unique_ptr<PlaneSource> stream_planes(PlaneStack stack, const std::string& 
     const bool check_range = !d.scaling.identity() && stack.declared_range &&
                              *stack.declared_range != type_range(d.type);
     const bool ahead = stack.read_ahead;
+    const glm::ivec3 dims = d.dims;  // `d` is moved away with `stack` below
+    const glm::vec3 spacing = d.spacing;
     auto decode = [stack = std::move(stack), out, mirror, plane, check_range, where,
                    stored = std::vector<std::byte>()](int z0, int z1, std::byte* to) mutable {
         const Decoded& h = stack.head;
@@ -83,7 +85,7 @@ std::unique_ptr<PlaneSource> stream_planes(PlaneStack stack, const std::string& 
         }
         if (mirror) mirror_rows(planes, h.dims.x, out);
     };
-    return std::make_unique<DecodedPlanes>(d.dims, out, d.spacing, where, std::move(decode), ahead);
+    return std::make_unique<DecodedPlanes>(dims, out, spacing, where, std::move(decode), ahead);
 }
 
 }  // namespace isowall::formats
