@@ -1,5 +1,6 @@
 #include "common/formats/child_process.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -28,6 +29,21 @@ namespace isowall::formats {
 void Fd::reset() {
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
+}
+
+Pipe make_pipe(const std::string& where) {
+    int ends[2];
+    if (::pipe2(ends, O_CLOEXEC) != 0)
+        throw std::runtime_error(where +
+                                 ": cannot make a pipe for the reader: " + std::strerror(errno));
+    return {Fd(ends[0]), Fd(ends[1])};
+}
+
+pid_t fork_reader(const std::string& where) {
+    const pid_t pid = ::fork();
+    if (pid < 0)
+        throw std::runtime_error(where + ": cannot start the reader: " + std::strerror(errno));
+    return pid;
 }
 
 bool write_all(int fd, const void* data, std::size_t n) {

@@ -26,6 +26,15 @@ class Fd {
     int fd_;
 };
 
+// A pipe (close-on-exec); std::runtime_error naming `where` when none can be made.
+struct Pipe {
+    Fd read, write;
+};
+Pipe make_pipe(const std::string& where);
+
+// fork(): 0 in the child, its pid in the parent; std::runtime_error naming `where` on failure.
+pid_t fork_reader(const std::string& where);
+
 // All of `n` bytes to `fd` (false on an error or a closed reader).
 bool write_all(int fd, const void* data, std::size_t n);
 

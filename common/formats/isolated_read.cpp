@@ -119,18 +119,12 @@ Volume read_isolated(const std::string& where, const std::string& decoder,
     if (data.get() < 0)
         throw std::runtime_error(
             where + ": cannot make a memory file for the reader: " + std::strerror(errno));
-    int ends[2];
-    if (::pipe2(ends, O_CLOEXEC) != 0)
-        throw std::runtime_error(where +
-                                 ": cannot make a pipe for the reader: " + std::strerror(errno));
-    Fd from_child(ends[0]), to_parent(ends[1]);
-    const pid_t pid = ::fork();
-    if (pid < 0)
-        throw std::runtime_error(where + ": cannot start the reader: " + std::strerror(errno));
-    if (pid == 0) child(read, data.get(), to_parent.get());
-    to_parent.reset();
+    Pipe errors = make_pipe(where);
+    const pid_t pid = fork_reader(where);
+    if (pid == 0) child(read, data.get(), errors.write.get());
+    errors.write.reset();
     std::string message;
-    if (!read_until_closed(from_child.get(), Clock::now() + limit, message)) {
+    if (!read_until_closed(errors.read.get(), Clock::now() + limit, message)) {
         ::kill(pid, SIGKILL);
         wait_for(pid);
         throw InputError(where, "data",

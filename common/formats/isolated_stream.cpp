@@ -114,26 +114,16 @@ class Child {
 std::unique_ptr<PlaneSource> stream_isolated(const std::string& where, const std::string& decoder,
                                              const std::function<PlaneStack()>& open,
                                              std::chrono::milliseconds quiet) {
-    int data[2], errors[2];
-    if (::pipe2(data, O_CLOEXEC) != 0)
-        throw std::runtime_error(where +
-                                 ": cannot make a pipe for the reader: " + std::strerror(errno));
-    Fd data_read(data[0]), data_write(data[1]);
-    if (::pipe2(errors, O_CLOEXEC) != 0)
-        throw std::runtime_error(where +
-                                 ": cannot make a pipe for the reader: " + std::strerror(errno));
-    Fd errors_read(errors[0]), errors_write(errors[1]);
-    const pid_t pid = ::fork();
-    if (pid < 0)
-        throw std::runtime_error(where + ": cannot start the reader: " + std::strerror(errno));
+    Pipe data = make_pipe(where), errors = make_pipe(where);
+    const pid_t pid = fork_reader(where);
     if (pid == 0) {
-        data_read.reset();
-        errors_read.reset();
-        child(where, open, data_write.get(), errors_write.get());
+        data.read.reset();
+        errors.read.reset();
+        child(where, open, data.write.get(), errors.write.get());
     }
-    data_write.reset();
-    errors_write.reset();
-    auto c = std::make_shared<Child>(pid, data_read.release(), errors_read.release(), where,
+    data.write.reset();
+    errors.write.reset();
+    auto c = std::make_shared<Child>(pid, data.read.release(), errors.read.release(), where,
                                      decoder, quiet);
     std::uint64_t length = 0;
     c->read(reinterpret_cast<std::byte*>(&length), 8);
