@@ -50,6 +50,13 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
 
 namespace {
 
+// --memory-limit caps a store's bricks; given for a file, it would silently do nothing.
+void check_no_memory_limit(const VolumeOptions& o) {
+    if (!o.memory_limit.empty())
+        throw InputError("--memory-limit", "value",
+                         "applies to a store (`isowall import`), not to " + quote(o.path));
+}
+
 std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
     const bool raw = !o.dims.empty() || !o.type.empty();
     if (!raw) return std::nullopt;
@@ -90,9 +97,7 @@ std::filesystem::path cache_dir(const VolumeOptions& o) {
 
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
     if (o.path.empty() || store::is_store(o.path)) return nullptr;
-    if (!o.memory_limit.empty())
-        throw InputError("--memory-limit", "value",
-                         "applies to a store (`isowall import`), not to " + quote(o.path));
+    check_no_memory_limit(o);
     return formats::open_planes(o.path, raw_spec(o));
 }
 
@@ -119,9 +124,7 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         // A volume not cast (import) streams its file itself, at the disk's pace.
         out.volume = formats::read_volume(o.path, raw_spec(o), use.casts);
         out.file = std::filesystem::path(o.path);
-        if (!o.memory_limit.empty())
-            throw InputError("--memory-limit", "value",
-                             "applies to a store (`isowall import`), not to " + quote(o.path));
+        check_no_memory_limit(o);
     }
     std::string huge_note;
     // A store's voxels stay paged: a copy would read them all.
