@@ -111,6 +111,14 @@ TEST(StoreFormat, MetadataRoundTripsAndNamesWhatIsWrong) {
     expect_line([&] { parse_layout(with(za, "\"<i2\"", "\">i2\""), at, "s"); }, {"dtype"});
     expect_line([&] { parse_layout(with(za, "\"zstd\"", "\"blosc\""), at, "s"); }, {"compressor"});
     expect_line([&] { parse_layout(with(za, "32,", "24,"), at, "s"); }, {"chunks", "cubic"});
+    // A member of the wrong type is the same one line, never nlohmann's type_error (fuzz_store
+    // found it: "id": 1 in the compressor).
+    expect_line([&] { parse_layout(with(za, "\"zstd\"", "1"), at, "s"); }, {"compressor"});
+    expect_line([&] { parse_layout(with(za, "\"C\"", "[]"), at, "s"); }, {"order"});
+    expect_line([&] { parse_layout(with(za, "\"/\"", "null"), at, "s"); }, {"dimension_separator"});
+    expect_line([&] { parse_layout(za, with(at, "\"format\": 1", "\"format\": \"1\""), "s"); },
+                {"isowall.format"});
+    EXPECT_EQ(parse_layout(za, with(at, "\"head.nrrd\"", "7"), "s").source, "7");
     const std::string count = "\"chunks\": " + std::to_string(l.chunk_count());
     expect_line([&] { parse_layout(za, with(at, count, "\"chunks\": 7"), "s"); },
                 {".zattrs", "isowall.chunks", "disagrees"});

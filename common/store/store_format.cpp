@@ -64,6 +64,16 @@ const json& member(const json& j, const char* name, const std::string& store,
     return *it;
 }
 
+// The member `name` of object `j` as text: `absent` when it is missing, and its JSON (never equal
+// to a string a caller asks for, which would be quoted) when it is not a string. nlohmann's
+// value(name, fallback) throws type_error for a member of another type; a store's metadata is
+// input, so no check may throw anything but the line naming the field.
+std::string text_member(const json& j, const char* name, const std::string& absent) {
+    const auto it = j.find(name);
+    if (it == j.end()) return absent;
+    return it->is_string() ? it->get<std::string>() : it->dump();
+}
+
 }  // namespace
 
 std::string zarr_dtype(VoxelType t) {
@@ -174,17 +184,17 @@ void parse_zarray(std::string_view zarray, const std::string& store, StoreLayout
             "expected a little-endian |u1 |i1 <u2 <i2 <u4 <i4 <f4 <f8, got " + quote(dtype.dump()));
     l.type = *type;
     const json& comp = member(a, "compressor", store, za);
-    if (!comp.is_object() || comp.value("id", "") != "zstd")
+    if (!comp.is_object() || text_member(comp, "id", "") != "zstd")
         bad(store, za + ": compressor", "expected zstd, got " + quote(comp.dump()));
     // The level the chunks were written with (any reads them): kept, so that the layout read back
     // is the layout written, and its content key the same.
     if (comp.contains("level") && comp["level"].is_number_integer())
         l.zstd_level = comp["level"].get<int>();
-    if (a.value("order", "C") != "C")
+    if (text_member(a, "order", "C") != "C")
         bad(store, za + ": order", "expected \"C\", got " + quote(a["order"].dump()));
     if (a.contains("filters") && !a["filters"].is_null())
         bad(store, za + ": filters", "expected null, got " + quote(a["filters"].dump()));
-    if (a.value("dimension_separator", ".") != "/")
+    if (text_member(a, "dimension_separator", ".") != "/")
         bad(store, za + ": dimension_separator", "expected \"/\"");
 }
 
@@ -194,10 +204,12 @@ void parse_zattrs(std::string_view zattrs, const std::string& store, StoreLayout
     const std::string at = ".zattrs";
     const json t = parse_json(zattrs, store, at);
     const json& iso = member(t, "isowall", store, at);
-    if (!iso.is_object() || iso.value("format", 0) != kFormatVersion)
+    const auto format = iso.is_object() ? iso.find("format") : iso.end();
+    if (format == iso.end() || !format->is_number_integer() ||
+        format->get<long long>() != kFormatVersion)
         bad(store, at + ": isowall.format",
             "expected " + std::to_string(kFormatVersion) + " (a store isowall wrote)");
-    l.source = iso.value("source", std::string());
+    l.source = text_member(iso, "source", "");
     l.id = iso.contains("id") && iso["id"].is_string() ? iso["id"].get<std::string>() : "";
     if (l.id.size() != 16 || l.id.find_first_not_of("0123456789abcdef") != std::string::npos)
         bad(store, at + ": isowall.id", "expected 16 hex digits, got " + quote(l.id));
