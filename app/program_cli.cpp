@@ -10,11 +10,12 @@ namespace {
 // parse_size first: from_chars, so no digits overflow an int on the way to parse_region.
 const CLI::Validator kRegion(
     [](std::string& s) {
-        return s == "tile" || (parse_size(s) && parse_region(s))
+        return s == "auto" || s == "tile" || (parse_size(s) && parse_region(s))
                    ? std::string()
-                   : "expected WxH, each 1 to 32768 (e.g. 256x192), or 'tile', got " + quote(s);
+                   : "expected auto, WxH, each 1 to 32768 (e.g. 256x192), or 'tile', got " +
+                         quote(s);
     },
-    "WxH|tile");
+    "auto|WxH|tile");
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
@@ -163,8 +164,9 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->default_str("on");
     wall_cmd
         ->add_option("--region", wall.region,
-                     "Size WxH of the screen regions the scheduler hands out (balancing on); "
-                     "'tile' for one region per tile")
+                     "Screen regions the scheduler hands out (balancing on): auto, cut where the "
+                     "work is (estimated from the octree, then measured in the last frame); WxH, "
+                     "a fixed grid of that size (for studies); 'tile', one region per tile")
         ->check(kRegion)
         ->capture_default_str();
     wall_cmd

@@ -96,7 +96,12 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
     mo.zoom = o.zoom;
     if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
+    mo.regions_from_work = o.region == "auto";
     std::tie(mo.region_w, mo.region_h) = parse_region(o.region).value_or(std::pair{0, 0});
+    // The work estimate's boxes: the screen mask's active nodes (engine/region_cursor.cpp).
+    mo.work_boxes = [&ex = *in.extractor](double iso) {
+        return ex.active_boxes(iso, kWorkBoxes, 0).boxes;
+    };
     mo.screen_box = to_engine_options(o.engine).screen_box;
     mo.measure = o.measure;
     mo.store = in.volume->store;

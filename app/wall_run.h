@@ -35,7 +35,8 @@ struct WallOptions {
     std::vector<float> orbit, pan;   // the first view: yaw pitch; dx dy (empty: none)
     float zoom = 1;
     bool balance = true;            // the screen-region scheduler migrates jobs
-    std::string region = "128x96";  // region size WxH, or "tile" (the study's best)
+    // "auto": regions planned from the work (master/region_plan.h); WxH a fixed grid, or "tile"
+    std::string region = "auto";
     bool measure = false;           // emulated wall-wide correctness curves
     bool windows = false;           // each tile shows its frame in a window on its display
     bool region_clip = true;        // propagation stays within each job's region

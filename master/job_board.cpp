@@ -144,7 +144,7 @@ std::optional<std::uint32_t> JobBoard::next_for(int rank) {
     return id;
 }
 
-void JobBoard::done(std::uint32_t id, std::uint64_t rays, double cpu_s) {
+void JobBoard::done(std::uint32_t id, double cpu_s) {
     BoardJob& j = jobs_.at(id);
     if (j.state != BoardJob::State::running)
         throw std::runtime_error("job " + std::to_string(id) + " reported done but not running");
@@ -157,7 +157,7 @@ void JobBoard::done(std::uint32_t id, std::uint64_t rays, double cpu_s) {
         const std::size_t k =
             2 * static_cast<std::size_t>(j.owner) + (j.band == Band::coarse ? 0 : 1);
         cpu_[k] += cpu_s;
-        rays_[k] += static_cast<double>(rays);
+        rays_[k] += j.rays;  // the estimate: what cost() scales
     }
     if (has_landed(j)) ++landed_;
 }

@@ -11,8 +11,9 @@
 //     the region is cast again from its first level by the helper, whose image must show all of
 //     it, so only while that holder keeps more work than the helper's whole region costs.
 // Stolen jobs are taken from the end of a queue, the owner works from its front. Estimated work is
-// a job's rays (its region inside the volume's screen box, 1/16 of them coarse) times the recent
-// CPU cost per ray of its tile in its band.
+// a job's estimate (its region's work from region_plan.h, or its rays inside the volume's screen
+// box for a fixed grid; 1/16 of it coarse) times the recent CPU cost per unit of estimate of its
+// tile in its band.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -37,7 +38,7 @@ struct BoardJob {
     int owner = 0;
     PixelRect rect;
     Band band = Band::coarse;
-    double rays = 0;  // estimated rays
+    double rays = 0;  // estimated work (rays, or region_plan.h's units)
     enum class State : std::uint8_t { queued, running, done } state = State::queued;
     bool arrived = false;      // the owner has composited the helper's result (helpers only)
     int worker = -1;           // the rank it was handed to
@@ -48,7 +49,7 @@ struct BoardJob {
 
 class JobBoard {
   public:
-    // regions[rank] and rays[rank]: the rank's regions and the estimated rays of each (rank 0,
+    // regions[rank] and rays[rank]: the rank's regions and the estimated work of each (rank 0,
     // the master, has none). Regions with no estimated ray get no job.
     JobBoard(const std::vector<std::vector<PixelRect>>& regions,
              const std::vector<std::vector<double>>& rays, bool balance, int depth = 1);
@@ -56,10 +57,11 @@ class JobBoard {
     // The next job for `rank`, now marked running, or nullopt when it has `depth` jobs in hand
     // or none is left for it.
     std::optional<std::uint32_t> next_for(int rank);
-    // The worker finished: frees its slot and learns the cost per ray. A job has landed once it
-    // is done and, when a helper ran it, the owner has its result (the two messages come from
-    // different ranks, so in either order).
-    void done(std::uint32_t id, std::uint64_t rays, double cpu_s);
+    // The worker finished: frees its slot and learns the CPU cost per unit of estimated work (the
+    // estimate's units: rays, or region_plan.h's work). A job has landed once it is done and,
+    // when a helper ran it, the owner has its result (the two messages come from different ranks,
+    // so in either order).
+    void done(std::uint32_t id, double cpu_s);
     void landed(std::uint32_t id);
 
     const BoardJob& job(std::uint32_t id) const { return jobs_.at(id); }

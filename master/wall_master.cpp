@@ -26,6 +26,7 @@ std::string rank_label(const WallSpec& spec, int rank) {
 WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
                        double iso, double value_min, double value_max)
     : o_(o), comm_(comm), spec_(spec), bounds_(bounds), iso_(iso), lo_(value_min), hi_(value_max) {
+    planner_ = RegionPlanner(o.work_boxes);
     const PixelSize vs = virtual_screen_size(spec);
     aspect_ = float(vs.width) / float(vs.height);
     camera_ = front_full_view(bounds, o.front_axes, aspect_);
@@ -202,8 +203,6 @@ void WallMaster::send_views() {
     ++generation_;
     const Camera cam = fit_depth_range(camera_, bounds_);
     const Frustum wall = cam.frustum(aspect_);
-    std::vector<std::vector<PixelRect>> regions(tiles_.size());
-    std::vector<std::vector<double>> rays(tiles_.size());
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         const PixelRect r = tile_rect(spec_, tile);
@@ -214,12 +213,15 @@ void WallMaster::send_views() {
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
         t.view = v.view;
-        const auto k = static_cast<std::size_t>(rank);
-        regions[k] = o_.balance ? cut_into_regions(r.width, r.height, o_.region_w, o_.region_h)
-                                : cut_into_regions(r.width, r.height, 0, 0);
-        rays[k] = estimated_rays(v.view, regions[k], bounds_, o_.screen_box);
     }
-    board_.emplace(regions, rays, o_.balance);
+    std::vector<FrameView> views;  // by rank: the master's is empty (width 0)
+    for (const TileState& t : tiles_) views.push_back(t.view);
+    const FramePlan plan =
+        o_.balance && o_.regions_from_work
+            ? planner_.next(views, iso_, board_ ? &*board_ : nullptr, bounds_, o_.screen_box)
+            : grid_plan(views, o_.balance ? o_.region_w : 0, o_.balance ? o_.region_h : 0, bounds_,
+                        o_.screen_box);
+    board_.emplace(plan.regions, plan.work, o_.balance);
     migrations_.clear();
     for (int rank = 1; rank < comm_.size(); ++rank) fill(rank);
     frame_start_ = Stopwatch();
@@ -259,7 +261,7 @@ void WallMaster::handle_job(int from, const Message& m) {
         if (j.worker != from || j.state != BoardJob::State::running)
             throw WireError(rank_label(spec_, from) + ": job " + std::to_string(id) +
                             " was not running on it");
-        board_->done(id, d->rays, d->cpu_s);
+        board_->done(id, d->cpu_s);
         if (j.owner != from) migrations_.push_back({j.owner, from, d->start_s, d->end_s, d->bytes});
         fill(from);
     } else {
@@ -341,10 +343,7 @@ Mosaic WallMaster::compose(OutputFiles* batch) {
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         ImageMsg& m = *tiles_[static_cast<std::size_t>(rank)].image;
-        Image img;
-        img.width = m.width;
-        img.height = m.height;
-        img.rgba = std::move(m.rgba);
+        Image img{m.width, m.height, std::move(m.rgba), {}};
         paste(mosaic, img, tile_rect(spec_, tile));
         if (batch && !o_.tiles_out.empty())
             write_image(

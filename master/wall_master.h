@@ -17,6 +17,7 @@
 #include "common/wall/wall.h"
 #include "master/job_board.h"
 #include "master/mosaic.h"
+#include "master/region_plan.h"
 #include "master/store_server.h"
 #include "master/wall_report.h"
 
@@ -39,7 +40,13 @@ struct MasterOptions {
     // front view is the patient's front whatever the acquisition.
     glm::mat3 front_axes{1.0f};
     bool balance = true;
-    int region_w = 128, region_h = 96;
+    // With balancing: regions planned from the work (master/region_plan.h), the default; or, for
+    // studies, a fixed grid of region_w x region_h (0 x 0: one region per tile).
+    bool regions_from_work = true;
+    int region_w = 0, region_h = 0;
+    // The active octree nodes at an isovalue (where the surface may be), for the work estimate;
+    // unset, the volume's box alone (a uniform estimate over its screen box).
+    std::function<std::vector<Box3>(double iso)> work_boxes;
     bool screen_box = true;  // the engine casts no ray outside the volume's screen box
     bool measure = false;    // tiles report emulated correctness curves
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
@@ -135,6 +142,7 @@ class WallMaster {
     TraceRecorder trace_;
     std::optional<JobBoard> board_;      // the current generation's jobs
     std::vector<Migration> migrations_;  // of the current generation
+    RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
     Stopwatch alive_sent_, alive_checked_;
     std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on
     std::vector<std::optional<PreviewMsg>> previews_;  // by rank

@@ -83,12 +83,12 @@ TEST(JobBoard, IdleRanksTakeCoarseJobsOfTheBusyTileFirst) {
     EXPECT_EQ(b.job(*third).band, Band::coarse) << "coarse jobs anywhere before fine ones";
     EXPECT_EQ(b.migrated(), 2u);
     // The helper's next job is the fine band of the region whose coarse band it cast.
-    b.done(*stolen, 50, 0.01);
+    b.done(*stolen, 0.01);
     const auto next = b.next_for(2);
     ASSERT_TRUE(next);
     // One coarse job is still queued (region 1 or 2): it goes before any fine job.
     EXPECT_EQ(b.job(*next).band, Band::coarse);
-    b.done(*next, 50, 0.01);
+    b.done(*next, 0.01);
     const auto fine = b.next_for(2);
     ASSERT_TRUE(fine);
     EXPECT_EQ(b.job(*fine).band, Band::fine);
@@ -107,11 +107,11 @@ TEST(JobBoard, AJobLandsWhenDoneAndDeliveredInEitherOrder) {
     EXPECT_FALSE(b.next_for(1));
     b.landed(*a);  // the owner's word can come before the helper's
     EXPECT_FALSE(b.complete());
-    b.done(*a, 10, 0.001);
+    b.done(*a, 0.001);
     const auto c = b.next_for(2);
     ASSERT_TRUE(c);
     EXPECT_EQ(b.job(*c).band, Band::fine);
-    b.done(*c, 90, 0.002);
+    b.done(*c, 0.002);
     EXPECT_FALSE(b.complete()) << "the helper's fine band has not landed";
     b.landed(*c);
     EXPECT_TRUE(b.complete());
@@ -123,8 +123,8 @@ TEST(JobBoard, ARankHelpsTheBusiestTileBeforeItsOwnCheapJobs) {
     const auto one = b.next_for(1);
     const auto two = b.next_for(2);
     ASSERT_TRUE(one && two);
-    b.done(*one, 6, 0.5);
-    b.done(*two, 6, 0.001);
+    b.done(*one, 0.5);
+    b.done(*two, 0.001);
     const auto next = b.next_for(2);
     ASSERT_TRUE(next);
     EXPECT_EQ(b.job(*next).owner, 1);
@@ -133,12 +133,12 @@ TEST(JobBoard, ARankHelpsTheBusiestTileBeforeItsOwnCheapJobs) {
 
 TEST(JobBoard, ReportsOutOfTurnThrow) {
     JobBoard b = board_of({0, 1, 0}, true, 2);
-    EXPECT_THROW(b.done(0, 1, 0.1), std::runtime_error) << "not handed out";
+    EXPECT_THROW(b.done(0, 0.1), std::runtime_error) << "not handed out";
     const auto own = b.next_for(1);
     ASSERT_TRUE(own);
     EXPECT_THROW(b.landed(*own), std::runtime_error) << "the owner's own job has no helper";
-    b.done(*own, 1, 0.1);
-    EXPECT_THROW(b.done(*own, 1, 0.1), std::runtime_error) << "done twice";
+    b.done(*own, 0.1);
+    EXPECT_THROW(b.done(*own, 0.1), std::runtime_error) << "done twice";
     EXPECT_THROW(b.next_for(7), std::out_of_range);
 }
 
@@ -148,7 +148,7 @@ TEST(JobBoard, StealsFromTheTileWithTheMostWorkLeft) {
     const auto id = b.next_for(3);
     ASSERT_TRUE(id);
     EXPECT_EQ(b.job(*id).owner, 2);
-    b.done(*id, 100, 0.01);
+    b.done(*id, 0.01);
     b.landed(*id);
     // Every job is handed out exactly once.
     std::set<std::uint32_t> seen{*id};
@@ -156,7 +156,7 @@ TEST(JobBoard, StealsFromTheTileWithTheMostWorkLeft) {
         for (int rank = 1; rank <= 3; ++rank)
             if (auto j = b.next_for(rank)) {
                 EXPECT_TRUE(seen.insert(*j).second);
-                b.done(*j, 100, 0.01);
+                b.done(*j, 0.01);
                 if (b.job(*j).worker != b.job(*j).owner) b.landed(*j);
             }
     EXPECT_EQ(seen.size(), b.size());

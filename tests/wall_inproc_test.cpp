@@ -226,6 +226,7 @@ TEST(WallBalance, BalancedAndStaticMosaicsAreEqual) {
         const WallOptions s =
             balance_wall(test::scratch_dir("balance_static_" + name), false, one_tile);
         WallOptions b = balance_wall(test::scratch_dir("balance_on_" + name), true, one_tile);
+        b.region = "auto";  // the default: regions planned from the work, two frames of them
         b.measure = true;
         b.trace = (std::filesystem::path(b.out).parent_path() / "trace").string();
         const WallRun rs = run_wall_in_process(s);
