@@ -34,12 +34,12 @@ struct WallOptions {
     std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
     std::vector<float> orbit, pan;   // the first view: yaw pitch; dx dy (empty: none)
     float zoom = 1;
-    bool balance = true;            // the screen-region scheduler migrates jobs
+    bool balance = true;  // the screen-region scheduler migrates jobs
     // "auto": regions planned from the work (master/region_plan.h); WxH a fixed grid, or "tile"
     std::string region = "auto";
-    bool measure = false;           // emulated wall-wide correctness curves
-    bool windows = false;           // each tile shows its frame in a window on its display
-    bool region_clip = true;        // propagation stays within each job's region
+    bool measure = false;     // emulated wall-wide correctness curves
+    bool windows = false;     // each tile shows its frame in a window on its display
+    bool region_clip = true;  // propagation stays within each job's region
     // Where a tile rank reads a store given as --volume: "auto", from its own host when the
     // folder is there, else from the master over the wall's messages; "master", always from the
     // master (to try a cluster's set-up on one machine).
