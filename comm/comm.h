@@ -54,6 +54,11 @@ class Comm {
     // Hands the bytes over and returns without waiting for the peer to take them (they are
     // copied); messages to one peer arrive in the order sent.
     virtual void send(int dest, Tag tag, std::span<const std::byte> bytes) = 0;
+    // The same, handing over bytes the transport may keep instead of copying (a region result is
+    // hundreds of kilobytes; a fresh copy of it costs page faults as well as the copy).
+    virtual void send(int dest, Tag tag, std::vector<std::byte>&& bytes) {
+        send(dest, tag, std::span<const std::byte>(bytes));
+    }
     // The next message from `source` (any rank when source < 0), waiting at most timeout_s
     // (0: only look, kForever: block); nullopt when none came in time.
     virtual std::optional<Envelope> receive(int source, double timeout_s) = 0;

@@ -17,6 +17,9 @@ class InProcComm final : public Comm {
     void send(int dest, Tag tag, std::span<const std::byte> bytes) override {
         world_.post(dest, Envelope{rank_, tag, std::vector<std::byte>(bytes.begin(), bytes.end())});
     }
+    void send(int dest, Tag tag, std::vector<std::byte>&& bytes) override {
+        world_.post(dest, Envelope{rank_, tag, std::move(bytes)});
+    }
     std::optional<Envelope> receive(int source, double timeout_s) override {
         return world_.take(rank_, source, timeout_s);
     }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -31,6 +32,11 @@ namespace {
 // Waiting polls with a short sleep instead of blocking in MPI_Probe: Open MPI spins inside a
 // blocking call, and with 25 ranks on 2 cores a spinning idle rank steals the busy ranks' core.
 constexpr auto kPollSleep = std::chrono::microseconds(200);
+// A receive sleeps longer the longer nothing has come (an eighth of the quiet time, up to this):
+// each poll costs a lock, an MPI_Iprobe and a wake-up, and a rank that waits a whole frame for
+// its next job polled 5,000 times a second at kPollSleep (issue 33: the communication thread took
+// a third of a tile rank's CPU). While messages flow, the sleep stays at kPollSleep.
+constexpr auto kPollSleepMax = std::chrono::microseconds(2000);
 // How long a rank that ends waits for its last sends to be taken.
 constexpr auto kFinalSendWait = std::chrono::seconds(10);
 
@@ -166,9 +172,12 @@ class MpiComm final : public Comm {
     // for a peer that is scheduled late (with 25 ranks on 2 cores, tens of milliseconds).
     // Messages to one peer still arrive in order (MPI does not let them overtake).
     void send(int dest, Tag tag, std::span<const std::byte> bytes) override {
+        send(dest, tag, std::vector<std::byte>(bytes.begin(), bytes.end()));
+    }
+    void send(int dest, Tag tag, std::vector<std::byte>&& bytes) override {
         std::lock_guard lock(mutex_);
         PendingSend& p = pending_.emplace_back();
-        p.bytes.assign(bytes.begin(), bytes.end());
+        p.bytes = std::move(bytes);
         ISOWALL_MPI_CALL(MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, dest,
                                    static_cast<int>(tag), comm_, &p.request));
         progress_sends();
@@ -183,13 +192,18 @@ class MpiComm final : public Comm {
                 MPI_Status status;
                 ISOWALL_MPI_CALL(MPI_Iprobe(source < 0 ? MPI_ANY_SOURCE : source, MPI_ANY_TAG,
                                             comm_, &flag, &status));
-                if (flag) return take(status);
+                if (flag) {
+                    last_message_ = std::chrono::steady_clock::now();
+                    return take(status);
+                }
                 progress_sends();
             }
-            const double waited =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            const auto now = std::chrono::steady_clock::now();
+            const double waited = std::chrono::duration<double>(now - start).count();
             if (waited >= timeout_s) return std::nullopt;
-            std::this_thread::sleep_for(kPollSleep);
+            const auto quiet =
+                std::chrono::duration_cast<std::chrono::microseconds>(now - last_message_.load());
+            std::this_thread::sleep_for(std::clamp(quiet / 8, kPollSleep, kPollSleepMax));
         }
     }
 
@@ -252,6 +266,9 @@ class MpiComm final : public Comm {
 
     MpiLimits limits_;
     mutable std::mutex mutex_;
+    // When this rank last received a message (receive's sleep grows with the quiet since).
+    std::atomic<std::chrono::steady_clock::time_point> last_message_{
+        std::chrono::steady_clock::now()};
     std::list<PendingSend> pending_;
     MPI_Comm comm_ = MPI_COMM_NULL;
     int rank_ = 0;

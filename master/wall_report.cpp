@@ -9,8 +9,31 @@ WallFigures wall_figures(const std::vector<TileResultMsg>& results) {
     WallFigures f;
     std::size_t tiles = 0;
     for (std::size_t rank = 1; rank < results.size(); ++rank, ++tiles) {
-        f.makespan_s = std::max(f.makespan_s, results[rank].cpu_s);
-        f.total_s += results[rank].cpu_s;
+        const TileResultMsg& r = results[rank];
+        f.makespan_s = std::max(f.makespan_s, r.cpu_s);
+        f.total_s += r.cpu_s;
+        double comm = 0, other = 0;
+        for (const TraceSpan& sp : r.spans) {
+            const auto stage = static_cast<Stage>(sp.stage);
+            if (stage == Stage::comm) comm += sp.cpu_s;
+            if (stage == Stage::send) f.send_s += sp.cpu_s;
+            if (stage == Stage::idle || stage == Stage::io) other += sp.cpu_s;
+        }
+        const double all = r.cpu_s + comm + other;
+        f.all_makespan_s = std::max(f.all_makespan_s, all);
+        f.all_total_s += all;
+        f.comm_s += comm;
+    }
+    // The share of communication in a rank's busy CPU, over the ranks that did work (a tenth of
+    // the makespan or more: a rank with nothing to do has nothing to compare its waits with).
+    for (std::size_t rank = 1; rank < results.size(); ++rank) {
+        const TileResultMsg& r = results[rank];
+        if (r.cpu_s < 0.1 * f.makespan_s || r.cpu_s <= 0) continue;
+        double comm = 0;
+        for (const TraceSpan& sp : r.spans)
+            if (static_cast<Stage>(sp.stage) == Stage::comm) comm += sp.cpu_s;
+        if (comm / r.cpu_s > f.comm_share_max)
+            f.comm_share_max = comm / r.cpu_s, f.comm_rank = rank;
     }
     f.balance = tiles ? f.total_s / double(tiles) / std::max(f.makespan_s, 1e-9) : 0;
     return f;
@@ -40,6 +63,12 @@ void print_rank_table(std::FILE* out, const WallSpec& spec,
     const WallFigures f = wall_figures(results);
     std::fprintf(out, "makespan %.3f s (CPU), total %.3f s, balance %.2f (mean/max)\n",
                  f.makespan_s, f.total_s, f.balance);
+    std::fprintf(out,
+                 "every thread (busy, communication, idle waits, pager): makespan %.3f s, total "
+                 "%.3f s; communication %.3f s, at most %.0f%% of a rank's busy CPU (rank %zu); "
+                 "region results sent (in busy) %.3f s\n",
+                 f.all_makespan_s, f.all_total_s, f.comm_s, 100.0 * f.comm_share_max, f.comm_rank,
+                 f.send_s);
 }
 
 std::vector<WallCurvePoint> wall_curve(const std::vector<TileResultMsg>& results) {

@@ -35,6 +35,14 @@ struct WallFigures {
     double makespan_s = 0;  // the largest CPU time of any tile's frame thread
     double total_s = 0;
     double balance = 0;  // mean / max
+    // Every thread of each tile rank: its busy CPU plus what its communication (the frame
+    // thread's message handling and the communication thread), its idle waits and the volume's
+    // pager spent (the trace's comm, idle and io stages).
+    double all_makespan_s = 0, all_total_s = 0;
+    double comm_s = 0;          // the comm stage, all tile ranks
+    double send_s = 0;          // the send stage (region results; part of busy), all tile ranks
+    double comm_share_max = 0;  // the largest comm / busy CPU of a tile rank that worked
+    std::size_t comm_rank = 0;  // that rank
 };
 
 // results[rank] for ranks 1..T (index 0, the master, is unused).

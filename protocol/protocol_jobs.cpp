@@ -123,6 +123,7 @@ JobDoneMsg job_wire::decode_job_done(std::span<const std::byte> bytes) {
 
 std::vector<std::byte> encode(const RegionMsg& m) {
     MessageWriter w(RegionMsg::kVersion);
+    w.reserve(64 + m.rgba.size() + 4 * m.depth.size());  // one allocation for the pixels
     w.put(m.generation);
     w.put(m.job);
     put_pixel_rect(w, m.rect);

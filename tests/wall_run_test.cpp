@@ -166,10 +166,12 @@ TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
 TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView) {
     const auto dir = test::scratch_dir("wall_script");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
-    // The change comes after 200 rays of a 76,800-ray frame: every tile is still casting.
+    // The change comes after 200 rays of a 76,800-ray frame: every tile is still casting. One
+    // region per tile, so that every rank is inside a job when it comes (with the regions planned
+    // from the work, a rank may be between two small jobs then, and has nothing to cut short).
     std::ofstream(dir / "script.txt")
         << "wait rays 200\norbit 60 -20\niso 160\nwait done\nsnapshot last\nquit\n";
-    ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --script '" +
+    ASSERT_EQ(run(mpirun(5) + "wall --region tile --wall '" + (dir / "2x2.toml").string() + "' --script '" +
                       (dir / "script.txt").string() + "' --out '" + (dir / "mosaic.png").string() +
                       "' --trace '" + (dir / "trace").string() + "'",
                   dir / "wall.log"),
@@ -339,7 +341,7 @@ TEST(WallRun, BadInputEndsEveryRank) {
          "iso.txt:1: iso: isovalue 999"},
         {"a timeout that is not a number", mpirun(5) + wall + " --timeout nan",
          "--timeout: expected a number in (0, 1e+06], got \"nan\""},
-        {"an empty region", mpirun(5) + wall + " --region 0x48", "--region: expected WxH"},
+        {"an empty region", mpirun(5) + wall + " --region 0x48", "--region: expected auto, WxH"},
         {"a balance that is neither on nor off", mpirun(5) + wall + " --balance maybe",
          "--balance"},
         {"a pan that is not a number", mpirun(5) + wall + " --pan nan 0",

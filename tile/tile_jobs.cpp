@@ -177,7 +177,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     return out;
 }
 
-void TileJobs::land(const RegionMsg& m) {
+void TileJobs::land(RegionMsg m) {
     const double c0 = thread_cpu_seconds();
     if (m.rect.x < 0 || m.rect.y < 0 || m.rect.x + m.rect.width > own_.width ||
         m.rect.y + m.rect.height > own_.height)
@@ -186,8 +186,8 @@ void TileJobs::land(const RegionMsg& m) {
     Image img;
     img.width = m.rect.width;
     img.height = m.rect.height;
-    img.rgba = m.rgba;
-    img.depth = m.depth;
+    img.rgba = std::move(m.rgba);
+    img.depth = std::move(m.depth);
     composite_by_depth(landed_, img, m.rect);
     landed_any_ = true;
     busy_cpu_s_ += thread_cpu_seconds() - c0;

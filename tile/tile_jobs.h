@@ -55,7 +55,7 @@ class TileJobs {
 
     // A helper's result for this rank's tile, composited by depth into what the tile shows.
     // Throws WireError when the rect is not inside the tile.
-    void land(const RegionMsg& m);
+    void land(RegionMsg m);
 
     // What the tile shows now: its own drawing with every landed result over it.
     Image image();

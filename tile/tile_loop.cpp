@@ -1,9 +1,12 @@
 #include "tile/tile_loop.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -37,6 +40,15 @@ class Receiver {
     ~Receiver() {
         ending_ = true;
         thread_.join();
+    }
+
+    // The CPU seconds this thread has used so far (its clock read from the frame thread).
+    double cpu_s() {
+        clockid_t id;
+        timespec ts{};
+        if (pthread_getcpuclockid(thread_.native_handle(), &id) != 0 || clock_gettime(id, &ts) != 0)
+            return 0;
+        return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
     }
 
   private:
@@ -130,6 +142,7 @@ class TileRank {
             std::optional<Message> m = inbox_.pop();
             trace_.switch_to(Stage::comm);
             charge_io();
+            charge_comm(receiver);
             if (!m) {
                 // snapshot requests only: answered below
             } else if (auto* v = std::get_if<ViewMsg>(&*m)) {
@@ -165,6 +178,14 @@ class TileRank {
         const double now = setup_.io_cpu_s();
         trace_.charge(Stage::io, now - io_charged_s_);
         io_charged_s_ = now;
+    }
+
+    // What the communication thread spent since the last charge, into the trace's comm stage:
+    // every CPU second of the rank is counted, not only the frame thread's.
+    void charge_comm(Receiver& r) {
+        const double now = r.cpu_s();
+        trace_.charge(Stage::comm, now - comm_charged_s_);
+        comm_charged_s_ = now;
     }
 
     EngineOptions options() {
@@ -224,6 +245,9 @@ class TileRank {
         // Jobs of an older frame are dropped: the master no longer counts on them.
         if (!jobs_.started() || j.generation != jobs_.generation()) return;
         if (j.owner != comm_.rank()) raise_test_signal(setup_.fault, FaultMoment::migration);
+        // A job starts by setting up its region (the help image and the groups that may show in
+        // it: render work) before the engine's stages take over.
+        trace_.switch_to(Stage::render);
         TileJobs::Outcome out = jobs_.run(j, comm_.rank());
         trace_.switch_to(Stage::comm);
         if (!out.completed) {
@@ -231,13 +255,15 @@ class TileRank {
             return;
         }
         if (out.result) {
+            trace_.switch_to(Stage::send);
             const double c0 = thread_cpu_seconds();
-            const auto bytes = encode(*out.result);
+            auto bytes = encode(*out.result);
             out.done.bytes = bytes.size();
             result_.bytes_sent += bytes.size();
-            comm_.send(j.owner, Tag::region, bytes);
+            comm_.send(j.owner, Tag::region, std::move(bytes));
             ++result_.jobs_helped;
             jobs_.add_busy(thread_cpu_seconds() - c0);  // sending is part of the job
+            trace_.switch_to(Stage::comm);
         } else {
             ++result_.jobs_own;
         }
@@ -253,8 +279,11 @@ class TileRank {
             return;
         }
         if (r.generation != jobs_.generation()) return;
-        jobs_.land(r);
-        send_message(comm_, kMasterRank, LandedMsg{r.generation, r.job});
+        const LandedMsg landed{r.generation, r.job};
+        trace_.switch_to(Stage::compose);
+        jobs_.land(std::move(r));
+        trace_.switch_to(Stage::comm);
+        send_message(comm_, kMasterRank, landed);
         changed(/*in_job=*/false);
     }
 
@@ -345,7 +374,7 @@ class TileRank {
     std::vector<Shown> shows_;
     Stopwatch shown_clock_;
     double cpu0_ = 0, last_progress_s_ = -1;
-    double io_charged_s_ = 0;
+    double io_charged_s_ = 0, comm_charged_s_ = 0;
     bool interrupted_ = false;
 };
 

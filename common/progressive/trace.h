@@ -22,9 +22,13 @@ struct TraceSpan {
 
 // show: presenting the frame in a window or as a preview as it builds (not part of the emulated
 // busy time). io: a store's pager threads reading bricks for this rank (common/store/
-// paged_voxels.h); charged as CPU without wall time, since they run beside the frame.
-inline constexpr const char* kTraceStages[] = {
-    "intersection", "propagation", "render", "comm", "idle", "compose", "setup", "show", "io"};
+// paged_voxels.h); charged as CPU without wall time, since they run beside the frame. send: a
+// helper encoding and sending a region result to its owner (communication, and part of the job:
+// the owner shows nothing of it before). comm: every other message, the communication thread's
+// CPU included (charged like io).
+inline constexpr const char* kTraceStages[] = {"intersection", "propagation", "render", "comm",
+                                               "idle",         "compose",     "setup",  "show",
+                                               "send",         "io"};
 enum class Stage : std::uint8_t {
     intersection,
     propagation,
@@ -34,6 +38,7 @@ enum class Stage : std::uint8_t {
     compose,
     setup,
     show,
+    send,
     io
 };
 
