@@ -171,11 +171,12 @@ TEST(WallRun, ScriptedChangeMidFrameInterruptsEveryRankAndTheMosaicIsTheLastView
     // from the work, a rank may be between two small jobs then, and has nothing to cut short).
     std::ofstream(dir / "script.txt")
         << "wait rays 200\norbit 60 -20\niso 160\nwait done\nsnapshot last\nquit\n";
-    ASSERT_EQ(run(mpirun(5) + "wall --region tile --wall '" + (dir / "2x2.toml").string() + "' --script '" +
-                      (dir / "script.txt").string() + "' --out '" + (dir / "mosaic.png").string() +
-                      "' --trace '" + (dir / "trace").string() + "'",
-                  dir / "wall.log"),
-              0)
+    ASSERT_EQ(
+        run(mpirun(5) + "wall --region tile --wall '" + (dir / "2x2.toml").string() +
+                "' --script '" + (dir / "script.txt").string() + "' --out '" +
+                (dir / "mosaic.png").string() + "' --trace '" + (dir / "trace").string() + "'",
+            dir / "wall.log"),
+        0)
         << slurp(dir / "wall.log");
     ASSERT_EQ(run(isowall_cmd() +
                       "render --size 320x240 --orbit 60 -20 --iso 160 -q --no-measure --out '" +
