@@ -158,12 +158,6 @@ std::string WallMaster::waiting_on() const {
     return list.empty() ? "all tiles" : list;
 }
 
-std::uint64_t WallMaster::total_rays() const {
-    std::uint64_t n = 0;
-    for (const TileState& t : tiles_) n += t.rays;
-    return n;
-}
-
 void WallMaster::start() {
     // Tiles load the volume and build their renderer before their hello: a start-up of its own
     // length, so a short --timeout for a running wall does not cut a slow load short.
@@ -200,6 +194,7 @@ void WallMaster::print_map() const {
 // ignored, cuts the screen into jobs and hands every rank its first ones.
 void WallMaster::send_views() {
     const Stage left = trace_.switch_to(Stage::comm);
+    if (board_ && board_->complete()) completed_.push_back(generation_);
     ++generation_;
     const Camera cam = fit_depth_range(camera_, bounds_);
     const Frustum wall = cam.frustum(aspect_);
@@ -388,6 +383,7 @@ void WallMaster::report(OutputFiles& batch) {
     for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
     print_rank_table(stdout, spec_, results);
     print_scheduler(stdout, o_.balance, frame_done(), *board_, migrations_, results);
+    print_earlier_frames(stdout, results, completed_);
     if (o_.results_out) *o_.results_out = results;
     trace_.close();
     print_stage_table(stdout, trace_.spans(), results);

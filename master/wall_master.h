@@ -76,7 +76,11 @@ class WallMaster {
     int finish();
 
     std::uint64_t generation() const { return generation_; }
-    std::uint64_t total_rays() const;
+    std::uint64_t total_rays() const {
+        std::uint64_t n = 0;
+        for (const TileState& t : tiles_) n += t.rays;
+        return n;
+    }
     // Every tile has finished the current frame.
     bool frame_done() const { return board_ && board_->complete(); }
     double iso() const { return iso_; }
@@ -140,8 +144,9 @@ class WallMaster {
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;
     TraceRecorder trace_;
-    std::optional<JobBoard> board_;      // the current generation's jobs
-    std::vector<Migration> migrations_;  // of the current generation
+    std::optional<JobBoard> board_;         // the current generation's jobs
+    std::vector<Migration> migrations_;     // of the current generation
+    std::vector<std::uint64_t> completed_;  // generations before the current one that completed
     RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
     Stopwatch alive_sent_, alive_checked_;
     std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on

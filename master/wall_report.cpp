@@ -104,6 +104,31 @@ double time_to(const std::vector<WallCurvePoint>& curve, double level, bool fina
     return -1;
 }
 
+void print_earlier_frames(std::FILE* out, const std::vector<TileResultMsg>& results,
+                          const std::vector<std::uint64_t>& completed) {
+    for (const std::uint64_t g : completed) {
+        // The frame's curves, as if they were the last frame's: wall_curve merges them.
+        std::vector<TileResultMsg> frame(results.size());
+        bool all = true;
+        for (std::size_t rank = 1; rank < results.size(); ++rank) {
+            const auto& e = results[rank].earlier;
+            const auto it = std::find_if(e.begin(), e.end(),
+                                         [&](const FrameCurve& f) { return f.generation == g; });
+            if (it == e.end()) {
+                all = false;
+                break;
+            }
+            frame[rank].significant = it->significant;
+            frame[rank].curve = it->points;
+        }
+        const auto curve = all ? wall_curve(frame) : std::vector<WallCurvePoint>{};
+        if (curve.empty()) continue;
+        std::fprintf(out, "frame %llu: emulated C = 90/99/100%%: %.3f / %.3f / %.3f s\n",
+                     (unsigned long long)g, time_to(curve, 0.9, false), time_to(curve, 0.99, false),
+                     time_to(curve, 1.0, false));
+    }
+}
+
 void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
                      const std::vector<Migration>& migrations,
                      const std::vector<TileResultMsg>& results) {

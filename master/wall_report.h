@@ -56,6 +56,11 @@ void print_rank_table(std::FILE* out, const WallSpec& spec,
 void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
                      const std::vector<Migration>& migrations,
                      const std::vector<TileResultMsg>& results);
+// With curves of earlier frames (--measure over several views): for each frame in `completed`
+// (generations whose every job landed), the emulated time to wall-wide C = 90/99/100% of that
+// frame, one line each: `frame G: emulated C = 90/99/100%: A / B / C s`.
+void print_earlier_frames(std::FILE* out, const std::vector<TileResultMsg>& results,
+                          const std::vector<std::uint64_t>& completed);
 // CPU seconds by stage, one row per rank (the master's first).
 void print_stage_table(std::FILE* out, const std::vector<TraceSpan>& master,
                        const std::vector<TileResultMsg>& results);

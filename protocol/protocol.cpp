@@ -173,6 +173,29 @@ static QuitMsg decode_quit(std::span<const std::byte> bytes) {
     return {};
 }
 
+static void put_curve(MessageWriter& w, const std::vector<CurvePoint>& curve) {
+    w.put(static_cast<std::uint64_t>(curve.size()));
+    for (const CurvePoint& c : curve) {
+        w.put(c.emulated_s);
+        w.put(c.final_px);
+        w.put(c.squared_error);
+    }
+}
+
+static std::vector<CurvePoint> get_curve(MessageReader& r) {
+    const std::size_t points = r.get_count(3 * 8);  // checked before the reserve
+    std::vector<CurvePoint> curve;
+    curve.reserve(points);
+    for (std::size_t i = 0; i < points; ++i) {
+        CurvePoint c;
+        c.emulated_s = get_finite<double>(r, "curve.emulated_s");
+        c.final_px = r.get<std::uint64_t>();
+        c.squared_error = get_finite<double>(r, "curve.squared_error");
+        curve.push_back(c);
+    }
+    return curve;
+}
+
 std::vector<std::byte> encode(const TileResultMsg& m) {
     MessageWriter w(TileResultMsg::kVersion);
     w.put_string(m.host);
@@ -188,11 +211,12 @@ std::vector<std::byte> encode(const TileResultMsg& m) {
     w.put(m.jobs_helped);
     w.put(m.bytes_sent);
     w.put(m.significant);
-    w.put(static_cast<std::uint64_t>(m.curve.size()));
-    for (const CurvePoint& c : m.curve) {
-        w.put(c.emulated_s);
-        w.put(c.final_px);
-        w.put(c.squared_error);
+    put_curve(w, m.curve);
+    w.put(static_cast<std::uint64_t>(m.earlier.size()));
+    for (const FrameCurve& f : m.earlier) {
+        w.put(f.generation);
+        w.put(f.significant);
+        put_curve(w, f.points);
     }
     w.put(static_cast<std::uint64_t>(m.spans.size()));
     for (const TraceSpan& s : m.spans) put_trace_span(w, s);
@@ -215,14 +239,15 @@ static TileResultMsg decode_tile_result(std::span<const std::byte> bytes) {
     m.jobs_helped = r.get<std::uint64_t>();
     m.bytes_sent = r.get<std::uint64_t>();
     m.significant = r.get<std::uint64_t>();
-    const std::size_t points = r.get_count(3 * 8);  // checked before the reserve
-    m.curve.reserve(points);
-    for (std::size_t i = 0; i < points; ++i) {
-        CurvePoint c;
-        c.emulated_s = get_finite<double>(r, "curve.emulated_s");
-        c.final_px = r.get<std::uint64_t>();
-        c.squared_error = get_finite<double>(r, "curve.squared_error");
-        m.curve.push_back(c);
+    m.curve = get_curve(r);
+    const std::size_t frames = r.get_count(3 * 8);  // checked before the reserve
+    m.earlier.reserve(frames);
+    for (std::size_t i = 0; i < frames; ++i) {
+        FrameCurve f;
+        f.generation = r.get<std::uint64_t>();
+        f.significant = r.get<std::uint64_t>();
+        f.points = get_curve(r);
+        m.earlier.push_back(std::move(f));
     }
     const std::size_t n = r.get_count(kTraceSpanWireBytes);  // checked before the reserve
     m.spans.reserve(n);

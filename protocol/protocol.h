@@ -95,9 +95,17 @@ struct CurvePoint {
     double squared_error = 0;    // sum over significant pixels of e(P)^2
 };
 
+// A frame before the last, measured (--measure) on one tile: its curve against that frame's final
+// image, kept when the next view came (the master uses those of frames it knows were complete).
+struct FrameCurve {
+    std::uint64_t generation = 0;
+    std::uint64_t significant = 0;
+    std::vector<CurvePoint> points;
+};
+
 struct TileResultMsg {
     static constexpr Tag kTag = Tag::tile_result;
-    static constexpr std::uint8_t kVersion = 3;
+    static constexpr std::uint8_t kVersion = 4;
     std::string host;
     double cpu_s = 0;    // the frame thread's CPU seconds, all frames
     double frame_s = 0;  // wall seconds of all frames
@@ -107,6 +115,7 @@ struct TileResultMsg {
     std::uint64_t bytes_sent = 0;                 // region results sent to other tiles
     std::uint64_t significant = 0;                // covered pixels of the last frame's final image
     std::vector<CurvePoint> curve;                // empty unless measured (--measure)
+    std::vector<FrameCurve> earlier;              // the earlier frames' curves (--measure)
     std::vector<TraceSpan> spans;
 };
 

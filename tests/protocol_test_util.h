@@ -43,6 +43,9 @@ inline bool operator==(const CurvePoint& a, const CurvePoint& b) {
     return a.emulated_s == b.emulated_s && a.final_px == b.final_px &&
            a.squared_error == b.squared_error;
 }
+inline bool operator==(const FrameCurve& a, const FrameCurve& b) {
+    return a.generation == b.generation && a.significant == b.significant && a.points == b.points;
+}
 inline bool operator==(const TraceSpan& a, const TraceSpan& b) {
     return a.stage == b.stage && a.start_s == b.start_s && a.wall_s == b.wall_s &&
            a.cpu_s == b.cpu_s;
@@ -72,7 +75,7 @@ inline bool operator==(const TileResultMsg& a, const TileResultMsg& b) {
            a.triangles == b.triangles && a.frames == b.frames && a.interrupted == b.interrupted &&
            a.jobs_own == b.jobs_own && a.jobs_helped == b.jobs_helped &&
            a.bytes_sent == b.bytes_sent && a.significant == b.significant && a.curve == b.curve &&
-           a.spans == b.spans;
+           a.earlier == b.earlier && a.spans == b.spans;
 }
 inline bool operator==(const ReleaseMsg&, const ReleaseMsg&) {
     return true;
@@ -297,6 +300,7 @@ inline TileResultMsg sample_tile_result() {
     m.bytes_sent = 1u << 30;
     m.significant = 209000;
     m.curve = {{0.125, 1000, 512.5}, {0.5, 208000, 3.25}};
+    m.earlier = {{1, 207000, {{0.25, 5, 100.5}}}, {2, 0, {}}};
     const std::uint8_t last_stage = std::size(kTraceStages) - 1;
     m.spans = {
         {0, 1.7e9, 0.5, 0.25}, {3, 1.7e9 + 0.5, 0.125, 0.0625}, {last_stage, 1.7e9 + 1, 2, 1}};

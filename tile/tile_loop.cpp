@@ -208,6 +208,7 @@ class TileRank {
         if (setup_.fault.action == FaultAction::throw_error)
             throw std::runtime_error("test fault: a tile throws");
         raise_test_signal(setup_.fault, FaultMoment::frame);
+        keep_curve();
         close_frame();
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             if (setup_.fault.action == FaultAction::slow)
@@ -227,6 +228,18 @@ class TileRank {
         cpu0_ = thread_cpu_seconds();
         ++result_.frames;
         land_early();
+    }
+
+    // With --measure, the curve of the frame a new view ends against what the tile shows now (final
+    // when the master saw the frame complete, the only ones it uses); outside every figure.
+    void keep_curve() {
+        if (!setup_.measure || !jobs_.started()) return;
+        const Stage left = trace_.switch_to(Stage::setup);
+        FrameCurve f;
+        f.generation = jobs_.generation();
+        f.points = jobs_.curve(f.significant);
+        result_.earlier.push_back(std::move(f));
+        trace_.switch_to(left);
     }
 
     // The figures of the frame that ends (a new view or quit).
