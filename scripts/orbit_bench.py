@@ -7,6 +7,7 @@ that makes at C = 99%.
 
 Usage: scripts/orbit_bench.py [--build build] [--data ../shared/data] [--out out/orbit]
                               [--volume FILE --iso V] [--steps 36] [--step-deg 10]
+                              [--wall walls/6x4.toml]
 
 Each step waits for the frame to finish ("orbit D 0", "wait done"), so every step's curve is
 measured against its complete picture: a step that interrupted the last would leave no complete
@@ -29,7 +30,15 @@ FRAME = re.compile(r"^frame (\d+): emulated C = 90/99/100%: (\S+) / (\S+) / (\S+
 LAST = re.compile(r"C = 90/99/100%: (\S+) / (\S+) / (\S+) s; final pixels")
 
 
-def run(isowall, volume, iso, steps, step_deg, balance, out_dir):
+def ranks_needed(isowall, wall):
+    proc = subprocess.run([isowall, "wall", "--wall", wall, "--ranks-needed"], capture_output=True,
+                          text=True)
+    if proc.returncode != 0 or not proc.stdout.strip().isdigit():
+        sys.exit(f"orbit_bench: error: --wall: {proc.stderr.strip() or proc.stdout.strip()}")
+    return proc.stdout.strip()
+
+
+def run(isowall, wall, volume, iso, steps, step_deg, balance, out_dir):
     script = os.path.join(out_dir, "orbit_script.txt")
     with open(script, "w") as f:
         f.write("wait done\n")
@@ -37,8 +46,8 @@ def run(isowall, volume, iso, steps, step_deg, balance, out_dir):
             f.write(f"orbit {step_deg} 0\nwait done\n")
         f.write("quit\n")
     mode = "balanced" if balance else "static"
-    cmd = ["mpirun", "--oversubscribe", "-np", "25", "-x", "LP_NUM_THREADS=0", isowall, "wall",
-           "--wall", WALL, "-v", volume, "--iso", str(iso), "--measure", "--script", script,
+    cmd = ["mpirun", "--oversubscribe", "-np", ranks_needed(isowall, wall), "-x",
+           "LP_NUM_THREADS=0", isowall, "wall", "--wall", wall, "-v", volume, "--iso", str(iso), "--measure", "--script", script,
            "--balance", "on" if balance else "off",
            "--out", os.path.join(out_dir, f"orbit_{mode}.png")]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -62,7 +71,7 @@ def run(isowall, volume, iso, steps, step_deg, balance, out_dir):
     return out
 
 
-def plot(rows, path, volume):
+def plot(rows, path, volume, wall):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -74,18 +83,23 @@ def plot(rows, path, volume):
         ax.plot(steps, [r["c99"] for r in mine], marker="o", color=colour, label=f"{mode} C=99%")
         ax.plot(steps, [r["c90"] for r in mine], linestyle="--", color=colour,
                 label=f"{mode} C=90%")
-    ax.set_xlabel("step (each turns the view 10 degrees; the frame runs to its end)")
+    ax.set_xlabel("step (each turns the view; the frame runs to its end)")
     ax.set_ylabel("emulated s after the step")
     ax.set_yscale("log")
-    ax.set_title(f"6x4 wall, {volume}: time to wall-wide correctness after each step")
+    ax.set_title(f"{wall}, {volume}: time to wall-wide correctness after each step")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
 
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line and status 1, as every bad option of isowall
+        sys.exit(f"orbit_bench: error: {message}")
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = Parser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "orbit"))
@@ -93,20 +107,23 @@ def main():
     ap.add_argument("--iso", type=float)
     ap.add_argument("--steps", type=int, default=36)
     ap.add_argument("--step-deg", type=float, default=10)
+    ap.add_argument("--wall", default=WALL)
     a = ap.parse_args()
     if a.steps < 2:
-        sys.exit("orbit_bench: --steps: expected 2 or more")
+        sys.exit("orbit_bench: error: --steps: expected 2 or more")
     if not a.step_deg > 0 or a.step_deg > 180:
-        sys.exit("orbit_bench: --step-deg: expected more than 0, at most 180")
+        sys.exit("orbit_bench: error: --step-deg: expected more than 0, at most 180")
     if (a.volume is None) != (a.iso is None):
-        sys.exit("orbit_bench: --volume and --iso go together")
+        sys.exit("orbit_bench: error: --volume and --iso go together")
     volume = a.volume or os.path.join(a.data, "vhp_ct_head.nhdr")
     iso = a.iso if a.iso is not None else 40
     if not os.path.exists(volume):
-        sys.exit(f"orbit_bench: --volume: no such file {volume}")
+        sys.exit(f"orbit_bench: error: --volume: no such file {volume}")
     isowall = os.path.join(a.build, "bin", "isowall")
     if not os.path.exists(isowall):
-        sys.exit(f"orbit_bench: --build: no {isowall} (build first)")
+        sys.exit(f"orbit_bench: error: --build: no {isowall} (build first)")
+    if not os.path.isfile(a.wall):
+        sys.exit(f"orbit_bench: error: --wall: no such file {a.wall}")
     os.makedirs(a.out, exist_ok=True)
     name = os.path.basename(volume).split(".")[0]
 
@@ -114,13 +131,14 @@ def main():
     for balance in (False, True):
         mode = "balanced" if balance else "static"
         for step, (c90, c99) in enumerate(
-                run(isowall, volume, iso, a.steps, a.step_deg, balance, a.out), start=1):
+                run(isowall, a.wall, volume, iso, a.steps, a.step_deg, balance, a.out), start=1):
             rows.append({"volume": name, "mode": mode, "step": step, "c90": c90, "c99": c99})
     with open(os.path.join(a.out, "orbit.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    plot(rows, os.path.join(a.out, f"orbit_{name}.png"), name)
+    plot(rows, os.path.join(a.out, f"orbit_{name}.png"), name,
+         os.path.basename(a.wall).split(".")[0] + " wall")
 
     print(f"{name}, {a.steps} steps of {a.step_deg:g} degrees, emulated seconds after each step "
           "to wall-wide C = 90% / 99%:")
