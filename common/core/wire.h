@@ -110,8 +110,10 @@ class MessageReader {
         std::vector<T> out(static_cast<std::size_t>(n));
         if constexpr (std::endian::native == std::endian::little && !std::is_enum_v<T> &&
                       !std::is_same_v<T, bool>) {
-            std::memcpy(out.data(), bytes_.data() + pos_, out.size() * sizeof(T));
-            pos_ += out.size() * sizeof(T);
+            if (!out.empty()) {  // memcpy of a null pointer is undefined even for 0 bytes
+                std::memcpy(out.data(), bytes_.data() + pos_, out.size() * sizeof(T));
+                pos_ += out.size() * sizeof(T);
+            }
         } else {
             for (T& v : out) v = get<T>();
         }
