@@ -14,14 +14,17 @@ WorkMap::WorkMap(int w, int h)
       rows((height + kCell - 1) / kCell),
       work(static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows), 0.0) {}
 
+WorkMap::Cells WorkMap::cells_in(const PixelRect& r) const {
+    return {std::max(0, (r.x + kCell - 1) / kCell), std::max(0, (r.y + kCell - 1) / kCell),
+            std::min(cols, (r.x + r.width + kCell - 1) / kCell),
+            std::min(rows, (r.y + r.height + kCell - 1) / kCell)};
+}
+
 double WorkMap::sum(const PixelRect& r) const {
-    const int c0 = std::max(0, (r.x + kCell - 1) / kCell);
-    const int r0 = std::max(0, (r.y + kCell - 1) / kCell);
-    const int c1 = std::min(cols, (r.x + r.width + kCell - 1) / kCell);
-    const int r1 = std::min(rows, (r.y + r.height + kCell - 1) / kCell);
+    const Cells c = cells_in(r);
     double s = 0;
-    for (int y = r0; y < r1; ++y)
-        for (int x = c0; x < c1; ++x) s += at(x, y);
+    for (int y = c.r0; y < c.r1; ++y)
+        for (int x = c.c0; x < c.c1; ++x) s += at(x, y);
     return s;
 }
 
@@ -51,15 +54,12 @@ WorkMap projected_work(std::span<const Box3> boxes, const glm::mat4& view, const
 
 WorkMap corrected(WorkMap map, std::span<const RegionCost> last, double wall_ratio) {
     if (!(wall_ratio > 0) || !std::isfinite(wall_ratio)) return map;
-    constexpr int C = WorkMap::kCell;
     for (const RegionCost& r : last) {
         if (!(r.estimated > 0) || !(r.measured > 0)) continue;
         const double f = std::clamp(r.measured / r.estimated / wall_ratio, 0.125, 8.0);
-        for (int row = (r.rect.y + C - 1) / C; row < map.rows && row * C < r.rect.y + r.rect.height;
-             ++row)
-            for (int col = (r.rect.x + C - 1) / C;
-                 col < map.cols && col * C < r.rect.x + r.rect.width; ++col)
-                map.at(col, row) *= f;
+        const WorkMap::Cells c = map.cells_in(r.rect);
+        for (int row = c.r0; row < c.r1; ++row)
+            for (int col = c.c0; col < c.c1; ++col) map.at(col, row) *= f;
     }
     return map;
 }

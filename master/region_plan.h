@@ -36,7 +36,12 @@ struct WorkMap {
     WorkMap(int width, int height);
     double& at(int col, int row) { return work[static_cast<std::size_t>(row * cols + col)]; }
     double at(int col, int row) const { return work[static_cast<std::size_t>(row * cols + col)]; }
-    // The work of the cells whose top-left pixel lies in `r`.
+    // The cells [c0, c1) x [r0, r1) whose top-left pixel lies in `r`.
+    struct Cells {
+        int c0, r0, c1, r1;
+    };
+    Cells cells_in(const PixelRect& r) const;
+    // The work of those cells.
     double sum(const PixelRect& r) const;
     double total() const;
 };

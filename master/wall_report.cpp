@@ -8,6 +8,7 @@ namespace isowall {
 WallFigures wall_figures(const std::vector<TileResultMsg>& results) {
     WallFigures f;
     std::size_t tiles = 0;
+    std::vector<double> comm_of(results.size(), 0.0);
     for (std::size_t rank = 1; rank < results.size(); ++rank, ++tiles) {
         const TileResultMsg& r = results[rank];
         f.makespan_s = std::max(f.makespan_s, r.cpu_s);
@@ -23,17 +24,15 @@ WallFigures wall_figures(const std::vector<TileResultMsg>& results) {
         f.all_makespan_s = std::max(f.all_makespan_s, all);
         f.all_total_s += all;
         f.comm_s += comm;
+        comm_of[rank] = comm;
     }
     // The share of communication in a rank's busy CPU, over the ranks that did work (a tenth of
     // the makespan or more: a rank with nothing to do has nothing to compare its waits with).
     for (std::size_t rank = 1; rank < results.size(); ++rank) {
         const TileResultMsg& r = results[rank];
         if (r.cpu_s < 0.1 * f.makespan_s || r.cpu_s <= 0) continue;
-        double comm = 0;
-        for (const TraceSpan& sp : r.spans)
-            if (static_cast<Stage>(sp.stage) == Stage::comm) comm += sp.cpu_s;
-        if (comm / r.cpu_s > f.comm_share_max)
-            f.comm_share_max = comm / r.cpu_s, f.comm_rank = rank;
+        if (comm_of[rank] / r.cpu_s > f.comm_share_max)
+            f.comm_share_max = comm_of[rank] / r.cpu_s, f.comm_rank = rank;
     }
     f.balance = tiles ? f.total_s / double(tiles) / std::max(f.makespan_s, 1e-9) : 0;
     return f;
