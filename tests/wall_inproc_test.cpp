@@ -71,8 +71,13 @@ TEST(WallInProcess, OneFrameOnEveryTileAndAMosaic) {
 TEST(WallInProcess, AChangeMidFrameInterruptsEveryTileAndTheMosaicIsTheLastView) {
     const auto dir = test::scratch_dir("inproc_interrupt");
     WallOptions o = small_wall(dir);
-    // One ray per tile is mid-frame on every tile (each has thousands to cast).
-    o.script = write_script(dir, "wait rays 4\norbit 60 -20\niso 160\nwait done\n").string();
+    // Every tile's engine pauses at each sample point (the `slow` test fault), so each view lasts
+    // many progress messages whatever the machine's load, and a few rays into a view every tile
+    // is inside a job of it (without the pause, a tile under a sanitizer on a loaded machine had
+    // once cast all its jobs before the master saw the rays it waited for).
+    o.fault = {FaultAction::slow, FaultMoment::none, TestFault::kEveryTile};
+    o.script =
+        write_script(dir, "wait rays 4\norbit 60 -20\nwait rays 4\niso 160\nwait done\n").string();
     const WallRun r = run_wall_in_process(o);
     for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
     ASSERT_EQ(r.results.size(), 5u);
