@@ -88,11 +88,13 @@ void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
     busy_cpu_s_ = thread_cpu_seconds() - c0;
 }
 
+void TileJobs::present_own() {
+    if (measure_ && in_own_job_) tile_sink_.present();
+}
+
 void TileJobs::measure_point() {
     if (!measure_ || !in_own_job_) return;
-    // What the tile shows now: queued groups drawn first, as busy time (a display shows them at
-    // its next refresh anyway); only the copy of the region is the measurement's own cost.
-    tile_sink_.present();
+    present_own();  // a no-op after the caller's present_own(): nothing queued since
     const double now = thread_cpu_seconds();
     const double busy_now = busy_cpu_s_ + job_cpu_s(now);
     if (busy_now - last_shot_s_ < kShotIntervalS) return;
@@ -152,10 +154,16 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     if (out.completed && !own) {
         Image img;
         help_sink_.read_back(img);
+        // Only what the job drew goes to the owner: the box of the pixels it covers (one
+        // background pixel when it covers none, as a region message is never empty). Pixels
+        // outside it are background, which compositing by depth leaves as they are.
+        PixelRect box = covered_box(img);
+        if (box.width <= 0 || box.height <= 0) box = {0, 0, 1, 1};
+        if (box.width != img.width || box.height != img.height) img = crop(img, box);
         RegionMsg r;
         r.generation = job.generation;
         r.job = job.job;
-        r.rect = job.rect;
+        r.rect = {job.rect.x + box.x, job.rect.y + box.y, box.width, box.height};
         r.rgba = std::move(img.rgba);
         r.depth = std::move(img.depth);
         out.result = std::move(r);

@@ -48,6 +48,10 @@ class TileJobs {
     // what the tile shows of the job's region, at most every kShotIntervalS of busy CPU. The
     // copy is not counted as busy.
     void measure_point();
+    // With `measure`, during a job for the rank's own tile: draws the queued groups, as busy time
+    // (a display shows them at its next refresh anyway), so that measure_point's copy, the
+    // measurement's own cost, can be charged apart.
+    void present_own();
     static constexpr double kShotIntervalS = 0.002;
     // CPU the caller spent inside a job on something that is not the job's (showing the frame in
     // a window): left out of the job's time and the emulated clock.

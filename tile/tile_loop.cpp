@@ -1,7 +1,5 @@
 #include "tile/tile_loop.h"
 
-#include <pthread.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -17,106 +15,13 @@
 #include "tile/remote_store.h"
 #include "tile/tile_inbox.h"
 #include "tile/tile_jobs.h"
+#include "tile/tile_receiver.h"
 
 namespace isowall {
 namespace {
 
-// How long the communication thread waits for a message before it looks at its stop request.
-constexpr double kReceivePollS = 0.05;
 // How often the frame thread tells the master how far it is.
 constexpr double kProgressIntervalS = 0.05;
-
-// The communication thread: every message for this rank into the inbox, until release (the last
-// message a master sends a tile) or until told to end. It tells the master it is alive every
-// kAliveIntervalS, whatever the frame thread is doing. A transport error, a malformed message,
-// one from a rank that may not send it, or a master silent for the timeout closes the inbox with
-// that error, so the frame thread reports it.
-class Receiver {
-  public:
-    Receiver(Comm& comm, TileInbox& inbox, double timeout_s, RemoteStore* store)
-        : comm_(comm), inbox_(inbox), timeout_s_(timeout_s), store_(store), thread_([this] {
-              loop();
-          }) {}
-    ~Receiver() {
-        ending_ = true;
-        thread_.join();
-    }
-
-    // The CPU seconds this thread has used so far (its clock read from the frame thread).
-    double cpu_s() {
-        clockid_t id;
-        timespec ts{};
-        if (pthread_getcpuclockid(thread_.native_handle(), &id) != 0 || clock_gettime(id, &ts) != 0)
-            return 0;
-        return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-    }
-
-  private:
-    void loop() {
-        try {
-            Stopwatch alive_sent, master_heard, turn;
-            while (!ending_) {
-                // A turn of this loop takes kReceivePollS; one far longer means this process was
-                // stopped (SIGSTOP, a debugger) and has just been let go: the master is not the
-                // one that went silent, so its clock starts again.
-                if (turn.seconds() > timeout_s_ / 2) master_heard.restart();
-                turn.restart();
-                if (alive_sent.seconds() >= kAliveIntervalS) {
-                    send_message(comm_, kMasterRank, AliveMsg{});
-                    alive_sent.restart();
-                }
-                auto e = comm_.receive(-1, kReceivePollS);
-                if (!e) {
-                    if (master_heard.seconds() > limit_s()) throw silent_master();
-                    continue;
-                }
-                if (e->from == kMasterRank) master_heard.restart();
-                Message m = decode_message(e->tag, e->bytes);
-                if (std::holds_alternative<AliveMsg>(m) && e->from == kMasterRank) continue;
-                if (auto* part = std::get_if<StorePartMsg>(&m); part && e->from == kMasterRank) {
-                    if (!store_)
-                        throw WireError("a store_part message, and this rank reads its own store");
-                    store_->deliver(std::move(*part));
-                    continue;
-                }
-                // Region results come from helpers (tile ranks); everything else from the master.
-                const bool from_helper = std::holds_alternative<RegionMsg>(m);
-                if (from_helper == (e->from == kMasterRank))
-                    throw WireError(std::string("a ") + to_string(e->tag) + " message from rank " +
-                                    std::to_string(e->from) + ", which does not send them");
-                const bool release = std::holds_alternative<ReleaseMsg>(m);
-                inbox_.push(std::move(m));
-                if (release) return;
-            }
-        } catch (const std::exception& e) {
-            // A pager waiting for a chunk would wait for nothing: it ends with this line.
-            if (store_)
-                store_->fail(std::string("rank ") + std::to_string(comm_.rank()) + ": " + e.what());
-            inbox_.close(std::current_exception());
-        } catch (...) {
-            if (store_) store_->fail("the communication thread ended");
-            inbox_.close(std::current_exception());
-        }
-    }
-
-    double limit_s() const { return timeout_s_ + tile_grace_s(comm_.rank()); }
-
-    std::runtime_error silent_master() const {
-        char msg[200];
-        std::snprintf(msg, sizeof(msg),
-                      "the master (rank 0) has sent nothing for %g s (--timeout): it has stopped, "
-                      "or its host cannot be reached",
-                      timeout_s_);
-        return std::runtime_error(msg);
-    }
-
-    Comm& comm_;
-    TileInbox& inbox_;
-    double timeout_s_;
-    RemoteStore* store_;
-    std::atomic<bool> ending_{false};
-    std::thread thread_;
-};
 
 class TileRank {
   public:
@@ -183,7 +88,7 @@ class TileRank {
     // What the communication thread spent since the last charge, into the trace's comm stage:
     // every CPU second of the rank is counted, not only the frame thread's.
     void charge_comm(Receiver& r) {
-        const double now = r.cpu_s();
+        const double now = std::max(comm_charged_s_, r.cpu_s());
         trace_.charge(Stage::comm, now - comm_charged_s_);
         comm_charged_s_ = now;
     }
@@ -210,10 +115,21 @@ class TileRank {
         raise_test_signal(setup_.fault, FaultMoment::frame);
         keep_curve();
         close_frame();
+        // Setting up the frame (its engine frame, the tile's image cleared) is part of the frame's
+        // busy CPU (TileJobs::begin), so it is render here, not comm.
+        trace_.switch_to(Stage::render);
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             if (setup_.fault.action == FaultAction::slow)
                 std::this_thread::sleep_for(std::chrono::duration<double>(TestFault::kSlowSampleS));
-            jobs_.measure_point();
+            if (setup_.measure) {
+                // The measurement's copy is outside every figure: charged to setup, not to the
+                // engine stage it interrupts (a whole tile's copy every 2 ms of busy CPU was 1.3 s
+                // of "intersection" on a one-tile head).
+                jobs_.present_own();
+                const Stage left = trace_.switch_to(Stage::setup);
+                jobs_.measure_point();
+                trace_.switch_to(left);
+            }
             changed(/*in_job=*/true);
             if (s.time_s - last_progress_s_ < kProgressIntervalS) return;
             last_progress_s_ = s.time_s;
@@ -224,6 +140,7 @@ class TileRank {
             answer_snapshots();
             trace_.switch_to(left);
         });
+        trace_.switch_to(Stage::comm);
         last_progress_s_ = -1;
         cpu0_ = thread_cpu_seconds();
         ++result_.frames;
@@ -363,7 +280,11 @@ class TileRank {
     }
 
     void send_result() {
-        if (setup_.measure && jobs_.started()) result_.curve = jobs_.curve(result_.significant);
+        if (setup_.measure && jobs_.started()) {
+            const Stage left = trace_.switch_to(Stage::setup);  // the measurement's, as keep_curve
+            result_.curve = jobs_.curve(result_.significant);
+            trace_.switch_to(left);
+        }
         close_frame();
         result_.host = comm_.host();
         result_.rss_mib = current_rss_mib();
