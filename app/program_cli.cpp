@@ -170,6 +170,14 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->check(kRegion)
         ->capture_default_str();
     wall_cmd
+        ->add_option("--dispatch", wall.dispatch,
+                     "Which rank asking for work is served first: arrival, the first to ask (a "
+                     "cluster, a core per rank); emulated, the one whose CPU clock is earliest, so "
+                     "that on fewer cores than ranks the operating system's choice of who ran does "
+                     "not decide who works (for studies; needs progress from busy ranks)")
+        ->check(CLI::IsMember({"arrival", "emulated"}))
+        ->capture_default_str();
+    wall_cmd
         ->add_option("--region-clip", wall.region_clip,
                      "Propagation stays within the screen region of each job (or tile): on, no "
                      "pass extracts surface its region cannot show; off, as in the text")

@@ -97,6 +97,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.zoom = o.zoom;
     if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
     mo.regions_from_work = o.region == "auto";
+    mo.dispatch = o.dispatch == "emulated" ? Dispatch::emulated : Dispatch::arrival;
     std::tie(mo.region_w, mo.region_h) = parse_region(o.region).value_or(std::pair{0, 0});
     // The work estimate's boxes: the screen mask's active nodes (engine/region_cursor.cpp).
     mo.work_boxes = [&ex = *in.extractor](double iso) {

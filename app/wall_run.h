@@ -37,6 +37,9 @@ struct WallOptions {
     bool balance = true;  // the screen-region scheduler migrates jobs
     // "auto": regions planned from the work (master/region_plan.h); WxH a fixed grid, or "tile"
     std::string region = "auto";
+    // Which asking rank gets the next job: "arrival" (the first to ask) or "emulated" (the one
+    // with the earliest CPU clock: for emulating a cluster on fewer cores than ranks).
+    std::string dispatch = "arrival";
     bool measure = false;     // emulated wall-wide correctness curves
     bool windows = false;     // each tile shows its frame in a window on its display
     bool region_clip = true;  // propagation stays within each job's region

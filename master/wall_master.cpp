@@ -16,16 +16,18 @@ namespace {
 // How long one receive waits before wait_until looks at its predicate and the silence again.
 constexpr double kReceiveSliceS = 0.05;
 
-std::string rank_label(const WallSpec& spec, int rank) {
-    return "rank " + std::to_string(rank) + " (tile " + std::to_string(tile_of_rank(spec, rank)) +
-           ")";
-}
-
 }  // namespace
 
 WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
                        double iso, double value_min, double value_max)
-    : o_(o), comm_(comm), spec_(spec), bounds_(bounds), iso_(iso), lo_(value_min), hi_(value_max) {
+    : o_(o),
+      comm_(comm),
+      spec_(spec),
+      bounds_(bounds),
+      iso_(iso),
+      lo_(value_min),
+      hi_(value_max),
+      order_(comm.size(), o.dispatch) {
     planner_ = RegionPlanner(o.work_boxes);
     const PixelSize vs = virtual_screen_size(spec);
     aspect_ = float(vs.width) / float(vs.height);
@@ -57,8 +59,11 @@ void WallMaster::handle(const Envelope& e) {
         (h->loaded ? t.hello : t.joined) = true;
     } else if (std::holds_alternative<AliveMsg>(m)) {  // its loop runs: heard is all it tells
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
-        if (p->generation == generation_)  // older generations: frames that were interrupted
+        if (p->generation == generation_ && board_) {  // older: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);
+            order_.clock(e.from, p->cpu_s);
+            dispatch();
+        }
     } else if (std::holds_alternative<JobDoneMsg>(m) || std::holds_alternative<LandedMsg>(m)) {
         handle_job(e.from, m);
     } else if (auto* img = std::get_if<ImageMsg>(&m)) {
@@ -218,53 +223,11 @@ void WallMaster::send_views() {
                         o_.screen_box);
     board_.emplace(plan.regions, plan.work, o_.balance);
     migrations_.clear();
-    for (int rank = 1; rank < comm_.size(); ++rank) fill(rank);
+    order_.begin_frame();
+    for (int rank = 1; rank < comm_.size(); ++rank) order_.ask(rank);
+    dispatch();
     frame_start_ = Stopwatch();
     trace_.switch_to(left);
-}
-
-void WallMaster::fill(int rank) {
-    while (auto id = board_->next_for(rank)) {
-        const BoardJob& j = board_->job(*id);
-        JobMsg m;
-        m.generation = generation_;
-        m.job = *id;
-        m.owner = j.owner;
-        m.band = j.band;
-        m.view = tiles_[static_cast<std::size_t>(j.owner)].view;
-        m.rect = j.rect;
-        send_message(comm_, rank, m);
-        if (j.owner != rank) raise_test_signal(o_.fault, FaultMoment::migration);
-    }
-}
-
-void WallMaster::handle_job(int from, const Message& m) {
-    const std::uint64_t generation = std::visit(
-        [](const auto& msg) -> std::uint64_t {
-            if constexpr (requires { msg.generation; }) return msg.generation;
-            return 0;
-        },
-        m);
-    if (generation != generation_ || !board_) return;  // an interrupted frame's
-    const std::uint32_t id = std::holds_alternative<JobDoneMsg>(m) ? std::get<JobDoneMsg>(m).job
-                                                                   : std::get<LandedMsg>(m).job;
-    if (id >= board_->size())
-        throw WireError(rank_label(spec_, from) + ": no job " + std::to_string(id) +
-                        " in this frame");
-    const BoardJob& j = board_->job(id);
-    if (auto* d = std::get_if<JobDoneMsg>(&m)) {
-        if (j.worker != from || j.state != BoardJob::State::running)
-            throw WireError(rank_label(spec_, from) + ": job " + std::to_string(id) +
-                            " was not running on it");
-        board_->done(id, d->cpu_s);
-        if (j.owner != from) migrations_.push_back({j.owner, from, d->start_s, d->end_s, d->bytes});
-        fill(from);
-    } else {
-        if (j.owner != from || j.worker == from || j.arrived || j.state == BoardJob::State::queued)
-            throw WireError(rank_label(spec_, from) + ": landed job " + std::to_string(id) +
-                            ", which no helper ran for it");
-        board_->landed(id);
-    }
 }
 
 bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
@@ -382,7 +345,7 @@ void WallMaster::report(OutputFiles& batch) {
     std::vector<TileResultMsg> results(tiles_.size());
     for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
     print_rank_table(stdout, spec_, results);
-    print_scheduler(stdout, o_.balance, frame_done(), *board_, migrations_, results);
+    print_scheduler(stdout, o_.balance, frame_done(), *board_, order_, migrations_, results);
     print_earlier_frames(stdout, results, completed_);
     if (o_.results_out) *o_.results_out = results;
     trace_.close();

@@ -15,6 +15,7 @@
 #include "common/progressive/trace.h"
 #include "common/wall/script.h"
 #include "common/wall/wall.h"
+#include "master/dispatch_order.h"
 #include "master/job_board.h"
 #include "master/mosaic.h"
 #include "master/region_plan.h"
@@ -44,6 +45,9 @@ struct MasterOptions {
     // studies, a fixed grid of region_w x region_h (0 x 0: one region per tile).
     bool regions_from_work = true;
     int region_w = 0, region_h = 0;
+    // Which asking rank gets the next job (master/dispatch_order.h): the first to ask, or, for
+    // emulation on fewer cores than ranks, the one with the earliest CPU clock.
+    Dispatch dispatch = Dispatch::arrival;
     // The active octree nodes at an isovalue (where the surface may be), for the work estimate;
     // unset, the volume's box alone (a uniform estimate over its screen box).
     std::function<std::vector<Box3>(double iso)> work_boxes;
@@ -111,6 +115,8 @@ class WallMaster {
     void handle_job(int from, const Message& m);
     // Hands `rank` jobs until it holds as many as the board allows.
     void fill(int rank);
+    // Serves the asking ranks the dispatch order lets through now.
+    void dispatch();
     // Receives and handles messages until done() holds. A wall silent for timeout_s throws,
     // naming the tiles still awaited.
     void wait_until(const std::function<bool()>& done, double timeout_s);
@@ -148,6 +154,7 @@ class WallMaster {
     std::vector<Migration> migrations_;     // of the current generation
     std::vector<std::uint64_t> completed_;  // generations before the current one that completed
     RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
+    DispatchOrder order_;    // which asking rank is served next
     Stopwatch alive_sent_, alive_checked_;
     std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on
     std::vector<std::optional<PreviewMsg>> previews_;  // by rank

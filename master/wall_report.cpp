@@ -128,16 +128,25 @@ void print_earlier_frames(std::FILE* out, const std::vector<TileResultMsg>& resu
     }
 }
 
+std::string rank_label(const WallSpec& spec, int rank) {
+    return "rank " + std::to_string(rank) + " (tile " + std::to_string(tile_of_rank(spec, rank)) +
+           ")";
+}
+
 void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
-                     const std::vector<Migration>& migrations,
+                     const DispatchOrder& order, const std::vector<Migration>& migrations,
                      const std::vector<TileResultMsg>& results) {
     std::uint64_t bytes = 0;
     for (const Migration& m : migrations) bytes += m.bytes;
     std::fprintf(out,
                  "scheduler: balancing %s, last frame %s: %zu jobs, %zu migrated, %.2f MB of "
-                 "region results moved\n",
+                 "region results moved; dispatch %s",
                  balance ? "on" : "off", complete ? "complete" : "interrupted", board.size(),
-                 board.migrated(), double(bytes) / 1e6);
+                 board.migrated(), double(bytes) / 1e6,
+                 order.order() == Dispatch::emulated ? "in emulated-time order" : "on arrival");
+    if (order.order() == Dispatch::emulated)
+        std::fprintf(out, " (%d requests held for a rank with an earlier clock)", order.holds());
+    std::fputc('\n', out);
     const auto curve = wall_curve(results);
     if (curve.empty()) return;
     auto at = [&](double level, bool px) {

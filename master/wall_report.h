@@ -8,6 +8,7 @@
 #include "common/core/output_files.h"
 #include "common/progressive/trace.h"
 #include "common/wall/wall.h"
+#include "master/dispatch_order.h"
 #include "master/job_board.h"
 #include "protocol/protocol.h"
 
@@ -53,8 +54,11 @@ void print_rank_table(std::FILE* out, const WallSpec& spec,
                       const std::vector<TileResultMsg>& results);
 // The scheduler's figures: jobs, migrations, bytes moved, and with curves the emulated time to
 // wall-wide C = 90/99/100%.
+// "rank R (tile T)", for the lines that name a rank.
+std::string rank_label(const WallSpec& spec, int rank);
+
 void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
-                     const std::vector<Migration>& migrations,
+                     const DispatchOrder& order, const std::vector<Migration>& migrations,
                      const std::vector<TileResultMsg>& results);
 // With curves of earlier frames (--measure over several views): for each frame in `completed`
 // (generations whose every job landed), the emulated time to wall-wide C = 90/99/100% of that
