@@ -109,6 +109,36 @@ void add_rank_options(CLI::App& wall_cmd, WallOptions& wall) {
         ->capture_default_str();
 }
 
+// The screen-region scheduler's options of `wall` (master/job_board.h, region_plan.h,
+// dispatch_order.h).
+void add_scheduler_options(CLI::App& cmd, WallOptions& wall) {
+    cmd.add_option("--balance", wall.balance,
+                   "Screen-region scheduler: on, idle ranks take regions of busy tiles; off, "
+                   "every tile casts its own screen (the static wall)")
+        ->transform(
+            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+        ->default_str("on");
+    cmd.add_option("--region", wall.region,
+                   "Screen regions the scheduler hands out (balancing on): auto, cut where the "
+                   "work is (estimated from the octree, then measured in the last frame); WxH, "
+                   "a fixed grid of that size (for studies); 'tile', one region per tile")
+        ->check(kRegion)
+        ->capture_default_str();
+    cmd.add_option("--dispatch", wall.dispatch,
+                   "Which rank asking for work is served first: arrival, the first to ask (a "
+                   "cluster, a core per rank); emulated, the one whose CPU clock is earliest, so "
+                   "that on fewer cores than ranks the operating system's choice of who ran does "
+                   "not decide who works (for studies; needs progress from busy ranks)")
+        ->check(CLI::IsMember({"arrival", "emulated"}))
+        ->capture_default_str();
+    cmd.add_option("--region-clip", wall.region_clip,
+                   "Propagation stays within the screen region of each job (or tile): on, no "
+                   "pass extracts surface its region cannot show; off, as in the text")
+        ->transform(
+            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+        ->default_str("on");
+}
+
 CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     auto* wall_cmd = app.add_subcommand(
         "wall",
@@ -155,35 +185,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
                      "Start panned: DX DY in screen widths and heights (the view moves right, up)")
         ->expected(2)
         ->transform(number_in(limits::kPan));
-    wall_cmd
-        ->add_option("--balance", wall.balance,
-                     "Screen-region scheduler: on, idle ranks take regions of busy tiles; off, "
-                     "every tile casts its own screen (the static wall)")
-        ->transform(
-            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
-        ->default_str("on");
-    wall_cmd
-        ->add_option("--region", wall.region,
-                     "Screen regions the scheduler hands out (balancing on): auto, cut where the "
-                     "work is (estimated from the octree, then measured in the last frame); WxH, "
-                     "a fixed grid of that size (for studies); 'tile', one region per tile")
-        ->check(kRegion)
-        ->capture_default_str();
-    wall_cmd
-        ->add_option("--dispatch", wall.dispatch,
-                     "Which rank asking for work is served first: arrival, the first to ask (a "
-                     "cluster, a core per rank); emulated, the one whose CPU clock is earliest, so "
-                     "that on fewer cores than ranks the operating system's choice of who ran does "
-                     "not decide who works (for studies; needs progress from busy ranks)")
-        ->check(CLI::IsMember({"arrival", "emulated"}))
-        ->capture_default_str();
-    wall_cmd
-        ->add_option("--region-clip", wall.region_clip,
-                     "Propagation stays within the screen region of each job (or tile): on, no "
-                     "pass extracts surface its region cannot show; off, as in the text")
-        ->transform(
-            CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
-        ->default_str("on");
+    add_scheduler_options(*wall_cmd, wall);
     wall_cmd->add_flag("--windows", wall.windows,
                        "Each tile shows its frame as it builds in a borderless window covering "
                        "its X screen (the wall file's display keys, else $DISPLAY)");
