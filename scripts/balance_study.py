@@ -4,7 +4,7 @@ tiles) with the surface inside 1 tile, across 2, across 4 and over all tiles, wi
 (every tile casts its own screen: the static wall) and on at several region sizes.
 
 Usage: scripts/balance_study.py [--build build] [--data ../shared/data] [--out out/study]
-                                [--volumes head,phantom] [--regions auto,256x192,128x96,64x48]
+                                [--volumes head,phantom] [--regions auto,auto:emulated,256x192,...]
                                 [--repeat 1]
 
 Every figure is derived from thread CPU time, not wall time: with 25 ranks on this machine's 2
@@ -21,6 +21,8 @@ N the lower of the two middle runs), with all its fields: a row never mixes runs
 judged at the default regions ("auto": planned from the work, what `isowall wall` gives without
 --region; issue 33's targets); the best
 region of each case, chosen after the fact, is printed for information with no verdict.
+"auto:emulated" is the default regions with jobs handed out in emulated-time order (--dispatch
+emulated); the script prints how far the two orders differ.
 """
 import argparse
 import csv
@@ -47,6 +49,8 @@ RANK_ROW = re.compile(
     r"^\s+(\d+)\s+(\S+)\s+(\d+)\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(\d+)"
     r"\s+([\d.]+)\s+(\d+)\s+(\d+)\s+([\d.]+)$")
 SUMMARY = re.compile(r"^makespan ([\d.]+) s \(CPU\), total ([\d.]+) s, balance ([\d.]+)")
+EVERY = re.compile(r"^every thread .*: makespan ([\d.]+) s, total ([\d.]+) s; communication "
+                   r"([\d.]+) s, at most (\d+)% of a rank's busy CPU")
 SCHED = re.compile(r"^scheduler: .*: (\d+) jobs, (\d+) migrated, ([\d.]+) MB")
 EMULATED = re.compile(r"C = 90/99/100%: (\S+) / (\S+) / (\S+) s; final pixels 90/99/100%: "
                       r"(\S+) / (\S+) / (\S+) s")
@@ -64,7 +68,10 @@ def run_wall(isowall, vol, case, balance, region, out_png):
            "--wall", WALL, *vol, "--zoom", str(zoom), "--pan", str(dx), str(dy), "--measure",
            "--balance", "on" if balance else "off", "--out", out_png]
     if region:
-        cmd += ["--region", region]
+        # "auto:emulated": the default regions, jobs handed out in emulated-time order
+        # (--dispatch emulated) instead of on arrival.
+        name, _, dispatch = region.partition(":")
+        cmd += ["--region", name] + (["--dispatch", dispatch] if dispatch else [])
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if proc.returncode != 0:
@@ -82,13 +89,16 @@ def parse(text, cmd):
             r["helped"].append(int(m.group(13)))
         elif m := SUMMARY.match(line):
             r["makespan"], r["total"], r["balance"] = map(float, m.groups())
+        elif m := EVERY.match(line):
+            r["all_makespan"], r["all_total"], r["comm"] = map(float, m.groups()[:3])
+            r["comm_pct"] = int(m.group(4))
         elif m := SCHED.match(line):
             r["job_count"], r["migrated"] = int(m.group(1)), int(m.group(2))
             r["mb_moved"] = float(m.group(3))
         elif m := EMULATED.search(line):
             vals = [float("nan") if v == "never" else float(v) for v in m.groups()]
             r["c90"], r["c99"], r["c100"], r["px90"], r["px99"], r["px100"] = vals
-    for key in ("makespan", "job_count", "c99"):
+    for key in ("makespan", "job_count", "c99", "comm_pct"):
         if key not in r:
             sys.exit(f"balance_study: no '{key}' in the output of {cmd}:\n{text[-2000:]}")
     r["tiles_with_rays"] = sum(1 for n in r["rays"] if n > 0)
@@ -109,7 +119,8 @@ def plot(rows, out_dir, volume):
 
     mine = [r for r in rows if r["volume"] == volume]
     regions = sorted({r["region"] for r in mine if r["region"] != "static"},
-                     key=lambda s: -1e9 if s == "auto" else -int(s.split("x")[0]))
+                     key=lambda s: -2e9 if s == "auto" else -1e9 if s.startswith("auto")
+                     else -int(s.split("x")[0]))
     fig, axes = plt.subplots(len(CASES), 1, figsize=(11, 2.6 * len(CASES)), sharex=True)
     for ax, case in zip(axes, CASES):
         runs = [r for r in mine if r["case"] == case[0]]
@@ -151,17 +162,20 @@ def target_figures(case, static, bal):
     """(figure, value, target, holds) for each of the issue's targets in a case; [] if none."""
     cpu = bal["total"] / static["total"]
     cpu_target = ("total CPU balanced/static", f"{cpu:.2f}", "<= 1.3", cpu <= 1.3)
+    comm_target = ("communication, the largest share of a working rank's busy CPU",
+                   f"{bal['comm_pct']}%", "<= 10%", bal["comm_pct"] <= 10)
     if case == "1 tile":
         ms = static["makespan"] / bal["makespan"]
         # Issue 33's efficiency: the static wall's work over the balanced wall's ranks x makespan.
         eff = static["total"] / (TILE_RANKS * bal["makespan"])
         return [("makespan static/balanced", f"{ms:.1f}x", ">= 12x", ms >= 12),
                 ("efficiency static total/(ranks x makespan)", f"{eff:.2f}", ">= 0.75",
-                 eff >= 0.75), cpu_target]
+                 eff >= 0.75), cpu_target, comm_target]
     if case == "all tiles":
         rel = bal["makespan"] / static["makespan"]
         return [("balance mean/max", f"{bal['balance']:.2f}", ">= 0.9", bal["balance"] >= 0.9),
-                ("makespan balanced/static", f"{rel:.2f}", "<= 0.45", rel <= 0.45), cpu_target]
+                ("makespan balanced/static", f"{rel:.2f}", "<= 0.45", rel <= 0.45), cpu_target,
+                comm_target]
     return []
 
 
@@ -196,13 +210,28 @@ def check_targets(rows, volume):
         judge_case(case, mine[(case, "static")], mine.get((case, DEFAULT_REGION)), best)
 
 
+def compare_dispatch(rows, volume):
+    """How far the two dispatch orders differ at the default regions (issue 33)."""
+    mine = {(r["case"], r["region"]): r for r in rows if r["volume"] == volume}
+    if not any(region == "auto:emulated" for _, region in mine):
+        return
+    print(f"\ndispatch orders ({volume}, regions auto): on arrival against emulated-time order")
+    for case, *_ in CASES:
+        a, e = mine.get((case, "auto")), mine.get((case, "auto:emulated"))
+        if a and e:
+            print(f"  {case}: makespan {a['makespan']:.3f} / {e['makespan']:.3f} s "
+                  f"({e['makespan'] / a['makespan']:.2f}x), efficiency {a['balance']:.2f} / "
+                  f"{e['balance']:.2f}, C=99% {a['c99']:.3f} / {e['c99']:.3f} s, total CPU "
+                  f"{a['total']:.3f} / {e['total']:.3f} s")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "study"))
     ap.add_argument("--volumes", default="head,phantom")
-    ap.add_argument("--regions", default="auto,256x192,128x96,64x48")
+    ap.add_argument("--regions", default="auto,auto:emulated,256x192,128x96,64x48")
     ap.add_argument("--repeat", type=int, default=1,
                     help="runs per configuration (the run with the median makespan is kept)")
     a = ap.parse_args()
@@ -235,11 +264,13 @@ def main():
                       f"C=90/99/100% at {r['c90']:.3f}/{r['c99']:.3f}/{r['c100']:.3f} s, "
                       f"{r['migrated']} of {r['job_count']} jobs migrated, "
                       f"{r['mb_moved']:.1f} MB moved, tiles with rays of their own "
-                      f"{r['tiles_with_rays']}", flush=True)
+                      f"{r['tiles_with_rays']}; every thread: makespan {r['all_makespan']:.3f} s, "
+                      f"communication {r['comm']:.3f} s, at most {r['comm_pct']}% of a rank's "
+                      f"busy CPU", flush=True)
         plot(rows, a.out, volume)
     fields = ["volume", "case", "region", "runs", "makespan", "total", "balance", "c90", "c99",
               "c100", "px90", "px99", "px100", "job_count", "migrated", "mb_moved",
-              "tiles_with_rays"]
+              "tiles_with_rays", "all_makespan", "all_total", "comm", "comm_pct"]
     with open(os.path.join(a.out, "study.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -248,15 +279,18 @@ def main():
         f.write(f"Each row: the median run of {a.repeat} by makespan, every field from that "
                 "run.\n\n")
         f.write("| volume | surface in | regions | makespan s | total s | efficiency | "
-                "C=90% s | C=99% s | C=100% s | migrated / jobs | MB moved |\n")
-        f.write("|---|---|---|---|---|---|---|---|---|---|---|\n")
+                "C=90% s | C=99% s | C=100% s | migrated / jobs | MB moved | every-thread "
+                "makespan s | comm s (largest % of busy) |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
             f.write(f"| {r['volume']} | {r['case']} | {r['region']} | {r['makespan']:.3f} | "
                     f"{r['total']:.3f} | {r['balance']:.2f} | {r['c90']:.3f} | {r['c99']:.3f} | "
                     f"{r['c100']:.3f} | {r['migrated']} / {r['job_count']} | "
-                    f"{r['mb_moved']:.1f} |\n")
+                    f"{r['mb_moved']:.1f} | {r['all_makespan']:.3f} | {r['comm']:.3f} "
+                    f"({r['comm_pct']}%) |\n")
     for volume in volumes:
         check_targets(rows, volume)
+        compare_dispatch(rows, volume)
     print(f"\nwrote {a.out}/study.csv, study.md, busy_*.png, summary_*.png, mosaic_*.png")
 
 
