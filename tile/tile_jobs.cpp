@@ -94,7 +94,6 @@ void TileJobs::present_own() {
 
 void TileJobs::measure_point() {
     if (!measure_ || !in_own_job_) return;
-    present_own();  // a no-op after the caller's present_own(): nothing queued since
     const double now = thread_cpu_seconds();
     const double busy_now = busy_cpu_s_ + job_cpu_s(now);
     if (busy_now - last_shot_s_ < kShotIntervalS) return;

@@ -44,9 +44,9 @@ class TileJobs {
     };
     Outcome run(const JobMsg& job, int rank);
 
-    // With `measure`, during a job for the rank's own tile (the engine's progress points): keeps
-    // what the tile shows of the job's region, at most every kShotIntervalS of busy CPU. The
-    // copy is not counted as busy.
+    // With `measure`, during a job for the rank's own tile (the engine's progress points), after
+    // present_own(): keeps what the tile shows of the job's region, at most every kShotIntervalS
+    // of busy CPU. The copy is not counted as busy.
     void measure_point();
     // With `measure`, during a job for the rank's own tile: draws the queued groups, as busy time
     // (a display shows them at its next refresh anyway), so that measure_point's copy, the
