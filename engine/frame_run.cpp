@@ -11,10 +11,10 @@ bool FrameRun::cast_level_parallel(int n, IntersectMode mode, bool second_pass, 
                                    const std::vector<BesideSeed>* seeds) {
     const std::size_t rays_before = now_.rays;
     bool begun = false;
-    const LevelJob job{
-        ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
-        mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_,
-        seeds};
+    LevelJob job{ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
+                 mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_,
+                 seeds};
+    job.want_seen = sink_->wants_seen();
     const double own0 = thread_cpu_seconds();
     const LevelTally t = isowall::cast_level_parallel(
         job, n, [this](FoundGroup& f) { add_found(f); },
@@ -30,6 +30,8 @@ bool FrameRun::cast_level_parallel(int n, IntersectMode mode, bool second_pass, 
     if (opt_.trace) opt_.trace->add_cpu(t.workers_cpu_s);
     ids_used_ = t.next_id - opt_.first_group_id;
     cursor_->beside.insert(cursor_->beside.end(), t.beside.begin(), t.beside.end());
+    // After the level's rays and before its coverage is read (cast_level), as the sink allows.
+    for (const std::uint32_t id : t.seen) sink_->seen(id);
     now_.t_intersect_s += t.intersect_s;
     cursor_->hits += t.hits;
     if (second_pass) frame_.rays_second_pass += t.rays;

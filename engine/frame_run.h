@@ -134,7 +134,7 @@ class FrameRun {
     int workers() const {
         const int have = ex_.threads();
         const int want = opt_.threads <= 0 ? have : std::min(opt_.threads, have);
-        return sink_->wants_seen() ? 1 : std::max(1, want);
+        return sink_->wants_seen() && !sink_->seen_after_level() ? 1 : std::max(1, want);
     }
 
     bool cast_level(RayOrder& order, bool second_pass) {

@@ -45,6 +45,10 @@ class GroupSink {
     // A ray met a cell that group `group_id` took earlier in this frame, or before it when the
     // frame went on from cached groups (EngineOptions::begin_extractor_frame).
     virtual void seen(std::uint32_t /*group_id*/) {}
+    // Whether seen() may come at the end of the level that met the cells, on the calling thread,
+    // instead of at each ray: the engine then casts the level on several threads as it would
+    // without seen(). False: seen() at each ray, and a level that wants it on one thread.
+    virtual bool seen_after_level() const { return false; }
 };
 
 // Draws every group into a renderer's frame, which begin() resizes and clears.

@@ -30,6 +30,7 @@ struct alignas(64) WorkerTally {
     double intersect_s = 0, cpu_s = 0;
     std::size_t next = 0, end = 0;  // the pixels claimed and not cast yet
     std::vector<BesideSeed> beside;
+    std::vector<std::uint32_t> seen;  // LevelJob::want_seen
     // `rays` as of the thread's last claim, for the caller's samples: a line the caller reads at
     // every one of its rays, which this thread writes once per claim, not once per ray.
     alignas(64) std::atomic<std::size_t> published{0};
@@ -78,6 +79,7 @@ class LevelCast {
             if (!hit.found) return true;
             ++t.hits;
             if (!hit.refine && job_.ex.visited(hit.cell)) {
+                if (job_.want_seen) t.seen.push_back(job_.ex.group_of(hit.cell));
                 note_beside(job_.ex, hit, ray, px, job_.mode == IntersectMode::exact, t.beside);
                 return true;
             }
@@ -148,6 +150,7 @@ class LevelCast {
         LevelTally sum;
         for (WorkerTally& t : tally_) {
             sum.beside.insert(sum.beside.end(), t.beside.begin(), t.beside.end());
+            sum.seen.insert(sum.seen.end(), t.seen.begin(), t.seen.end());
             sum.rays += t.rays;
             sum.hits += t.hits;
             sum.intersect_s += t.intersect_s;

@@ -32,6 +32,8 @@ struct LevelJob {
     // Not null: the level is these seeds instead of `pixels` (frontier seeds, beside_seeds.h):
     // each still unvisited is propagated from, with no ray cast.
     const std::vector<BesideSeed>* seeds = nullptr;
+    // The groups of the visited cells the rays meet are wanted (LevelTally::seen).
+    bool want_seen = false;
     std::size_t size() const { return seeds ? seeds->size() : pixels.size(); }
 };
 
@@ -52,6 +54,8 @@ struct LevelTally {
     std::uint32_t next_id = 0;  // the first id not handed out
     // Unvisited cells beside hits on visited ones, for the region's end (hit_neighbours.h).
     std::vector<BesideSeed> beside;
+    // With LevelJob::want_seen: the group of each visited cell a ray met (repeats included).
+    std::vector<std::uint32_t> seen;
 };
 
 // Casts every pixel of `job` on `threads` threads (at most the extractor's workers). `draw` and

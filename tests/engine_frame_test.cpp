@@ -1,9 +1,13 @@
 // EngineFrame, as a wall rank uses it: a region cast in two bands (a coarse band of a ray limit,
-// then the rest) casts every pixel of the region once, and its image is the one-call frame's.
+// then the rest) casts every pixel of the region once, and its image is the one-call frame's;
+// and a region whose rays meet groups an earlier region found hears of them (seen()), at each
+// ray or, where the sink allows, after each level with the level cast on several threads.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdint>
+#include <set>
+#include <vector>
 
 #include "common/volume/phantom.h"
 #include "engine/progressive_engine.h"
@@ -47,6 +51,61 @@ TEST(EngineFrame, ACoarseBandThenTheRestCastEveryPixelOnceWithLimitedPropagation
     const test::ImageComparison m = test::compare_images(banded, whole.final_image);
     EXPECT_GE(m.mask_iou, 0.999) << m;
     EXPECT_GE(m.equal_share, 0.999) << m;
+}
+
+// Records what the engine tells a sink: the groups added and the groups seen.
+class SeenSink final : public GroupSink {
+  public:
+    explicit SeenSink(bool after_level) : after_level_(after_level) {}
+    void begin(const FrameView&) override {}
+    void add(const Group& g) override { added.insert(g.id); }
+    double present() override { return 0; }
+    bool wants_seen() const override { return true; }
+    void seen(std::uint32_t id) override { seen_ids.push_back(id); }
+    bool seen_after_level() const override { return after_level_; }
+    std::set<std::uint32_t> added;
+    std::vector<std::uint32_t> seen_ids;
+
+  private:
+    bool after_level_;
+};
+
+TEST(EngineFrame, ARegionHearsOfTheEarlierGroupsItsRaysMeetAtEachRayOrAfterEachLevel) {
+    const Volume p = make_phantom();
+    const FrameView fv = test::make_view(p, 160, 120, kPhantomSkinIso);
+    const PixelRect left{0, 0, 80, 120}, right{80, 0, 80, 120};
+    for (const bool after_level : {false, true}) {
+        SCOPED_TRACE(after_level ? "after each level" : "at each ray");
+        auto ex = make_surface_extractor(p, {}, nullptr, ThreadBudget{2});
+        EngineOptions opt;
+        opt.threads = 2;
+        ProgressiveEngine engine(*ex, opt);
+        std::atomic<bool> stop{false};
+        EngineFrame frame(engine, fv, stop);
+        // The left half first: its groups (passes of up to 1000 cells) reach across.
+        SeenSink left_sink(after_level);
+        RegionCursor a = frame.cursor(fv, left);
+        ASSERT_TRUE(frame.cast(fv, a, left_sink));
+        ASSERT_FALSE(left_sink.added.empty());
+        SeenSink sink(after_level);
+        RegionCursor b = frame.cursor(fv, right);
+        const double workers0 = frame.workers().sum_s;
+        ASSERT_TRUE(frame.cast(fv, b, sink));
+        ASSERT_FALSE(sink.seen_ids.empty());
+        std::size_t earlier = 0;
+        for (const std::uint32_t id : sink.seen_ids) {
+            // Each seen group is one of the left half's or one this region found itself.
+            const bool of_left = left_sink.added.count(id) == 1;
+            EXPECT_TRUE(of_left || sink.added.count(id) == 1) << id;
+            earlier += of_left;
+        }
+        EXPECT_GT(earlier, 0u) << "the right half's rays met none of the left half's groups";
+        // Seen at each ray needs one thread; after each level, the level runs on both.
+        if (after_level)
+            EXPECT_GT(frame.workers().sum_s, workers0);
+        else
+            EXPECT_EQ(frame.workers().sum_s, workers0);
+    }
 }
 
 }  // namespace

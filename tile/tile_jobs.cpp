@@ -22,7 +22,8 @@ FrameView region_view(const FrameView& owner, const PixelRect& rect) {
 // Where a job's groups go: every group is kept (a later job may need it), drawn into the help
 // image when the job is for another tile, and drawn into the rank's own tile when it may show
 // there (a group whose bounds project outside the tile cannot be what a later ray of the tile
-// hits, so leaving it out loses nothing).
+// hits, so leaving it out loses nothing). In a help job, the earlier groups whose cells its rays
+// meet are drawn before the engine reads the help image's coverage or the job's result is read.
 class TileJobs::JobSink final : public GroupSink {
   public:
     JobSink(TileJobs& jobs, GroupSink* help) : jobs_(jobs), help_(help) {}
@@ -31,14 +32,21 @@ class TileJobs::JobSink final : public GroupSink {
         for (const glm::vec3& p : group.mesh.positions) b.merge(p);
         if (help_) help_->add(group);
         if (jobs_.shows(b, jobs_.own_)) jobs_.tile_sink_.add(group);
-        jobs_.groups_.push_back({group, b});
+        jobs_.group_index_[group.id] = jobs_.groups_.size();
+        jobs_.groups_.push_back({group, b, jobs_.job_key_, help_ ? jobs_.help_job_ : 0});
     }
     double present() override {
+        if (help_) jobs_.draw_seen_groups();
         return (help_ ? help_->present() : 0.0) + jobs_.tile_sink_.present();
     }
     bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
-        return help_ ? help_->coverage(covered, rect) : jobs_.tile_sink_.coverage(covered, rect);
+        if (!help_) return jobs_.tile_sink_.coverage(covered, rect);
+        jobs_.help_coverage(covered, rect);
+        return true;
     }
+    bool wants_seen() const override { return help_ != nullptr; }
+    void seen(std::uint32_t group_id) override { jobs_.seen_.push_back(group_id); }
+    bool seen_after_level() const override { return true; }
     bool tells_coverage() const override {
         return help_ ? help_->tells_coverage() : jobs_.tile_sink_.tells_coverage();
     }
@@ -76,6 +84,9 @@ void TileJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
     generation_ = v.generation;
     own_ = v.view;
     groups_.clear();
+    group_index_.clear();
+    seen_.clear();
+    band_cover_.clear();
     cursors_.clear();
     shots_.clear();
     last_draw_s_ = 0;
@@ -108,12 +119,27 @@ double TileJobs::job_cpu_s(double now) const {
     return now - job_c0_ - job_measure_cpu_ + (frame_->workers().beyond_s - job_beyond0_);
 }
 
-// Every group found earlier in the frame that may show in `view`: the engine casts no new pass
-// where a ray meets one of its cells, and its triangles may cover pixels of the region whose own
-// rays meet other cells (a whole frame on one rank would show them too).
-void TileJobs::draw_earlier_groups(const FrameView& view) {
-    for (const Recorded& r : groups_)
-        if (shows(r.bounds, view)) help_sink_.add(r.group);
+void TileJobs::draw_seen_groups() {
+    for (const std::uint32_t id : seen_) {
+        const auto it = group_index_.find(id);
+        if (it == group_index_.end()) continue;  // kFree: nothing took the cell
+        Recorded& r = groups_[it->second];
+        if (r.drawn_in == help_job_ || r.found_by == job_key_) continue;
+        r.drawn_in = help_job_;
+        help_sink_.add(r.group);
+    }
+    seen_.clear();
+}
+
+void TileJobs::help_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) {
+    draw_seen_groups();
+    help_sink_.coverage(covered, rect);
+    if (!earlier_cover_) return;
+    for (int y = 0; y < rect.height; ++y)
+        for (int x = 0; x < rect.width; ++x) {
+            const auto from = static_cast<std::size_t>((rect.y + y) * help_width_ + rect.x + x);
+            covered[static_cast<std::size_t>(y * rect.width + x)] |= (*earlier_cover_)[from];
+        }
 }
 
 TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
@@ -129,14 +155,19 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const bool own = job.owner == rank;
     const FrameView view = own ? own_ : region_view(job.view, job.rect);
     const PixelRect region = own ? job.rect : view.screen();
-    const auto key = std::make_tuple(job.owner, job.rect.x, job.rect.y);
+    const RegionKey key = std::make_tuple(job.owner, job.rect.x, job.rect.y);
+    job_key_ = key;
     auto it = cursors_.find(key);
     if (it == cursors_.end()) it = cursors_.emplace(key, frame_->cursor(view, region)).first;
     RegionCursor& cursor = it->second;
 
     if (!own) {
+        ++help_job_;
+        seen_.clear();
         help_sink_.begin(view);
-        draw_earlier_groups(view);
+        const auto earlier = band_cover_.find(key);
+        earlier_cover_ = earlier == band_cover_.end() ? nullptr : &earlier->second;
+        help_width_ = view.width;
     }
     JobSink sink(*this, own ? nullptr : &help_sink_);
     in_own_job_ = own;
@@ -151,8 +182,14 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     out.done.groups = after.groups - before.groups;
     out.done.triangles = after.triangles - before.triangles;
     if (out.completed && !own) {
+        draw_seen_groups();
         Image img;
         help_sink_.read_back(img);
+        if (job.band == Band::coarse) {
+            std::vector<std::uint8_t>& cover = band_cover_[key];
+            cover.resize(img.depth.size());
+            for (std::size_t i = 0; i < cover.size(); ++i) cover[i] = img.depth[i] < 1.0f;
+        }
         // Only what the job drew goes to the owner: the box of the pixels it covers (one
         // background pixel when it covers none, as a region message is never empty). Pixels
         // outside it are background, which compositing by depth leaves as they are.
