@@ -17,7 +17,7 @@
 namespace isowall {
 namespace {
 
-constexpr std::string_view kName = "egl";
+constexpr std::string_view kEglName = "egl";
 
 GlProc egl_loader(const char* name) {
     return eglGetProcAddress(name);
@@ -61,7 +61,7 @@ std::string egl_error_name(EGLint error) {
 }
 
 [[noreturn]] void fail(std::string_view call) {
-    throw RendererError(kName,
+    throw RendererError(kEglName,
                         std::string(call) + " failed (" + egl_error_name(eglGetError()) + ")");
 }
 
@@ -120,9 +120,9 @@ std::vector<EGLDisplay> candidate_displays() {
         char* end = nullptr;
         const long n = std::strtol(want, &end, 10);
         if (*end != '\0' || n < 0 || n >= count)
-            throw RendererError(kName, "ISOWALL_EGL_DEVICE=" + std::string(want) +
-                                           ": expected a device index from 0 to " +
-                                           std::to_string(count - 1));
+            throw RendererError(kEglName, "ISOWALL_EGL_DEVICE=" + std::string(want) +
+                                              ": expected a device index from 0 to " +
+                                              std::to_string(count - 1));
         EGLDisplay d = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[n], nullptr);
         if (d == EGL_NO_DISPLAY)
             fail("eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device " + std::string(want) +
@@ -173,7 +173,7 @@ class EglRenderer final : public GlRenderer {
         try {
             create_context();
             make_current();
-            core_ = std::make_unique<GlCore>(kName, egl_loader);
+            core_ = std::make_unique<GlCore>(kEglName, egl_loader);
         } catch (...) {
             release();
             throw;
@@ -185,14 +185,14 @@ class EglRenderer final : public GlRenderer {
     EglRenderer(const EglRenderer&) = delete;
     EglRenderer& operator=(const EglRenderer&) = delete;
 
-    std::string_view name() const override { return kName; }
+    std::string_view name() const override { return kEglName; }
 
   private:
     void create_context() {
         if (!eglBindAPI(EGL_OPENGL_API)) fail("eglBindAPI(EGL_OPENGL_API)");
         const char* extensions = eglQueryString(display_, EGL_EXTENSIONS);
         if (!has_extension(extensions, "EGL_KHR_surfaceless_context"))
-            throw RendererError(kName, "display lacks EGL_KHR_surfaceless_context");
+            throw RendererError(kEglName, "display lacks EGL_KHR_surfaceless_context");
         // Without a surface the config only matters for its renderable type; skip it where the
         // driver allows.
         EGLConfig config = EGL_NO_CONFIG_KHR;

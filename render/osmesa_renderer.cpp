@@ -11,7 +11,7 @@
 namespace isowall {
 namespace {
 
-constexpr std::string_view kName = "osmesa";
+constexpr std::string_view kOsmesaName = "osmesa";
 
 GlProc osmesa_loader(const char* name) {
     return OSMesaGetProcAddress(name);
@@ -35,7 +35,8 @@ OSMesaContext create_context() {
     const int compat[] = {
         OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
     if (OSMesaContext ctx = OSMesaCreateContextAttribs(compat, nullptr)) return ctx;
-    throw RendererError(kName, "OSMesaCreateContextAttribs failed (no core 3.3 or compat context)");
+    throw RendererError(kOsmesaName,
+                        "OSMesaCreateContextAttribs failed (no core 3.3 or compat context)");
 }
 
 class OsmesaRenderer final : public GlRenderer {
@@ -43,7 +44,7 @@ class OsmesaRenderer final : public GlRenderer {
     OsmesaRenderer() : context_(create_context()) {
         try {
             make_current();
-            core_ = std::make_unique<GlCore>(kName, osmesa_loader);
+            core_ = std::make_unique<GlCore>(kOsmesaName, osmesa_loader);
         } catch (...) {
             OSMesaDestroyContext(context_);
             throw;
@@ -60,14 +61,14 @@ class OsmesaRenderer final : public GlRenderer {
     OsmesaRenderer(const OsmesaRenderer&) = delete;
     OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
 
-    std::string_view name() const override { return kName; }
+    std::string_view name() const override { return kOsmesaName; }
 
   private:
     // Every call makes the context current: another renderer (OSMesa or EGL) may have taken the
     // thread since the last call.
     void make_current() override {
         if (!OSMesaMakeCurrent(context_, dummy_.data(), GL_UNSIGNED_BYTE, 1, 1))
-            throw RendererError(kName, "OSMesaMakeCurrent failed");
+            throw RendererError(kOsmesaName, "OSMesaMakeCurrent failed");
     }
 
     OSMesaContext context_;

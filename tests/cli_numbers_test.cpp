@@ -11,14 +11,14 @@
 namespace isowall {
 namespace {
 
-struct Slot {
+struct CliSlot {
     std::string args;                 // with {} where the value goes
     std::string option;               // the option the error names
     std::vector<std::string> beyond;  // finite values outside the option's range
 };
 
 const std::vector<std::string> kTimeouts = {"0", "-5", "1e7", "1e300"};
-const std::vector<Slot> kSlots = {
+const std::vector<CliSlot> kCliSlots = {
     {"render --iso {}", "--iso", {}},  // any finite isovalue: the volume's range decides
     {"render --orbit {} 0", "--orbit", {"1e300", "-1e300", "1000001"}},
     {"render --orbit 0 {}", "--orbit", {"1e300", "-1000001"}},
@@ -43,7 +43,7 @@ const std::vector<Slot> kSlots = {
     {"wall --wall w.toml --threads {}", "--threads", {"-5", "1025", "2.5"}},
 };
 
-std::string fill(const std::string& slot, const std::string& value) {
+std::string cli_fill(const std::string& slot, const std::string& value) {
     std::string args = slot;
     return args.replace(args.find("{}"), 2, value);
 }
@@ -52,12 +52,12 @@ using test::parse_error;
 
 TEST(CliNumbers, EveryNumberOptionRefusesNonFiniteAndOutOfRangeValues) {
     int tried = 0;
-    for (const Slot& s : kSlots) {
+    for (const CliSlot& s : kCliSlots) {
         std::vector<std::string> bad = {"nan", "-nan", "inf", "-inf", "1e999", "0x10", "5abc"};
         bad.insert(bad.end(), s.beyond.begin(), s.beyond.end());
         for (const std::string& b : bad) {
-            const std::string e = parse_error(fill(s.args, b));
-            SCOPED_TRACE(fill(s.args, b));
+            const std::string e = parse_error(cli_fill(s.args, b));
+            SCOPED_TRACE(cli_fill(s.args, b));
             EXPECT_NE(e.find(s.option), std::string::npos) << e;
             // CLI11 takes "-nan" and "-inf" for options, not values: refused all the same.
             if (b != "-nan" && b != "-inf") {

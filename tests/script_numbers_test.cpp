@@ -12,22 +12,22 @@ namespace isowall {
 namespace {
 
 // Each numeric slot of each command, as a line with {} where the value goes.
-const std::vector<std::string> kSlots = {"orbit {} 0",
-                                         "orbit 0 {}",
-                                         "look-at {} 0 0 1 1 1",
-                                         "look-at 0 {} 0 1 1 1",
-                                         "look-at 0 0 {} 1 1 1",
-                                         "look-at 0 0 0 {} 1 1",
-                                         "look-at 0 0 0 1 {} 1",
-                                         "look-at 0 0 0 1 1 {}",
-                                         "zoom {}",
-                                         "pan {} 0",
-                                         "pan 0 {}",
-                                         "iso {}",
-                                         "wait rays {}",
-                                         "wait time {}"};
+const std::vector<std::string> kScriptSlots = {"orbit {} 0",
+                                               "orbit 0 {}",
+                                               "look-at {} 0 0 1 1 1",
+                                               "look-at 0 {} 0 1 1 1",
+                                               "look-at 0 0 {} 1 1 1",
+                                               "look-at 0 0 0 {} 1 1",
+                                               "look-at 0 0 0 1 {} 1",
+                                               "look-at 0 0 0 1 1 {}",
+                                               "zoom {}",
+                                               "pan {} 0",
+                                               "pan 0 {}",
+                                               "iso {}",
+                                               "wait rays {}",
+                                               "wait time {}"};
 
-std::string fill(const std::string& slot, const std::string& value) {
+std::string script_fill(const std::string& slot, const std::string& value) {
     std::string line = slot;
     return line.replace(line.find("{}"), 2, value);
 }
@@ -44,10 +44,10 @@ std::string error_of(const std::string& line) {
 
 TEST(ScriptNumbers, NoSlotTakesANonNumber) {
     int tried = 0;
-    for (const std::string& slot : kSlots)
+    for (const std::string& slot : kScriptSlots)
         for (const char* bad : {"nan", "-nan", "NaN", "inf", "-inf", "infinity", "1e999", "-1e999",
                                 "0x10", "5abc", "1e", "--1", "+-1", "1,5"}) {
-            const std::string line = fill(slot, bad);
+            const std::string line = script_fill(slot, bad);
             const std::string command = line.substr(0, line.find(' '));
             const std::string e = error_of(line);
             EXPECT_EQ(e.rfind("s.txt:1: " + command + ": expected ", 0), 0u) << line << ": " << e;

@@ -11,7 +11,7 @@
 namespace isowall {
 namespace {
 
-struct Slot {
+struct WallSlot {
     std::string text;   // a wall file with {} where the value goes
     std::string field;  // the field its error names
 };
@@ -19,7 +19,7 @@ struct Slot {
 const std::string kGrid = "tiles = [2, 2]\ntile_size_px = [100, 80]\n";
 const std::string kPhys = kGrid + "[physical]\ntile_size_mm = [400, 300]\n";
 
-const std::vector<Slot> kSlots = {
+const std::vector<WallSlot> kWallSlots = {
     {"tiles = [{}, 2]\ntile_size_px = [100, 80]\n", "tiles"},
     {"tiles = [2, 2]\ntile_size_px = [100, {}]\n", "tile_size_px"},
     {kGrid + "bezel_px = {}\n", "bezel_px"},
@@ -33,18 +33,18 @@ const std::vector<Slot> kSlots = {
     {kPhys + "viewer_mm = [0, 0, {}]\n", "physical.viewer_mm"},
 };
 
-std::string fill(const std::string& slot, const std::string& value) {
+std::string wall_fill(const std::string& slot, const std::string& value) {
     std::string text = slot;
     return text.replace(text.find("{}"), 2, value);
 }
 
 TEST(WallNumbers, NoFieldTakesNonFiniteOrHugeValues) {
     int tried = 0;
-    for (const Slot& s : kSlots)
+    for (const WallSlot& s : kWallSlots)
         for (const char* bad : {"nan", "+nan", "-nan", "inf", "+inf", "-inf", "1e300", "-1e300",
                                 "9223372036854775807", "-9223372036854775808", "2147483648", "1e8",
                                 "\"5\"", "true"}) {
-            const std::string text = fill(s.text, bad);
+            const std::string text = wall_fill(s.text, bad);
             try {
                 const WallSpec w = parse_wall(text, "bad.toml");
                 ADD_FAILURE() << s.field << " = " << bad << ": accepted " << w;

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/core/pixel_rect_ops.h"
+
 namespace isowall {
 
 std::string_view to_string(RayOrderKind kind) {
@@ -34,10 +36,6 @@ namespace {
 
 bool is_dynamic(RayOrderKind kind) {
     return kind == RayOrderKind::dynamic_grid || kind == RayOrderKind::dynamic_gaps;
-}
-
-bool is_empty(const PixelRect& r) {
-    return r.width <= 0 || r.height <= 0;
 }
 
 PixelRect clip_to_screen(PixelRect r, int screen_width, int screen_height) {

@@ -36,14 +36,6 @@ struct InflateStream::State {
     }
 };
 
-namespace {
-
-bool starts_gzip(std::span<const std::byte> b) {
-    return b.size() >= 2 && b[0] == std::byte{0x1f} && b[1] == std::byte{0x8b};
-}
-
-}  // namespace
-
 InflateStream::InflateStream(std::span<const std::byte> in, std::uint64_t total, std::string where,
                              std::string field)
     : s_(std::make_unique<State>()) {

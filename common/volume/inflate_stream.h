@@ -29,4 +29,9 @@ class InflateStream {
     std::unique_ptr<State> s_;
 };
 
+// Whether `b` starts with the gzip magic number (zlib's raw deflate and zlib streams do not).
+inline bool starts_gzip(std::span<const std::byte> b) {
+    return b.size() >= 2 && b[0] == std::byte{0x1f} && b[1] == std::byte{0x8b};
+}
+
 }  // namespace isowall

@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "common/core/error.h"
+#include "common/volume/inflate_stream.h"
 #include "common/volume/load_checks.h"
 
 namespace isowall {
@@ -68,10 +69,6 @@ class GrowingOutput {
 
 unsigned clamp_uint(std::size_t n) {
     return static_cast<unsigned>(std::min<std::size_t>(n, UINT_MAX));
-}
-
-bool starts_gzip(std::span<const std::byte> rest) {
-    return rest.size() >= 2 && rest[0] == std::byte{0x1f} && rest[1] == std::byte{0x8b};
 }
 
 bool starts_bzip2(std::span<const std::byte> rest) {
