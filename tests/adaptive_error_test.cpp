@@ -16,12 +16,13 @@
 namespace isowall {
 namespace {
 
-struct Figures {
+struct ErrorFigures {
     double c = 0;  // final image against the full surface at full resolution
     std::size_t triangles = 0, coarse_units = 0;
 };
 
-Figures run(const Volume& volume, const FrameView& fv, float error_px, int threads = 1) {
+ErrorFigures run_at_error(const Volume& volume, const FrameView& fv, float error_px,
+                          int threads = 1) {
     auto ex = make_surface_extractor(volume, {}, nullptr, ThreadBudget{threads});
     auto renderer = make_renderer("osmesa");
     EngineOptions opt;
@@ -32,7 +33,7 @@ Figures run(const Volume& volume, const FrameView& fv, float error_px, int threa
     opt.threads = threads;
     const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
     EXPECT_TRUE(fr.completed);
-    Figures f;
+    ErrorFigures f;
     for (const Group& g : fr.groups) {
         f.triangles += g.mesh.triangle_count();
         for (std::size_t i = 0; i < g.cells.size(); ++i) f.coarse_units += g.level_of_cell(i) > 0;
@@ -47,8 +48,8 @@ TEST(AdaptiveError, ThinStructuresStayWhereTheSizeRuleAloneLosesThem) {
     const Volume v = test::make_thin_structures();
     const FrameView fv = test::make_view(v, 200, 150, test::kThinIso);
     std::cout << "thin structures 96^3, 200x150, meta-cells up to 4 px:\n";
-    const Figures size_only = run(v, fv, std::numeric_limits<float>::infinity());
-    const Figures bounded = run(v, fv, 0.5f);
+    const ErrorFigures size_only = run_at_error(v, fv, std::numeric_limits<float>::infinity());
+    const ErrorFigures bounded = run_at_error(v, fv, 0.5f);
     EXPECT_LT(size_only.c, 0.97);  // tubes and sheet broken or gone
     EXPECT_GE(bounded.c, 0.99);
     EXPECT_GT(bounded.coarse_units, 0u);  // the ball's smooth surface still coarse

@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr glm::ivec3 kDims{9, 6, 7};
+constexpr glm::ivec3 kCacheDims{9, 6, 7};
 
 void write_floats(const fs::path& p, const std::vector<float>& v) {
     std::ofstream out(p, std::ios::binary | std::ios::trunc);
@@ -26,7 +26,7 @@ void write_floats(const fs::path& p, const std::vector<float>& v) {
 }
 
 std::vector<float> ramp(float scale) {
-    std::vector<float> v(std::size_t(kDims.x) * kDims.y * kDims.z);
+    std::vector<float> v(std::size_t(kCacheDims.x) * kCacheDims.y * kCacheDims.z);
     for (std::size_t i = 0; i < v.size(); ++i) v[i] = scale * float(i % 50);
     return v;
 }
@@ -202,7 +202,7 @@ void all_nan_but_one(std::vector<float>& v, glm::ivec3 d) {
 // with one line naming the file and status 1, however far the program has got.
 TEST(OctreeCache, ABackgroundCheckPassesASoundOctreeAndEndsTheProgramOnADamagedOne) {
     const fs::path dir = test::scratch_dir("octree_background");
-    const octree_cache::Key key{7, kDims, 42};
+    const octree_cache::Key key{7, kCacheDims, 42};
     std::vector<std::byte> nodes(4096);
     for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = std::byte(i * 31);
     FiniteRange range;

@@ -21,7 +21,7 @@ namespace {
 
 using namespace remote;
 
-constexpr int kW = 240, kH = 180;
+constexpr int kGenW = 240, kGenH = 180;
 constexpr double kOtherIso = 120.0;  // between the skin and the bone
 
 // A session and a client joined by an in-process wire that records each group's generation.
@@ -73,7 +73,7 @@ struct Pair {
 
 TEST(RemoteCacheGen, TheClientHoldsWhatTheServerNamesWhenTheServerSkippedARequest) {
     Pair p;
-    const FrameView front = phantom_view(kW, kH, 0), turned = phantom_view(kW, kH, 30);
+    const FrameView front = phantom_view(kGenW, kGenH, 0), turned = phantom_view(kGenW, kGenH, 30);
     const RequestMsg r1 = Pair::request(1, front);
     p.client.begin(r1, 0);
     ASSERT_TRUE(p.run(r1).completed);
@@ -81,7 +81,7 @@ TEST(RemoteCacheGen, TheClientHoldsWhatTheServerNamesWhenTheServerSkippedAReques
     ASSERT_FALSE(p.gens.empty());
     for (const std::uint64_t g : p.gens) EXPECT_EQ(g, 1u) << "request 1 begins generation 1";
     // Requests 2 (another isovalue) and 3 follow at once; the server's worker takes only 3.
-    p.client.begin(Pair::request(2, phantom_view(kW, kH, 0, kOtherIso)), 1);
+    p.client.begin(Pair::request(2, phantom_view(kGenW, kGenH, 0, kOtherIso)), 1);
     const RequestMsg r3 = Pair::request(3, turned);
     p.client.begin(r3, 2);
     RequestFigures f;
@@ -98,9 +98,9 @@ TEST(RemoteCacheGen, TheClientHoldsWhatTheServerNamesWhenTheServerSkippedAReques
 
 TEST(RemoteCacheGen, ARequestAtAnotherIsovalueBeginsAGenerationAndTheNextNamesNothing) {
     Pair p;
-    const FrameView turned = phantom_view(kW, kH, 30);
-    const RequestMsg requests[] = {Pair::request(1, phantom_view(kW, kH, 0)),
-                                   Pair::request(2, phantom_view(kW, kH, 0, kOtherIso)),
+    const FrameView turned = phantom_view(kGenW, kGenH, 30);
+    const RequestMsg requests[] = {Pair::request(1, phantom_view(kGenW, kGenH, 0)),
+                                   Pair::request(2, phantom_view(kGenW, kGenH, 0, kOtherIso)),
                                    Pair::request(3, turned)};
     RequestFigures f;
     for (const RequestMsg& r : requests) {
@@ -120,15 +120,15 @@ TEST(RemoteCacheGen, ARequestAtAnotherIsovalueBeginsAGenerationAndTheNextNamesNo
 
 TEST(RemoteCacheGen, ARequestWithoutCachingSendsGenerationZeroAndTheSeedRaysNameInOneMessage) {
     Pair p;
-    RequestMsg plain = Pair::request(1, phantom_view(kW, kH, 0));
+    RequestMsg plain = Pair::request(1, phantom_view(kGenW, kGenH, 0));
     plain.cached_groups = false;
     p.client.begin(plain, 0);
     ASSERT_TRUE(p.run(plain).completed);
     for (const std::uint64_t g : p.gens) EXPECT_EQ(g, 0u);
-    const RequestMsg r2 = Pair::request(2, phantom_view(kW, kH, 0));
+    const RequestMsg r2 = Pair::request(2, phantom_view(kGenW, kGenH, 0));
     p.client.begin(r2, 1);
     ASSERT_TRUE(p.run(r2).completed);
-    const RequestMsg r3 = Pair::request(3, phantom_view(kW, kH, 10));
+    const RequestMsg r3 = Pair::request(3, phantom_view(kGenW, kGenH, 10));
     p.client.begin(r3, 2);
     ASSERT_TRUE(p.run(r3).completed);
     ASSERT_FALSE(p.visible.empty());

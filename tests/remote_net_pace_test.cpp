@@ -17,7 +17,7 @@ namespace {
 
 using namespace remote_testing;
 
-constexpr double kTimeout_s = 10;
+constexpr double kPaceTimeoutS = 10;
 
 struct Pair {
     std::unique_ptr<Connection> sender, receiver;
@@ -25,8 +25,8 @@ struct Pair {
 
 Pair connected_pair() {
     Listener listener = Listener::open("127.0.0.1", 0);
-    Socket client = connect_tcp("127.0.0.1", listener.port(), kTimeout_s);
-    std::optional<Socket> server = listener.accept(kTimeout_s);
+    Socket client = connect_tcp("127.0.0.1", listener.port(), kPaceTimeoutS);
+    std::optional<Socket> server = listener.accept(kPaceTimeoutS);
     if (!server) throw NetError("accept timed out");
     return {std::make_unique<Connection>(std::move(*server), "client"),
             std::make_unique<Connection>(std::move(client), "server")};
@@ -45,7 +45,7 @@ bool send_while_receiving(Pair& pair, Send send) {
     bool arrived = false;
     std::thread reader([&] {
         try {
-            arrived = pair.receiver->receive(kTimeout_s).has_value();
+            arrived = pair.receiver->receive(kPaceTimeoutS).has_value();
         } catch (const NetError&) {  // shut down after a failed send: reported by the caller
         }
     });
@@ -130,7 +130,7 @@ TEST(RemoteNetPace, ShutdownCutsAPacedWaitShort) {
     pair.sender->shutdown();
     sender.join();
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-              kTimeout_s / 2);
+              kPaceTimeoutS / 2);
     EXPECT_NE(error.find("shut down"), std::string::npos) << error;
 }
 

@@ -21,7 +21,7 @@ namespace {
 using namespace remote;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kTimeoutS = 30;
+constexpr double kFloodTimeoutS = 30;
 // A flood: this many pings per send, until kFloodPings or kFloodSeconds, whichever comes first.
 constexpr int kPingsPerSend = 4096;
 constexpr long kFloodPings = 1 << 20;
@@ -31,7 +31,7 @@ constexpr double kFloodSeconds = 3;
 constexpr double kMaxGrowthMiB = 48;
 
 void expect_ready(RawWs& ws) {
-    const RemoteMessage m = ws.receive_message(kTimeoutS);
+    const RemoteMessage m = ws.receive_message(kFloodTimeoutS);
     ASSERT_TRUE(std::holds_alternative<ReadyMsg>(m)) << to_string(type_of(m));
 }
 
@@ -42,7 +42,7 @@ EndOfFrameMsg one_frame(RawWs& ws) {
     r.view = phantom_view(64, 48, 0);
     ws.send_message(r);
     for (;;) {
-        const RemoteMessage m = ws.receive_message(kTimeoutS);
+        const RemoteMessage m = ws.receive_message(kFloodTimeoutS);
         if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) return *e;
         if (const auto* e = std::get_if<ErrorMsg>(&m)) throw std::runtime_error(e->text);
     }
@@ -124,7 +124,7 @@ TEST(RemoteWebFlood, APingFloodKeepsOnePongWaitingAndTheServerSmall) {
         f = flood_pings(ws, rss0);
         reader.expect("last");
         ws.send_raw(RawWs::frame(ws_opcode::kPing, "last"));
-        EXPECT_TRUE(reader.wait_last(kTimeoutS)) << "the newest ping was never answered";
+        EXPECT_TRUE(reader.wait_last(kFloodTimeoutS)) << "the newest ping was never answered";
         pongs = reader.pongs();
     }
     std::printf(
@@ -185,7 +185,7 @@ TEST(RemoteWebFlood, AnOutgoingQueueOverItsCapClosesTheConnection) {
     while (sent < 4096 && server.send(id, chunk.data(), chunk.size())) ++sent;
     EXPECT_LT(sent, 4096) << "256 MiB queued for a client that reads nothing";
     int code = 0;
-    EXPECT_TRUE(deaf.wait_closed(kTimeoutS, &code));
+    EXPECT_TRUE(deaf.wait_closed(kFloodTimeoutS, &code));
     EXPECT_EQ(code, 1008);
     std::printf("[ measured ] %d sends of 64 KiB before the cap of 1 MiB closed the connection\n",
                 sent);
@@ -198,12 +198,12 @@ TEST(RemoteWebFlood, AnIdleWebSocketIsClosedNamingTheLimit) {
     RawWs ws(server.http_port());
     ws.send_message(phantom_hello());
     expect_ready(ws);
-    const RemoteMessage m = ws.receive_message(kTimeoutS);
+    const RemoteMessage m = ws.receive_message(kFloodTimeoutS);
     const auto* e = std::get_if<ErrorMsg>(&m);
     ASSERT_TRUE(e) << "expected an error, got " << to_string(type_of(m));
     EXPECT_NE(e->text.find("--idle-timeout"), std::string::npos) << e->text;
     EXPECT_NE(e->text.find("0.5 s"), std::string::npos) << e->text;
-    EXPECT_TRUE(ws.wait_closed(kTimeoutS));
+    EXPECT_TRUE(ws.wait_closed(kFloodTimeoutS));
 }
 
 }  // namespace
