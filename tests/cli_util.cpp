@@ -25,13 +25,6 @@ RunResult run_isowall(const std::filesystem::path& dir, const std::string& args,
     return r;
 }
 
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 void write_text(const std::filesystem::path& p, const std::string& text) {
     std::ofstream(p) << text;
 }

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_util.h"  // slurp
+
 namespace isowall::test {
 
 struct RunResult {
@@ -18,7 +20,6 @@ struct RunResult {
 RunResult run_isowall(const std::filesystem::path& dir, const std::string& args,
                       const std::string& prefix = "");
 
-std::string slurp(const std::filesystem::path& p);
 void write_text(const std::filesystem::path& p, const std::string& text);
 
 // A non-zero exit that is not a timeout, and exactly one line on stderr, "isowall: error: ...",

@@ -10,32 +10,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/cli_util.h"
 #include "tests/test_util.h"
 
 namespace isowall {
 namespace {
 
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-struct RunOutcome {
-    int exit_code = -1;
-    std::string err;
-};
-
-// The real binary under `timeout`: a hang fails the case (exit 124) instead of the suite.
-RunOutcome run_isowall(const std::filesystem::path& dir, const std::string& args) {
-    const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = "cd '" + dir.string() + "' && timeout 60 '" +
-                            std::string(ISOWALL_BINARY) + "' " + args + " > '" + out.string() +
-                            "' 2> '" + err.string() + "'";
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
-}
+using test::run_isowall;
+using test::RunResult;
+using test::slurp;
 
 void write_bytes(const std::filesystem::path& p, const std::string& bytes) {
     std::ofstream(p, std::ios::binary) << bytes;
@@ -90,7 +73,7 @@ TEST(CliVolume, HostileVolumesAndOptionsAreOneLineEach) {
     };
     for (const CliCase& c : cases) {
         SCOPED_TRACE(c.args);
-        const RunOutcome r = run_isowall(dir, c.args);
+        const RunResult r = run_isowall(dir, c.args);
         EXPECT_NE(r.exit_code, 0);
         EXPECT_NE(r.exit_code, 124) << "timed out";
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

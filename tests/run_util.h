@@ -9,6 +9,8 @@
 #include <iterator>
 #include <string>
 
+#include "tests/test_util.h"
+
 namespace isowall::test {
 
 // Runs a command under `timeout` (the test guards against hangs itself) and returns its exit code.
@@ -32,11 +34,6 @@ inline std::string mpirun(int np) {
     s += std::to_string(np);
     s += ' ';
     return s + isowall_cmd();
-}
-
-inline std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace isowall::test

@@ -1,6 +1,8 @@
 #include "tests/test_util.h"
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 
 namespace isowall::test {
 
@@ -26,6 +28,11 @@ std::size_t count_of(const std::string& text, const std::string& what) {
     std::size_t n = 0;
     for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
     return n;
+}
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace isowall::test

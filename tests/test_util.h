@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the tests: where the shared data lives, temporary folders.
+// Helpers shared by the tests: where the shared data lives, temporary folders, reading a file.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -16,5 +16,8 @@ std::filesystem::path scratch_dir(const std::string& name);
 
 // How many times `what` occurs in `text` (e.g. error lines in a log).
 std::size_t count_of(const std::string& text, const std::string& what);
+
+// The whole of a text file ("" when it cannot be read).
+std::string slurp(const std::filesystem::path& p);
 
 }  // namespace isowall::test
