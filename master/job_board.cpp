@@ -103,28 +103,6 @@ std::optional<std::uint32_t> JobBoard::steal(const Queues& q, Band band) const {
     return q.last[most];
 }
 
-// The first fine band rank `r` holds whose coarse band is cast or being cast, when the fine bands
-// it holds so exceed its share of all the work queued: a fine band costs its coarse band again on
-// any other rank, so what a rank holds is in effect its own, and one that kept taking coarse
-// bands while the others ran out would end the frame alone (balance 0.75 on the all-tiles head).
-std::optional<std::uint32_t> JobBoard::own_fine_first(std::size_t r) const {
-    double held = 0, all = 0;
-    std::optional<std::uint32_t> first;
-    for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
-        const BoardJob& j = jobs_[id];
-        if (j.state != BoardJob::State::queued) continue;
-        const double c = cost(j);
-        all += c;
-        if (j.band == Band::fine && static_cast<std::size_t>(j.holder) == r &&
-            jobs_[j.coarse].state != BoardJob::State::queued) {
-            held += c;
-            if (!first) first = id;
-        }
-    }
-    const auto workers = static_cast<double>(std::max<std::size_t>(1, in_hand_.size() - 1));
-    return held > all / workers ? first : std::nullopt;
-}
-
 std::optional<std::uint32_t> JobBoard::pick(int rank) const {
     auto first = [&](Band band) -> std::optional<std::uint32_t> {
         for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
@@ -134,8 +112,6 @@ std::optional<std::uint32_t> JobBoard::pick(int rank) const {
         return std::nullopt;
     };
     const auto r = static_cast<std::size_t>(rank);
-    if (balance_)
-        if (auto id = own_fine_first(r)) return id;
     for (const Band band : {Band::coarse, Band::fine}) {
         if (!balance_) {
             if (auto id = first(band)) return id;

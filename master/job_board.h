@@ -10,8 +10,6 @@
 //     nothing is cast twice) under the same rule, else (balancing) one of the busiest holder:
 //     the region is cast again from its first level by the helper, whose image must show all of
 //     it, so only while that holder keeps more work than the helper's whole region costs.
-// A rank that holds more fine work than its share of all the work queued runs its own fine bands
-// before any other job (the coarse-first order yields there: see own_fine_first).
 // Stolen jobs are taken from the end of a queue, the owner works from its front. Estimated work is
 // a job's estimate (its region's work from region_plan.h, or its rays inside the volume's screen
 // box for a fixed grid; 1/16 of it coarse) times the recent CPU cost per unit of estimate of its
@@ -83,7 +81,6 @@ class JobBoard {
     };
     Queues queued(Band band) const;
     std::optional<std::uint32_t> pick(int rank) const;
-    std::optional<std::uint32_t> own_fine_first(std::size_t rank) const;
     std::optional<std::uint32_t> steal(const Queues& q, Band band) const;
     double cost(const BoardJob& j) const;
     int key(const BoardJob& j) const { return j.band == Band::coarse ? j.owner : j.holder; }

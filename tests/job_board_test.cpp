@@ -97,34 +97,6 @@ TEST(JobBoard, IdleRanksTakeCoarseJobsOfTheBusyTileFirst) {
                 b.job(*fine).rect.x == b.job(*next).rect.x);
 }
 
-TEST(JobBoard, ARankHoldingMoreThanItsShareRunsItsOwnFineBandsBeforeMoreCoarseOnes) {
-    // Two tile ranks, rank 1 with 8 regions, rank 2 with 8. Rank 1 takes coarse bands while
-    // rank 2 is busy: once the fine bands it holds exceed its share of all the work queued, it
-    // runs those before taking another coarse band.
-    JobBoard b = board_of({0, 8, 8}, true, 1);
-    const auto busy = b.next_for(2);
-    ASSERT_TRUE(busy);
-    std::size_t coarse_taken = 0;
-    for (;;) {
-        const auto id = b.next_for(1);
-        ASSERT_TRUE(id);
-        if (b.job(*id).band == Band::fine) {
-            EXPECT_EQ(b.job(*id).holder, 1) << "its own fine band, not another's";
-            break;
-        }
-        ++coarse_taken;
-        b.done(*id, 0.001);
-    }
-    // All queued: 16 regions' fine bands (15/16 each) and the coarse bands left; rank 1's share
-    // is half of it, about 8 fine bands' worth.
-    EXPECT_GE(coarse_taken, 7u);
-    EXPECT_LE(coarse_taken, 9u);
-    bool coarse_left = false;
-    for (std::uint32_t id = 0; id < b.size(); ++id)
-        coarse_left |= b.job(id).band == Band::coarse && b.job(id).state == BoardJob::State::queued;
-    EXPECT_TRUE(coarse_left) << "the fine band came while coarse bands were still queued";
-}
-
 TEST(JobBoard, AJobLandsWhenDoneAndDeliveredInEitherOrder) {
     JobBoard b = board_of({0, 1, 0}, true, 1);
     const auto a = b.next_for(2);  // the helper takes the coarse job
