@@ -3,9 +3,8 @@
 // side is master/job_board.h). A rank draws every group it extracts into its own tile's image,
 // whatever job found it: all jobs of a frame share one set of visited cells (EngineFrame), so a
 // group found for another tile may be the one a later ray of its own tile hits. A job for another
-// tile (the owner) is drawn into a region image of the owner's view, first with the groups found
-// earlier in the frame that may show in it, and is sent to the owner, which composites it by
-// depth into what its tile shows.
+// tile (the owner) is drawn into a region image of the owner's view and sent to the owner, which
+// composites it by depth into what its tile shows.
 //
 // A region's image needs the groups found earlier in the frame whose cells its rays meet: the
 // engine casts no new pass there. Each is drawn once a ray of the job meets one of its cells (the
