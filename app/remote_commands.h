@@ -20,6 +20,7 @@ struct ServeCommand {
     int port = -1;       // --port; -1: not given (the port in --listen, else kServePort)
     int http_port = -1;  // --http: the page and WebSocket on this port (0: any free); -1: none
     std::string token;
+    std::string tls_cert, tls_key;  // PEM files; both or neither (TLS on every port)
     double rate_mbps = 0;
     int max_clients = 8;
     double idle_timeout_s = 300;  // --idle-timeout: a connection idle this long after its hello
@@ -34,6 +35,8 @@ struct ViewCommand {
     std::string connect = "127.0.0.1:7878";
     std::string dataset = "phantom";
     std::string token;
+    bool tls = false;    // --tls: TLS, the server's certificate checked against the system's CAs
+    std::string tls_ca;  // --tls-ca: TLS, trusting the authorities in this PEM file
     int test_case = 0;  // 1-5: the study's cases; 0: the options below
     std::string encoding = "compact-zstd";
     bool lod = false, cache = false;

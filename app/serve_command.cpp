@@ -63,7 +63,7 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
                   "offered as 'phantom'");
     c->add_option("--listen", o.listen,
                   "Where to listen: HOST, HOST:PORT or [IPV6]:PORT, as view --connect takes it "
-                  "(PORT 0: any free port, printed); anything but loopback needs --token")
+                  "(PORT 0: any free port, printed); anything but loopback needs TLS and --token")
         ->capture_default_str();
     c->add_option("--port", o.port,
                   "TCP port when --listen names none (default " + std::to_string(kServePort) +
@@ -74,6 +74,10 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
                   "port, at the --listen address (0: any free port, printed)")
         ->check(CLI::Range(0, 65535));
     c->add_option("--token", o.token, "A secret every client must present in its hello");
+    c->add_option("--tls-cert", o.tls_cert,
+                  "TLS on every port (the protocol, the page and its WebSocket): this PEM "
+                  "certificate chain, with --tls-key");
+    c->add_option("--tls-key", o.tls_key, "The PEM private key of --tls-cert (no passphrase)");
     c->add_option("--rate-mbps", o.rate_mbps,
                   "Emulate a link of this many Mbit/s (token bucket on every send); 0: no limit")
         ->transform(number_in({0, 1e6}))
@@ -102,6 +106,15 @@ int run_serve(const ServeCommand& o) {
     so.address = at.host;
     so.port = at.port;
     so.token = o.token;
+    if (o.tls_cert.empty() != o.tls_key.empty())
+        throw InputError(o.tls_cert.empty() ? "--tls-key" : "--tls-cert", "value",
+                         "TLS needs both --tls-cert and --tls-key");
+    if (!o.tls_cert.empty())
+        so.tls = std::make_shared<const remote::TlsContext>(
+            remote::TlsContext::server(o.tls_cert, o.tls_key));
+    // Before the datasets load (a large one takes a while): ViewServer checks it again.
+    if (std::string p = remote::exposure_problem(so, "listening"); !p.empty())
+        throw InputError("--listen", "address", p);
     so.rate_bits_per_s = o.rate_mbps * 1e6;
     so.max_clients = o.max_clients;
     so.idle_timeout_s = o.idle_timeout_s;
@@ -128,11 +141,11 @@ int run_serve(const ServeCommand& o) {
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
     std::printf(
-        "serve: listening on %s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
-        o.token.empty() ? "" : " (token required)",
+        "serve: listening on %s%s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
+        so.tls ? " (TLS)" : "", o.token.empty() ? "" : " (token required)",
         o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
     if (http)
-        std::printf("serve: page at http://%s/ (WebSocket /ws)\n",
+        std::printf("serve: page at %s://%s/ (WebSocket /ws)\n", so.tls ? "https" : "http",
                     remote::host_port(at.host, http->port()).c_str());
     std::fflush(stdout);
     server.serve(g_stop);

@@ -145,6 +145,12 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     c->add_option("--connect", o.connect, "Server as HOST:PORT")->capture_default_str();
     c->add_option("--dataset", o.dataset, "Dataset name the server offers")->capture_default_str();
     c->add_option("--token", o.token, "The server's token, if it asks for one");
+    c->add_flag("--tls", o.tls,
+                "Connect over TLS (a server started with --tls-cert); its certificate must chain "
+                "to an authority the system trusts and name the --connect host");
+    c->add_option("--tls-ca", o.tls_ca,
+                  "Connect over TLS, trusting the authorities in this PEM file (a self-signed "
+                  "server certificate may be its own)");
     c->add_option("--case", o.test_case,
                   "The study's cases: 1 base, 2 indexed, 3 indexed + progressive LOD, 4 indexed "
                   "+ LOD + cache, 5 compact+zstd + LOD + cache (overrides the three options "
@@ -204,6 +210,8 @@ int run_view(const ViewCommand& o) {
     hello.port = ep.port;
     hello.dataset = o.dataset;
     hello.token = o.token;
+    if (o.tls || !o.tls_ca.empty())
+        hello.tls = std::make_shared<const TlsContext>(TlsContext::client(o.tls_ca));
     hello.encoding = setting.encoding;
     hello.connect_timeout_s = o.timeout_s;  // connecting and the hello's answer too (once 10 s)
     ViewClient client(*renderer, hello);

@@ -5,6 +5,7 @@
 //
 // Threads, as for Connection: any number of senders, one receiver, shutdown() from anywhere.
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -19,6 +20,11 @@ class MessageChannel {
 
     // Who is at the other end, for log lines ("127.0.0.1:51234", "ws 127.0.0.1:51234").
     virtual const std::string& peer() const = 0;
+    // What the channel does before the first message, within `timeout_s` (a TCP channel's TLS
+    // handshake); on the connection's own thread. Throws TlsHandshakeError when it fails, and
+    // WireError (after which the error goes back in plain text) when a client that speaks
+    // plain text came to a TLS port.
+    virtual void open(double timeout_s) { (void)timeout_s; }
     // Sends one whole message; returns the bytes it took on the wire, frame header included.
     // Throws NetError or PeerClosed (also after shutdown()).
     virtual std::size_t send(const RemoteMessage& m) = 0;
@@ -33,13 +39,16 @@ class MessageChannel {
     virtual void close_gracefully() = 0;
 };
 
-// A TCP connection of the protocol: a framed byte stream (remote/net/connection.h).
+// A TCP connection of the protocol: a framed byte stream (remote/net/connection.h), over TLS
+// when the server has a context (`tls`, shared by every connection).
 class TcpChannel final : public MessageChannel {
   public:
-    TcpChannel(Socket s, std::string peer, std::uint32_t max_payload_bytes)
-        : conn_(std::move(s), std::move(peer), max_payload_bytes) {}
+    TcpChannel(Socket s, std::string peer, std::uint32_t max_payload_bytes,
+               std::shared_ptr<const TlsContext> tls = nullptr)
+        : conn_(std::move(s), std::move(peer), max_payload_bytes), tls_(std::move(tls)) {}
 
     const std::string& peer() const override { return conn_.peer(); }
+    void open(double timeout_s) override;
     std::size_t send(const RemoteMessage& m) override { return conn_.send(m); }
     std::optional<RemoteMessage> receive(double timeout_s) override {
         return conn_.receive(timeout_s);
@@ -50,6 +59,7 @@ class TcpChannel final : public MessageChannel {
 
   private:
     Connection conn_;
+    std::shared_ptr<const TlsContext> tls_;
 };
 
 }  // namespace isowall::remote

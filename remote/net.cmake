@@ -1,9 +1,10 @@
 # isowall_remote_net: TCP for `isowall serve` / `isowall view` (remote/net/): sockets with
 # timeouts, HOST:PORT endpoints, framed connections and the emulated link's token bucket. POSIX
-# sockets only.
+# sockets, and TLS through OpenSSL (tls.cpp).
 add_library(isowall_remote_net
     ${CMAKE_CURRENT_LIST_DIR}/net/socket.cpp ${CMAKE_CURRENT_LIST_DIR}/net/endpoint.cpp
-    ${CMAKE_CURRENT_LIST_DIR}/net/token_bucket.cpp ${CMAKE_CURRENT_LIST_DIR}/net/connection.cpp)
+    ${CMAKE_CURRENT_LIST_DIR}/net/token_bucket.cpp ${CMAKE_CURRENT_LIST_DIR}/net/connection.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/net/tls.cpp)
 target_include_directories(isowall_remote_net PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_net PUBLIC isowall_remote_proto Threads::Threads
-    PRIVATE isowall_warnings)
+    PRIVATE OpenSSL::SSL isowall_warnings)

@@ -17,6 +17,8 @@ struct ClientHello {
     int port = 7878;
     std::string dataset = "phantom";
     std::string token;
+    // TLS with this client context (the authorities trusted); null: plain TCP.
+    std::shared_ptr<const TlsContext> tls;
     GroupEncoding encoding = GroupEncoding::compact_zstd;
     double connect_timeout_s = 10;
 };

@@ -29,6 +29,13 @@ bool is_loopback(const std::string& address) {
     return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
 }
 
+std::string exposure_problem(const ServerOptions& o, const std::string& what) {
+    if (is_loopback(o.address) || (!o.token.empty() && o.tls)) return "";
+    return what + " on " + o.address +
+           " (not loopback) needs TLS (--tls-cert and --tls-key) and --token, which every "
+           "client must present: anyone on the path could read the surfaces and the token";
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -159,9 +166,15 @@ class ViewServer::Client {
 
     void run() {
         try {
+            conn_.open(server_.options_.hello_timeout_s);
             if (const Dataset* d = hello()) serve(*d);
         } catch (const WireError& e) {
             refuse(code_of(e), e.what());
+        } catch (const TlsHandshakeError& e) {
+            // Nothing can reach the client. The text starts with the peer, which say() adds.
+            std::string_view text = e.what();
+            if (text.rfind(conn_.peer() + ": ", 0) == 0) text.remove_prefix(conn_.peer().size() + 2);
+            say("serve: %s: error: %s\n", std::string(text));
         } catch (const PeerClosed& e) {
             // A client that stops sending inside a message may still read the reply.
             if (std::string_view(e.what()).find("inside a message") != std::string_view::npos)
@@ -291,10 +304,8 @@ class ViewServer::Client {
 
 ViewServer::ViewServer(std::vector<Dataset> datasets, ServerOptions options)
     : datasets_(std::move(datasets)), options_(std::move(options)) {
-    if (options_.token.empty() && !is_loopback(options_.address))
-        throw InputError("--listen", "address",
-                         "listening on " + options_.address +
-                             " (not loopback) needs --token, which every client must present");
+    if (std::string p = exposure_problem(options_, "listening"); !p.empty())
+        throw InputError("--listen", "address", p);
     impl_ = std::make_unique<Impl>(Listener::open(options_.address, options_.port));
 }
 
@@ -325,7 +336,8 @@ void ViewServer::serve(const std::atomic<bool>& stop) {
         std::optional<Socket> s = impl_->listener.accept(0.1, &peer);
         reap(false);
         if (!s) continue;
-        adopt(std::make_unique<TcpChannel>(std::move(*s), peer, options_.max_payload_bytes));
+        adopt(std::make_unique<TcpChannel>(std::move(*s), peer, options_.max_payload_bytes,
+                                           options_.tls));
     }
 }
 

@@ -55,6 +55,8 @@ struct ServerOptions {
     std::string address = "127.0.0.1";
     int port = 7878;             // 0: any free port (see ViewServer::port)
     std::string token;           // empty: none asked for (only allowed on a loopback address)
+    // The TCP protocol over TLS with this server context; null: plain TCP (loopback only).
+    std::shared_ptr<const TlsContext> tls;
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
     int max_clients = 8;
     double hello_timeout_s = 10;
@@ -66,6 +68,11 @@ struct ServerOptions {
     SessionOptions session;                     // the encoding comes from each hello
     bool verbose = true;                        // a line per connection and request
 };
+
+// Why serving on `o.address` would expose it ("" when it may go on): anything but loopback
+// needs TLS and a token. For InputError("--listen", "address", ...); `what` is "listening"
+// or "serving the page".
+std::string exposure_problem(const ServerOptions& o, const std::string& what);
 
 class ViewServer {
   public:

@@ -179,6 +179,10 @@ bool recv_some(const Socket& s, std::span<std::byte> buf, double timeout_s, std:
     }
 }
 
+bool wait_ready(const Socket& s, bool for_write, double timeout_s, const std::string& peer) {
+    return wait_for(s.fd(), for_write ? POLLOUT : POLLIN, deadline_after(timeout_s), peer) != 0;
+}
+
 Socket connect_tcp(const std::string& host, int port, double timeout_s) {
     const std::string peer = host_port(host, port);
     const auto deadline = deadline_after(timeout_s);

@@ -54,6 +54,11 @@ void send_all(const Socket& s, std::span<const std::byte> bytes, const std::stri
 bool recv_some(const Socket& s, std::span<std::byte> buf, double timeout_s, std::size_t& got,
                const std::string& peer);
 
+// Waits at most `timeout_s` (negative or infinite: for ever) until `s` can be read (or written,
+// `for_write`), or has hung up or failed; false when the time ran out. The TLS layer waits here
+// between its non-blocking reads and writes.
+bool wait_ready(const Socket& s, bool for_write, double timeout_s, const std::string& peer);
+
 // Connects to `host` (numeric IPv4 or IPv6, or a name for getaddrinfo) trying each address in
 // turn, each within what is left of `timeout_s` (a non-blocking connect, then poll). The socket
 // returned is blocking, with TCP_NODELAY on (a request must not wait behind Nagle). NetError

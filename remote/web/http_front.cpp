@@ -8,11 +8,10 @@ namespace isowall::remote {
 
 HttpFrontEnd::HttpFrontEnd(ViewServer& server, int port) : server_(server) {
     const ServerOptions& so = server.options();
-    if (so.token.empty() && !is_loopback(so.address))
-        throw InputError("--listen", "address",
-                         "serving the page on " + so.address +
-                             " (not loopback) needs --token, which every client must present");
+    if (std::string p = exposure_problem(so, "serving the page"); !p.empty())
+        throw InputError("--listen", "address", p);
     web::WebOptions wo;
+    if (so.tls) wo.tls = so.tls->native();
     wo.address = so.address;
     wo.port = port;
     wo.max_message_bytes = kHeaderBytes + so.max_payload_bytes;

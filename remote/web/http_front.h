@@ -16,8 +16,9 @@ namespace isowall::remote {
 class HttpFrontEnd {
   public:
     // Listens at once on the server's --listen address and `port` (0: any free port) and starts
-    // the io thread. Throws InputError naming --http when it cannot listen (a port in use), or
-    // --listen when the address is not loopback and the server has no token.
+    // the io thread, over TLS when the server has a context (https and wss). Throws InputError
+    // naming --http when it cannot listen (a port in use), or --listen when the address is not
+    // loopback and the server has no token or no TLS.
     HttpFrontEnd(ViewServer& server, int port);
     // Stops the io thread and ends every WebSocket; destroy it before the ViewServer.
     ~HttpFrontEnd();

@@ -10,7 +10,8 @@ set_target_properties(isowall_remote_web PROPERTIES CXX_STANDARD 17 CXX_STANDARD
 target_include_directories(isowall_remote_web PUBLIC ${PROJECT_SOURCE_DIR}
     PRIVATE ${WEBSOCKETPP_INCLUDE_DIR} ${ASIO_INCLUDE_DIR})
 target_compile_definitions(isowall_remote_web PRIVATE ASIO_STANDALONE)
-target_link_libraries(isowall_remote_web PUBLIC Threads::Threads PRIVATE isowall_warnings)
+target_link_libraries(isowall_remote_web PUBLIC Threads::Threads
+    PRIVATE OpenSSL::SSL isowall_warnings)
 
 # isowall_remote_http (C++20): the WebSocket as a MessageChannel (web_channel.cpp), the HTTP
 # routes (web_routes.cpp, pure), the front end that joins them to a ViewServer (http_front.cpp),

@@ -10,15 +10,15 @@
 #include <thread>
 #include <utility>
 
+#include <openssl/ssl.h>
+#include <websocketpp/config/asio.hpp>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
 namespace isowall::web {
 namespace {
 
-using Endpoint = websocketpp::server<websocketpp::config::asio>;
 using Handle = websocketpp::connection_hdl;
-using Message = websocketpp::config::asio::message_type;
 namespace status = websocketpp::http::status_code;
 
 // How often a send blocked by back-pressure looks at the connection's buffer again.
@@ -39,17 +39,20 @@ void split_resource(const std::string& resource, std::string& path, std::string&
 // payload is at most 125 bytes, which websocketpp checks) and the payload, unmasked. Prepared
 // here rather than by websocketpp's pong() so that its owner can see when it has been written:
 // websocketpp holds a reference until then.
-Endpoint::message_ptr pong_frame(std::string payload) {
+template <class Config>
+typename websocketpp::server<Config>::message_ptr pong_frame(std::string payload) {
+    using Message = typename Config::message_type;
     payload.resize(std::min<std::size_t>(payload.size(), 125));
-    auto m =
-        std::make_shared<Message>(Message::con_msg_man_ptr(), websocketpp::frame::opcode::pong, 0);
+    auto m = std::make_shared<Message>(typename Message::con_msg_man_ptr(),
+                                       websocketpp::frame::opcode::pong, 0);
     m->set_header(std::string{static_cast<char>(0x8A), static_cast<char>(payload.size())});
     m->set_payload(payload);
     m->set_prepared(true);
     return m;
 }
 
-void refuse(const Endpoint::connection_ptr& con, status::value code, const std::string& text) {
+template <class ConnectionPtr>
+void refuse(const ConnectionPtr& con, status::value code, const std::string& text) {
     con->set_status(code);
     con->replace_header("Content-Type", "text/plain; charset=utf-8");
     con->replace_header("Cache-Control", "no-store");
@@ -58,14 +61,42 @@ void refuse(const Endpoint::connection_ptr& con, status::value code, const std::
 
 }  // namespace
 
-bool origin_allowed(const std::string& origin, const std::string& host) {
-    return origin.empty() || (!host.empty() && origin == "http://" + host);
+bool origin_allowed(const std::string& origin, const std::string& host, bool tls) {
+    return origin.empty() || (!host.empty() && origin == (tls ? "https://" : "http://") + host);
 }
 
+// What WebServer does, whichever endpoint (plain or TLS) does it.
 struct WebServer::Impl {
+    virtual ~Impl() = default;
+    virtual int port() const = 0;
+    virtual void start() = 0;
+    virtual void stop() = 0;
+    virtual bool send(ConnectionId id, const void* bytes, std::size_t size,
+                      const std::atomic<bool>* cancel) = 0;
+    virtual void close(ConnectionId id, const std::string& reason) = 0;
+};
+
+namespace {
+
+template <class Config>
+struct Server final : WebServer::Impl {
+    using Endpoint = websocketpp::server<Config>;
+    using MessagePtr = typename Endpoint::message_ptr;
+    using ConnectionPtr = typename Endpoint::connection_ptr;
+    static constexpr bool kTls = !std::is_same_v<Config, websocketpp::config::asio>;
+
+    Server(WebOptions o, WebCallbacks cb);
+    ~Server() override { stop(); }
+    int port() const override;
+    void start() override;
+    void stop() override;
+    bool send(ConnectionId id, const void* bytes, std::size_t size,
+              const std::atomic<bool>* cancel) override;
+    void close(ConnectionId id, const std::string& reason) override;
+
     WebOptions options;
     WebCallbacks callbacks;
-    Endpoint endpoint;
+    mutable Endpoint endpoint;  // mutable: websocketpp's get_local_endpoint is not const
     std::thread thread;
     std::mutex mutex;
     std::condition_variable changed;  // a connection closed, or the server stopped
@@ -77,7 +108,7 @@ struct WebServer::Impl {
     // At most one pong per connection in websocketpp's hands (queued or being written), and the
     // newest ping's payload not answered yet; io thread only.
     struct PongSlot {
-        Endpoint::message_ptr out;  // the last pong sent; still held by websocketpp until written
+        MessagePtr out;  // the last pong sent; still held by websocketpp until written
         std::string next;           // the payload of the newest ping not answered yet
         bool waiting = false;       // `next` waits for `out` to be written
         bool timer = false;         // a timer will look again
@@ -94,17 +125,18 @@ struct WebServer::Impl {
     ConnectionId id_of(Handle h);
     bool on_ping(Handle h, std::string payload);
     void send_pong(ConnectionId id);
-    bool over_cap(const Endpoint::connection_ptr& con, std::size_t more);
+    bool over_cap(const ConnectionPtr& con, std::size_t more);
 };
 
-void WebServer::Impl::install_handlers() {
+template <class Config>
+void Server<Config>::install_handlers() {
     endpoint.set_validate_handler([this](Handle h) { return validate(h); });
     endpoint.set_http_handler([this](Handle h) { serve_http(h); });
     endpoint.set_open_handler([this](Handle h) { on_open(h); });
     endpoint.set_close_handler([this](Handle h) { on_end(h); });
     endpoint.set_fail_handler([this](Handle h) { on_end(h); });
     endpoint.set_ping_handler([this](Handle h, std::string p) { return on_ping(h, std::move(p)); });
-    endpoint.set_message_handler([this](Handle h, Endpoint::message_ptr m) {
+    endpoint.set_message_handler([this](Handle h, MessagePtr m) {
         const ConnectionId id = id_of(h);
         if (id == 0) return;
         const bool binary = m->get_opcode() == websocketpp::frame::opcode::binary;
@@ -112,8 +144,9 @@ void WebServer::Impl::install_handlers() {
     });
 }
 
-bool WebServer::Impl::validate(Handle h) {
-    const Endpoint::connection_ptr con = endpoint.get_con_from_hdl(h);
+template <class Config>
+bool Server<Config>::validate(Handle h) {
+    const ConnectionPtr con = endpoint.get_con_from_hdl(h);
     std::string path, query;
     split_resource(con->get_resource(), path, query);
     if (path != options.ws_path) {
@@ -121,15 +154,16 @@ bool WebServer::Impl::validate(Handle h) {
                "no WebSocket at " + path + " (it is at " + options.ws_path + ")");
         return false;
     }
-    if (!origin_allowed(con->get_request_header("Origin"), con->get_request_header("Host"))) {
-        refuse(con, status::forbidden, "Origin must be http://<Host>");
+    if (!origin_allowed(con->get_request_header("Origin"), con->get_request_header("Host"), kTls)) {
+        refuse(con, status::forbidden, kTls ? "Origin must be https://<Host>" : "Origin must be http://<Host>");
         return false;
     }
     return true;
 }
 
-void WebServer::Impl::serve_http(Handle h) {
-    const Endpoint::connection_ptr con = endpoint.get_con_from_hdl(h);
+template <class Config>
+void Server<Config>::serve_http(Handle h) {
+    const ConnectionPtr con = endpoint.get_con_from_hdl(h);
     HttpRequest request;
     request.method = con->get_request().get_method();
     split_resource(con->get_resource(), request.path, request.query);
@@ -145,7 +179,8 @@ void WebServer::Impl::serve_http(Handle h) {
     con->set_body(std::move(response.body));
 }
 
-void WebServer::Impl::on_open(Handle h) {
+template <class Config>
+void Server<Config>::on_open(Handle h) {
     ConnectionId id = 0;
     {
         std::lock_guard lock(mutex);
@@ -157,7 +192,8 @@ void WebServer::Impl::on_open(Handle h) {
 }
 
 // Close and fail both end a connection; only one that opened has an id (and a `closed`).
-void WebServer::Impl::on_end(Handle h) {
+template <class Config>
+void Server<Config>::on_end(Handle h) {
     ConnectionId id = 0;
     {
         std::lock_guard lock(mutex);
@@ -172,7 +208,8 @@ void WebServer::Impl::on_end(Handle h) {
     callbacks.closed(id);
 }
 
-ConnectionId WebServer::Impl::id_of(Handle h) {
+template <class Config>
+ConnectionId Server<Config>::id_of(Handle h) {
     std::lock_guard lock(mutex);
     const auto it = ids.find(h);
     return it == ids.end() ? 0 : it->second;
@@ -180,7 +217,8 @@ ConnectionId WebServer::Impl::id_of(Handle h) {
 
 // Never websocketpp's own pong (it would queue one for every ping): the newest payload waits in
 // the connection's slot until the pong before it has been written.
-bool WebServer::Impl::on_ping(Handle h, std::string payload) {
+template <class Config>
+bool Server<Config>::on_ping(Handle h, std::string payload) {
     const ConnectionId id = id_of(h);
     if (id == 0) return false;
     PongSlot& slot = pongs[id];
@@ -190,7 +228,8 @@ bool WebServer::Impl::on_ping(Handle h, std::string payload) {
     return false;
 }
 
-void WebServer::Impl::send_pong(ConnectionId id) {
+template <class Config>
+void Server<Config>::send_pong(ConnectionId id) {
     const auto it = pongs.find(id);
     Handle h;
     if (it == pongs.end() || !it->second.waiting || !find(id, h)) return;
@@ -209,9 +248,9 @@ void WebServer::Impl::send_pong(ConnectionId id) {
         return;
     }
     websocketpp::lib::error_code ec;
-    const Endpoint::connection_ptr con = endpoint.get_con_from_hdl(h, ec);
+    const ConnectionPtr con = endpoint.get_con_from_hdl(h, ec);
     if (ec) return;
-    slot.out = pong_frame(std::move(slot.next));
+    slot.out = pong_frame<Config>(std::move(slot.next));
     slot.waiting = false;
     slot.poll_ms = kPongPollMs;
     if (!over_cap(con, slot.out->get_payload().size()))
@@ -219,7 +258,8 @@ void WebServer::Impl::send_pong(ConnectionId id) {
 }
 
 // Whether `more` bytes would take the connection's queue past max_queued_bytes; if so, closes it.
-bool WebServer::Impl::over_cap(const Endpoint::connection_ptr& con, std::size_t more) {
+template <class Config>
+bool Server<Config>::over_cap(const ConnectionPtr& con, std::size_t more) {
     if (con->get_buffered_amount() + more <= options.max_queued_bytes) return false;
     websocketpp::lib::error_code ec;
     con->close(websocketpp::close::status::policy_violation,
@@ -229,7 +269,8 @@ bool WebServer::Impl::over_cap(const Endpoint::connection_ptr& con, std::size_t 
     return true;
 }
 
-bool WebServer::Impl::find(ConnectionId id, Handle& h) {
+template <class Config>
+bool Server<Config>::find(ConnectionId id, Handle& h) {
     std::lock_guard lock(mutex);
     const auto it = handles.find(id);
     if (stopped || it == handles.end()) return false;
@@ -237,23 +278,119 @@ bool WebServer::Impl::find(ConnectionId id, Handle& h) {
     return true;
 }
 
-WebServer::WebServer(WebOptions options, WebCallbacks callbacks) : impl_(std::make_unique<Impl>()) {
-    impl_->options = std::move(options);
-    impl_->callbacks = std::move(callbacks);
-    Endpoint& e = impl_->endpoint;
+template <class Config>
+Server<Config>::Server(WebOptions o, WebCallbacks cb)
+    : options(std::move(o)), callbacks(std::move(cb)) {
+    Endpoint& e = endpoint;
     e.clear_access_channels(websocketpp::log::alevel::all);
     e.clear_error_channels(websocketpp::log::elevel::all);
     e.init_asio();
     e.set_reuse_addr(true);
-    e.set_max_message_size(impl_->options.max_message_bytes);
-    e.set_max_http_body_size(impl_->options.max_message_bytes);  // only GET is served
-    impl_->install_handlers();
+    e.set_max_message_size(options.max_message_bytes);
+    e.set_max_http_body_size(options.max_message_bytes);  // only GET is served
+    if constexpr (kTls) {
+        // The caller's context (its certificate and key, checked when it was made), shared:
+        // asio's context frees the reference it is given.
+        SSL_CTX_up_ref(options.tls);
+        auto context = std::make_shared<websocketpp::lib::asio::ssl::context>(options.tls);
+        e.set_tls_init_handler([context](Handle) { return context; });
+    }
+    install_handlers();
     websocketpp::lib::error_code ec;
-    e.listen(impl_->options.address, std::to_string(impl_->options.port), ec);
+    e.listen(options.address, std::to_string(options.port), ec);
     if (!ec) e.start_accept(ec);
     if (ec)
-        throw std::runtime_error("cannot listen on " + impl_->options.address + ":" +
-                                 std::to_string(impl_->options.port) + ": " + ec.message());
+        throw std::runtime_error("cannot listen on " + options.address + ":" +
+                                 std::to_string(options.port) + ": " + ec.message());
+}
+
+template <class Config>
+int Server<Config>::port() const {
+    websocketpp::lib::asio::error_code ec;
+    const auto local = endpoint.get_local_endpoint(ec);
+    return ec ? -1 : local.port();
+}
+
+template <class Config>
+void Server<Config>::start() {
+    thread = std::thread([this] { endpoint.run(); });
+}
+
+template <class Config>
+void Server<Config>::stop() {
+    {
+        std::lock_guard lock(mutex);
+        if (stopped) return;
+        stopped = true;
+    }
+    changed.notify_all();
+    if (thread.joinable()) {
+        websocketpp::lib::asio::post(endpoint.get_io_service(), [this] {
+            websocketpp::lib::error_code ec;
+            endpoint.stop_listening(ec);
+            std::map<ConnectionId, Handle> open;
+            {
+                std::lock_guard lock(mutex);  // not held while closing: a handler may run
+                open = handles;
+            }
+            for (const auto& entry : open)
+                endpoint.close(entry.second, websocketpp::close::status::going_away,
+                               "server stops", ec);
+        });
+        std::unique_lock lock(mutex);
+        changed.wait_for(lock, kCloseGrace, [this] { return handles.empty(); });
+        lock.unlock();
+        endpoint.stop();
+        thread.join();
+    }
+    std::map<ConnectionId, Handle> left;
+    {
+        std::lock_guard lock(mutex);
+        left.swap(handles);
+        ids.clear();
+    }
+    for (const auto& entry : left) callbacks.closed(entry.first);
+}
+
+template <class Config>
+bool Server<Config>::send(ConnectionId id, const void* bytes, std::size_t size,
+                          const std::atomic<bool>* cancel) {
+    Handle h;
+    if (!find(id, h)) return false;
+    websocketpp::lib::error_code ec;
+    const ConnectionPtr con = endpoint.get_con_from_hdl(h, ec);
+    if (ec) return false;
+    {
+        // Back-pressure: a slow reader holds at most max_buffered_bytes (plus one message) here.
+        // get_buffered_amount() reads a size_t that the io thread updates; websocketpp takes no
+        // lock for it either, and a stale value only delays the next look by kDrainPoll.
+        std::unique_lock lock(mutex);
+        while (con->get_buffered_amount() > options.max_buffered_bytes) {
+            if (stopped || !handles.count(id) || (cancel && cancel->load())) return false;
+            changed.wait_for(lock, kDrainPoll);
+        }
+    }
+    if (over_cap(con, size)) return false;
+    return !con->send(bytes, size, websocketpp::frame::opcode::binary);
+}
+
+template <class Config>
+void Server<Config>::close(ConnectionId id, const std::string& reason) {
+    Handle h;
+    if (!find(id, h)) return;
+    websocketpp::lib::error_code ec;
+    endpoint.close(h, websocketpp::close::status::normal, reason, ec);
+}
+
+}  // namespace
+
+WebServer::WebServer(WebOptions options, WebCallbacks callbacks) {
+    if (options.tls)
+        impl_ = std::make_unique<Server<websocketpp::config::asio_tls>>(std::move(options),
+                                                                         std::move(callbacks));
+    else
+        impl_ = std::make_unique<Server<websocketpp::config::asio>>(std::move(options),
+                                                                     std::move(callbacks));
 }
 
 WebServer::~WebServer() {
@@ -261,78 +398,24 @@ WebServer::~WebServer() {
 }
 
 int WebServer::port() const {
-    websocketpp::lib::asio::error_code ec;
-    const auto local = impl_->endpoint.get_local_endpoint(ec);
-    return ec ? -1 : local.port();
+    return impl_->port();
 }
 
 void WebServer::start() {
-    impl_->thread = std::thread([this] { impl_->endpoint.run(); });
+    impl_->start();
 }
 
 void WebServer::stop() {
-    Impl& im = *impl_;
-    {
-        std::lock_guard lock(im.mutex);
-        if (im.stopped) return;
-        im.stopped = true;
-    }
-    im.changed.notify_all();
-    if (im.thread.joinable()) {
-        websocketpp::lib::asio::post(im.endpoint.get_io_service(), [&im] {
-            websocketpp::lib::error_code ec;
-            im.endpoint.stop_listening(ec);
-            std::map<ConnectionId, Handle> open;
-            {
-                std::lock_guard lock(im.mutex);  // not held while closing: a handler may run
-                open = im.handles;
-            }
-            for (const auto& entry : open)
-                im.endpoint.close(entry.second, websocketpp::close::status::going_away,
-                                  "server stops", ec);
-        });
-        std::unique_lock lock(im.mutex);
-        im.changed.wait_for(lock, kCloseGrace, [&im] { return im.handles.empty(); });
-        lock.unlock();
-        im.endpoint.stop();
-        im.thread.join();
-    }
-    std::map<ConnectionId, Handle> left;
-    {
-        std::lock_guard lock(im.mutex);
-        left.swap(im.handles);
-        im.ids.clear();
-    }
-    for (const auto& entry : left) im.callbacks.closed(entry.first);
+    impl_->stop();
 }
 
 bool WebServer::send(ConnectionId id, const void* bytes, std::size_t size,
                      const std::atomic<bool>* cancel) {
-    Handle h;
-    if (!impl_->find(id, h)) return false;
-    websocketpp::lib::error_code ec;
-    const Endpoint::connection_ptr con = impl_->endpoint.get_con_from_hdl(h, ec);
-    if (ec) return false;
-    {
-        // Back-pressure: a slow reader holds at most max_buffered_bytes (plus one message) here.
-        // get_buffered_amount() reads a size_t that the io thread updates; websocketpp takes no
-        // lock for it either, and a stale value only delays the next look by kDrainPoll.
-        std::unique_lock lock(impl_->mutex);
-        while (con->get_buffered_amount() > impl_->options.max_buffered_bytes) {
-            if (impl_->stopped || !impl_->handles.count(id) || (cancel && cancel->load()))
-                return false;
-            impl_->changed.wait_for(lock, kDrainPoll);
-        }
-    }
-    if (impl_->over_cap(con, size)) return false;
-    return !con->send(bytes, size, websocketpp::frame::opcode::binary);
+    return impl_->send(id, bytes, size, cancel);
 }
 
 void WebServer::close(ConnectionId id, const std::string& reason) {
-    Handle h;
-    if (!impl_->find(id, h)) return;
-    websocketpp::lib::error_code ec;
-    impl_->endpoint.close(h, websocketpp::close::status::normal, reason, ec);
+    impl_->close(id, reason);
 }
 
 }  // namespace isowall::web

@@ -4,8 +4,10 @@
 // 0.8.2 does not compile as C++20, so web_server.cpp is built as C++17 in a target of its own
 // (isowall_remote_web) and the C++20 side (remote/http_front.h) sees only this.
 //
+// With a TLS context (WebOptions::tls) every request and WebSocket goes over TLS (https, wss).
+//
 // Upgrades are accepted only on `ws_path`, and only when the Origin header is absent or is
-// http://<Host header> (a page of another site cannot drive the server); anything else is
+// http://<Host header> (https:// with TLS) (a page of another site cannot drive the server); anything else is
 // refused (403 for the Origin, 404 for the path) before the handshake completes. Plain HTTP
 // requests go to the `http` callback. Every WebSocket message over `max_message_bytes` closes
 // its connection (1009, message too big) without reaching `message`.
@@ -21,6 +23,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+
+struct ssl_ctx_st;  // OpenSSL's SSL_CTX
 
 namespace isowall::web {
 
@@ -59,10 +63,14 @@ struct WebOptions {
     // max_buffered_bytes above it gets there. websocketpp writes all that is queued at once, so
     // a connection holds at most about twice this (queued and being written).
     std::size_t max_queued_bytes = std::size_t{64} << 20;
+    // HTTPS and wss with this OpenSSL context (the server's certificate and key, as
+    // remote::TlsContext::server made it; the server holds a reference of its own); null: plain.
+    ssl_ctx_st* tls = nullptr;
 };
 
-// Whether a WebSocket upgrade with these headers may go on ("" when a header is absent).
-bool origin_allowed(const std::string& origin, const std::string& host);
+// Whether a WebSocket upgrade with these headers may go on ("" when a header is absent): the
+// page's own origin, https:// on a TLS server.
+bool origin_allowed(const std::string& origin, const std::string& host, bool tls = false);
 
 class WebServer {
   public:
@@ -88,8 +96,9 @@ class WebServer {
     // Starts the closing handshake (after every message already queued); any thread.
     void close(ConnectionId id, const std::string& reason);
 
+    struct Impl;  // the endpoint, plain or TLS (web_server.cpp)
+
   private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 
