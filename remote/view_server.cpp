@@ -173,7 +173,8 @@ class ViewServer::Client {
         } catch (const TlsHandshakeError& e) {
             // Nothing can reach the client. The text starts with the peer, which say() adds.
             std::string_view text = e.what();
-            if (text.rfind(conn_.peer() + ": ", 0) == 0) text.remove_prefix(conn_.peer().size() + 2);
+            if (text.rfind(conn_.peer() + ": ", 0) == 0)
+                text.remove_prefix(conn_.peer().size() + 2);
             say("serve: %s: error: %s\n", std::string(text));
         } catch (const PeerClosed& e) {
             // A client that stops sending inside a message may still read the reply.

@@ -53,8 +53,8 @@ struct Dataset {
 
 struct ServerOptions {
     std::string address = "127.0.0.1";
-    int port = 7878;             // 0: any free port (see ViewServer::port)
-    std::string token;           // empty: none asked for (only allowed on a loopback address)
+    int port = 7878;    // 0: any free port (see ViewServer::port)
+    std::string token;  // empty: none asked for (only allowed on a loopback address)
     // The TCP protocol over TLS with this server context; null: plain TCP (loopback only).
     std::shared_ptr<const TlsContext> tls;
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)

@@ -194,14 +194,14 @@ std::unique_ptr<TlsSession> TlsSession::handshake(std::unique_ptr<TlsSession> se
                                         std::to_string(timeout_s) + " s");
             continue;
         }
-        if (!server) throw TlsHandshakeError(peer + ": TLS handshake: " + client_failure(ssl, err, host));
+        if (!server)
+            throw TlsHandshakeError(peer + ": TLS handshake: " + client_failure(ssl, err, host));
         const std::string reason = take_reason("");
         const bool alert = reason.find("alert") != std::string::npos;
-        throw TlsHandshakeError(
-            peer + ": TLS handshake: " +
-            (reason.empty() ? std::string("the client closed the connection")
-             : alert        ? "the client refused it (" + reason + ")"
-                            : reason));
+        throw TlsHandshakeError(peer + ": TLS handshake: " +
+                                (reason.empty() ? std::string("the client closed the connection")
+                                 : alert        ? "the client refused it (" + reason + ")"
+                                                : reason));
     }
 }
 
@@ -242,10 +242,9 @@ bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double tim
                            std::size_t& got, const std::string& peer) {
     got = 0;
     const bool forever = !(timeout_s >= 0) || std::isinf(timeout_s) || timeout_s > 1e9;
-    const auto deadline =
-        forever ? Clock::time_point::max()
-                : Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                     std::chrono::duration<double>(timeout_s));
+    const auto deadline = forever ? Clock::time_point::max()
+                                  : Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                       std::chrono::duration<double>(timeout_s));
     for (;;) {
         int err = 0;
         {

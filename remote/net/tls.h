@@ -41,7 +41,8 @@ class TlsContext {
     ssl_ctx_st* native() const { return ctx_.get(); }
 
   private:
-    TlsContext(std::shared_ptr<ssl_ctx_st> ctx, bool server) : ctx_(std::move(ctx)), server_(server) {}
+    TlsContext(std::shared_ptr<ssl_ctx_st> ctx, bool server)
+        : ctx_(std::move(ctx)), server_(server) {}
     std::shared_ptr<ssl_ctx_st> ctx_;
     bool server_ = false;
 };

@@ -5,7 +5,8 @@
 find_path(WEBSOCKETPP_INCLUDE_DIR websocketpp/server.hpp REQUIRED)
 find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)
 
-add_library(isowall_remote_web ${CMAKE_CURRENT_LIST_DIR}/web_server.cpp)
+add_library(isowall_remote_web ${CMAKE_CURRENT_LIST_DIR}/web_server.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/web_endpoint.cpp)
 set_target_properties(isowall_remote_web PROPERTIES CXX_STANDARD 17 CXX_STANDARD_REQUIRED ON)
 target_include_directories(isowall_remote_web PUBLIC ${PROJECT_SOURCE_DIR}
     PRIVATE ${WEBSOCKETPP_INCLUDE_DIR} ${ASIO_INCLUDE_DIR})

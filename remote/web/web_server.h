@@ -7,10 +7,10 @@
 // With a TLS context (WebOptions::tls) every request and WebSocket goes over TLS (https, wss).
 //
 // Upgrades are accepted only on `ws_path`, and only when the Origin header is absent or is
-// http://<Host header> (https:// with TLS) (a page of another site cannot drive the server); anything else is
-// refused (403 for the Origin, 404 for the path) before the handshake completes. Plain HTTP
-// requests go to the `http` callback. Every WebSocket message over `max_message_bytes` closes
-// its connection (1009, message too big) without reaching `message`.
+// http://<Host header> (https:// with TLS) (a page of another site cannot drive the server);
+// anything else is refused (403 for the Origin, 404 for the path) before the handshake completes.
+// Plain HTTP requests go to the `http` callback. Every WebSocket message over `max_message_bytes`
+// closes its connection (1009, message too big) without reaching `message`.
 //
 // What a client can make a connection hold is bounded: its sends wait while max_buffered_bytes
 // wait to go out, a send that would take the queue past max_queued_bytes closes the connection
