@@ -374,9 +374,9 @@ void Server<Config>::close(ConnectionId id, const std::string& reason) {
 std::unique_ptr<WebServer::Impl> make_web_endpoint(WebOptions options, WebCallbacks callbacks) {
     if (options.tls)
         return std::make_unique<Server<websocketpp::config::asio_tls>>(std::move(options),
-                                                                        std::move(callbacks));
+                                                                       std::move(callbacks));
     return std::make_unique<Server<websocketpp::config::asio>>(std::move(options),
-                                                                std::move(callbacks));
+                                                               std::move(callbacks));
 }
 
 }  // namespace isowall::web

@@ -21,7 +21,6 @@ struct WebServer::Impl {
     virtual void close(ConnectionId id, const std::string& reason) = 0;
 };
 
-
 // Listens at once (throws std::runtime_error when it cannot), over TLS when options.tls is set.
 std::unique_ptr<WebServer::Impl> make_web_endpoint(WebOptions options, WebCallbacks callbacks);
 
