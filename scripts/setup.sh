@@ -12,6 +12,7 @@ PACKAGES=(
     libopenmpi-dev openmpi-bin
     libgtest-dev libgmock-dev libbenchmark-dev
     libmeshoptimizer-dev libzstd-dev nlohmann-json3-dev libwebsocketpp-dev libasio-dev
+    libssl-dev openssl
     libembree-dev python3-vtk9
     libgdcm-dev libnifti2-dev libhdf5-dev
     python3 python3-numpy python3-matplotlib python3-zarr

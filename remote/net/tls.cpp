@@ -5,6 +5,8 @@
 #include <openssl/err.h>
 #include <openssl/ssl.h>
 #include <openssl/x509v3.h>
+#include <pthread.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -62,6 +64,45 @@ void make_non_blocking(const Socket& s, const std::string& peer) {
     const int flags = ::fcntl(s.fd(), F_GETFL);
     if (flags < 0 || ::fcntl(s.fd(), F_SETFL, flags | O_NONBLOCK) != 0)
         throw NetError(peer + ": fcntl(O_NONBLOCK): " + std::strerror(errno));
+}
+
+// OpenSSL writes to the socket with write(), which raises SIGPIPE when the peer has gone (the
+// plain path uses send's MSG_NOSIGNAL). Each call that may write blocks SIGPIPE in its thread and
+// takes a SIGPIPE it raised, so the peer going away is an error (EPIPE), never the end of the
+// process, and no signal handler of the program is touched.
+class NoSigpipe {
+  public:
+    NoSigpipe() {
+        sigemptyset(&pipe_);
+        sigaddset(&pipe_, SIGPIPE);
+        sigset_t pending;
+        sigpending(&pending);
+        was_pending_ = sigismember(&pending, SIGPIPE) == 1;
+        pthread_sigmask(SIG_BLOCK, &pipe_, &old_);
+    }
+    ~NoSigpipe() {
+        if (!was_pending_) {
+            sigset_t pending;
+            sigpending(&pending);
+            if (sigismember(&pending, SIGPIPE) == 1) {
+                const timespec zero{0, 0};
+                sigtimedwait(&pipe_, nullptr, &zero);
+            }
+        }
+        pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+    }
+    NoSigpipe(const NoSigpipe&) = delete;
+    NoSigpipe& operator=(const NoSigpipe&) = delete;
+
+  private:
+    sigset_t pipe_, old_;
+    bool was_pending_ = false;
+};
+
+// Whether OpenSSL's error is the connection ending without TLS's close_notify (OpenSSL 3 calls
+// an EOF that: a peer that went away, or this side's shutdown_both()).
+bool peer_gone() {
+    return ERR_GET_REASON(ERR_peek_error()) == SSL_R_UNEXPECTED_EOF_WHILE_READING;
 }
 
 double seconds_left(Clock::time_point deadline) {
@@ -185,9 +226,13 @@ std::unique_ptr<TlsSession> TlsSession::handshake(std::unique_ptr<TlsSession> se
     for (;;) {
         ERR_clear_error();
         errno = 0;
-        const int rc = server ? SSL_accept(ssl) : SSL_connect(ssl);
-        if (rc == 1) return session;
-        const int err = SSL_get_error(ssl, rc);
+        int rc = 0, err = 0;
+        {
+            const NoSigpipe no_sigpipe;
+            rc = server ? SSL_accept(ssl) : SSL_connect(ssl);
+            if (rc == 1) return session;
+            err = SSL_get_error(ssl, rc);
+        }
         if (err == SSL_ERROR_WANT_READ || err == SSL_ERROR_WANT_WRITE) {
             if (!wait_ready(s, err == SSL_ERROR_WANT_WRITE, seconds_left(deadline), peer))
                 throw TlsHandshakeError(peer + ": TLS handshake: no answer within " +
@@ -211,6 +256,7 @@ void TlsSession::write_all(const Socket& s, std::span<const std::byte> bytes,
         int err = 0;
         {
             std::lock_guard lock(mutex_);
+            const NoSigpipe no_sigpipe;
             ERR_clear_error();
             errno = 0;
             const int n = SSL_write(ssl_, bytes.data(),
@@ -229,7 +275,7 @@ void TlsSession::write_all(const Socket& s, std::span<const std::byte> bytes,
         } else if (err == SSL_ERROR_SYSCALL && errno != 0 && errno != EPIPE &&
                    errno != ECONNRESET) {
             throw NetError(peer + ": send: " + std::strerror(errno));
-        } else if (err == SSL_ERROR_SSL) {
+        } else if (err == SSL_ERROR_SSL && !peer_gone()) {
             throw NetError(peer + ": TLS: " + take_reason("write failed"));
         } else {
             ERR_clear_error();
@@ -249,6 +295,7 @@ bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double tim
         int err = 0;
         {
             std::lock_guard lock(mutex_);
+            const NoSigpipe no_sigpipe;  // a read may write (TLS 1.3's key updates, alerts)
             ERR_clear_error();
             errno = 0;
             const int n = SSL_read(ssl_, buf.data(),
@@ -271,7 +318,8 @@ bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double tim
         }
         if (err == SSL_ERROR_SYSCALL && errno != 0 && errno != EPIPE && errno != ECONNRESET)
             throw NetError(peer + ": recv: " + std::strerror(errno));
-        if (err == SSL_ERROR_SSL) throw NetError(peer + ": TLS: " + take_reason("read failed"));
+        if (err == SSL_ERROR_SSL && !peer_gone())
+            throw NetError(peer + ": TLS: " + take_reason("read failed"));
         ERR_clear_error();
         throw PeerClosed(peer + ": the peer closed the connection");
     }
@@ -279,6 +327,7 @@ bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double tim
 
 void TlsSession::close_notify() {
     std::lock_guard lock(mutex_);
+    const NoSigpipe no_sigpipe;
     ERR_clear_error();
     SSL_shutdown(ssl_);  // may not go out on a full socket: the peer then sees an EOF
     ERR_clear_error();
