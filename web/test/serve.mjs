@@ -16,7 +16,7 @@ export function startServe(bin, extra = [], { log = null, timeoutS = 60 } = {}) 
     const take = (d) => {
       text += d;
       if (log) log(String(d));
-      const page = /page at (http:\/\/\S+)/.exec(text);
+      const page = /page at (https?:\/\/\S+)/.exec(text);
       const tcp = /listening on \S+:(\d+)/.exec(text);
       if (page && tcp) {
         clearTimeout(timer);

@@ -2,7 +2,8 @@
 # The page end to end in headless Chromium, against the real server (CTest: web_page_e2e):
 #   web/tools/run_e2e.sh ISOWALL OUT_DIR
 # Starts `isowall serve --port 0 --http 0`, runs test/e2e_page.mjs (front view, slider, drag,
-# wheel, bad isovalue, picker) and test/e2e_errors.mjs (which starts its own server with a token),
+# wheel, bad isovalue, picker), test/e2e_errors.mjs (which starts its own server with a token) and
+# test/e2e_tls.mjs (its own server over TLS: https, wss, the front view),
 # draws each view the page drew (views.json) with `isowall render`, and compares the images with
 # compare_images.py: mask IoU >= 0.99 and 99% of the pixels both cover within 2/255.
 set -eu
@@ -23,6 +24,7 @@ done
 [ -n "$URL" ] || { echo "run_e2e: isowall serve printed no page line:"; cat "$OUT/serve.log"; exit 1; }
 ISOWALL_PAGE_URL=$URL ISOWALL_OUT=$OUT node "$WEB/test/e2e_page.mjs"
 ISOWALL_BIN=$ISOWALL node "$WEB/test/e2e_errors.mjs"
+ISOWALL_BIN=$ISOWALL ISOWALL_OUT=$OUT node "$WEB/test/e2e_tls.mjs"
 status=0
 for view in front iso2 dragged zoomed; do
     set -- $(/usr/bin/python3 -c "import json,sys; v=json.load(open(sys.argv[1]))[sys.argv[2]]; print(repr(v['yaw']), repr(v['pitch']), repr(v['zoom']), repr(v['iso']), '%dx%d' % (v['width'], v['height']))" "$OUT/views.json" $view)
@@ -31,4 +33,7 @@ for view in front iso2 dragged zoomed; do
     /usr/bin/python3 "$WEB/test/compare_images.py" "$OUT/$view.png" "$OUT/ref_$view.png" \
         --min-iou 0.99 --min-within2 0.99 --diff "$OUT/diff_$view.png" || status=1
 done
+echo "== the front view over TLS (e2e_tls.mjs), against the same reference"
+/usr/bin/python3 "$WEB/test/compare_images.py" "$OUT/tls_front.png" "$OUT/ref_front.png" \
+    --min-iou 0.99 --min-within2 0.99 --diff "$OUT/diff_tls_front.png" || status=1
 exit $status
