@@ -10,6 +10,7 @@
 #include "common/core/error.h"
 #include "remote/net/socket.h"
 #include "remote/web/web_routes.h"
+#include "remote/web/web_server.h"
 #include "tests/remote_web_util.h"
 
 namespace isowall::test {
@@ -158,6 +159,16 @@ TEST(RemoteWebHttp, UpgradesOnlyAtWsFromTheSameOrigin) {
     EXPECT_EQ(upgrade_status(port, "/ws", "https://127.0.0.1:" + std::to_string(port)), 403);
     EXPECT_EQ(upgrade_status(port, "/other", self), 404);
     EXPECT_EQ(upgrade_status(port, "/", ""), 404);
+}
+
+// Over TLS the page's origin is https://<Host>, and only that one (issue 35).
+TEST(RemoteWebHttp, OverTlsTheSameOriginIsHttps) {
+    EXPECT_TRUE(web::origin_allowed("https://127.0.0.1:8443", "127.0.0.1:8443", true));
+    EXPECT_FALSE(web::origin_allowed("http://127.0.0.1:8443", "127.0.0.1:8443", true));
+    EXPECT_TRUE(web::origin_allowed("", "127.0.0.1:8443", true));
+    EXPECT_FALSE(web::origin_allowed("https://evil.example", "127.0.0.1:8443", true));
+    EXPECT_FALSE(web::origin_allowed("https://127.0.0.1:8443", "", true));
+    EXPECT_FALSE(web::origin_allowed("https://127.0.0.1:8443", "127.0.0.1:8443", false));
 }
 
 TEST(RemoteWebHttp, APortInUseNamesHttp) {
