@@ -106,8 +106,8 @@ TEST(RemoteTls, ACertificateTheClientDoesNotTrustOrForAnotherHostIsRefused) {
         [&] { ViewClient c(*renderer, tls_hello(server.port(), other.cert)); });
     expect_words(untrusted, {"not trusted", "--tls-ca"});
     // The system's authorities do not know a self-signed certificate either.
-    const std::string system = error_of<TlsHandshakeError>(
-        [&] { ViewClient c(*renderer, tls_hello(server.port(), "")); });
+    const std::string system =
+        error_of<TlsHandshakeError>([&] { ViewClient c(*renderer, tls_hello(server.port(), "")); });
     expect_words(system, {"not trusted"});
     // Trusted, but it names localhost and 127.0.0.1 only.
     const TestCert named = make_test_cert(scratch_dir("tls_named"), "named", "DNS:localhost");
@@ -138,8 +138,7 @@ TEST(RemoteTls, BadCertificateFilesNameTheFileAndTheOption) {
     expect_words(server_error(text, a.key), {"text.pem", "--tls-cert", "not a PEM certificate"});
     expect_words(server_error(a.cert, text), {"text.pem", "--tls-key", "not a PEM private key"});
     expect_words(server_error(a.cert, b.key), {"b.key", "--tls-key", "does not match", "a.crt"});
-    expect_words(error_of<InputError>([&] { TlsContext::client(text); }),
-                 {"text.pem", "--tls-ca"});
+    expect_words(error_of<InputError>([&] { TlsContext::client(text); }), {"text.pem", "--tls-ca"});
     expect_words(error_of<InputError>([&] { TlsContext::client(missing); }),
                  {"missing.pem", "--tls-ca", "cannot read"});
     EXPECT_NO_THROW(TlsContext::server(a.cert, a.key));
