@@ -43,6 +43,10 @@ using Clock = std::chrono::steady_clock;
 // How long an error may take to go out, and a worker to stop, before the connection is shut
 // down: a send to a client that does not read waits for room in its buffers for ever.
 constexpr double kErrorSendTimeoutS = 2;
+// Connections being turned away at once (each a thread for at most about 3 s); past it a
+// connection is closed without a word. And how long one may take to open and hear why.
+constexpr std::size_t kMaxRefusals = 16;
+constexpr double kRefusalTimeoutS = 2;
 
 std::string seconds_text(double s) {
     char buf[32];
@@ -81,11 +85,37 @@ ErrorCode code_of(const WireError& e) {
 
 }  // namespace
 
+// A connection turned away (max_clients): its own thread opens the channel (a TLS handshake,
+// bounded), sends the busy error and closes, so the client reads why, in TLS on a TLS port.
+struct ViewServer::Refusal {
+    Refusal(std::unique_ptr<MessageChannel> c, std::string text) : channel(std::move(c)) {
+        thread = std::thread([this, text = std::move(text)] {
+            within(*channel, kRefusalTimeoutS, [&] {
+                try {
+                    channel->open(kRefusalTimeoutS);
+                    channel->send(make_error(ErrorCode::internal, text));
+                } catch (const std::exception&) {  // the client is gone or speaks nonsense
+                }
+            });
+            channel->close_gracefully();
+            done = true;
+        });
+    }
+    ~Refusal() {
+        channel->shutdown();
+        thread.join();
+    }
+    std::unique_ptr<MessageChannel> channel;
+    std::thread thread;
+    std::atomic<bool> done{false};
+};
+
 struct ViewServer::Impl {
     explicit Impl(Listener l) : listener(std::move(l)) {}
     Listener listener;
     std::mutex mutex;
     std::list<std::unique_ptr<Client>> clients;
+    std::list<std::unique_ptr<Refusal>> refusals;  // at most kMaxRefusals
 };
 
 // One connection: this reader thread, and the worker it starts once the hello is accepted.
@@ -324,6 +354,8 @@ void ViewServer::reap(bool all) {
         std::lock_guard lock(impl_->mutex);
         gone = impl_->clients.remove_if(
             [all](const std::unique_ptr<Client>& c) { return all || c->done(); });
+        impl_->refusals.remove_if(
+            [all](const std::unique_ptr<Refusal>& r) { return all || r->done.load(); });
     }
     // What a client that left had the server hold goes back to the system: `isowall` keeps
     // freed memory for the next frame (keep_freed_memory, common/core/util.h), which would keep
@@ -352,12 +384,12 @@ bool ViewServer::adopt(std::unique_ptr<MessageChannel> channel) {
             return true;
         }
     }
-    try {  // the channel closes as it goes out of scope
-        channel->send(
-            make_error(ErrorCode::internal, "server busy: " + std::to_string(options_.max_clients) +
-                                                " clients connected (--max-clients)"));
-    } catch (const std::exception&) {
-    }
+    std::lock_guard lock(impl_->mutex);
+    impl_->refusals.remove_if([](const std::unique_ptr<Refusal>& r) { return r->done.load(); });
+    if (impl_->refusals.size() < kMaxRefusals)  // else the channel closes as it goes out of scope
+        impl_->refusals.push_back(std::make_unique<Refusal>(
+            std::move(channel), "server busy: " + std::to_string(options_.max_clients) +
+                                    " clients connected (--max-clients)"));
     return false;
 }
 

@@ -98,6 +98,7 @@ class ViewServer {
 
   private:
     class Client;
+    struct Refusal;
     void reap(bool all);
 
     std::vector<Dataset> datasets_;

@@ -124,6 +124,18 @@ TEST(RemoteTls, ACertificateTheClientDoesNotTrustOrForAnotherHostIsRefused) {
     ok.close();
 }
 
+TEST(RemoteTls, AClientTurnedAwayHearsWhyOverTls) {
+    ServerOptions o = tls_options();
+    o.max_clients = 1;
+    TestServer server(o);
+    auto renderer = make_renderer("osmesa");
+    ViewClient first(*renderer, tls_hello(server.port(), server_cert().cert));
+    const std::string e = error_of<RemoteError>(
+        [&] { ViewClient second(*renderer, tls_hello(server.port(), server_cert().cert)); });
+    expect_words(e, {"busy", "--max-clients"});
+    first.close();
+}
+
 TEST(RemoteTls, BadCertificateFilesNameTheFileAndTheOption) {
     const auto dir = scratch_dir("tls_bad_files");
     const TestCert a = make_test_cert(dir, "a"), b = make_test_cert(dir, "b");
