@@ -17,25 +17,6 @@
 
 namespace isowall::remote {
 
-bool same_token(const std::string& a, const std::string& b) {
-    unsigned diff = a.size() == b.size() ? 0u : 1u;
-    for (std::size_t i = 0; i < b.size(); ++i)
-        diff |= static_cast<unsigned>(static_cast<unsigned char>(i < a.size() ? a[i] : 0) ^
-                                      static_cast<unsigned char>(b[i]));
-    return diff == 0;
-}
-
-bool is_loopback(const std::string& address) {
-    return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
-}
-
-std::string exposure_problem(const ServerOptions& o, const std::string& what) {
-    if (is_loopback(o.address) || (!o.token.empty() && o.tls)) return "";
-    return what + " on " + o.address +
-           " (not loopback) needs TLS (--tls-cert and --tls-key) and --token, which every "
-           "client must present: anyone on the path could read the surfaces and the token";
-}
-
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -43,8 +24,8 @@ using Clock = std::chrono::steady_clock;
 // How long an error may take to go out, and a worker to stop, before the connection is shut
 // down: a send to a client that does not read waits for room in its buffers for ever.
 constexpr double kErrorSendTimeoutS = 2;
-// Connections being turned away at once (each a thread for at most about 3 s); past it a
-// connection is closed without a word. And how long one may take to open and hear why.
+// Connections turned away at once (a thread each, about 3 s at most; past it one is closed
+// without a word), and how long one may take to open and hear why.
 constexpr std::size_t kMaxRefusals = 16;
 constexpr double kRefusalTimeoutS = 2;
 
@@ -94,7 +75,7 @@ struct ViewServer::Refusal {
                 try {
                     channel->open(kRefusalTimeoutS);
                     channel->send(make_error(ErrorCode::internal, text));
-                } catch (const std::exception&) {  // the client is gone or speaks nonsense
+                } catch (const std::exception&) {  // gone, or speaks nonsense: nothing to tell
                 }
             });
             channel->close_gracefully();
