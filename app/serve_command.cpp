@@ -144,6 +144,7 @@ int run_serve(const ServeCommand& o) {
         "serve: listening on %s%s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
         so.tls ? " (TLS)" : "", o.token.empty() ? "" : " (token required)",
         o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
+    if (so.tls) std::printf("serve: TLS certificate: %s\n", so.tls->certificate_summary().c_str());
     if (http)
         std::printf("serve: page at %s://%s/ (WebSocket /ws)\n", so.tls ? "https" : "http",
                     remote::host_port(at.host, http->port()).c_str());

@@ -44,7 +44,10 @@ class Serve:
                                      stdout=open(log, "w"), stderr=subprocess.STDOUT)
         self.port = None
         for _ in range(300):
-            m = re.search(r"listening on \S+:(\d+)", open(log).read())
+            text = open(log).read()
+            m = re.search(r"listening on \S+:(\d+)", text)
+            if m and "(TLS)" in text and "TLS certificate" not in text:
+                m = None  # the certificate's line follows the listening one
             if m:
                 self.port = int(m.group(1))
                 return
@@ -84,6 +87,10 @@ def main():
     plain = Serve(isowall, [], os.path.join(d, "plain.log"))
     try:
         check("(TLS)" in open(tls.log).read(), "serve says it listens with TLS")
+        summary = re.search(r"TLS certificate: (.*)", open(tls.log).read())
+        check(summary is not None and "/CN=server" in summary.group(1) and "IP:127.0.0.1" in
+              summary.group(1) and "valid until" in summary.group(1),
+              "serve names its certificate: " + (summary.group(1) if summary else "no line"))
         view = ["view", "--size", "320x240", "--orbit", "30", "10"]
         a = os.path.join(d, "tls.png")
         r = run(isowall, [*view, "--connect", f"127.0.0.1:{tls.port}", "--tls-ca", cert,

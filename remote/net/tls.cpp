@@ -169,6 +169,41 @@ TlsContext TlsContext::server(const std::string& cert_file, const std::string& k
     return TlsContext(std::move(ctx), true);
 }
 
+std::string TlsContext::certificate_summary() const {
+    X509* cert = server_ ? SSL_CTX_get0_certificate(ctx_.get()) : nullptr;
+    if (!cert) return "";
+    std::string text = "subject ";
+    char subject[256] = "";
+    X509_NAME_oneline(X509_get_subject_name(cert), subject, sizeof subject);
+    text += subject;
+    if (auto* names = static_cast<GENERAL_NAMES*>(
+            X509_get_ext_d2i(cert, NID_subject_alt_name, nullptr, nullptr))) {
+        std::string list;
+        for (int i = 0; i < sk_GENERAL_NAME_num(names); ++i) {
+            const GENERAL_NAME* n = sk_GENERAL_NAME_value(names, i);
+            if (n->type == GEN_DNS) {
+                list += (list.empty() ? "" : " ") + std::string("DNS:") +
+                        reinterpret_cast<const char*>(ASN1_STRING_get0_data(n->d.dNSName));
+            } else if (n->type == GEN_IPADD && ASN1_STRING_length(n->d.iPAddress) == 4) {
+                const unsigned char* a = ASN1_STRING_get0_data(n->d.iPAddress);
+                list += (list.empty() ? "" : " ") + std::string("IP:") + std::to_string(a[0]) +
+                        "." + std::to_string(a[1]) + "." + std::to_string(a[2]) + "." +
+                        std::to_string(a[3]);
+            }
+        }
+        GENERAL_NAMES_free(names);
+        if (!list.empty()) text += ", names " + list;
+    }
+    if (BIO* bio = BIO_new(BIO_s_mem())) {
+        ASN1_TIME_print(bio, X509_get0_notAfter(cert));
+        char* data = nullptr;
+        const long n = BIO_get_mem_data(bio, &data);
+        text += ", valid until " + std::string(data, static_cast<std::size_t>(std::max(0L, n)));
+        BIO_free(bio);
+    }
+    return text;
+}
+
 TlsContext TlsContext::client(const std::string& ca_file) {
     std::shared_ptr<ssl_ctx_st> ctx = new_context(false);
     if (ca_file.empty()) {

@@ -38,6 +38,9 @@ class TlsContext {
     static TlsContext client(const std::string& ca_file);
 
     bool is_server() const { return server_; }
+    // A server's certificate in one line for its start-up log: "subject CN=wall.example.org,
+    // names DNS:wall.example.org, valid until Nov 28 09:41:02 2027 GMT" ("" for a client).
+    std::string certificate_summary() const;
     ssl_ctx_st* native() const { return ctx_.get(); }
 
   private:
