@@ -2,7 +2,9 @@
 // one; a plain client on a TLS port, a TLS client on a plain port, an untrusted certificate and
 // one for another host each fail with one line that says so; bad certificate files name the file
 // and the option; framed connections over TLS carry large messages and wake on shutdown.
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <fstream>
 #include <thread>
 
@@ -134,6 +136,32 @@ TEST(RemoteTls, AClientTurnedAwayHearsWhyOverTls) {
         [&] { ViewClient second(*renderer, tls_hello(server.port(), server_cert().cert)); });
     expect_words(e, {"busy", "--max-clients"});
     first.close();
+}
+
+// A client that starts a handshake and stalls holds its slot only until the hello's limit (5 s
+// in TestServer), and never the accept loop: another client is served meanwhile.
+TEST(RemoteTls, AStalledHandshakeEndsAtTheHelloLimitAndBlocksNoOne) {
+    TestServer server(tls_options());
+    Socket stalled = connect_tcp("127.0.0.1", server.port(), 5);
+    const std::byte start[] = {std::byte{22}, std::byte{3}, std::byte{1}};
+    send_all(stalled, start, "stalled");
+    auto renderer = make_renderer("osmesa");
+    ViewClient other(*renderer, tls_hello(server.port(), server_cert().cert));
+    other.close();
+    std::array<std::byte, 64> buf{};
+    std::size_t got = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    bool closed = false;
+    try {
+        while (recv_some(stalled, buf, 30, got, "stalled")) {
+        }
+    } catch (const PeerClosed&) {
+        closed = true;
+    }
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_TRUE(closed) << "the server did not close the stalled connection within 30 s";
+    EXPECT_LT(waited, 20) << "the stalled handshake was held past the hello's limit";
 }
 
 TEST(RemoteTls, BadCertificateFilesNameTheFileAndTheOption) {
