@@ -2,6 +2,8 @@
 // one; a plain client on a TLS port, a TLS client on a plain port, an untrusted certificate and
 // one for another host each fail with one line that says so; bad certificate files name the file
 // and the option; framed connections over TLS carry large messages and wake on shutdown.
+#include <unistd.h>
+
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -25,9 +27,12 @@ using namespace remote;
 
 constexpr int kTlsW = 200, kTlsH = 150;
 
-// A certificate for localhost and 127.0.0.1, made once for the whole file.
+// A certificate for localhost and 127.0.0.1, made once per process. CTest runs each test in a
+// process of its own, two at once: a folder shared by all of them let one process remake the
+// certificate between another's server loading it and its client trusting it.
 const TestCert& server_cert() {
-    static const TestCert c = make_test_cert(scratch_dir("tls_server_cert"), "isowall-test");
+    static const TestCert c = make_test_cert(
+        scratch_dir("tls_server_cert_" + std::to_string(::getpid())), "isowall-test");
     return c;
 }
 
