@@ -23,9 +23,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The reason of OpenSSL's most recent error in words ("wrong version number"), and the queue
-// emptied; `fallback` when the queue held none.
-// OpenSSL's generic reasons ("PEM lib") say less than the one beneath them ("no start line").
+// The reason of OpenSSL's error in words ("wrong version number"), the queue emptied; `fallback`
+// when it held none. The first reason queued, unless a later one says more than a generic one
+// ("no start line" beneath "PEM lib").
 std::string take_reason(const std::string& fallback) {
     std::string best;
     while (const unsigned long e = ERR_get_error()) {
@@ -224,22 +224,25 @@ TlsSession::~TlsSession() {
     SSL_free(ssl_);
 }
 
-std::unique_ptr<TlsSession> TlsSession::accept(const TlsContext& ctx, const Socket& s,
-                                               const std::string& peer, double timeout_s) {
+std::unique_ptr<TlsSession> TlsSession::start(const TlsContext& ctx, const Socket& s,
+                                              const std::string& peer) {
     SSL* ssl = SSL_new(ctx.native());
     if (!ssl) throw NetError(peer + ": TLS: " + take_reason("out of memory"));
     std::unique_ptr<TlsSession> session(new TlsSession(ssl));
     if (SSL_set_fd(ssl, s.fd()) != 1) throw NetError(peer + ": TLS: " + take_reason("set_fd"));
-    return handshake(std::move(session), s, "", peer, timeout_s);
+    return session;
+}
+
+std::unique_ptr<TlsSession> TlsSession::accept(const TlsContext& ctx, const Socket& s,
+                                               const std::string& peer, double timeout_s) {
+    return handshake(start(ctx, s, peer), s, "", peer, timeout_s);
 }
 
 std::unique_ptr<TlsSession> TlsSession::connect(const TlsContext& ctx, const Socket& s,
                                                 const std::string& host, const std::string& peer,
                                                 double timeout_s) {
-    SSL* ssl = SSL_new(ctx.native());
-    if (!ssl) throw NetError(peer + ": TLS: " + take_reason("out of memory"));
-    std::unique_ptr<TlsSession> session(new TlsSession(ssl));
-    if (SSL_set_fd(ssl, s.fd()) != 1) throw NetError(peer + ": TLS: " + take_reason("set_fd"));
+    std::unique_ptr<TlsSession> session = start(ctx, s, peer);
+    SSL* ssl = session->ssl_;
     if (is_numeric_address(host)) {
         X509_VERIFY_PARAM_set1_ip_asc(SSL_get0_param(ssl), host.c_str());
     } else {
@@ -342,13 +345,11 @@ bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double tim
             err = SSL_get_error(ssl_, n);
         }
         if (err == SSL_ERROR_WANT_READ || err == SSL_ERROR_WANT_WRITE) {
-            const double left = forever ? -1 : seconds_left(deadline);
-            if (!forever && left <= 0) return false;
-            // At most a second per wait: a writer may have taken what this read waits for.
-            if (!wait_ready(s, err == SSL_ERROR_WANT_WRITE, forever ? 1.0 : std::min(left, 1.0),
-                            peer) &&
-                !forever && seconds_left(deadline) <= 0)
-                return false;
+            const double left = forever ? 1.0 : seconds_left(deadline);
+            if (left <= 0) return false;
+            // At most a second per wait: a writer may have taken what this read waits for. The
+            // next turn reads again, and ends when the time has run out.
+            wait_ready(s, err == SSL_ERROR_WANT_WRITE, std::min(left, 1.0), peer);
             continue;
         }
         if (err == SSL_ERROR_SYSCALL && errno != 0 && errno != EPIPE && errno != ECONNRESET)

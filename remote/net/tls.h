@@ -76,6 +76,9 @@ class TlsSession {
 
   private:
     explicit TlsSession(ssl_st* ssl) : ssl_(ssl) {}
+    // A session of `ctx` on `s`, before its handshake.
+    static std::unique_ptr<TlsSession> start(const TlsContext& ctx, const Socket& s,
+                                             const std::string& peer);
     // The server's handshake when `host` is empty, else the client's.
     static std::unique_ptr<TlsSession> handshake(std::unique_ptr<TlsSession> session,
                                                  const Socket& s, const std::string& host,
