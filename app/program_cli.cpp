@@ -90,6 +90,21 @@ void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
                       "Escape quits (after --script FILE, if given)");
     wall_cmd.add_option("--control-display", wall.control_display,
                         "X display of the control window (default $DISPLAY)");
+    wall_cmd
+        .add_option("--http", wall.http_port,
+                    "Serve the wall's page on this port (0: any free port, printed): the live "
+                    "mosaic, steering from a browser, several pages watching")
+        ->check(CLI::Range(0, 65535));
+    wall_cmd
+        .add_option("--http-listen", wall.http_listen,
+                    "Address of the page; anything but loopback needs --tls-cert, --tls-key and "
+                    "--token")
+        ->capture_default_str();
+    wall_cmd.add_option("--token", wall.token, "A secret every page must present (--http)");
+    wall_cmd.add_option("--tls-cert", wall.tls_cert,
+                        "The page over https and wss: this PEM certificate chain, with --tls-key");
+    wall_cmd.add_option("--tls-key", wall.tls_key,
+                        "The PEM private key of --tls-cert (no passphrase)");
 }
 
 // What each rank of a wall may use: its threads, and where it reads a store.

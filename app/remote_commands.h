@@ -1,5 +1,6 @@
 #pragma once
 // `isowall serve` and `isowall view` (issue 12): their options, command lines and runs.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +10,9 @@
 #include "cli/engine_cli.h"
 
 namespace isowall {
+namespace remote {
+class TlsContext;
+}
 
 // The port `isowall serve` listens on when the command line names none.
 inline constexpr int kServePort = 7878;
@@ -51,6 +55,11 @@ struct ViewCommand {
     double timeout_s = 120;
     bool quiet = false;
 };
+
+// --tls-cert and --tls-key of serve and wall: both or neither (InputError naming the one given);
+// null when neither.
+std::shared_ptr<const remote::TlsContext> server_tls(const std::string& cert,
+                                                     const std::string& key);
 
 CLI::App* add_serve_command(CLI::App& app, ServeCommand& o);
 CLI::App* add_view_command(CLI::App& app, ViewCommand& o);

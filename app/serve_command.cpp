@@ -52,6 +52,15 @@ remote::Endpoint listen_endpoint(const ServeCommand& o) {
 
 }  // namespace
 
+std::shared_ptr<const remote::TlsContext> server_tls(const std::string& cert,
+                                                     const std::string& key) {
+    if (cert.empty() != key.empty())
+        throw InputError(cert.empty() ? "--tls-key" : "--tls-cert", "value",
+                         "TLS needs both --tls-cert and --tls-key");
+    if (cert.empty()) return nullptr;
+    return std::make_shared<const remote::TlsContext>(remote::TlsContext::server(cert, key));
+}
+
 CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
     auto* c = app.add_subcommand(
         "serve",
@@ -106,12 +115,7 @@ int run_serve(const ServeCommand& o) {
     so.address = at.host;
     so.port = at.port;
     so.token = o.token;
-    if (o.tls_cert.empty() != o.tls_key.empty())
-        throw InputError(o.tls_cert.empty() ? "--tls-key" : "--tls-cert", "value",
-                         "TLS needs both --tls-cert and --tls-key");
-    if (!o.tls_cert.empty())
-        so.tls = std::make_shared<const remote::TlsContext>(
-            remote::TlsContext::server(o.tls_cert, o.tls_key));
+    so.tls = server_tls(o.tls_cert, o.tls_key);
     // Before the datasets load (a large one takes a while): ViewServer checks it again.
     if (std::string p = remote::exposure_problem(so, "listening"); !p.empty())
         throw InputError("--listen", "address", p);

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <tuple>
 
+#include "app/remote_commands.h"
+#include "app/wall_http.h"
 #include "app/wall_outputs.h"
 #include "common/core/error.h"
 #include "common/core/util.h"
@@ -70,11 +72,18 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
             ov.file ? ov.file->string() : "phantom", "--iso",
             "isovalue " + std::to_string(in.iso) + " is outside the volume's value range");
     to_engine_options(o.engine);
-    // The console and the window would both take the operator's commands; one at a time.
-    if (o.control && o.script == "-")
-        throw InputError("--control", "--script",
-                         "the console (--script -) and the control "
-                         "window cannot both drive the wall; give one, or a script file");
+    // The console and the window or page would both take the operator's commands; one at a
+    // time (the window and the page share one loop and take turns).
+    if ((o.control || o.http_port >= 0) && o.script == "-")
+        throw InputError(o.control ? "--control" : "--http", "--script",
+                         "the console (--script -) cannot drive the wall beside the control "
+                         "window or the page; give one, or a script file");
+    if (o.http_port < 0)
+        for (const auto& [given, name] : {std::pair{!o.token.empty(), "--token"},
+                                          {!o.tls_cert.empty(), "--tls-cert"},
+                                          {!o.tls_key.empty(), "--tls-key"},
+                                          {o.http_listen != "127.0.0.1", "--http-listen"}})
+            if (given) throw InputError(name, "value", "applies to the page: give --http PORT");
     // A folder, a device or a missing file is an error naming --script (a folder read as empty).
     if (!o.script.empty() && o.script != "-") in.script = load_script(o.script);
     check_wall_outputs(o, load_wall(o.wall), in.script);
@@ -109,9 +118,14 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.store_octree = in.volume->volume.own_octree();
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),
                       in.extractor->value_max());
-    // Opened before the tiles load: a display that cannot open ends the job at once.
+    // Opened before the tiles load: a display that cannot open, a port in use or a certificate
+    // that does not load ends the job at once.
     std::optional<ControlWindow> control;
     if (o.control) control.emplace(spec, o.control_display, o.out);
+    std::optional<WallHttp> http;
+    if (o.http_port >= 0)
+        http.emplace(spec, WallHttpOptions{o.http_listen, o.http_port, o.token,
+                                           server_tls(o.tls_cert, o.tls_key), o.out, o.wall});
     master.start();
     const std::string where = o.script.empty() ? std::string("--script") : o.script;
     bool quit = false;
@@ -127,8 +141,11 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
                 break;
             }
     }
-    if (control && !quit)
-        control->run(master);
+    std::vector<SteeringSource*> steering;
+    if (control) steering.push_back(&*control);
+    if (http) steering.push_back(&*http);
+    if (!steering.empty() && !quit)
+        run_steering(master, steering, control ? "control" : "http");
     else if (o.script.empty())
         master.execute(WaitCmd{WaitCmd::Until::done, 0}, where);
     return master.finish();
@@ -190,7 +207,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
         setup.shows.push_back(&*window);
     }
     std::optional<PreviewShow> preview;
-    if (o.control) {
+    if (o.control || o.http_port >= 0) {
         preview.emplace(comm, preview_max_side(spec));
         setup.shows.push_back(&*preview);
     }

@@ -28,7 +28,14 @@ struct WallOptions {
     // if any, the operator drives the wall from it until Escape. Every rank parses the same
     // command line, so tiles know from this that the master wants their previews.
     bool control = false;
-    std::string control_display;     // empty: $DISPLAY
+    std::string control_display;  // empty: $DISPLAY
+    // The browser page (app/wall_http.h), served by the master: its port (0: any free port;
+    // -1: none), address, token and TLS files. Tiles send previews when either this or the
+    // control window is on.
+    int http_port = -1;
+    std::string http_listen = "127.0.0.1";
+    std::string token;
+    std::string tls_cert, tls_key;
     double timeout_s = 120;          // a wall silent this long ends the job
     double startup_timeout_s = 600;  // the same while the tiles load the volume and start
     std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv

@@ -37,13 +37,10 @@ PixelSize control_window_size(const ControlLayout& layout) {
     return {layout.mosaic.width, layout.mosaic.height + kControlStatusHeight};
 }
 
-Image compose_control(const ControlLayout& layout, const std::vector<Image>& previews,
-                      const std::vector<std::string>& status) {
-    const PixelSize size = control_window_size(layout);
-    Image img;
-    img.width = size.width;
-    img.height = size.height;
-    img.rgba.assign(img.pixel_count() * 4, 255);
+namespace {
+
+// The mosaic of the control window into the top of `img` (at least the mosaic's size).
+void draw_mosaic(Image& img, const ControlLayout& layout, const std::vector<Image>& previews) {
     fill_rect(img, {0, 0, layout.mosaic.width, layout.mosaic.height}, kControlBezel);
     for (std::size_t t = 0; t < layout.tiles.size(); ++t) {
         const PixelRect& r = layout.tiles[t];
@@ -54,6 +51,29 @@ Image compose_control(const ControlLayout& layout, const std::vector<Image>& pre
             fill_rect(img, r, {0, 0, 0});
     }
     for (const PixelRect& r : layout.tiles) frame_rect(img, r, kControlBezel);
+}
+
+Image blank(PixelSize size) {
+    Image img;
+    img.width = size.width;
+    img.height = size.height;
+    img.rgba.assign(img.pixel_count() * 4, 255);
+    return img;
+}
+
+}  // namespace
+
+Image compose_mosaic(const ControlLayout& layout, const std::vector<Image>& previews) {
+    Image img = blank(layout.mosaic);
+    draw_mosaic(img, layout, previews);
+    return img;
+}
+
+Image compose_control(const ControlLayout& layout, const std::vector<Image>& previews,
+                      const std::vector<std::string>& status) {
+    const PixelSize size = control_window_size(layout);
+    Image img = blank(size);
+    draw_mosaic(img, layout, previews);
     const PixelRect bar{0, layout.mosaic.height, size.width, kControlStatusHeight};
     fill_rect(img, bar, kControlStatusBackground);
     const int line_height = (kGlyphHeight + 2) * kControlTextScale;

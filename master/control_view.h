@@ -36,6 +36,12 @@ std::string keys_line();
 // The window's size for `layout`: the mosaic with the status bar under it.
 PixelSize control_window_size(const ControlLayout& layout);
 
+// The mosaic alone (layout.mosaic's size): bezel grey, each tile's preview (by tile index; an
+// image of 0x0 when none has come yet, shown black) scaled into its rect of the layout with
+// resample_nearest, and a one-pixel grey frame round every tile. The browser page (wall --http)
+// shows this.
+Image compose_mosaic(const ControlLayout& layout, const std::vector<Image>& previews);
+
 // The window's picture: bezel grey, each tile's preview (by tile index; an image of 0x0 when none
 // has come yet, shown black) scaled into its rect of the layout, a one-pixel grey frame round
 // every tile (so a seamless wall shows its seams too), and the status lines under the mosaic,

@@ -6,17 +6,19 @@
 #include <memory>
 #include <string>
 
+#include "common/core/pacer.h"
 #include "common/core/util.h"
 #include "common/wall/control_layout.h"
 #include "display/x_window.h"
 #include "master/control_input.h"
+#include "master/steering.h"
 #include "master/wall_master.h"
 
 namespace isowall {
 
 inline constexpr const char* kControlTitle = "isowall control";
 
-class ControlWindow {
+class ControlWindow : public SteeringSource {
   public:
     // Opens the window on `display` (empty: $DISPLAY); throws DisplayError naming the display.
     // Snapshots go beside `out` (--out), numbered from the first free control-NNN.png.
@@ -27,20 +29,24 @@ class ControlWindow {
     // ("control: frame 3 done in 1.25 s"); between them the master takes the tiles' messages.
     // A command that cannot apply (a zoom past the limits) is printed and skipped, as at the
     // console. Returns when quit has been executed (the caller then finishes the wall).
+    // The same as run_steering(master, {this}, "control").
     void run(WallMaster& master);
+
+    // As a source of run_steering (master/steering.h), beside the browser page.
+    void begin() override;
+    std::vector<SteeringLine> take(const WallMaster& master) override;
+    void ran(const SteeringLine& line, const std::string& error) override;
+    void show(const WallMaster& master, const FrameNote& frame, bool changed) override;
 
   private:
     void present(const WallMaster& master);
-    void note_frame(const WallMaster& master);
 
-    const WallSpec& spec_;
     ControlLayout layout_;
     XWindow window_;
     ControlInput input_;
-    std::string last_;  // the last command taken, for the status bar
-    std::uint64_t frame_ = 0;
-    bool frame_reported_ = false;
-    Stopwatch frame_clock_;
+    std::string last_;  // the last command taken (from any source), for the status bar
+    PresentPacer pacer_;
+    Stopwatch clock_, since_present_;
 };
 
 }  // namespace isowall

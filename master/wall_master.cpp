@@ -223,6 +223,8 @@ void WallMaster::send_views() {
                         o_.screen_box);
     board_.emplace(plan.regions, plan.work, o_.balance);
     migrations_.clear();
+    frame_busy_s_.assign(tiles_.size(), 0.0);
+    frame_clock_s_.assign(tiles_.size(), 0.0);
     order_.begin_frame();
     for (int rank = 1; rank < comm_.size(); ++rank) order_.ask(rank);
     dispatch();

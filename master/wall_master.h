@@ -60,6 +60,18 @@ struct MasterOptions {
     std::filesystem::path store_octree;
 };
 
+// The current frame as the master has seen it so far, from its jobs' ends (JobDoneMsg): what
+// the browser page (wall --http) shows while the wall runs.
+struct FrameFigures {
+    std::size_t jobs = 0, jobs_done = 0;
+    std::size_t migrated = 0;  // jobs done by a rank other than their tile's
+    // Emulated time (master/dispatch_order.h: a rank's frame-thread CPU clock is its time): the
+    // latest a rank's clock read when one of its jobs ended. At the frame's end, its makespan.
+    double emulated_s = 0;
+    // Mean over max of the tile ranks' busy CPU (the jobs' CPU seconds) so far; 1 with no work.
+    double balance = 1;
+};
+
 class WallMaster {
   public:
     WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec, const Box3& bounds,
@@ -97,6 +109,8 @@ class WallMaster {
     const std::vector<std::optional<PreviewMsg>>& previews() const { return previews_; }
     std::uint64_t previews_taken() const { return previews_taken_; }
     const StoreSent& store_sent() const { return store_sent_; }
+    FrameFigures frame_figures() const;
+    const WallSpec& spec() const { return spec_; }
 
   private:
     struct TileState {
@@ -150,8 +164,10 @@ class WallMaster {
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;
     TraceRecorder trace_;
-    std::optional<JobBoard> board_;         // the current generation's jobs
-    std::vector<Migration> migrations_;     // of the current generation
+    std::optional<JobBoard> board_;      // the current generation's jobs
+    std::vector<Migration> migrations_;  // of the current generation
+    // Of the current generation, by rank: CPU seconds of its jobs, and its clock at its last job.
+    std::vector<double> frame_busy_s_, frame_clock_s_;
     std::vector<std::uint64_t> completed_;  // generations before the current one that completed
     RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
     DispatchOrder order_;    // which asking rank is served next

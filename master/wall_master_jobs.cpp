@@ -1,5 +1,6 @@
 // The wall master's side of the screen-region scheduler: handing out jobs (master/job_board.h)
 // in the dispatch order (master/dispatch_order.h) and taking their ends and landings.
+#include <algorithm>
 #include <string>
 
 #include "common/core/error.h"
@@ -50,6 +51,9 @@ void WallMaster::handle_job(int from, const Message& m) {
         board_->done(id, d->cpu_s);
         if (j.owner != from) migrations_.push_back({j.owner, from, d->start_s, d->end_s, d->bytes});
         order_.clock(from, d->cpu_end_s);
+        const auto r = static_cast<std::size_t>(from);
+        frame_busy_s_.at(r) += d->cpu_s;
+        frame_clock_s_.at(r) = std::max(frame_clock_s_.at(r), d->cpu_end_s);
         order_.ask(from);
         dispatch();
     } else {
@@ -58,6 +62,24 @@ void WallMaster::handle_job(int from, const Message& m) {
                             ", which no helper ran for it");
         board_->landed(id);
     }
+}
+
+FrameFigures WallMaster::frame_figures() const {
+    FrameFigures f;
+    if (!board_) return f;
+    f.jobs = board_->size();
+    for (std::uint32_t id = 0; id < board_->size(); ++id)
+        if (board_->job(id).state == BoardJob::State::done) ++f.jobs_done;
+    f.migrated = migrations_.size();
+    double sum = 0, most = 0;
+    for (std::size_t r = 1; r < frame_busy_s_.size(); ++r) {
+        sum += frame_busy_s_[r];
+        most = std::max(most, frame_busy_s_[r]);
+        f.emulated_s = std::max(f.emulated_s, frame_clock_s_[r]);
+    }
+    const std::size_t ranks = frame_busy_s_.size() > 1 ? frame_busy_s_.size() - 1 : 1;
+    if (most > 0) f.balance = sum / static_cast<double>(ranks) / most;
+    return f;
 }
 
 }  // namespace isowall

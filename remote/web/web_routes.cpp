@@ -117,7 +117,7 @@ web::HttpResponse route(const web::HttpRequest& request, const RouteContext& con
     if (request.method != "GET") return text(405, "only GET is served here");
     if (request.path == "/datasets") return datasets(request, context);
     const std::string_view name =
-        request.path == "/" ? std::string_view("index.html") : std::string_view(request.path);
+        request.path == "/" ? context.index : std::string_view(request.path);
     const WebAsset* asset =
         find_asset(context.assets, name.starts_with('/') ? name.substr(1) : name);
     if (!asset) return text(404, "not found: " + request.path);

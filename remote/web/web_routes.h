@@ -1,6 +1,6 @@
 #pragma once
 // The HTTP side of `isowall serve --http` (issue 13), pure: which response each GET gets.
-//   /, /index.html      the page (web/dist/index.html)
+//   /, /index.html      the page (web/dist/index.html; RouteContext::index)
 //   /<file>             any other file of web/dist/, with its content type
 //   /datasets?token=T   {"datasets":[...],"token_required":...}; 403 {"error":"wrong token"}
 //                       when the server has a token and T is missing or another
@@ -20,6 +20,7 @@ struct RouteContext {
     std::vector<std::string> datasets;  // in the order the server loaded them
     std::string token;                  // empty: none asked for
     std::span<const WebAsset> assets;
+    std::string_view index = "index.html";  // what "/" serves (wall --http: "wall.html")
 };
 
 web::HttpResponse route(const web::HttpRequest& request, const RouteContext& context);

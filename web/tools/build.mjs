@@ -1,5 +1,6 @@
 // `npm run build`: bundles src/ into dist/app.js (esbuild, minified, no source map) and copies
-// index.html and app.css (minified) beside it. Deterministic: the same sources give the same bytes.
+// index.html and app.css (minified) beside it; the wall's page (src/wall/) likewise into wall.js,
+// wall.html and wall.css. Deterministic: the same sources give the same bytes.
 // `node tools/build.mjs DIR` builds into DIR instead (tools/check_dist.mjs compares the two).
 import { build } from 'esbuild';
 import { copyFileSync, mkdirSync, readdirSync, rmSync } from 'node:fs';
@@ -22,6 +23,24 @@ await build({
   legalComments: 'eof',
   logLevel: 'warning',
 });
+// The wall's page (isowall wall --http): its own bundle and style.
+await build({
+  entryPoints: [join(root, 'src/wall/wall.js')],
+  outfile: join(dist, 'wall.js'),
+  bundle: true,
+  format: 'iife',
+  target: ['es2020', 'chrome90', 'firefox90', 'safari15'],
+  minify: true,
+  sourcemap: false,
+  legalComments: 'eof',
+  logLevel: 'warning',
+});
+await build({
+  entryPoints: [join(root, 'src/wall/wall.css')],
+  outfile: join(dist, 'wall.css'),
+  minify: true,
+  logLevel: 'warning',
+});
 await build({
   entryPoints: [join(root, 'src/app.css')],
   outfile: join(dist, 'app.css'),
@@ -29,4 +48,5 @@ await build({
   logLevel: 'warning',
 });
 copyFileSync(join(root, 'src/index.html'), join(dist, 'index.html'));
+copyFileSync(join(root, 'src/wall/wall.html'), join(dist, 'wall.html'));
 console.log(`build: ${readdirSync(dist).sort().join(', ')} in ${dist}`);

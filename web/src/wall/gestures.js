@@ -1,0 +1,56 @@
+// The page's input as script lines, as the control window makes them (master/control_input.h):
+// a drag orbits at kOrbitDegPerPx degrees per mosaic pixel (a right drag or a shift drag pans, in
+// mosaic sizes), a wheel step or a pinch zooms, so the page, the control window and a script
+// drive the wall alike. Pure: the caller converts screen pixels to mosaic pixels.
+export const kOrbitDegPerPx = 0.5;
+export const kZoomStep = 1.25;
+
+// Six significant digits, no trailing zeros: "-30", "0.125".
+export function num(v) {
+  const s = String(Number(Number(v).toPrecision(6)));
+  return s === '-0' ? '0' : s;
+}
+
+export function orbitLine(dx, dy) {
+  return `orbit ${num(-dx * kOrbitDegPerPx)} ${num(-dy * kOrbitDegPerPx)}`;
+}
+
+export function panLine(dx, dy, mosaicWidth, mosaicHeight) {
+  return `pan ${num(-dx / Math.max(mosaicWidth, 1))} ${num(dy / Math.max(mosaicHeight, 1))}`;
+}
+
+// Wheel steps (negative: towards the user, closer) as one zoom line.
+export function zoomLine(steps) {
+  return `zoom ${num(kZoomStep ** -steps)}`;
+}
+
+export function pinchLine(startDistance, endDistance) {
+  return `zoom ${num(endDistance / Math.max(startDistance, 1))}`;
+}
+
+export function isoLine(v) {
+  return `iso ${num(v)}`;
+}
+
+// A drag's motion in mosaic pixels, cut into lines no more often than the caller flushes.
+export class Drag {
+  constructor(kind) {
+    this.kind = kind;  // 'orbit' | 'pan'
+    this.dx = 0;
+    this.dy = 0;
+  }
+
+  move(dx, dy) {
+    this.dx += dx;
+    this.dy += dy;
+  }
+
+  // The line for the motion since the last flush, or null when there was none.
+  flush(mosaicWidth, mosaicHeight) {
+    if (this.dx === 0 && this.dy === 0) return null;
+    const line = this.kind === 'orbit' ? orbitLine(this.dx, this.dy) : panLine(this.dx, this.dy, mosaicWidth, mosaicHeight);
+    this.dx = 0;
+    this.dy = 0;
+    return line;
+  }
+}
