@@ -1,5 +1,6 @@
 // The control window (isowall wall --control) under mpirun on a private Xvfb: a drag, a wheel step
-// and an isovalue key sent with xdotool change the final mosaic to the one the equivalent script
+// and an isovalue key sent with xdotool, and a pan from the wall's page (--http, a WebSocket client
+// here) in the same steering loop, change the final mosaic to the one the equivalent script
 // gives (the acceptance rule of the wall tests: mask IoU >= 0.999, >= 99.9% of pixels within
 // 1/255), and a display that cannot open ends every rank with one line naming it.
 //
@@ -18,6 +19,8 @@
 #include <string>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "common/core/image_ops.h"
 #include "common/core/preview.h"
 #include "common/core/util.h"
@@ -29,6 +32,7 @@
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
+#include "tests/ws_test_client.h"
 #include "tests/xvfb_util.h"
 
 namespace isowall {
@@ -48,7 +52,7 @@ constexpr int kGuardS = 180;  // the wall's own limit (timeout) in every run her
 constexpr int kDragPx = 60;
 static_assert(kOrbitDegPerPx == 0.5 && kZoomStep == 1.25 && kIsoStep == 0.01,
               "the script below spells out these constants");
-const char* const kScript = "orbit -30 0\nzoom 1.25\niso 52.2\nwait done\nquit\n";
+const char* const kScript = "orbit -30 0\nzoom 1.25\niso 52.2\npan 0.1 0\nwait done\nquit\n";
 
 bool have(const char* program) {
     return std::system(("command -v " + std::string(program) + " >/dev/null 2>&1").c_str()) == 0;
@@ -83,7 +87,7 @@ class ControlRun {
         const std::string cmd = "(timeout " + std::to_string(kGuardS) + " " + mpirun(5) +
                                 "wall --wall '" + (dir / "2x2.toml").string() + "' --out '" +
                                 (dir / "control.png").string() + "' --control --control-display " +
-                                display + " > '" + log().string() + "' 2>&1; echo $? > '" +
+                                display + " --http 0 > '" + log().string() + "' 2>&1; echo $? > '" +
                                 (dir / "rc").string() + "') & echo $! > '" +
                                 (dir / "pid").string() + "'";
         std::system(
@@ -163,6 +167,14 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
     ASSERT_TRUE(wait_for(
         wall.log(), [](const std::string& t) { return contains(t, "control: window on"); }, 120))
         << slurp(wall.log());
+    // The page beside the window (wall --http): it hears every line, the window's too.
+    const std::string page_at = "http: page at http://127.0.0.1:";
+    ASSERT_TRUE(wait_for(
+        wall.log(), [&](const std::string& t) { return contains(t, page_at); }, 60))
+        << slurp(wall.log());
+    const std::string text = slurp(wall.log());
+    test::WsTestClient page(std::atoi(text.c_str() + text.find(page_at) + page_at.size()));
+    page.send_text(R"({"hello": ""})");
     ASSERT_EQ(xdotool("search --sync --name '^isowall control$'", "window"), 0);
     const std::string w = std::to_string(std::atoll(slurp(dir_ / "window").c_str()));
     ASSERT_NE(w, "0") << slurp(dir_ / "window");
@@ -192,6 +204,19 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
     ASSERT_TRUE(wait_for(
         wall.log(), [](const std::string& t) { return done_after(t, "control: iso "); }, 60))
         << slurp(wall.log());
+    page.send_text(R"({"run": "pan 0.1 0"})");
+    ASSERT_TRUE(wait_for(
+        wall.log(), [](const std::string& t) { return done_after(t, "page 1: pan "); }, 60))
+        << slurp(wall.log());
+    std::string heard;  // "WHO: LINE" of every line the page was told ran (states keep coming)
+    for (Stopwatch reading; reading.seconds() < 10 && !contains(heard, "page 1: pan");)
+        if (auto m = page.receive(0.5); m && m->bytes.starts_with("{")) {
+            const auto j = nlohmann::json::parse(m->bytes);
+            if (j["type"] == "ran")
+                heard += j["who"].get<std::string>() + ": " + j["line"].get<std::string>() + "\n";
+        }
+    EXPECT_TRUE(contains(heard, "control: orbit -30 0\n")) << heard;
+    EXPECT_TRUE(contains(heard, "page 1: pan 0.1 0\n")) << heard;
     ASSERT_EQ(xdotool("key --window " + w + " Escape"), 0);
     const int rc = wall.exit_code(60);
     const double control_s = took.seconds();
@@ -200,7 +225,7 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
     // Each gesture became one command, the line a script would hold.
     for (const char* line :
          {"control: orbit -30 0\n", "control: zoom 1.25\n", "control: iso 52.2\n",
-          "control: snapshot control-001\n", "control: quit\n"})
+          "page 1: pan 0.1 0\n", "control: snapshot control-001\n", "control: quit\n"})
         EXPECT_EQ(test::count_of(log, line), 1u) << line << " in:\n" << log;
 
     std::ofstream(dir_ / "same.txt") << kScript;
