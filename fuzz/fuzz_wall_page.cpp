@@ -14,7 +14,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     using isowall::PageMessage;
     using isowall::fuzz::check;
     try {
-        const PageMessage m = isowall::parse_page_message(isowall::fuzz::as_text(data, size), "page 1");
+        const PageMessage m =
+            isowall::parse_page_message(isowall::fuzz::as_text(data, size), "page 1");
         check(size <= isowall::kMaxPageMessage, "a message within the size bound");
         if (m.kind == PageMessage::Kind::run) {
             const isowall::ScriptCommand c = isowall::parse_command(m.text, "page 1");

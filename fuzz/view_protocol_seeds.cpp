@@ -28,7 +28,7 @@ std::vector<RemoteMessage> samples() {
     request.cached_groups = true;
     const GroupKey key{{4, 5, 6}, 2, 105.5, true};
     return {
-        HelloMsg{1, "ct_head", "s3cret", 2},
+        HelloMsg{1, "ct_head", "s3cret", 2, SessionRole::none, ""},
         ReadyMsg{{{0, 0, 0}, {1, 2, 3}},
                  -1024,
                  3071,
@@ -40,7 +40,8 @@ std::vector<RemoteMessage> samples() {
         VisibleMsg{3, {0, 1, 2, 5, 7, 11}},  // a bitmap; the deltas form is in the fuzzer's reach
         EndOfFrameMsg{3, 480000, 120, 90000, 2400000},
         make_error(ErrorCode::bad_token, "wrong token"),
-        ByeMsg{}};
+        ByeMsg{},
+        SessionMsg{"class 3b", "10.0.0.7:51234", 12}};
 }
 
 bool write(const std::filesystem::path& path, const std::vector<std::byte>& bytes) {

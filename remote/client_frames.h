@@ -63,6 +63,8 @@ class ClientFrames {
     bool handle(const RemoteMessage& m, std::size_t wire_bytes, double now_s);
     // The last frame ended; measure() first fills the correctness of its samples.
     const ClientFrameResult& result() const { return result_; }
+    // The request of the current (or last) frame.
+    const RequestMsg& request() const { return request_; }
     // Replays the frame's draw steps and measures each sample against the final image.
     void measure();
     // What is on screen now.

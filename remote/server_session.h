@@ -73,6 +73,8 @@ class ServerSession {
     // Casts the request's view and sends its groups, then an EndOfFrameMsg (not when stopped).
     // `stop` is read between rays (a newer request, a closed connection).
     RequestFigures run(const RequestMsg& request, const std::atomic<bool>& stop);
+    // The next cached request begins a new generation (a shared session's follower joined).
+    void restart_cache() { cache_valid_ = false; }
 
   private:
     struct LodLevel;

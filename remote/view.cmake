@@ -5,6 +5,7 @@
 add_library(isowall_remote_view
     ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
     ${CMAKE_CURRENT_LIST_DIR}/tcp_channel.cpp ${CMAKE_CURRENT_LIST_DIR}/server_access.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/shared_session.cpp ${CMAKE_CURRENT_LIST_DIR}/server_refusal.cpp
     ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)
 target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_view

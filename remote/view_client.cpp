@@ -15,6 +15,8 @@ ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(rende
     hello.dataset = h.dataset;
     hello.token = h.token;
     hello.encoding = static_cast<std::uint8_t>(h.encoding);
+    hello.role = h.role;
+    hello.session = h.session;
     conn_->send(hello);
     std::optional<RemoteMessage> m = conn_->receive(h.connect_timeout_s);
     if (!m)
@@ -48,8 +50,24 @@ bool ViewClient::receive_one(double timeout_s) {
     if (!m) return false;
     // Its bytes on the wire: a payload that decodes encodes back to exactly its bytes.
     const std::size_t bytes = kHeaderBytes + encode_payload(*m).size();
-    if (frames_.handle(*m, bytes, now_s())) active_ = false;
+    if (const auto* s = std::get_if<SessionMsg>(&*m)) {
+        session_ = *s;
+    } else if (const auto* r = std::get_if<RequestMsg>(&*m)) {
+        frames_.begin(*r, now_s());  // a follower: the presenter's next view
+        active_ = true;
+    } else if (frames_.handle(*m, bytes, now_s())) {
+        active_ = false;
+    }
     return true;
+}
+
+const ClientFrameResult* ViewClient::next_frame(double timeout_s) {
+    bool began = active_;
+    for (;;) {
+        if (!receive_one(timeout_s)) return nullptr;
+        began = began || active_;
+        if (began && !active_) return &frames_.result();
+    }
 }
 
 const ClientFrameResult& ViewClient::wait_done(double timeout_s) {

@@ -21,6 +21,10 @@ struct ClientHello {
     std::shared_ptr<const TlsContext> tls;
     GroupEncoding encoding = GroupEncoding::compact_zstd;
     double connect_timeout_s = 10;
+    // A shared session (remote/shared_session.h): present it, or follow it; none: a view of
+    // one's own.
+    SessionRole role = SessionRole::none;
+    std::string session;
 };
 
 class ViewClient {
@@ -37,6 +41,12 @@ class ViewClient {
     const ClientFrameResult& wait_done(double timeout_s);
     // Receives for `seconds` (or until the frame ends); true when it ended.
     bool receive_for(double seconds);
+    // A follower: receives until the next frame the presenter asked for has ended (its
+    // request came from the server); nullptr when nothing arrives for `timeout_s`. Throws
+    // RemoteError when the server drops it (a follower too slow for the session).
+    const ClientFrameResult* next_frame(double timeout_s);
+    // The latest SessionMsg of a shared session (its presenter and size), if one came.
+    const std::optional<SessionMsg>& session() const { return session_; }
     bool frame_active() const { return active_; }
     ClientFrames& frames() { return frames_; }
     std::uint64_t bytes_received() const { return conn_->bytes_received(); }
@@ -50,6 +60,7 @@ class ViewClient {
     ClientFrames frames_;
     std::unique_ptr<Connection> conn_;
     ReadyMsg ready_;
+    std::optional<SessionMsg> session_;
     std::uint64_t next_id_ = 1;
     bool active_ = false;
     std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();

@@ -101,21 +101,52 @@ bool get_flag(MessageReader& r, const char* field) {
 // ---- one encoder and its decoder per message ---------------------------------------------------
 
 static std::vector<std::byte> encode(const HelloMsg& m) {
-    MessageWriter w(HelloMsg::kVersion);
+    const bool shared = m.role != SessionRole::none;
+    MessageWriter w(shared ? HelloMsg::kVersion : 1);
     w.put(m.protocol_version);
     put_text(w, m.dataset);
     put_text(w, m.token);
     w.put(m.encoding);
+    if (shared) {
+        w.put(static_cast<std::uint8_t>(m.role));
+        put_text(w, m.session);
+    }
     return w.take();
 }
 
 static HelloMsg decode_hello(std::span<const std::byte> bytes) {
-    MessageReader r(bytes, HelloMsg::kVersion, "hello message");
+    const bool v1 = !bytes.empty() && bytes[0] == std::byte{1};
+    MessageReader r(bytes, v1 ? 1 : HelloMsg::kVersion, "hello message");
     HelloMsg m;
     m.protocol_version = r.get<std::uint16_t>();
     m.dataset = get_text(r, "dataset", kMaxDatasetNameBytes, false);
     m.token = get_text(r, "token", kMaxTokenBytes, true);
     m.encoding = r.get<std::uint8_t>();
+    if (!v1) {
+        const auto role = r.get<std::uint8_t>();
+        if (role < 1 || role > 2)
+            r.fail("role: " + std::to_string(role) + ", expected 1 (presenter) or 2 (follower)");
+        m.role = static_cast<SessionRole>(role);
+        m.session = get_text(r, "session", kMaxSessionNameBytes, false);
+    }
+    r.finish();
+    return m;
+}
+
+static std::vector<std::byte> encode(const SessionMsg& m) {
+    MessageWriter w(SessionMsg::kVersion);
+    put_text(w, m.session);
+    put_text(w, m.presenter);
+    w.put(m.members);
+    return w.take();
+}
+
+static SessionMsg decode_session(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, SessionMsg::kVersion, "session message");
+    SessionMsg m;
+    m.session = get_text(r, "session", kMaxSessionNameBytes, false);
+    m.presenter = get_text(r, "presenter", kMaxPeerNameBytes, true);
+    m.members = r.get<std::uint32_t>();
     r.finish();
     return m;
 }
@@ -306,6 +337,8 @@ const char* to_string(RemoteTag type) {
             return "error";
         case RemoteTag::bye:
             return "bye";
+        case RemoteTag::session:
+            return "session";
     }
     return "unknown";
 }
@@ -336,6 +369,8 @@ RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload)
             return decode_error(payload);
         case RemoteTag::bye:
             return decode_bye(payload);
+        case RemoteTag::session:
+            return decode_session(payload);
     }
     throw WireError("view protocol: unknown message type " +
                     std::to_string(static_cast<unsigned>(type)));

@@ -30,14 +30,17 @@ enum class RemoteTag : std::uint16_t {
     end_of_frame = 6,  // server -> client: the request is complete; its figures
     error = 7,         // either way: what was wrong; the sender closes the connection after it
     bye = 8,           // either way: the sender closes the connection, nothing was wrong
+    session = 9,       // server -> a shared session's members: its name, presenter and size
 };
-inline constexpr std::uint16_t kLastRemoteTag = 8;
+inline constexpr std::uint16_t kLastRemoteTag = 9;
 const char* to_string(RemoteTag type);
 
 // ---- limits: each is checked by the decoder before anything is sized from the bytes -----------
 inline constexpr std::size_t kMaxDatasetNameBytes = 256;  // printable ASCII, not empty
 inline constexpr std::size_t kMaxTokenBytes = 256;        // printable ASCII, may be empty
 inline constexpr std::size_t kMaxErrorTextBytes = 256;    // one printable ASCII line
+inline constexpr std::size_t kMaxSessionNameBytes = 64;   // printable ASCII
+inline constexpr std::size_t kMaxPeerNameBytes = 128;     // printable ASCII ("ADDR:PORT")
 // An encoded group. Groups of the default propagation (1000 cells) take a few hundred KiB; the
 // bound keeps every valid group message under the framing's default payload limit (64 MiB).
 inline constexpr std::size_t kMaxGroupBytes = std::size_t{32} << 20;
@@ -46,13 +49,31 @@ inline constexpr std::size_t kMaxVisibleKeys = std::size_t{1} << 20;
 // A group's level: meta-cells of 2^level cells per side, so anything past 30 overflows an int.
 inline constexpr int kMaxGroupLevel = 30;
 
+// A shared session (view --present / --follow NAME): the presenter's requests are extracted once
+// and streamed to every member; a follower sends no request, and gets each of the presenter's
+// as a RequestMsg from the server, before its groups.
+enum class SessionRole : std::uint8_t { none = 0, presenter = 1, follower = 2 };
+
 struct HelloMsg {
     static constexpr RemoteTag kTag = RemoteTag::hello;
-    static constexpr std::uint8_t kVersion = 1;
+    // 2: session and role. Encoded as version 1 (without them) when the role is none, so a
+    // client that shares no session speaks to servers of version 1; both decode.
+    static constexpr std::uint8_t kVersion = 2;
     std::uint16_t protocol_version = 1;  // the newest the client speaks
     std::string dataset;                 // the name the server loaded the volume under
     std::string token;                   // empty unless the server asks for one (--token)
     std::uint8_t encoding = 0;           // the group encoding the client wants (remote codec's id)
+    SessionRole role = SessionRole::none;
+    std::string session;  // with a role: 1..kMaxSessionNameBytes printable ASCII; else empty
+};
+
+// Sent to every member of a shared session when one joins or leaves.
+struct SessionMsg {
+    static constexpr RemoteTag kTag = RemoteTag::session;
+    static constexpr std::uint8_t kVersion = 1;
+    std::string session;        // its name
+    std::string presenter;      // who presents ("ADDR:PORT"), empty while nobody does
+    std::uint32_t members = 0;  // presenter included
 };
 
 struct ReadyMsg {
@@ -119,8 +140,9 @@ enum class ErrorCode : std::uint16_t {
     unknown_dataset = 4,
     too_large = 5,  // a frame's payload over the receiver's limit
     internal = 6,   // the sender failed (loading, extracting); the text says how
+    session = 7,    // a shared session refused the hello, or dropped a follower; the text says why
 };
-inline constexpr std::uint16_t kLastErrorCode = 6;
+inline constexpr std::uint16_t kLastErrorCode = 7;
 
 struct ErrorMsg {
     static constexpr RemoteTag kTag = RemoteTag::error;
@@ -138,7 +160,7 @@ struct ByeMsg {
 };
 
 using RemoteMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
-                                   EndOfFrameMsg, ErrorMsg, ByeMsg>;
+                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg>;
 
 // The payload of a message (what follows the frame header).
 std::vector<std::byte> encode_payload(const RemoteMessage& m);

@@ -14,6 +14,7 @@
 #include "common/core/newest_request.h"
 #include "remote/net/socket.h"
 #include "remote/request_checks.h"
+#include "remote/server_refusal.h"
 
 namespace isowall::remote {
 
@@ -25,35 +26,13 @@ using Clock = std::chrono::steady_clock;
 // down: a send to a client that does not read waits for room in its buffers for ever.
 constexpr double kErrorSendTimeoutS = 2;
 // Connections turned away at once (a thread each, about 3 s at most; past it one is closed
-// without a word), and how long one may take to open and hear why.
+// without a word).
 constexpr std::size_t kMaxRefusals = 16;
-constexpr double kRefusalTimeoutS = 2;
 
 std::string seconds_text(double s) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", s);
     return buf;
-}
-
-// Runs `f` (which must not throw) and shuts `conn` down if it has not returned within
-// `timeout_s`: that ends any send or receive of `conn` that `f` waits in.
-template <class F>
-void within(MessageChannel& conn, double timeout_s, F&& f) {
-    std::mutex mutex;
-    std::condition_variable changed;
-    bool done = false;
-    std::thread watchdog([&] {
-        std::unique_lock lock(mutex);
-        if (!changed.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return done; }))
-            conn.shutdown();
-    });
-    f();
-    {
-        std::lock_guard lock(mutex);
-        done = true;
-    }
-    changed.notify_all();
-    watchdog.join();
 }
 
 // The error code of a broken stream: the framing's and decoders' WireError texts name the field.
@@ -65,31 +44,6 @@ ErrorCode code_of(const WireError& e) {
 }
 
 }  // namespace
-
-// A connection turned away (max_clients): its own thread opens the channel (a TLS handshake,
-// bounded), sends the busy error and closes, so the client reads why, in TLS on a TLS port.
-struct ViewServer::Refusal {
-    Refusal(std::unique_ptr<MessageChannel> c, std::string text) : channel(std::move(c)) {
-        thread = std::thread([this, text = std::move(text)] {
-            within(*channel, kRefusalTimeoutS, [&] {
-                try {
-                    channel->open(kRefusalTimeoutS);
-                    channel->send(make_error(ErrorCode::internal, text));
-                } catch (const std::exception&) {  // gone, or speaks nonsense: nothing to tell
-                }
-            });
-            channel->close_gracefully();
-            done = true;
-        });
-    }
-    ~Refusal() {
-        channel->shutdown();
-        thread.join();
-    }
-    std::unique_ptr<MessageChannel> channel;
-    std::thread thread;
-    std::atomic<bool> done{false};
-};
 
 struct ViewServer::Impl {
     explicit Impl(Listener l) : listener(std::move(l)) {}
@@ -169,7 +123,11 @@ class ViewServer::Client {
         for (const Dataset& d : server_.datasets_)
             if (d.name == h->dataset) {
                 encoding_ = static_cast<GroupEncoding>(h->encoding);
-                return &d;
+                if (h->role == SessionRole::none) return &d;
+                std::string why;
+                seat_ = server_.hub_.join(*h, conn_.peer(), why);
+                if (!seat_) refuse(ErrorCode::session, why);
+                return seat_ ? &d : nullptr;
             }
         refuse(ErrorCode::unknown_dataset, "hello: dataset: no dataset named " + quote(h->dataset));
         return nullptr;
@@ -195,6 +153,8 @@ class ViewServer::Client {
             refuse(ErrorCode::internal, e.what());
         }
         stop_worker();
+        if (seat_) say("serve: %s: left session %s\n", seat_->session().name());
+        seat_.reset();
         conn_.close_gracefully();
         --server_.open_;
         done_ = true;
@@ -220,12 +180,16 @@ class ViewServer::Client {
                 const std::size_t bytes = conn_.send(m);
                 touch();
                 computing_ = true;
+                if (seat_ && !seat_->queue()) seat_->session().fan_out(m);
                 return bytes;
             });
+        if (seat_ && seat_->queue()) return follow();
+        if (seat_) say("serve: %s: presents session %s\n", seat_->session().name());
         worker_ = std::thread([this] { work(); });
         const double limit = server_.options_.idle_timeout_s;
         touch();
         for (;;) {
+            tell_status();
             // The server's own work on a request is not the client's silence (a frame may
             // take longer than the limit: a large view, a slow build).
             const double idle = computing_ ? 0.0 : idle_s();
@@ -269,6 +233,7 @@ class ViewServer::Client {
             const RequestMsg& r = *next;
             try {
                 computing_ = true;
+                if (seat_ && seat_->session().begin_request(r)) session_->restart_cache();
                 const RequestFigures f = session_->run(r, requests_.stop_flag());
                 computing_ = false;
                 touch();
@@ -299,12 +264,64 @@ class ViewServer::Client {
     // read is woken by shutting the connection down.
     void stop_worker() {
         requests_.close();
+        if (seat_ && seat_->queue()) seat_->queue()->close();
         if (worker_.joinable()) within(conn_, kErrorSendTimeoutS, [this] { worker_.join(); });
+    }
+
+    // A presenter's connection sends its session's status when it changed.
+    void tell_status() {
+        if (!seat_ || seat_->session().version() == status_seen_) return;
+        status_seen_ = seat_->session().version();
+        conn_.send(seat_->session().status());
+    }
+
+    // A follower (shared_session.h): the reader takes only bye; the worker catches up with the
+    // latest request, then sends what the session queues for it until it leaves or is dropped.
+    // A follower waits for views as long as it likes: the idle limit does not apply.
+    void follow() {
+        say("serve: %s: follows session %s\n", seat_->session().name());
+        worker_ = std::thread([this] {
+            try {
+                follow_work();
+            } catch (const std::exception&) {  // gone: the reader ends the connection
+            }
+            worker_done_ = true;
+        });
+        for (;;) {
+            // Dropped: refuse's limit shuts down a connection whose worker is stuck in a send.
+            if (const std::string why = seat_->queue()->why(); !why.empty()) {
+                refuse(ErrorCode::session, why);
+                return;
+            }
+            if (worker_done_.load()) return;
+            std::optional<RemoteMessage> m = conn_.receive(0.5);
+            if (!m) continue;
+            if (std::holds_alternative<ByeMsg>(*m)) return;
+            refuse(ErrorCode::session,
+                   std::holds_alternative<RequestMsg>(*m)
+                       ? "a follower asks for no views: the presenter's come by themselves"
+                       : std::string("unexpected ") + to_string(type_of(*m)) +
+                             " message from a follower");
+            return;
+        }
+    }
+
+    void follow_work() {
+        FollowerQueue& queue = *seat_->queue();
+        conn_.send(seat_->session().status());
+        if (const std::optional<RequestMsg> r = seat_->session().latest(); r && !queue.armed()) {
+            conn_.send(*r);
+            session_->run(*r, queue.armed_flag());
+        }
+        while (const std::optional<RemoteMessage> m = queue.pop()) conn_.send(*m);
     }
 
     ViewServer& server_;
     std::unique_ptr<MessageChannel> channel_;
     MessageChannel& conn_;
+    std::unique_ptr<SessionSeat> seat_;  // in a shared session
+    std::uint64_t status_seen_ = 0;
+    std::atomic<bool> worker_done_{false};
     GroupEncoding encoding_ = GroupEncoding::compact_zstd;
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;

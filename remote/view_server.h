@@ -37,6 +37,7 @@
 #include "common/extract/surface_extractor.h"
 #include "remote/message_channel.h"
 #include "remote/server_session.h"
+#include "remote/shared_session.h"
 
 namespace isowall::remote {
 
@@ -66,6 +67,7 @@ struct ServerOptions {
     double idle_timeout_s = 300;
     std::uint32_t max_payload_bytes = 1 << 16;  // what a client's message may be
     SessionOptions session;                     // the encoding comes from each hello
+    SessionLimits sessions;                     // shared sessions (view --present, --follow)
     bool verbose = true;                        // a line per connection and request
 };
 
@@ -95,6 +97,7 @@ class ViewServer {
     // Connections accepted so far (both kinds), and those open now.
     int accepted() const { return accepted_.load(); }
     int open_connections() const { return open_.load(); }
+    const SessionHub& sessions() const { return hub_; }
 
   private:
     class Client;
@@ -103,6 +106,7 @@ class ViewServer {
 
     std::vector<Dataset> datasets_;
     ServerOptions options_;
+    SessionHub hub_{options_.sessions};
     struct Impl;
     std::unique_ptr<Impl> impl_;
     std::atomic<int> accepted_{0}, open_{0};

@@ -66,6 +66,29 @@ TEST(RemoteProtocolMalformed, HelloFields) {
     EXPECT_NO_THROW(decode_payload(RemoteTag::hello, encode_payload(ok)));
 }
 
+// A hello that joins a shared session is version 2 and round-trips; one without a role is
+// version 1, as before sessions, so older servers and the page's hello stay valid.
+TEST(RemoteProtocolMalformed, SharedHelloFields) {
+    const HelloMsg shared = sample_shared_hello();
+    EXPECT_EQ(std::get<HelloMsg>(decode_payload(RemoteTag::hello, encode_payload(shared))), shared);
+    EXPECT_EQ(encode_payload(shared)[0], std::byte{2});
+    EXPECT_EQ(encode_payload(sample_hello())[0], std::byte{1});
+    expect_faults<HelloMsg>(shared,
+                            {{"session: expected a name", [](HelloMsg& m) { m.session.clear(); }},
+                             {"session: 65 bytes", [](HelloMsg& m) { m.session.assign(65, 's'); }},
+                             {"session: byte 0 is 9", [](HelloMsg& m) { m.session = "\tx"; }},
+                             {"role: 3, expected 1 (presenter) or 2 (follower)",
+                              [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
+}
+
+TEST(RemoteProtocolMalformed, SessionFields) {
+    expect_faults<SessionMsg>(
+        sample_session(),
+        {{"session: expected a name", [](SessionMsg& m) { m.session.clear(); }},
+         {"presenter: 129 bytes", [](SessionMsg& m) { m.presenter.assign(129, 'p'); }},
+         {"presenter: byte 0 is 127", [](SessionMsg& m) { m.presenter.assign(1, char(0x7f)); }}});
+}
+
 TEST(RemoteProtocolMalformed, ReadyFields) {
     expect_faults<ReadyMsg>(
         sample_ready(),
@@ -253,8 +276,8 @@ TEST(RemoteProtocolMalformed, VisibleWithAHugeCountThrowsWithoutAllocating) {
 TEST(RemoteProtocolMalformed, ErrorFields) {
     expect_faults<ErrorMsg>(
         sample_error(),
-        {{"code: expected 1..6, got 0", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(0); }},
-         {"code: expected 1..6, got 7", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(7); }},
+        {{"code: expected 1..7, got 0", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(0); }},
+         {"code: expected 1..7, got 8", [](ErrorMsg& m) { m.code = static_cast<ErrorCode>(8); }},
          {"text: byte 3 is 10", [](ErrorMsg& m) { m.text = "one\ntwo"; }},
          {"text: 257 bytes", [](ErrorMsg& m) { m.text.assign(257, 'e'); }}});
 }
@@ -271,7 +294,7 @@ TEST(RemoteProtocolMalformed, WrongLayoutVersionThrows) {
 
 TEST(RemoteProtocolMalformed, AnUnknownTypeThrows) {
     EXPECT_THROW(decode_payload(static_cast<RemoteTag>(0), encode_payload(ByeMsg{})), WireError);
-    EXPECT_THROW(decode_payload(static_cast<RemoteTag>(9), encode_payload(ByeMsg{})), WireError);
+    EXPECT_THROW(decode_payload(static_cast<RemoteTag>(10), encode_payload(ByeMsg{})), WireError);
 }
 
 }  // namespace

@@ -15,7 +15,11 @@ namespace isowall::remote {
 
 inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
     return a.protocol_version == b.protocol_version && a.dataset == b.dataset &&
-           a.token == b.token && a.encoding == b.encoding;
+           a.token == b.token && a.encoding == b.encoding && a.role == b.role &&
+           a.session == b.session;
+}
+inline bool operator==(const SessionMsg& a, const SessionMsg& b) {
+    return a.session == b.session && a.presenter == b.presenter && a.members == b.members;
 }
 inline bool operator==(const ReadyMsg& a, const ReadyMsg& b) {
     return a.bounds.min == b.bounds.min && a.bounds.max == b.bounds.max &&
@@ -48,7 +52,14 @@ inline bool operator==(const ByeMsg&, const ByeMsg&) {
 namespace remote_testing {
 
 inline HelloMsg sample_hello() {
-    return {7, "ct_head 256", "s3cret token", 3};
+    return {7, "ct_head 256", "s3cret token", 3, SessionRole::none, ""};
+}
+// A hello that joins a shared session (version 2 on the wire).
+inline HelloMsg sample_shared_hello() {
+    return {7, "ct_head 256", "s3cret token", 3, SessionRole::follower, "class 3b"};
+}
+inline SessionMsg sample_session() {
+    return {"class 3b", "10.0.0.7:51234", 12};
 }
 inline ReadyMsg sample_ready() {
     // A volume turned a quarter about z: its x runs to the patient's back.
@@ -99,8 +110,9 @@ inline ErrorMsg sample_error() {
 }
 
 inline std::vector<RemoteMessage> samples() {
-    return {sample_hello(),   sample_ready(),        sample_request(), sample_group(),
-            sample_visible(), sample_end_of_frame(), sample_error(),   ByeMsg{}};
+    return {sample_hello(), sample_ready(),   sample_request(),
+            sample_group(), sample_visible(), sample_end_of_frame(),
+            sample_error(), ByeMsg{},         sample_session()};
 }
 
 // decode_payload(type, bytes) throws a WireError naming the message and `field`.

@@ -8,18 +8,18 @@ import { getSlots, putSlots } from './slot_list.js';
 import { cameraProblem } from './camera.js';
 
 export const MsgType = {
-  hello: 1, ready: 2, request: 3, group: 4, visible: 5, end_of_frame: 6, error: 7, bye: 8,
+  hello: 1, ready: 2, request: 3, group: 4, visible: 5, end_of_frame: 6, error: 7, bye: 8, session: 9,
 };
-export const kLastMsgType = 8;
+export const kLastMsgType = 9;
 const typeNames = Object.fromEntries(Object.entries(MsgType).map(([k, v]) => [v, k]));
 export function typeName(type) {
   return typeNames[type] ?? 'unknown';
 }
 
 export const ErrorCode = {
-  malformed: 1, unsupported_version: 2, bad_token: 3, unknown_dataset: 4, too_large: 5, internal: 6,
+  malformed: 1, unsupported_version: 2, bad_token: 3, unknown_dataset: 4, too_large: 5, internal: 6, session: 7,
 };
-export const kLastErrorCode = 6;
+export const kLastErrorCode = 7;
 
 export const kProtocolVersion = 1;
 export const kHeaderBytes = 12;
@@ -27,12 +27,15 @@ export const kDefaultMaxPayloadBytes = 64 * 1024 * 1024;
 export const kMaxDatasetNameBytes = 256;
 export const kMaxTokenBytes = 256;
 export const kMaxErrorTextBytes = 256;
+export const kMaxSessionNameBytes = 64;
+export const kMaxPeerNameBytes = 128;
 export const kMaxGroupBytes = 32 * 1024 * 1024;
 export const kMaxGroupLevel = 30;
 export const kMaxImageSide = 32768;
 const MAGIC = [0x49, 0x57, 0x56, 0x50];
 
-const VERSION = { hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1 };
+// hello: 1 without a shared session, 2 with one (role and session); both decode.
+const VERSION = { hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1 };
 
 // ---- text ----------------------------------------------------------------------------------
 
@@ -140,11 +143,22 @@ function getGroupKey(r) {
 
 const encoders = {
   hello(m) {
-    const w = new Writer(VERSION.hello);
+    const w = new Writer(m.role ? 2 : VERSION.hello);
     w.u16(m.protocol_version ?? 1);
     putText(w, m.dataset);
     putText(w, m.token ?? '');
     w.u8(m.encoding ?? 0);
+    if (m.role) {
+      w.u8(m.role);
+      putText(w, m.session);
+    }
+    return w.take();
+  },
+  session(m) {
+    const w = new Writer(VERSION.session);
+    putText(w, m.session);
+    putText(w, m.presenter);
+    w.u32(m.members);
     return w.take();
   },
   ready(m) {
@@ -196,12 +210,24 @@ const encoders = {
 };
 
 const decoders = {
-  hello(r) {
+  hello(r, version) {
     const m = {};
     m.protocol_version = r.u16();
     m.dataset = getText(r, 'dataset', kMaxDatasetNameBytes, false);
     m.token = getText(r, 'token', kMaxTokenBytes, true);
     m.encoding = r.u8();
+    if (version === 2) {
+      m.role = r.u8();
+      if (m.role < 1 || m.role > 2) r.fail(`role: ${m.role}, expected 1 (presenter) or 2 (follower)`);
+      m.session = getText(r, 'session', kMaxSessionNameBytes, false);
+    }
+    return m;
+  },
+  session(r) {
+    const m = {};
+    m.session = getText(r, 'session', kMaxSessionNameBytes, false);
+    m.presenter = getText(r, 'presenter', kMaxPeerNameBytes, true);
+    m.members = r.u32();
     return m;
   },
   ready(r) {
@@ -283,8 +309,9 @@ export function encodePayload(type, m) {
 export function decodePayload(type, payload) {
   const name = typeNames[type];
   if (!name) throw new WireError(`view protocol: unknown message type ${type}`);
-  const r = new Reader(payload, `${name} message`, VERSION[name]);
-  const m = decoders[name](r);
+  const version = name === 'hello' && payload.length > 0 && payload[0] === 2 ? 2 : VERSION[name];
+  const r = new Reader(payload, `${name} message`, version);
+  const m = decoders[name](r, version);
   r.finish();
   return m;
 }

@@ -12,7 +12,7 @@ const read = (dir, name) => new Uint8Array(readFileSync(new URL(name, dir)));
 
 test('corpus payloads decode, and encode back to their bytes', () => {
   const names = readdirSync(corpus).filter((n) => n.startsWith('payload-'));
-  assert.equal(names.length, 8);
+  assert.equal(names.length, 9);
   for (const name of names) {
     const b = read(corpus, name);
     assert.equal(b[0] % 2, 0, name);
@@ -52,16 +52,17 @@ test('corpus values are the seeds\' (fuzz/view_protocol_seeds.cpp)', () => {
   assert.deepEqual(msg('end_of_frame'), { request_id: 3, rays: 480000, groups: 120, triangles: 90000, bytes: 2400000 });
   assert.deepEqual(msg('error'), { code: 3, text: 'wrong token' });
   assert.deepEqual(msg('bye'), {});
+  assert.deepEqual(msg('session'), { session: 'class 3b', presenter: '10.0.0.7:51234', members: 12 });
 });
 
-test('stream-all splits into its eight frames, whatever the chunks', () => {
+test('stream-all splits into its nine frames, whatever the chunks', () => {
   const stream = read(corpus, 'stream-all').subarray(2);
   for (const chunk of [1, 5, 13, 1000]) {
     const s = new FrameSplitter();
     const frames = [];
     for (let i = 0; i < stream.length; i += chunk) frames.push(...s.push(stream.subarray(i, i + chunk)));
     assert.deepEqual(frames.map((f) => decodeFrame(f).name),
-      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye'], `chunks of ${chunk}`);
+      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye', 'session'], `chunks of ${chunk}`);
   }
 });
 
@@ -102,7 +103,7 @@ test('decoders name the message and the field', () => {
   const hello = encodePayload(MsgType.hello, { protocol_version: 1, dataset: 'phantom', token: '', encoding: 3 });
   assert.throws(() => decodePayload(MsgType.hello, hello.subarray(0, 5)), /^WireError: hello message: truncated$/);
   assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([...hello, 0])), /hello message: 1 trailing bytes/);
-  assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([2, ...hello.subarray(1)])), /hello message: version 2, expected 1/);
+  assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([3, ...hello.subarray(1)])), /hello message: version 3, expected 1/);
   const empty = encodePayload(MsgType.hello, { protocol_version: 1, dataset: 'x', token: '', encoding: 3 });
   empty[11] = 0x07;  // the dataset's one byte
   assert.throws(() => decodePayload(MsgType.hello, empty), /hello message: dataset: byte 0 is 7, expected printable ASCII/);
@@ -116,12 +117,12 @@ test('decoders name the message and the field', () => {
     /request message: view.camera: the eye and the target are the same point/);
   const err = encodePayload(MsgType.error, { code: 3, text: 'x' });
   err[1] = 9;
-  assert.throws(() => decodePayload(MsgType.error, err), /error message: code: expected 1..6, got 9/);
+  assert.throws(() => decodePayload(MsgType.error, err), /error message: code: expected 1..7, got 9/);
   const ready = encodePayload(MsgType.ready, { bounds: { min: [0, 0, 0], max: [1, 1, 1] }, value_min: 5, value_max: 1, dims: [2, 2, 2], spacing: [1, 1, 1] });
   assert.throws(() => decodePayload(MsgType.ready, ready), /ready message: value_max: expected >= value_min/);
   const mirrored = encodePayload(MsgType.ready, { bounds: { min: [0, 0, 0], max: [1, 1, 1] }, value_min: 0, value_max: 1, dims: [2, 2, 2], spacing: [1, 1, 1], axes: [[-1, 0, 0], [0, 1, 0], [0, 0, 1]] });
   assert.throws(() => decodePayload(MsgType.ready, mirrored), /ready message: axes: expected a rotation/);
-  assert.throws(() => decodePayload(9, new Uint8Array([1])), /view protocol: unknown message type 9/);
+  assert.throws(() => decodePayload(10, new Uint8Array([1])), /view protocol: unknown message type 10/);
 });
 
 test('headers are checked before the payload', () => {
@@ -129,7 +130,7 @@ test('headers are checked before the payload', () => {
   const h = (patch) => { const b = f.slice(); patch(b); return b; };
   assert.throws(() => decodeHeader(h((b) => { b[0] = 0x58; })), /view protocol header: magic: expected 49 57 56 50 \("IWVP"\), got 58 57 56 50/);
   assert.throws(() => decodeHeader(h((b) => { b[4] = 2; })), /header: version: expected 1, got 2/);
-  assert.throws(() => decodeHeader(h((b) => { b[6] = 9; })), /header: type: expected 1..8, got 9/);
+  assert.throws(() => decodeHeader(h((b) => { b[6] = 10; })), /header: type: expected 1..9, got 10/);
   assert.throws(() => decodeHeader(h((b) => { b[11] = 0x10; })), /header: length: 268435457 bytes is over the limit of 67108864 \(bye message\)/);
   assert.throws(() => decodeFrame(new Uint8Array([...f, 0])), /header: length: the header says 1 payload bytes, the frame holds 2/);
 });

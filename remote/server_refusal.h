@@ -1,0 +1,51 @@
+#pragma once
+// Two pieces of the server's connections (view_server.cpp): a bounded wait on a channel, and a
+// connection turned away (max_clients) that still hears why.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "remote/message_channel.h"
+#include "remote/view_server.h"
+
+namespace isowall::remote {
+
+// Runs `f` (which must not throw) and shuts `conn` down if it has not returned within
+// `timeout_s`: that ends any send or receive of `conn` that `f` waits in.
+template <class F>
+inline void within(MessageChannel& conn, double timeout_s, F&& f) {
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool done = false;
+    std::thread watchdog([&] {
+        std::unique_lock lock(mutex);
+        if (!changed.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return done; }))
+            conn.shutdown();
+    });
+    f();
+    {
+        std::lock_guard lock(mutex);
+        done = true;
+    }
+    changed.notify_all();
+    watchdog.join();
+}
+
+// How long a connection turned away may take to open and hear why.
+inline constexpr double kRefusalTimeoutS = 2;
+
+// A connection turned away (max_clients): its own thread opens the channel (a TLS handshake,
+// bounded), sends the busy error and closes, so the client reads why, in TLS on a TLS port.
+struct ViewServer::Refusal {
+    Refusal(std::unique_ptr<MessageChannel> c, std::string text);
+    ~Refusal();
+    std::unique_ptr<MessageChannel> channel;
+    std::thread thread;
+    std::atomic<bool> done{false};
+};
+
+}  // namespace isowall::remote
