@@ -132,6 +132,25 @@ class ControlWindowTest : public testing::Test {
     std::filesystem::path dir_ = test::scratch_dir("control_window");
 };
 
+// The master's line with the page's port (wall --http 0).
+const std::string kPageAt = "http: page at http://127.0.0.1:";
+int page_port(const std::string& log) {
+    return std::atoi(log.c_str() + log.find(kPageAt) + kPageAt.size());
+}
+
+// "WHO: LINE" of every line the page was told ran, until `last` is among them (at most 10 s:
+// states keep coming, so the page never falls silent).
+std::string heard_lines(test::WsTestClient& page, const std::string& last) {
+    std::string heard;
+    for (Stopwatch reading; reading.seconds() < 10 && !contains(heard, last);)
+        if (auto m = page.receive(0.5); m && m->bytes.starts_with("{")) {
+            const auto j = nlohmann::json::parse(m->bytes);
+            if (j["type"] == "ran")
+                heard += j["who"].get<std::string>() + ": " + j["line"].get<std::string>() + "\n";
+        }
+    return heard;
+}
+
 // The mosaic part of the control window (status bar aside), as it should show `mosaic`: each
 // tile's previews composed by the window's own layout (tiles at full size on this small wall).
 Image expected_control_mosaic(const WallSpec& spec, const Image& mosaic) {
@@ -160,6 +179,30 @@ test::ImageComparison wait_for_previews(const std::string& display, const std::s
     return m;
 }
 
+// The wall's final mosaic (control.png) equals the one kScript gives (script.png).
+void expect_the_scripts_mosaic(const std::filesystem::path& dir, double control_s) {
+    std::ofstream(dir / "same.txt") << kScript;
+    Stopwatch took;
+    ASSERT_EQ(
+        run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --out '" +
+                (dir / "script.png").string() + "' --script '" + (dir / "same.txt").string() + "'",
+            dir / "script.log", kGuardS),
+        0)
+        << slurp(dir / "script.log");
+    const double script_s = took.seconds();
+
+    const Image control = read_image(dir / "control.png");
+    const Image script = read_image(dir / "script.png");
+    const test::ImageComparison same = test::compare_images(control, script, kFromFiles);
+    std::printf("control window vs script: %s\ncontrol run %.1f s, script run %.1f s\n",
+                testing::PrintToString(same).c_str(), control_s, script_s);
+    EXPECT_GT(same.covered_both, 1000u) << same;  // an empty pair would agree trivially
+    EXPECT_GE(same.mask_iou, 0.999) << same;
+    EXPECT_GE(same.equal_share, 0.999) << same;
+    if (same.mask_iou < 0.999 || same.equal_share < 0.999)
+        test::write_diff_images(dir, "control_vs_script", control, script, kFromFiles);
+}
+
 TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) {
     std::ofstream(dir_ / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
     Stopwatch took;
@@ -168,12 +211,10 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
         wall.log(), [](const std::string& t) { return contains(t, "control: window on"); }, 120))
         << slurp(wall.log());
     // The page beside the window (wall --http): it hears every line, the window's too.
-    const std::string page_at = "http: page at http://127.0.0.1:";
     ASSERT_TRUE(wait_for(
-        wall.log(), [&](const std::string& t) { return contains(t, page_at); }, 60))
+        wall.log(), [&](const std::string& t) { return contains(t, kPageAt); }, 60))
         << slurp(wall.log());
-    const std::string text = slurp(wall.log());
-    test::WsTestClient page(std::atoi(text.c_str() + text.find(page_at) + page_at.size()));
+    test::WsTestClient page(page_port(slurp(wall.log())));
     page.send_text(R"({"hello": ""})");
     ASSERT_EQ(xdotool("search --sync --name '^isowall control$'", "window"), 0);
     const std::string w = std::to_string(std::atoll(slurp(dir_ / "window").c_str()));
@@ -208,13 +249,7 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
     ASSERT_TRUE(wait_for(
         wall.log(), [](const std::string& t) { return done_after(t, "page 1: pan "); }, 60))
         << slurp(wall.log());
-    std::string heard;  // "WHO: LINE" of every line the page was told ran (states keep coming)
-    for (Stopwatch reading; reading.seconds() < 10 && !contains(heard, "page 1: pan");)
-        if (auto m = page.receive(0.5); m && m->bytes.starts_with("{")) {
-            const auto j = nlohmann::json::parse(m->bytes);
-            if (j["type"] == "ran")
-                heard += j["who"].get<std::string>() + ": " + j["line"].get<std::string>() + "\n";
-        }
+    const std::string heard = heard_lines(page, "page 1: pan");
     EXPECT_TRUE(contains(heard, "control: orbit -30 0\n")) << heard;
     EXPECT_TRUE(contains(heard, "page 1: pan 0.1 0\n")) << heard;
     ASSERT_EQ(xdotool("key --window " + w + " Escape"), 0);
@@ -228,32 +263,11 @@ TEST_F(ControlWindowTest, DragWheelAndIsoKeyGiveTheMosaicOfTheEquivalentScript) 
           "page 1: pan 0.1 0\n", "control: snapshot control-001\n", "control: quit\n"})
         EXPECT_EQ(test::count_of(log, line), 1u) << line << " in:\n" << log;
 
-    std::ofstream(dir_ / "same.txt") << kScript;
-    took.restart();
-    ASSERT_EQ(run(mpirun(5) + "wall --wall '" + (dir_ / "2x2.toml").string() + "' --out '" +
-                      (dir_ / "script.png").string() + "' --script '" +
-                      (dir_ / "same.txt").string() + "'",
-                  dir_ / "script.log", kGuardS),
-              0)
-        << slurp(dir_ / "script.log");
-    const double script_s = took.seconds();
-
-    const Image control = read_image(dir_ / "control.png");
-    const Image script = read_image(dir_ / "script.png");
-    const test::ImageComparison same = test::compare_images(control, script, kFromFiles);
-    const test::ImageComparison first =
-        test::compare_images(read_image(dir_ / "control-001.png"), control, kFromFiles);
-    std::printf(
-        "control window vs script: %s\nfirst view vs after the gestures: %s\n"
-        "control run %.1f s, script run %.1f s\n",
-        testing::PrintToString(same).c_str(), testing::PrintToString(first).c_str(), control_s,
-        script_s);
-    EXPECT_GT(same.covered_both, 1000u) << same;  // an empty pair would agree trivially
-    EXPECT_GE(same.mask_iou, 0.999) << same;
-    EXPECT_GE(same.equal_share, 0.999) << same;
-    if (same.mask_iou < 0.999 || same.equal_share < 0.999)
-        test::write_diff_images(dir_, "control_vs_script", control, script, kFromFiles);
+    expect_the_scripts_mosaic(dir_, control_s);
     // The gestures changed the view: the first one is far from the last.
+    const test::ImageComparison first = test::compare_images(
+        read_image(dir_ / "control-001.png"), read_image(dir_ / "control.png"), kFromFiles);
+    std::printf("first view vs after the gestures: %s\n", testing::PrintToString(first).c_str());
     EXPECT_LT(first.equal_share, 0.9) << first;
 }
 
