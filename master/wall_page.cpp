@@ -57,7 +57,11 @@ PageMessage parse_page_message(std::string_view bytes, const std::string& who) {
                          "expected one of {\"hello\": TOKEN}, {\"run\": LINE}, "
                          "{\"snapshot\": true}, {\"take\": true}, got " +
                              quote(std::string(bytes.substr(0, 80))));
-    const auto& [key, value] = *j.items().begin();
+    // The key and value through an iterator of `j` itself: items() is a temporary view, and a
+    // binding to its element outlived it (the fuzzer's ASan build caught the read).
+    const auto first = j.begin();
+    const std::string key = first.key();
+    const json& value = first.value();
     PageMessage m;
     if (key == "hello") {
         m.kind = PageMessage::Kind::hello;
