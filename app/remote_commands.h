@@ -27,6 +27,9 @@ struct ServeCommand {
     std::string tls_cert, tls_key;  // PEM files; both or neither (TLS on every port)
     double rate_mbps = 0;
     int max_clients = 8;
+    // Shared sessions (remote/shared_session.h): how many, members each, a follower's queue.
+    int max_sessions = 16, session_members = 32;
+    double follower_queue_mib = 64;
     double idle_timeout_s = 300;  // --idle-timeout: a connection idle this long after its hello
     double lod_rays_percent = 0.25;
     std::string cache_dir;
@@ -54,6 +57,10 @@ struct ViewCommand {
     std::string gl = "osmesa";
     double timeout_s = 120;
     bool quiet = false;
+    // Shared sessions (remote/shared_session.h): present this view as session NAME, or follow
+    // session NAME (every view its presenter asks for; --out after each frame, --frames of them).
+    std::string present, follow;
+    int frames = 0;  // with --follow: end after this many frames; 0: when the connection ends
 };
 
 // --tls-cert and --tls-key of serve and wall: both or neither (InputError naming the one given);

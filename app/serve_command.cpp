@@ -94,6 +94,19 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
     c->add_option("--max-clients", o.max_clients, "Connections served at once")
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();
+    c->add_option("--max-sessions", o.max_sessions,
+                  "Shared sessions (view --present NAME) open at once")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    c->add_option("--session-members", o.session_members,
+                  "Members of one shared session, its presenter included")
+        ->check(CLI::Range(1, 1024))
+        ->capture_default_str();
+    c->add_option("--follower-queue", o.follower_queue_mib,
+                  "MiB of groups that may wait for one follower; a follower that falls further "
+                  "behind is dropped with an error")
+        ->transform(number_in({1, 65536}))
+        ->capture_default_str();
     c->add_option("--idle-timeout", o.idle_timeout_s,
                   "Close a connection on which nothing was received or sent for this many "
                   "seconds after its hello, with an error naming the limit")
@@ -122,6 +135,9 @@ int run_serve(const ServeCommand& o) {
     so.rate_bits_per_s = o.rate_mbps * 1e6;
     so.max_clients = o.max_clients;
     so.idle_timeout_s = o.idle_timeout_s;
+    so.sessions.max_sessions = static_cast<std::size_t>(o.max_sessions);
+    so.sessions.max_members = static_cast<std::size_t>(o.session_members);
+    so.sessions.max_queue_bytes = static_cast<std::size_t>(o.follower_queue_mib * (1 << 20));
     so.verbose = !o.quiet;
     so.session.engine = to_engine_options(o.engine);
     so.session.lod_ray_share = o.lod_rays_percent / 100.0;

@@ -180,6 +180,16 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     c->add_option("--gl", o.gl, "OpenGL back end")
         ->check(CLI::IsMember({"osmesa", "egl"}))
         ->capture_default_str();
+    c->add_option("--present", o.present,
+                  "Share the views as session NAME: every view asked here is extracted once and "
+                  "streamed to the session's followers too");
+    c->add_option("--follow", o.follow,
+                  "Follow session NAME: draw every view its presenter asks for, writing --out "
+                  "after each frame (the encoding must be the presenter's)");
+    c->add_option("--frames", o.frames,
+                  "With --follow: end after this many frames (0: when the "
+                  "server ends the connection)")
+        ->check(CLI::Range(0, 1 << 30));
     c->add_option("--timeout", o.timeout_s,
                   "Give up when nothing arrives for this long (s), from the connection on")
         ->transform(number_in(limits::kSeconds))
@@ -187,7 +197,53 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
     return c;
 }
 
+namespace {
+
+// --follow: every frame the presenter's views give, until --frames or the connection ends.
+int follow_session(const ViewCommand& o, ViewClient& client, Viewer& v) {
+    for (;;) {
+        const ClientFrameResult* r = nullptr;
+        try {
+            r = client.next_frame(1.0);  // a presenter may leave a view up for as long as it likes
+        } catch (const PeerClosed&) {
+            std::printf("view: the server ended the connection after %d frame(s)\n", v.frames);
+            return 0;
+        }
+        if (!r) continue;
+        if (client.session())
+            std::printf("view: session %s, presenter %s, %u member(s)\n",
+                        client.session()->session.c_str(),
+                        client.session()->presenter.empty() ? "(none)"
+                                                            : client.session()->presenter.c_str(),
+                        client.session()->members);
+        v.report(*r);
+        OutputFiles batch;
+        write_image(batch, o.out, r->final_image);
+        batch.commit();
+        std::printf("wrote %s\n", o.out.c_str());
+        std::fflush(stdout);
+        if (o.frames > 0 && v.frames >= o.frames) {
+            client.close();
+            return 0;
+        }
+    }
+}
+
+void check_session_options(const ViewCommand& o) {
+    if (!o.present.empty() && !o.follow.empty())
+        throw InputError("--follow", "value", "a client presents a session or follows one");
+    if (!o.follow.empty() && (!o.script.empty() || !o.orbit.empty() || o.iso || o.zoom != 1.0))
+        throw InputError("--follow", "value",
+                         "a follower asks for no views (--script, --orbit, --iso, --zoom): the "
+                         "presenter's come by themselves");
+    if (o.frames > 0 && o.follow.empty())
+        throw InputError("--frames", "value", "counts a follower's frames: give --follow NAME");
+}
+
+}  // namespace
+
 int run_view(const ViewCommand& o) {
+    check_session_options(o);
     const auto size = parse_size(o.size);
     if (!size)
         throw InputError(
@@ -214,12 +270,17 @@ int run_view(const ViewCommand& o) {
         hello.tls = std::make_shared<const TlsContext>(TlsContext::client(o.tls_ca));
     hello.encoding = setting.encoding;
     hello.connect_timeout_s = o.timeout_s;  // connecting and the hello's answer too (once 10 s)
+    hello.role = !o.present.empty()  ? SessionRole::presenter
+                 : !o.follow.empty() ? SessionRole::follower
+                                     : SessionRole::none;
+    hello.session = !o.present.empty() ? o.present : o.follow;
     ViewClient client(*renderer, hello);
     std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
                 o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
                 to_string(setting.encoding), setting.lod ? ", progressive LOD" : "",
                 setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
+    if (!o.follow.empty()) return follow_session(o, client, v);
     const float aspect = float(size->x) / float(size->y);
     v.camera = front_full_view(client.ready().bounds, client.ready().axes, aspect);
     if (o.orbit.size() == 2) v.camera = orbit(v.camera, o.orbit[0], o.orbit[1]);

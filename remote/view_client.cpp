@@ -80,12 +80,9 @@ const ClientFrameResult& ViewClient::wait_done(double timeout_s) {
 }
 
 bool ViewClient::receive_for(double seconds) {
+    // The whole pause, as a script's `wait time` says, whether or not the frame ends first.
     const double end = now_s() + seconds;
-    while (active_) {
-        const double left = end - now_s();
-        if (left <= 0) break;
-        receive_one(left);
-    }
+    for (double left = seconds; left > 0; left = end - now_s()) receive_one(left);
     return !active_;
 }
 

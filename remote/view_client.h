@@ -39,7 +39,7 @@ class ViewClient {
     // Receives until the current request's end of frame: the frame, measured. Throws NetError
     // when nothing arrives for `timeout_s`.
     const ClientFrameResult& wait_done(double timeout_s);
-    // Receives for `seconds` (or until the frame ends); true when it ended.
+    // Receives for `seconds`, whether or not the frame ends first; true when it has ended.
     bool receive_for(double seconds);
     // A follower: receives until the next frame the presenter asked for has ended (its
     // request came from the server); nullptr when nothing arrives for `timeout_s`. Throws

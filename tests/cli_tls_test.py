@@ -137,4 +137,5 @@ def main():
     print("cli_tls_test: all checks pass")
 
 
-main()
+if __name__ == "__main__":
+    main()
