@@ -51,7 +51,7 @@ void check_exposure(const WallHttpOptions& o) {
 }  // namespace
 
 WallHttp::WallHttp(const WallSpec& spec, WallHttpOptions options)
-    : o_(std::move(options)), layout_(control_layout(spec)), pacer_(kMosaicIntervalS) {
+    : o_(std::move(options)), layout_(control_layout(spec)), pacer_(kMosaicIntervalS), spec_(spec) {
     check_exposure(o_);
     web::WebCallbacks cb;
     cb.http = [](const web::HttpRequest& r) {
@@ -70,9 +70,46 @@ WallHttp::WallHttp(const WallSpec& spec, WallHttpOptions options)
                              ": " + e.what());
     }
     web_->start();
+    encoder_ = std::thread([this] { encode_loop(); });
+}
+
+void WallHttp::encode_loop() {
+    for (;;) {
+        Pictures p;
+        {
+            std::unique_lock lock(encoder_mutex_);
+            encoder_wake_.wait(lock, [&] { return encoder_stop_ || to_encode_; });
+            if (encoder_stop_) return;
+            p = std::move(*to_encode_);
+            to_encode_.reset();
+            encoding_ = true;
+        }
+        const Stopwatch making;
+        auto bytes = std::make_shared<const std::string>(
+            encode_mosaic(compose_mosaic(layout_, tile_previews(spec_, p.by_rank)), p.frame));
+        std::lock_guard lock(encoder_mutex_);
+        made_s_ += making.seconds();
+        made_bytes_ += bytes->size();
+        ++mosaics_;
+        encoded_ = std::move(bytes);
+        encoding_ = false;
+    }
 }
 
 WallHttp::~WallHttp() {
+    {
+        std::lock_guard lock(encoder_mutex_);
+        encoder_stop_ = true;
+    }
+    encoder_wake_.notify_all();
+    encoder_.join();
+    if (mosaics_ > 0)
+        std::printf(
+            "http: %llu mosaics of %dx%d made, %.1f KiB each on average, %.2f ms each to "
+            "compose and compress; %llu page(s) connected in all\n",
+            static_cast<unsigned long long>(mosaics_), layout_.mosaic.width, layout_.mosaic.height,
+            double(made_bytes_) / double(mosaics_) / 1024, 1000 * made_s_ / double(mosaics_),
+            static_cast<unsigned long long>(next_page_ - 1));
     web_->stop();  // every `closed` runs: each page is in gone_
     std::lock_guard lock(mutex_);
     for (auto& [id, page] : pages_) gone_.push_back(page);
@@ -118,7 +155,8 @@ void WallHttp::closed(web::ConnectionId id) {
 void WallHttp::send_loop(Page& page) {
     for (;;) {
         std::deque<std::string> texts;
-        std::optional<std::string> state, mosaic, close_reason;
+        std::optional<std::string> state, close_reason;
+        std::shared_ptr<const std::string> mosaic;
         {
             std::unique_lock lock(page.mutex);
             page.wake.wait(lock, [&] {
@@ -132,9 +170,11 @@ void WallHttp::send_loop(Page& page) {
             close_reason.swap(page.close_reason);
         }
         if (state && !close_reason) texts.push_back(std::move(*state));
-        if (mosaic && !close_reason) texts.push_back(std::move(*mosaic));
         for (const std::string& t : texts)
             if (!web_->send(page.id, t.data(), t.size(), &page.closed)) return;
+        if (mosaic && !close_reason &&
+            !web_->send(page.id, mosaic->data(), mosaic->size(), &page.closed))
+            return;
         if (close_reason) {
             web_->close(page.id, *close_reason);
             return;
@@ -193,7 +233,7 @@ void WallHttp::handle(const std::shared_ptr<Page>& page, const std::string& byte
         post(*page, welcome_json(page->name, layout_, o_.wall_name));
         if (last_mosaic_) {
             std::lock_guard lock(page->mutex);
-            page->mosaic = *last_mosaic_;
+            page->mosaic = last_mosaic_;
         }
         return;
     }
@@ -296,16 +336,25 @@ void WallHttp::show(const WallMaster& master, const FrameNote& frame, bool chang
         roster_changed_ = false;
     }
     // A new picture when a tile sent one (at most every kMosaicIntervalS), or for a page that
-    // came before any was made.
+    // came before any was made: the encoder makes it; the latest it made goes to every page.
     const bool pictures = master.previews_taken() != previews_seen_;
-    if ((pictures && pacer_.changed(now)) || pacer_.due(now) || (joined && !last_mosaic_)) {
-        previews_seen_ = master.previews_taken();
-        last_mosaic_ = encode_mosaic(compose_mosaic(layout_, tile_previews(master)), frame.frame);
-        for (auto& page : roster_) {
-            std::lock_guard lock(page->mutex);
-            page->mosaic = *last_mosaic_;
-            page->wake.notify_one();
+    std::shared_ptr<const std::string> fresh;
+    {
+        std::lock_guard lock(encoder_mutex_);
+        if ((pictures && pacer_.changed(now)) || pacer_.due(now) ||
+            (joined && !last_mosaic_ && !encoding_ && !encoded_)) {
+            previews_seen_ = master.previews_taken();
+            to_encode_ = Pictures{master.previews(), frame.frame};
+            encoder_wake_.notify_one();
         }
+        fresh.swap(encoded_);
+    }
+    if (!fresh) return;
+    last_mosaic_ = fresh;
+    for (auto& page : roster_) {
+        std::lock_guard lock(page->mutex);
+        page->mosaic = fresh;
+        page->wake.notify_one();
     }
 }
 

@@ -6,9 +6,11 @@
 // Several pages may watch; one steers at a time, and any may take over (master/wall_page.h).
 //
 // Threads: the WebServer's io thread takes the pages' messages into an inbox; the master's
-// thread runs them (take) and hands every page its state and the latest mosaic (show); each page
-// has a sender thread of its own, which keeps only the latest mosaic and state, so a slow page
-// sees fewer pictures and never slows the wall or the other pages.
+// thread runs them (take), hands every page its state, and hands the tiles' previews to an
+// encoder thread, which composes and compresses the mosaic (tens of milliseconds that would
+// otherwise hold up the wall's jobs); the master's thread then gives each page the latest mosaic.
+// Each page has a sender thread of its own, which keeps only the latest mosaic and state, so a
+// slow page sees fewer pictures and never slows the wall or the other pages.
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -69,8 +71,9 @@ class WallHttp : public SteeringSource {
         std::mutex mutex;
         std::condition_variable wake;
         std::deque<std::string> texts;
-        std::optional<std::string> state, mosaic;
-        std::optional<std::string> close_reason;  // close once the texts before it are sent
+        std::optional<std::string> state;
+        std::shared_ptr<const std::string> mosaic;  // shared by every page
+        std::optional<std::string> close_reason;    // close once the texts before it are sent
         std::atomic<bool> closed{false};
         std::thread sender;
     };
@@ -98,12 +101,27 @@ class WallHttp : public SteeringSource {
     // Master's thread only:
     SteeringSeat seat_;
     int next_snapshot_ = 1;
-    std::vector<std::shared_ptr<Page>> roster_;  // the pages that said hello, in that order
-    std::optional<std::string> last_mosaic_;     // for a page that says hello
+    std::vector<std::shared_ptr<Page>> roster_;       // the pages that said hello, in that order
+    std::shared_ptr<const std::string> last_mosaic_;  // for a page that says hello
     PresentPacer pacer_;
     Stopwatch clock_, since_state_;
     bool roster_changed_ = false;
     std::uint64_t previews_seen_ = ~std::uint64_t{0};
+    // The encoder thread and what it is given and gives back (guarded by encoder_mutex_).
+    struct Pictures {
+        std::vector<std::optional<PreviewMsg>> by_rank;
+        std::uint64_t frame = 0;
+    };
+    void encode_loop();
+    std::thread encoder_;
+    std::mutex encoder_mutex_;
+    std::condition_variable encoder_wake_;
+    std::optional<Pictures> to_encode_;
+    std::shared_ptr<const std::string> encoded_;
+    bool encoder_stop_ = false, encoding_ = false;
+    const WallSpec spec_;
+    std::uint64_t mosaics_ = 0, made_bytes_ = 0;  // for the closing line (encoder's)
+    double made_s_ = 0;
     // Guards what the io thread hands the master's thread.
     std::mutex mutex_;
     std::uint64_t next_page_ = 1;

@@ -75,9 +75,12 @@ void run_steering(WallMaster& master, const std::vector<SteeringSource*>& source
 }
 
 std::vector<Image> tile_previews(const WallMaster& master) {
-    const WallSpec& spec = master.spec();
+    return tile_previews(master.spec(), master.previews());
+}
+
+std::vector<Image> tile_previews(const WallSpec& spec,
+                                 const std::vector<std::optional<PreviewMsg>>& by_rank) {
     std::vector<Image> previews(static_cast<std::size_t>(tile_count(spec)));
-    const auto& by_rank = master.previews();
     for (std::size_t rank = 1; rank < by_rank.size(); ++rank)
         if (by_rank[rank]) {
             const int tile = tile_of_rank(spec, static_cast<int>(rank));

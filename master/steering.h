@@ -50,5 +50,8 @@ void run_steering(WallMaster& master, const std::vector<SteeringSource*>& source
 
 // The master's latest preview of each tile as images, by tile index (0x0 where none came yet).
 std::vector<Image> tile_previews(const WallMaster& master);
+// The same from previews by rank ([0], the master's, empty), as WallMaster::previews holds them.
+std::vector<Image> tile_previews(const WallSpec& spec,
+                                 const std::vector<std::optional<PreviewMsg>>& by_rank);
 
 }  // namespace isowall

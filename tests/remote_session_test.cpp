@@ -16,6 +16,7 @@
 #include "common/core/util.h"
 #include "remote/net/socket.h"
 #include "remote/view_client.h"
+#include "tests/remote_rss_util.h"
 #include "tests/remote_view_util.h"
 
 namespace isowall::remote {
@@ -93,6 +94,7 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     ServerOptions o;
     o.sessions.max_queue_bytes = kQueueBound;
     test::TestServer server(o);
+    const double rss_start = current_rss_mib();  // the process's: server and clients
     auto renderer = make_renderer("osmesa");
     ViewClient presenter(*renderer, session_hello(server.port(), SessionRole::presenter));
     const FrameView views[] = {test::phantom_view(640, 480, 0), test::phantom_view(640, 480, 35),
@@ -149,6 +151,10 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
                 peak >> 10, kQueueBound >> 10, server.server().sessions().dropped());
     EXPECT_EQ(server.server().sessions().dropped(), 1u);
     EXPECT_LE(peak, kQueueBound);
+    // The process holds the server and every client; what it grew by, for the note (judged by
+    // the queue's bound above; RSS under ASan holds its quarantine).
+    std::printf("process RSS %.1f MiB at the start, %.1f MiB now, peak %.1f MiB%s\n", rss_start,
+                current_rss_mib(), peak_rss_mib(), test::kRssJudged ? "" : " (ASan)");
     presenter.close();
     ::close(stalled);
 }
