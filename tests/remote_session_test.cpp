@@ -159,6 +159,16 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     ::close(stalled);
 }
 
+// The hellos of a presenter and a follower of session "s".
+std::pair<HelloMsg, HelloMsg> session_hellos() {
+    HelloMsg p = test::phantom_hello();
+    p.role = SessionRole::presenter;
+    p.session = "s";
+    HelloMsg f = p;
+    f.role = SessionRole::follower;
+    return {p, f};
+}
+
 TEST(RemoteSession, TheQueueKeepsNothingBeforeARequestAndDropsPastItsBound) {
     FollowerQueue q(10000);
     GroupMsg g;
@@ -184,11 +194,7 @@ TEST(RemoteSession, TheQueueKeepsNothingBeforeARequestAndDropsPastItsBound) {
 // generation get new numbers, never one a follower holds.
 TEST(RemoteSession, RequestsAndGenerationsAreRenumberedForFollowers) {
     SessionHub hub;
-    HelloMsg p = test::phantom_hello();
-    p.role = SessionRole::presenter;
-    p.session = "s";
-    HelloMsg f = p;
-    f.role = SessionRole::follower;
+    const auto [p, f] = session_hellos();
     std::string why;
     auto first = hub.join(p, "a:1", why);
     auto follower = hub.join(f, "b:2", why);
@@ -229,11 +235,7 @@ TEST(RemoteSession, HellosThatCannotJoinAreRefusedSayingWhy) {
     limits.max_sessions = 1;
     limits.max_members = 2;
     SessionHub hub(limits);
-    HelloMsg p = test::phantom_hello();
-    p.role = SessionRole::presenter;
-    p.session = "s";
-    HelloMsg f = p;
-    f.role = SessionRole::follower;
+    const auto [p, f] = session_hellos();
     std::string why;
     HelloMsg nobody = f;
     nobody.session = "t";

@@ -12,41 +12,29 @@ const dist = process.argv[2] ? resolve(process.argv[2]) : join(root, 'dist');
 mkdirSync(dist, { recursive: true });
 for (const f of readdirSync(dist)) rmSync(join(dist, f), { recursive: true });
 
-await build({
-  entryPoints: [join(root, 'src/main.js')],
-  outfile: join(dist, 'app.js'),
-  bundle: true,
-  format: 'iife',
-  target: ['es2020', 'chrome90', 'firefox90', 'safari15'],
-  minify: true,
-  sourcemap: false,
-  legalComments: 'eof',
-  logLevel: 'warning',
-});
-// The wall's page (isowall wall --http): its own bundle and style.
-await build({
-  entryPoints: [join(root, 'src/wall/wall.js')],
-  outfile: join(dist, 'wall.js'),
-  bundle: true,
-  format: 'iife',
-  target: ['es2020', 'chrome90', 'firefox90', 'safari15'],
-  minify: true,
-  sourcemap: false,
-  legalComments: 'eof',
-  logLevel: 'warning',
-});
-await build({
-  entryPoints: [join(root, 'src/wall/wall.css')],
-  outfile: join(dist, 'wall.css'),
-  minify: true,
-  logLevel: 'warning',
-});
-await build({
-  entryPoints: [join(root, 'src/app.css')],
-  outfile: join(dist, 'app.css'),
-  minify: true,
-  logLevel: 'warning',
-});
+// A page's script, bundled and minified, and its style.
+async function bundle(entry, out) {
+  await build({
+    entryPoints: [join(root, entry)],
+    outfile: join(dist, out),
+    bundle: true,
+    format: 'iife',
+    target: ['es2020', 'chrome90', 'firefox90', 'safari15'],
+    minify: true,
+    sourcemap: false,
+    legalComments: 'eof',
+    logLevel: 'warning',
+  });
+}
+async function style(entry, out) {
+  await build({ entryPoints: [join(root, entry)], outfile: join(dist, out), minify: true, logLevel: 'warning' });
+}
+
+await bundle('src/main.js', 'app.js');
+await style('src/app.css', 'app.css');
+// The wall's page (isowall wall --http).
+await bundle('src/wall/wall.js', 'wall.js');
+await style('src/wall/wall.css', 'wall.css');
 copyFileSync(join(root, 'src/index.html'), join(dist, 'index.html'));
 copyFileSync(join(root, 'src/wall/wall.html'), join(dist, 'wall.html'));
 console.log(`build: ${readdirSync(dist).sort().join(', ')} in ${dist}`);
