@@ -163,7 +163,7 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
 std::pair<HelloMsg, HelloMsg> session_hellos() {
     HelloMsg p = test::phantom_hello();
     p.role = SessionRole::presenter;
-    p.session = "s";
+    p.session.assign(1, 's');  // GCC 12 warns falsely (-Wrestrict) on assigning "s" here
     HelloMsg f = p;
     f.role = SessionRole::follower;
     return {p, f};
