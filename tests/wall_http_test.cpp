@@ -5,7 +5,9 @@
 // against a wall under mpirun.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "app/wall_http.h"
 #include "comm/inproc_comm.h"
@@ -53,6 +55,16 @@ json next_of(WsTestClient& c, WallHttp& http, const WallMaster& master, const st
     return nullptr;
 }
 
+// The lines the source gives, turning it until there are `n` (or 10 s have passed).
+std::vector<SteeringLine> lines_of(WallHttp& http, const WallMaster& master, std::size_t n) {
+    std::vector<SteeringLine> lines;
+    for (int turn = 0; turn < 1000 && lines.size() < n; ++turn) {
+        for (SteeringLine& l : http.take(master)) lines.push_back(std::move(l));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return lines;
+}
+
 WallHttpOptions options(std::size_t max_pages = 16) {
     WallHttpOptions o;
     o.port = 0;
@@ -75,17 +87,19 @@ TEST(WallHttp, PagesSayHelloSteerOneAtATimeAndHearEveryLine) {
     b.send_text(R"({"hello": "t0k3n"})");
     EXPECT_EQ(next_of(b, http, f.master, "welcome")["you"], "page 2");
     // Each page gets the mosaic of the control window's layout.
+    // The mosaic is made on the encoder's thread and handed out by the next show().
     std::optional<test::WsMessage> picture;
-    for (int i = 0; i < 50 && !picture; ++i)
+    for (int i = 0; i < 100 && !picture; ++i) {
+        http.show(f.master, FrameNote{1, false, 0.5}, false);
         if (auto m = b.receive(0.1); m && m->bytes.rfind("IWM1", 0) == 0) picture = m;
+    }
     ASSERT_TRUE(picture);
     const Image mosaic = decode_mosaic(picture->bytes);
     EXPECT_EQ(mosaic.width, wa["width"]);
 
     // Page 1's command is a line to run; it now steers, and page 2 is refused.
-    std::vector<SteeringLine> lines;
     a.send_text(R"({"run": "orbit -30 0"})");
-    const json state = next_of(b, http, f.master, "state", &lines);
+    std::vector<SteeringLine> lines = lines_of(http, f.master, 1);
     ASSERT_EQ(lines.size(), 1u);
     EXPECT_EQ(lines[0].text, "orbit -30 0");
     EXPECT_EQ(lines[0].who, "page 1");
