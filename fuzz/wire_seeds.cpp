@@ -58,7 +58,9 @@ std::vector<Message> samples() {
             preview,
             StoreAskMsg{StorePart::chunk, 42},
             StoreMetaMsg{true, R"({"zarr_format": 2})", R"({"isowall": {}})", 4096, 100},
-            StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}}};  // new last
+            StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}},
+            CurveAskMsg{9},
+            CurveMsg{{9, 100, {{0.5, 40, 1.25}, {0.75, 100, 0}}}}};  // new last
 }
 
 }  // namespace

@@ -84,6 +84,13 @@ void WallMaster::handle(const Envelope& e) {
     } else if (auto* res = std::get_if<TileResultMsg>(&m)) {
         raise_test_signal(o_.fault, FaultMoment::gather);
         t.result = std::move(*res);
+    } else if (auto* c = std::get_if<CurveMsg>(&m)) {
+        if (c->curve.generation == generation_ && curves_asked_) {
+            TileResultMsg& r = frame_curves_.at(static_cast<std::size_t>(e.from));
+            r.significant = c->curve.significant;
+            r.curve = std::move(c->curve.points);
+            r.frames = 1;  // came
+        }
     } else {
         throw WireError(rank_label(spec_, e.from) + " sent a " + to_string(e.tag) +
                         " message, which only the master sends");
@@ -225,6 +232,8 @@ void WallMaster::send_views() {
     migrations_.clear();
     frame_busy_s_.assign(tiles_.size(), 0.0);
     frame_clock_s_.assign(tiles_.size(), 0.0);
+    curves_asked_ = false;
+    frame_curves_.assign(tiles_.size(), TileResultMsg{});
     order_.begin_frame();
     for (int rank = 1; rank < comm_.size(); ++rank) order_.ask(rank);
     dispatch();

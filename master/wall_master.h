@@ -70,6 +70,9 @@ struct FrameFigures {
     double emulated_s = 0;
     // Mean over max of the tile ranks' busy CPU (the jobs' CPU seconds) so far; 1 with no work.
     double balance = 1;
+    // With --measure, once the frame is complete and every tile has sent its curve: the emulated
+    // time to wall-wide C = 99% (master/wall_report.h: wall_curve); negative until then.
+    double c99_s = -1;
 };
 
 class WallMaster {
@@ -127,6 +130,8 @@ class WallMaster {
 
     void handle(const Envelope& e);
     void handle_job(int from, const Message& m);
+    // With --measure, once every job of the frame has landed: asks each tile for its curve.
+    void ask_curves();
     // Hands `rank` jobs until it holds as many as the board allows.
     void fill(int rank);
     // Serves the asking ranks the dispatch order lets through now.
@@ -168,6 +173,10 @@ class WallMaster {
     std::vector<Migration> migrations_;  // of the current generation
     // Of the current generation, by rank: CPU seconds of its jobs, and its clock at its last job.
     std::vector<double> frame_busy_s_, frame_clock_s_;
+    // With --measure: whether the tiles were asked for the complete frame's curves, and those
+    // that came (by rank; results' significant and curve fields, for wall_curve).
+    bool curves_asked_ = false;
+    std::vector<TileResultMsg> frame_curves_;
     std::vector<std::uint64_t> completed_;  // generations before the current one that completed
     RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
     DispatchOrder order_;    // which asking rank is served next

@@ -62,6 +62,14 @@ void WallMaster::handle_job(int from, const Message& m) {
                             ", which no helper ran for it");
         board_->landed(id);
     }
+    ask_curves();
+}
+
+void WallMaster::ask_curves() {
+    if (!o_.measure || curves_asked_ || !board_ || !board_->complete()) return;
+    curves_asked_ = true;
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        send_message(comm_, rank, CurveAskMsg{generation_});
 }
 
 FrameFigures WallMaster::frame_figures() const {
@@ -79,6 +87,9 @@ FrameFigures WallMaster::frame_figures() const {
     }
     const std::size_t ranks = frame_busy_s_.size() > 1 ? frame_busy_s_.size() - 1 : 1;
     if (most > 0) f.balance = sum / static_cast<double>(ranks) / most;
+    bool all = curves_asked_;
+    for (std::size_t r = 1; r < frame_curves_.size(); ++r) all = all && frame_curves_[r].frames;
+    if (all) f.c99_s = time_to(wall_curve(frame_curves_), 0.99, false);
     return f;
 }
 

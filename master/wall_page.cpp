@@ -110,7 +110,8 @@ std::string state_json(const PageState& s) {
                 {"frame_s", s.frame_s},     {"emulated_s", f.emulated_s},
                 {"balance", f.balance},     {"jobs", f.jobs},
                 {"jobs_done", f.jobs_done}, {"migrated", f.migrated},
-                {"steering", s.steering},   {"pages", s.pages}}
+                {"c99_s", f.c99_s},         {"steering", s.steering},
+                {"pages", s.pages}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

@@ -173,7 +173,7 @@ static QuitMsg decode_quit(std::span<const std::byte> bytes) {
     return {};
 }
 
-static void put_curve(MessageWriter& w, const std::vector<CurvePoint>& curve) {
+void job_wire::put_curve(MessageWriter& w, const std::vector<CurvePoint>& curve) {
     w.put(static_cast<std::uint64_t>(curve.size()));
     for (const CurvePoint& c : curve) {
         w.put(c.emulated_s);
@@ -182,7 +182,7 @@ static void put_curve(MessageWriter& w, const std::vector<CurvePoint>& curve) {
     }
 }
 
-static std::vector<CurvePoint> get_curve(MessageReader& r) {
+std::vector<CurvePoint> job_wire::get_curve(MessageReader& r) {
     const std::size_t points = r.get_count(3 * 8);  // checked before the reserve
     std::vector<CurvePoint> curve;
     curve.reserve(points);
@@ -211,12 +211,12 @@ std::vector<std::byte> encode(const TileResultMsg& m) {
     w.put(m.jobs_helped);
     w.put(m.bytes_sent);
     w.put(m.significant);
-    put_curve(w, m.curve);
+    job_wire::put_curve(w, m.curve);
     w.put(static_cast<std::uint64_t>(m.earlier.size()));
     for (const FrameCurve& f : m.earlier) {
         w.put(f.generation);
         w.put(f.significant);
-        put_curve(w, f.points);
+        job_wire::put_curve(w, f.points);
     }
     w.put(static_cast<std::uint64_t>(m.spans.size()));
     for (const TraceSpan& s : m.spans) put_trace_span(w, s);
@@ -239,14 +239,14 @@ static TileResultMsg decode_tile_result(std::span<const std::byte> bytes) {
     m.jobs_helped = r.get<std::uint64_t>();
     m.bytes_sent = r.get<std::uint64_t>();
     m.significant = r.get<std::uint64_t>();
-    m.curve = get_curve(r);
+    m.curve = job_wire::get_curve(r);
     const std::size_t frames = r.get_count(3 * 8);  // checked before the reserve
     m.earlier.reserve(frames);
     for (std::size_t i = 0; i < frames; ++i) {
         FrameCurve f;
         f.generation = r.get<std::uint64_t>();
         f.significant = r.get<std::uint64_t>();
-        f.points = get_curve(r);
+        f.points = job_wire::get_curve(r);
         m.earlier.push_back(std::move(f));
     }
     const std::size_t n = r.get_count(kTraceSpanWireBytes);  // checked before the reserve
@@ -304,6 +304,10 @@ const char* to_string(Tag tag) {
             return "store_meta";
         case Tag::store_part:
             return "store_part";
+        case Tag::curve_ask:
+            return "curve_ask";
+        case Tag::curve:
+            return "curve";
     }
     // A tag comes off the wire as any int32, so this is reachable.
     return "unknown";
@@ -347,9 +351,13 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return store_wire::decode_store_meta(bytes);
         case Tag::store_part:
             return store_wire::decode_store_part(bytes);
+        case Tag::curve_ask:
+            return job_wire::decode_curve_ask(bytes);
+        case Tag::curve:
+            return job_wire::decode_curve(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
-                    ": unknown tag, expected 1..14 or 16..19");
+                    ": unknown tag, expected 1..14 or 16..21");
 }
 
 }  // namespace isowall

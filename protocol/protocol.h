@@ -38,6 +38,8 @@ enum class Tag : std::int32_t {
     job_done = 17,    // worker -> master: the job's figures; the worker is free for the next
     region = 18,      // worker -> owner: colour and depth of a region it filled for the owner
     landed = 19,      // owner -> master: a helper's region result has been composited
+    curve_ask = 20,   // master -> tile (--measure): the frame is complete; send its curve
+    curve = 21,       // tile -> master: that frame's correctness curve (the page's C = 99%)
 };
 const char* to_string(Tag tag);
 
@@ -225,10 +227,25 @@ struct LandedMsg {
     std::uint32_t job = 0;
 };
 
+// With --measure, once every job of a frame has landed, the master asks each tile for the frame's
+// curve (its shown image is then final) and merges them into the wall's C = 99% while the wall
+// runs (app/wall_http.h shows it). A tile whose frame is another answers nothing.
+struct CurveAskMsg {
+    static constexpr Tag kTag = Tag::curve_ask;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t generation = 0;
+};
+
+struct CurveMsg {
+    static constexpr Tag kTag = Tag::curve;
+    static constexpr std::uint8_t kVersion = 1;
+    FrameCurve curve;  // its generation is the frame's
+};
+
 using Message =
     std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg, TileResultMsg,
                  ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg, JobDoneMsg, RegionMsg,
-                 LandedMsg, StoreAskMsg, StoreMetaMsg, StorePartMsg>;
+                 LandedMsg, StoreAskMsg, StoreMetaMsg, StorePartMsg, CurveAskMsg, CurveMsg>;
 
 std::vector<std::byte> encode(const TileHelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -248,6 +265,8 @@ std::vector<std::byte> encode(const LandedMsg& m);
 std::vector<std::byte> encode(const StoreAskMsg& m);
 std::vector<std::byte> encode(const StoreMetaMsg& m);
 std::vector<std::byte> encode(const StorePartMsg& m);
+std::vector<std::byte> encode(const CurveAskMsg& m);
+std::vector<std::byte> encode(const CurveMsg& m);
 std::vector<std::byte> encode(const Message& m);
 Tag tag_of(const Message& m);
 

@@ -163,4 +163,36 @@ LandedMsg job_wire::decode_landed(std::span<const std::byte> bytes) {
     return m;
 }
 
+std::vector<std::byte> encode(const CurveAskMsg& m) {
+    MessageWriter w(CurveAskMsg::kVersion);
+    w.put(m.generation);
+    return w.take();
+}
+
+CurveAskMsg job_wire::decode_curve_ask(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, CurveAskMsg::kVersion, "curve_ask message");
+    CurveAskMsg m;
+    m.generation = r.get<std::uint64_t>();
+    r.finish();
+    return m;
+}
+
+std::vector<std::byte> encode(const CurveMsg& m) {
+    MessageWriter w(CurveMsg::kVersion);
+    w.put(m.curve.generation);
+    w.put(m.curve.significant);
+    job_wire::put_curve(w, m.curve.points);
+    return w.take();
+}
+
+CurveMsg job_wire::decode_curve(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, CurveMsg::kVersion, "curve message");
+    CurveMsg m;
+    m.curve.generation = r.get<std::uint64_t>();
+    m.curve.significant = r.get<std::uint64_t>();
+    m.curve.points = get_curve(r);
+    r.finish();
+    return m;
+}
+
 }  // namespace isowall

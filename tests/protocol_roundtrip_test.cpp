@@ -36,6 +36,7 @@ TEST(Protocol, DegenerateMessagesRoundTrip) {
     expect_round_trip(PreviewMsg{});  // one black pixel
     expect_round_trip(JobDoneMsg{});
     expect_round_trip(LandedMsg{});
+    expect_round_trip(CurveAskMsg{});
 }
 
 TEST(Protocol, ViewAtTheLimitsRoundTrips) {
@@ -101,6 +102,11 @@ TEST(Protocol, RegionRoundTrips) {
 TEST(Protocol, LandedRoundTrips) {
     expect_round_trip(LandedMsg{0xfedcba9876543210ULL, 0xffffffffu});
 }
+TEST(Protocol, CurveAskAndCurveRoundTrip) {
+    expect_round_trip(CurveAskMsg{0xfedcba9876543210ULL});
+    expect_round_trip(CurveMsg{});
+    expect_round_trip(CurveMsg{{7, 123456, {{0.25, 100, 1.5}, {0.5, 123456, 0}}}});
+}
 
 TEST(Protocol, PerspectiveProjectionRoundTrips) {
     ViewMsg m = sample_view();
@@ -149,7 +155,9 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::store_meta), "store_meta");
     EXPECT_STREQ(to_string(Tag::store_part), "store_part");
     EXPECT_STREQ(to_string(static_cast<Tag>(15)), "unknown");
-    EXPECT_STREQ(to_string(static_cast<Tag>(20)), "unknown");
+    EXPECT_STREQ(to_string(Tag::curve_ask), "curve_ask");
+    EXPECT_STREQ(to_string(Tag::curve), "curve");
+    EXPECT_STREQ(to_string(static_cast<Tag>(22)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }
 

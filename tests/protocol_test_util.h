@@ -107,6 +107,12 @@ inline bool operator==(const RegionMsg& a, const RegionMsg& b) {
 inline bool operator==(const LandedMsg& a, const LandedMsg& b) {
     return a.generation == b.generation && a.job == b.job;
 }
+inline bool operator==(const CurveAskMsg& a, const CurveAskMsg& b) {
+    return a.generation == b.generation;
+}
+inline bool operator==(const CurveMsg& a, const CurveMsg& b) {
+    return a.curve == b.curve;
+}
 
 inline bool operator==(const StoreAskMsg& a, const StoreAskMsg& b) {
     return a.part == b.part && a.index == b.index;

@@ -96,6 +96,7 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     EXPECT_EQ(j["migrated"], 12);
     EXPECT_EQ(j["emulated_s"], 0.75);
     EXPECT_EQ(j["balance"], 0.82);
+    EXPECT_EQ(j["c99_s"], -1);  // not measured
     EXPECT_EQ(j["steering"], "page 2");
     EXPECT_EQ(j["pages"].size(), 2u);
 

@@ -56,6 +56,8 @@ class TileRank {
                 if (!quit) job(*j);
             } else if (auto* r = std::get_if<RegionMsg>(&*m)) {
                 if (!quit) land(std::move(*r));
+            } else if (auto* a = std::get_if<CurveAskMsg>(&*m)) {
+                if (!quit) answer_curve(a->generation);
             } else if (std::holds_alternative<QuitMsg>(*m)) {
                 raise_test_signal(setup_.fault, FaultMoment::gather);
                 quit = true;
@@ -151,12 +153,24 @@ class TileRank {
     // when the master saw the frame complete, the only ones it uses); outside every figure.
     void keep_curve() {
         if (!setup_.measure || !jobs_.started()) return;
+        result_.earlier.push_back(current_curve());
+    }
+
+    // The current frame's curve against what the tile shows now; outside every figure.
+    FrameCurve current_curve() {
         const Stage left = trace_.switch_to(Stage::setup);
         FrameCurve f;
         f.generation = jobs_.generation();
         f.points = jobs_.curve(f.significant);
-        result_.earlier.push_back(std::move(f));
         trace_.switch_to(left);
+        return f;
+    }
+
+    // The master saw frame `generation` complete (--measure): its curve now, so the wall's
+    // C = 99% is known while it runs. A tile already on another frame says nothing.
+    void answer_curve(std::uint64_t generation) {
+        if (!setup_.measure || !jobs_.started() || jobs_.generation() != generation) return;
+        send_message(comm_, kMasterRank, CurveMsg{current_curve()});
     }
 
     // The figures of the frame that ends (a new view or quit).

@@ -7,8 +7,9 @@
 //      a second page sees who steers, is refused while it does not, takes over and steers; the
 //      first page is refused after. Both pages end on the same picture.
 //   3. The wall ended from the page; its mosaic equals that of the script the printed lines make.
-//   4. Over https with a token: the page and its WebSocket (wss), a wrong token refused; an
-//      address off loopback without TLS refused with one line.
+//   4. Over https with a token and --measure: the page and its WebSocket (wss), the emulated time
+//      to the wall's C = 99% on the page, a wrong token refused; an address off loopback without
+//      TLS refused with one line.
 //   ISOWALL_BIN=build/bin/isowall ISOWALL_PAGE_MOSAIC=build/tests/isowall_test_page_mosaic \
 //     ISOWALL_OUT=out node test/e2e_wall.mjs
 import { chromium } from 'playwright-core';
@@ -168,8 +169,9 @@ try {
   execFileSync('openssl', ['req', '-x509', '-newkey', 'ec', '-pkeyopt', 'ec_paramgen_curve:prime256v1',
     '-nodes', '-days', '1', '-subj', '/CN=localhost', '-addext', 'subjectAltName=DNS:localhost,IP:127.0.0.1',
     '-keyout', key, '-out', cert], { stdio: 'ignore' });
+  // With --measure: the page also shows the emulated time to the wall's C = 99%.
   wall = new WallRun(bin, 5, [...wallArgs, '--http', '0', '--token', 't0k3n', '--tls-cert', cert, '--tls-key', key,
-    '--out', join(out, 'tls_wall.png')]);
+    '--measure', '--out', join(out, 'tls_wall.png')]);
   const tlsUrl = (await wall.waitFor(/http: page at (https:\/\/\S+)/))[1];
   check(/http: TLS certificate: .*localhost/.test(wall.text), 'the wall prints its certificate');
   const tls = await browser.newContext({ ignoreHTTPSErrors: true, viewport: { width: 1100, height: 800 } });
@@ -184,6 +186,10 @@ try {
   const sp = await settled(p, 'the first frame over TLS');
   check(sp.mosaics > 0 && (await p.evaluate(() => location.protocol)) === 'https:', `the page over https shows the wall (${sp.mosaics} mosaics)`);
   check(sockets.length > 0 && sockets.every((u) => u.startsWith('wss://')), `its WebSocket: ${sockets.join(', ')}`);
+  const measured = await until(p, (x) => x.state.c99_s >= 0, 'the emulated time to C = 99%', 60);
+  check(measured.state.c99_s > 0 && measured.state.c99_s <= measured.state.emulated_s + 1e-9,
+    `--measure: C = 99% at ${measured.state.c99_s.toFixed(3)} s emulated, makespan ${measured.state.emulated_s.toFixed(3)} s; ` +
+    `the page reads "${await p.textContent('#s-c99')}"`);
   await p.click('#quit');
   check((await wall.exit(120)) === 0, 'the TLS wall ended from the page');
   await tls.close();

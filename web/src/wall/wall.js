@@ -11,7 +11,7 @@ const el = {
   rangeMin: $('range-min'), rangeMax: $('range-max'), snapshot: $('snapshot'),
   steering: $('steering'), take: $('take'), quit: $('quit'), message: $('message'),
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
-  emulated: $('s-emulated'), balance: $('s-balance'), jobs: $('s-jobs'), migrated: $('s-migrated'),
+  emulated: $('s-emulated'), c99: $('s-c99'), balance: $('s-balance'), jobs: $('s-jobs'), migrated: $('s-migrated'),
   pages: $('s-pages'), log: $('log'),
 };
 const ctx = el.canvas.getContext('2d');
@@ -140,6 +140,8 @@ function showState(s) {
   el.frame.textContent = String(s.frame);
   el.wall.textContent = `${s.frame_s.toFixed(2)} s`;
   el.emulated.textContent = `${s.emulated_s.toFixed(3)} s`;
+  // Known once the frame is complete, and only when the wall measures (--measure).
+  el.c99.textContent = s.c99_s >= 0 ? `${s.c99_s.toFixed(3)} s` : '-';
   el.balance.textContent = s.balance.toFixed(2);
   el.jobs.textContent = `${s.jobs_done}/${s.jobs}`;
   el.migrated.textContent = String(s.migrated);
