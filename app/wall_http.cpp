@@ -1,9 +1,9 @@
 #include "app/wall_http.h"
 
 #include <cstdio>
-#include <filesystem>
 
 #include "common/core/error.h"
+#include "master/control_input.h"
 #include "master/control_view.h"
 #include "remote/view_server.h"
 #include "remote/web/web_routes.h"
@@ -18,17 +18,6 @@ constexpr double kStateIntervalS = 0.25;
 // Texts a page may leave unsent before it is closed as too slow (states and mosaics never pile
 // up: each replaces the last).
 constexpr std::size_t kMaxQueuedTexts = 256;
-
-// "page-001" ...: the first name with no PNG beside `out`.
-std::string free_snapshot_name(const std::string& out, int& next) {
-    const auto dir = std::filesystem::path(out).parent_path();
-    std::error_code ec;
-    for (;; ++next) {
-        char name[32];
-        std::snprintf(name, sizeof(name), "page-%03d", next);
-        if (!std::filesystem::exists(dir / (std::string(name) + ".png"), ec)) return name;
-    }
-}
 
 web::WebOptions web_options(const WallHttpOptions& o) {
     web::WebOptions w;
@@ -266,11 +255,11 @@ void WallHttp::handle(const std::shared_ptr<Page>& page, const std::string& byte
         std::printf("http: %s steers\n", page->name.c_str());
         std::fflush(stdout);
     }
-    lines.push_back({m.kind == PageMessage::Kind::run
-                         ? m.text
-                         : "snapshot " + free_snapshot_name(o_.out, next_snapshot_),
-                     page->name});
-    if (m.kind == PageMessage::Kind::snapshot) ++next_snapshot_;
+    if (m.kind == PageMessage::Kind::snapshot) {  // page-001 ..., the first name not taken
+        next_snapshot_ = first_free_snapshot(o_.out, next_snapshot_, "page");
+        m.text = "snapshot " + snapshot_name(next_snapshot_++, "page");
+    }
+    lines.push_back({m.text, page->name});
 }
 
 std::vector<SteeringLine> WallHttp::take(const WallMaster&) {

@@ -1,5 +1,7 @@
 #include "master/control_input.h"
 
+#include <filesystem>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -27,10 +29,18 @@ double iso_steps_of(const std::string& key) {
 
 }  // namespace
 
-std::string snapshot_name(int n) {
+std::string snapshot_name(int n, std::string_view prefix) {
     char buf[32];
-    std::snprintf(buf, sizeof(buf), "control-%03d", n);
-    return buf;
+    std::snprintf(buf, sizeof(buf), "-%03d", n);
+    return std::string(prefix) + buf;
+}
+
+int first_free_snapshot(const std::string& out, int from, std::string_view prefix) {
+    const auto dir = std::filesystem::path(out).parent_path();
+    std::error_code ec;
+    int n = from;
+    while (std::filesystem::exists(dir / (snapshot_name(n, prefix) + ".png"), ec)) ++n;
+    return n;
 }
 
 std::string iso_line(double iso, double lo, double hi) {

@@ -13,6 +13,7 @@
 //   s              snapshot control-NNN (beside --out)
 //   Escape, close  quit
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "display/x_window.h"
@@ -30,7 +31,10 @@ struct ControlState {
 };
 
 // "control-001" ...: the name of snapshot n.
-std::string snapshot_name(int n);
+std::string snapshot_name(int n, std::string_view prefix = "control");
+// The first n from `from` up with no PREFIX-NNN.png beside `out` (--out), so a second session
+// does not overwrite the first one's snapshots (the control window's and the page's).
+int first_free_snapshot(const std::string& out, int from = 1, std::string_view prefix = "control");
 
 // "iso V" with V written so that it reads back as itself inside [lo, hi] (six significant
 // digits when that suffices, so the line stays readable).

@@ -1,7 +1,6 @@
 #include "master/control_window.h"
 
 #include <cstdio>
-#include <filesystem>
 
 #include "common/core/error.h"
 #include "master/control_view.h"
@@ -25,16 +24,6 @@ WindowOptions window_options(const ControlLayout& layout, const std::string& dis
     o.height = size.height;
     o.input = true;
     return o;
-}
-
-// The first n with no control-NNN.png beside `out`, so a second session does not overwrite the
-// first one's snapshots.
-int first_free_snapshot(const std::string& out) {
-    const auto dir = std::filesystem::path(out).parent_path();
-    int n = 1;
-    std::error_code ec;
-    while (std::filesystem::exists(dir / (snapshot_name(n) + ".png"), ec)) ++n;
-    return n;
 }
 
 }  // namespace

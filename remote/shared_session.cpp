@@ -116,6 +116,10 @@ std::optional<RequestMsg> SharedSession::latest() const {
 
 SessionMsg SharedSession::status() const {
     std::lock_guard lock(mutex_);
+    return status_held();
+}
+
+SessionMsg SharedSession::status_held() const {
     return {name_, presenter_,
             static_cast<std::uint32_t>(followers_.size() + (presenter_.empty() ? 0 : 1))};
 }
@@ -134,8 +138,7 @@ std::size_t SharedSession::peak_queue_bytes() const {
 
 void SharedSession::changed() {
     ++version_;
-    const SessionMsg now{name_, presenter_,
-                         static_cast<std::uint32_t>(followers_.size() + !presenter_.empty())};
+    const SessionMsg now = status_held();
     for (Follower& f : followers_) f.queue->push(now);
 }
 
@@ -175,7 +178,7 @@ std::unique_ptr<SessionSeat> SessionHub::join(const HelloMsg& h, const std::stri
               std::to_string(s.encoding_) + " (view --encoding)";
         return nullptr;
     }
-    if (s.followers_.size() + 1 + (s.presenter_.empty() ? 0 : 1) > limits_.max_members) {
+    if (s.status_held().members + 1 > limits_.max_members) {
         why = "hello: session: " + named + " has " + std::to_string(limits_.max_members) +
               " members, the server's limit";
         return nullptr;

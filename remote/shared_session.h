@@ -95,7 +95,8 @@ class SharedSession {
         std::string peer;
         std::shared_ptr<FollowerQueue> queue;
     };
-    void changed();  // mutex_ held: a member joined or left
+    void changed();                  // mutex_ held: a member joined or left
+    SessionMsg status_held() const;  // mutex_ held
 
     const std::string name_, dataset_;
     const std::uint8_t encoding_;

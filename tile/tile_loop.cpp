@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -156,8 +157,11 @@ class TileRank {
         result_.earlier.push_back(current_curve());
     }
 
-    // The current frame's curve against what the tile shows now; outside every figure.
+    // The current frame's curve against what the tile shows now; outside every figure. A frame
+    // whose curve the master asked for is complete (its image changes no more until the next
+    // view), so that curve is the one kept: it is measured once.
     FrameCurve current_curve() {
+        if (answered_ && answered_->generation == jobs_.generation()) return *answered_;
         const Stage left = trace_.switch_to(Stage::setup);
         FrameCurve f;
         f.generation = jobs_.generation();
@@ -170,7 +174,8 @@ class TileRank {
     // C = 99% is known while it runs. A tile already on another frame says nothing.
     void answer_curve(std::uint64_t generation) {
         if (!setup_.measure || !jobs_.started() || jobs_.generation() != generation) return;
-        send_message(comm_, kMasterRank, CurveMsg{current_curve()});
+        answered_ = current_curve();
+        send_message(comm_, kMasterRank, CurveMsg{*answered_});
     }
 
     // The figures of the frame that ends (a new view or quit).
@@ -295,9 +300,9 @@ class TileRank {
 
     void send_result() {
         if (setup_.measure && jobs_.started()) {
-            const Stage left = trace_.switch_to(Stage::setup);  // the measurement's, as keep_curve
-            result_.curve = jobs_.curve(result_.significant);
-            trace_.switch_to(left);
+            FrameCurve last = current_curve();
+            result_.curve = std::move(last.points);
+            result_.significant = last.significant;
         }
         close_frame();
         result_.host = comm_.host();
@@ -314,7 +319,8 @@ class TileRank {
     TileJobs jobs_;
     TileInbox inbox_;
     TileResultMsg result_;
-    std::vector<RegionMsg> early_;  // helpers' results that came before their frame's view
+    std::optional<FrameCurve> answered_;  // the curve sent for a complete frame (--measure)
+    std::vector<RegionMsg> early_;        // helpers' results that came before their frame's view
     struct Shown {
         FrameShow* show;
         PresentPacer pacer;

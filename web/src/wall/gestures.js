@@ -2,12 +2,14 @@
 // a drag orbits at kOrbitDegPerPx degrees per mosaic pixel (a right drag or a shift drag pans, in
 // mosaic sizes), a wheel step or a pinch zooms, so the page, the control window and a script
 // drive the wall alike. Pure: the caller converts screen pixels to mosaic pixels.
+import { formatValue } from '../ui.js';
+
 export const kOrbitDegPerPx = 0.5;
 export const kZoomStep = 1.25;
 
 // Six significant digits, no trailing zeros: "-30", "0.125".
 export function num(v) {
-  const s = String(Number(Number(v).toPrecision(6)));
+  const s = formatValue(v);
   return s === '-0' ? '0' : s;
 }
 

@@ -4,6 +4,7 @@
 // window.isowallWall is kept up to date for tests.
 import { ready as mosaicReady, isMosaic, decodeMosaic } from './mosaic.js';
 import { Drag, zoomLine, pinchLine, isoLine, num } from './gestures.js';
+import { showMessage as show } from '../ui.js';
 
 const $ = (id) => document.getElementById(id);
 const el = {
@@ -35,9 +36,7 @@ const api = {
 window.isowallWall = api;
 
 function showMessage(text, kind = 'error') {
-  el.message.textContent = text;
-  el.message.className = text ? kind : '';
-  el.message.title = text;
+  show(el, text, kind);
 }
 
 const params = new URLSearchParams(location.search);
