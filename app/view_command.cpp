@@ -42,7 +42,7 @@ GroupEncoding parse_encoding(const std::string& s) {
         if (name == s) return e;
     }
     throw InputError("--encoding", "value",
-                     "expected vertices, indexed, compact or compact-zstd, got " + quote(s));
+                     "expected vertices, indexed, compact, compact-zstd or cells, got " + quote(s));
 }
 
 struct Viewer {
@@ -156,8 +156,10 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
                   "+ LOD + cache, 5 compact+zstd + LOD + cache (overrides the three options "
                   "below)")
         ->check(CLI::Range(1, 5));
-    c->add_option("--encoding", o.encoding, "vertices, indexed, compact or compact-zstd")
-        ->check(CLI::IsMember({"vertices", "indexed", "compact", "compact-zstd"}))
+    c->add_option("--encoding", o.encoding,
+                  "How groups travel: vertices, indexed, compact, compact-zstd, or cells (the "
+                  "units and the voxel values marching cubes needs; the client triangulates)")
+        ->check(CLI::IsMember({"vertices", "indexed", "compact", "compact-zstd", "cells"}))
         ->capture_default_str();
     c->add_flag("--lod", o.lod, "Progressive LOD: two coarser LOD levels first");
     c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");

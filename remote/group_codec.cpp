@@ -8,6 +8,7 @@
 #include <zstd.h>
 
 #include "remote/byte_io.h"
+#include "remote/cell_codec.h"
 #include "remote/compact_mesh.h"
 
 namespace isowall::remote {
@@ -20,6 +21,9 @@ constexpr int kMaxLevel = 30;
 // meshoptimizer's bound of 16 bytes a triangle is far above what its codec writes.
 constexpr std::uint64_t kMaxCompactBytes =
     std::uint64_t{kMaxGroupVertices} * 10 + std::uint64_t{kMaxGroupTriangles} * 16 + 256;
+// The largest cells body: every voxel of the largest box as a float64, and the units' gaps.
+constexpr std::uint64_t kMaxCellBytes =
+    kMaxCellBoxVoxels * 8 + std::uint64_t{kMaxGroupTriangles} * 10 + 256;
 
 // ---- the group header ----------------------------------------------------------------------
 
@@ -156,10 +160,10 @@ void put_zstd(ByteWriter& w, const std::vector<std::uint8_t>& compact) {
 
 // The compact message inside the frame; its size is checked against the limits, the frame's
 // own claim and the expansion cap before it is allocated.
-std::vector<std::uint8_t> get_zstd(ByteReader& r) {
+std::vector<std::uint8_t> get_zstd(ByteReader& r, std::uint64_t limit) {
     const auto size = r.get<std::uint64_t>();
     const auto frame = r.get_span(r.remaining());
-    if (size > kMaxCompactBytes || size > frame.size() * kMaxZstdExpansion)
+    if (size > limit || size > frame.size() * kMaxZstdExpansion)
         r.fail("zstd: " + std::to_string(size) + " bytes claimed from a frame of " +
                std::to_string(frame.size()));
     if (ZSTD_getFrameContentSize(frame.data(), frame.size()) != size)
@@ -201,6 +205,8 @@ const char* to_string(GroupEncoding e) {
             return "compact";
         case GroupEncoding::compact_zstd:
             return "compact+zstd";
+        case GroupEncoding::cells:
+            return "cells";
     }
     return "unknown";
 }
@@ -211,8 +217,18 @@ float position_grid_step(float extent) {
 }
 
 std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
-                                       float grid_step) {
+                                       float grid_step, const Volume* volume) {
     check_encodable(group);
+    if (encoding == GroupEncoding::cells) {
+        const auto body = volume ? encode_cell_body(group, *volume) : std::nullopt;
+        if (!body) return encode_group(group, GroupEncoding::compact_zstd, grid_step);
+        ByteWriter w;
+        w.put(kGroupCodecVersion);
+        w.put(static_cast<std::uint8_t>(encoding));
+        put_header(w, group);
+        put_zstd(w, *body);
+        return w.take();
+    }
     if (encoding == GroupEncoding::compact_zstd) {
         const auto compact = encode_group(group, GroupEncoding::compact, grid_step);
         ByteWriter w;
@@ -246,8 +262,8 @@ GroupEncoding encoding_of(std::span<const std::uint8_t> bytes) {
         r.fail("version " + std::to_string(version) + ", expected " +
                std::to_string(kGroupCodecVersion));
     const auto e = r.get<std::uint8_t>();
-    if (e > static_cast<std::uint8_t>(GroupEncoding::compact_zstd))
-        r.fail("encoding: expected 0..3, got " + std::to_string(e));
+    if (e > static_cast<std::uint8_t>(GroupEncoding::cells))
+        r.fail("encoding: expected 0..4, got " + std::to_string(e));
     return static_cast<GroupEncoding>(e);
 }
 
@@ -255,13 +271,20 @@ Group decode_group(std::span<const std::uint8_t> bytes) {
     const GroupEncoding encoding = encoding_of(bytes);
     ByteReader r(bytes.subspan(2), kWhat);
     if (encoding == GroupEncoding::compact_zstd) {
-        const std::vector<std::uint8_t> compact = get_zstd(r);
+        const std::vector<std::uint8_t> compact = get_zstd(r, kMaxCompactBytes);
         if (encoding_of(compact) != GroupEncoding::compact)
             r.fail("zstd: the frame holds a " + std::string(to_string(encoding_of(compact))) +
                    " group, expected compact");
         return decode_group(compact);
     }
     Group g = get_header(r);
+    if (encoding == GroupEncoding::cells) {
+        const std::vector<std::uint8_t> body = get_zstd(r, kMaxCellBytes);
+        ByteReader cells(body, kWhat);
+        g.mesh = decode_cell_body(cells, g.iso);
+        cells.finish();
+        return g;
+    }
     switch (encoding) {
         case GroupEncoding::vertices:
             g.mesh = get_vertices(r);

@@ -9,6 +9,9 @@
 //                 as floats), normals as octahedral 2 x 16 bits, indices through meshoptimizer's
 //                 index codec after its vertex cache and vertex fetch orders
 //   compact_zstd  the compact bytes through zstd (level kZstdLevel)
+//   cells         what marching cubes needs, not what it made: the group's units and the voxel
+//                 values that triangulate them (remote/cell_codec.h), through zstd; the client runs
+//                 marching cubes and gets the server's triangles and normals. Needs the volume.
 //
 // Bytes: [version u8][encoding u8][group header][body]; compact_zstd's body is the u64 size of
 // the compact message, then one zstd frame holding that whole message (its own version and
@@ -32,6 +35,7 @@
 
 #include "common/core/wire.h"
 #include "common/extract/group.h"
+#include "common/volume/volume.h"
 
 namespace isowall::remote {
 
@@ -39,11 +43,12 @@ enum class GroupEncoding : std::uint8_t {
     vertices = 0,
     indexed = 1,
     compact = 2,
-    compact_zstd = 3
+    compact_zstd = 3,
+    cells = 4
 };
 inline constexpr GroupEncoding kAllGroupEncodings[] = {
     GroupEncoding::vertices, GroupEncoding::indexed, GroupEncoding::compact,
-    GroupEncoding::compact_zstd};
+    GroupEncoding::compact_zstd, GroupEncoding::cells};
 const char* to_string(GroupEncoding e);
 inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
     return os << to_string(e);
@@ -67,13 +72,16 @@ inline constexpr std::uint64_t kMaxZstdExpansion = 64;
 // over every code direction in tests/remote_codec_test.cpp, with margin).
 inline constexpr double kOctNormalMaxErrorDeg = 0.01;
 
+// `volume` (cells): the volume the group was extracted from. A group `cells` cannot carry (see
+// remote/cell_codec.h), or any group when `volume` is null, goes as compact_zstd instead: the
+// encoding byte of the result says which.
 // grid_step (compact encodings): 0 quantises each group in its own box, so a vertex two groups
 // share may decode to two points a quantum apart, and a pixel may see through the crack between
 // them. A step > 0 (a power of two, at least the whole volume's extent / 65534, see
 // position_grid_step) puts every group's positions on one grid: a shared vertex decodes alike in
 // every group, and no crack opens. A group too large for 65535 steps falls back to its own box.
 std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
-                                       float grid_step = 0);
+                                       float grid_step = 0, const Volume* volume = nullptr);
 // The smallest power of two at least `extent` / 65534: the grid step for a volume of that largest
 // extent (object units).
 float position_grid_step(float extent);

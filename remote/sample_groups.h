@@ -11,9 +11,12 @@
 
 namespace isowall::remote {
 
-inline std::vector<Group> sample_groups(const Volume& volume, double iso, int grid, int max_count) {
+// `levels`: the units the passes take (uniform_levels(l): meta-cells of 2^l cells, cells at the
+// volume's border).
+inline std::vector<Group> sample_groups(const Volume& volume, double iso, int grid, int max_count,
+                                        const ResolutionLevels& levels = {}) {
     auto ex = make_surface_extractor(volume);
-    ex->begin_frame(iso);
+    ex->begin_frame(iso, levels);
     PropagationParams params;
     params.max_count = max_count;
     const Box3 box = volume.bounds();

@@ -50,7 +50,7 @@ class ServerSession::Sink final : public GroupSink {
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const std::vector<std::uint8_t> bytes =
-            encode_group(g, s_.options_.encoding, s_.grid_step_);
+            encode_group(g, s_.options_.encoding, s_.grid_step_, &s_.prototype_.volume());
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });

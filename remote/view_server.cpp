@@ -115,7 +115,7 @@ class ViewServer::Client {
             refuse(ErrorCode::bad_token, "hello: token: wrong token");
             return nullptr;
         }
-        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::compact_zstd)) {
+        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::cells)) {
             refuse(ErrorCode::malformed,
                    "hello: encoding: unknown group encoding " + std::to_string(h->encoding));
             return nullptr;

@@ -89,7 +89,7 @@ TEST(RemoteCodecMalformed, AnotherVersionEncodingOrTrailingByteThrows) {
             b[0] = static_cast<std::uint8_t>(v);
             EXPECT_THROW(decode_group(b), WireError) << e << " version " << int(v);
         }
-        for (std::uint8_t k : {4, 5, 255}) {
+        for (std::uint8_t k : {5, 6, 255}) {
             Bytes b = bytes;
             b[1] = k;
             EXPECT_THROW(decode_group(b), WireError) << e << " encoding " << int(k);

@@ -57,12 +57,16 @@ struct InsideTest {
 // copies, full extraction and propagation of vhp_ct_head at 40 ran no slower (and no more
 // instructions under callgrind).
 
+// The functions that read voxels take any View with VolumeView's members (data, dims, spacing,
+// bricked(), index(), at()): a view that says bricked() reads each voxel through at() alone, so
+// a client that holds only some voxels of a volume (remote/cell_codec.cpp) runs this same code.
+
 // Index offsets from a unit's first voxel to its corners along x, y and z.
 struct UnitStrides {
     std::size_t x, y, z;
 };
-template <class T>
-inline UnitStrides unit_strides(const VolumeView<T>& v, int level) {
+template <class View>
+inline UnitStrides unit_strides(const View& v, int level) {
     const std::size_t s = std::size_t{1} << level;
     const std::size_t row = static_cast<std::size_t>(v.dims.x);
     return {s, s * row, s * row * static_cast<std::size_t>(v.dims.y)};
@@ -70,8 +74,8 @@ inline UnitStrides unit_strides(const VolumeView<T>& v, int level) {
 
 // Corner values of the unit of `level` at `base` (corner k at base + 2^level * kCornerOffset[k]);
 // the unit must be complete (all eight corners inside the volume).
-template <class T>
-inline void meta_cell_corners(const VolumeView<T>& v, glm::ivec3 base, int level, double out[8]) {
+template <class View>
+inline void meta_cell_corners(const View& v, glm::ivec3 base, int level, double out[8]) {
     if (v.bricked()) {
         const int s = 1 << level;
         for (int k = 0; k < 8; ++k)
@@ -80,7 +84,7 @@ inline void meta_cell_corners(const VolumeView<T>& v, glm::ivec3 base, int level
         return;
     }
     const UnitStrides d = unit_strides(v, level);
-    const T* p = v.data + v.index(base.x, base.y, base.z);
+    const auto* p = v.data + v.index(base.x, base.y, base.z);
     out[0] = static_cast<double>(p[0]);
     out[1] = static_cast<double>(p[d.x]);
     out[2] = static_cast<double>(p[d.y]);
@@ -127,8 +131,8 @@ inline int cell_case(const double corner[8], double iso) {
 
 // Central differences in voxel units (one-sided at the volume's faces), scaled per axis by
 // `inv_step` = 1 / (2 * spacing), so the result is in object units without a division per axis.
-template <class T>
-inline glm::vec3 gradient(const VolumeView<T>& v, glm::ivec3 p, glm::vec3 inv_step) {
+template <class View>
+inline glm::vec3 gradient(const View& v, glm::ivec3 p, glm::vec3 inv_step) {
     const std::size_t i = v.index(p.x, p.y, p.z);
     const std::size_t step[3] = {
         1, static_cast<std::size_t>(v.dims.x),
@@ -195,8 +199,8 @@ inline double crossing_fraction(double iso, double va, double vb) {
     return f >= 0 && f <= 1 ? f : f > 1 ? 1.0 : 0.0;  // NaN (an overflowed difference) to 0
 }
 
-template <class T>
-inline EdgeCrossing edge_crossing(const VolumeView<T>& v, glm::ivec3 pa, int axis, int level,
+template <class View>
+inline EdgeCrossing edge_crossing(const View& v, glm::ivec3 pa, int axis, int level,
                                   double iso, double va, double vb) {
     EdgeCrossing best;
     best.frac = static_cast<float>(crossing_fraction(iso, va, vb));
@@ -267,8 +271,8 @@ int cell_triangles(const VolumeView<T>& v, glm::ivec3 c, double iso,
 // the crossing: the normal the full-resolution surface has at that point. (Gradients at stride
 // 2^level at the corners were tried: they smooth away shading the pixels show, and the phantom's
 // zoomed-out C fell by 0.01 to 0.02.) Returns the number of triangles added.
-template <class T, class Cache>
-inline int emit_meta_cell(const VolumeView<T>& v, glm::ivec3 base, int level, double iso, int cs,
+template <class View, class Cache>
+inline int emit_meta_cell(const View& v, glm::ivec3 base, int level, double iso, int cs,
                           const double corner[8], Cache& cache, Mesh& mesh) {
     const int count = mc::kTriangleCount[static_cast<std::size_t>(cs)];
     const auto& edges = mc::kTriangleEdges[static_cast<std::size_t>(cs)];

@@ -1,0 +1,53 @@
+#pragma once
+// The body of the `cells` group encoding (remote/group_codec.h; issue 34, the dissertation's
+// open problem 5.2.3): a group sent as what marching cubes needs, not what it made. The client
+// runs the project's own marching cubes (common/extract/marching_cubes.h) on what it receives and
+// gets the server's triangles: the same positions (to float rounding) and the same normals, the
+// interpolated central-difference gradients, with nothing quantised.
+//
+// What travels: the group's units (the cells, or meta-cells of a level, whose triangles the mesh
+// is) and the values of the voxels marching cubes reads to triangulate them, in three phases, each
+// one's voxels named by what the previous phases gave, so no voxel position is sent:
+//   1. the eight corners of every unit (they give its case and its crossed edges);
+//   2. the inner voxels of every crossed edge of a meta-cell (level >= 1): a long edge's vertex is
+//      the crossing between fine voxels nearest the linear estimate (edge_crossing);
+//   3. the six neighbours of the two voxels that bracket each crossing: the gradients there give
+//      the vertex's normal.
+// Each phase's voxels go in increasing linear index (z, then y, then x), without those of an
+// earlier phase, as byte planes (every value's low byte, then the next byte, ...).
+//
+// Byte layout: voxel type u8, volume dims 3 x i32, spacing 3 x f32, bucket count u8; per bucket
+// level u8, unit count u32 and the units as LEB128 gaps between their increasing indices in the
+// grid of units of that level; then the three phases' values. group_codec.cpp sends it through
+// zstd.
+//
+// A group whose mesh is not the marching cubes of its units (a mesh from elsewhere, units past the
+// volume) or whose units spread over more than kMaxCellBoxVoxels has no cells body: the encoder
+// returns nullopt and the caller sends another encoding. The decoder checks every count against
+// the bytes left and the limits before it allocates, every unit against the volume, and fails with
+// WireError naming the field.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "common/core/mesh.h"
+#include "common/extract/group.h"
+#include "common/volume/volume.h"
+#include "remote/byte_io.h"
+
+namespace isowall::remote {
+
+// The box a decoder holds voxels in: the units' extent and one voxel around it, of which it keeps
+// only the 4x4x4 bricks that hold voxels it receives (and a directory of 4 bytes a brick). A
+// propagation pass of the engine spans a few thousand units, far under this.
+inline constexpr std::uint64_t kMaxCellBoxVoxels = std::uint64_t{1} << 24;
+// The largest volume side a cells body may name.
+inline constexpr int kMaxCellVolumeSide = 1 << 20;
+
+// The cells body of `group`, extracted from `volume` at group.iso; nullopt when the group cannot
+// be sent this way (see above).
+std::optional<std::vector<std::uint8_t>> encode_cell_body(const Group& group, const Volume& volume);
+// The mesh a cells body gives at `iso`; throws WireError on anything malformed or truncated.
+Mesh decode_cell_body(ByteReader& r, double iso);
+
+}  // namespace isowall::remote

@@ -1,0 +1,278 @@
+// Issue 34's `cells` encoding (remote/cell_codec.h): a group sent as its units and the voxel values
+// marching cubes reads, triangulated again by the client. Round trips give the server's triangles
+// (same corners, same winding, positions to float rounding) and the very same normals: on the
+// phantom at full resolution, at meta-cell levels (with cells at the volume's border), for
+// refinements, and on every shared volume at its README isovalues. Hostile bodies (every
+// truncation, seeded mutations, huge counts, units past the volume) throw WireError, and a huge
+// claim throws before anything of its size is allocated.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+#include "common/volume/phantom.h"
+#include "remote/cell_codec.h"
+#include "remote/group_codec.h"
+#include "remote/sample_groups.h"
+#include "tests/largest_allocation.h"
+#include "tests/test_util.h"
+
+namespace isowall::remote {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+const Volume& cells_phantom() {
+    static const Volume v = make_phantom();
+    return v;
+}
+
+// A triangle as its corners' positions and normals, turned so the smallest corner comes first
+// (winding kept).
+using Corner = std::array<float, 6>;
+using Triangle = std::array<Corner, 3>;
+
+std::vector<Triangle> triangles_of(const Mesh& m) {
+    std::vector<Triangle> out;
+    for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+        Triangle tri;
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t i = m.indices[t + static_cast<std::size_t>(k)];
+            const glm::vec3 p = m.positions[i], n = m.normals[i];
+            tri[static_cast<std::size_t>(k)] = {p.x, p.y, p.z, n.x, n.y, n.z};
+        }
+        const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
+        std::rotate(tri.begin(), tri.begin() + first, tri.end());
+        out.push_back(tri);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+// `got` has the triangles of `want`, corner by corner, with the same winding, positions and
+// normals to the bit: the client runs the server's arithmetic on the server's voxel values.
+void expect_same_mesh(const Mesh& got, const Mesh& want, const std::string& what) {
+    ASSERT_EQ(got.triangle_count(), want.triangle_count()) << what;
+    const std::vector<Triangle> a = triangles_of(got), b = triangles_of(want);
+    std::vector<Triangle> only_a;
+    std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(only_a));
+    EXPECT_TRUE(only_a.empty()) << what << ": " << only_a.size() << " of " << a.size()
+                                << " triangles differ from the server's";
+}
+
+Group round_trip(const Group& g, const Volume& v) {
+    const Bytes bytes = encode_group(g, GroupEncoding::cells, 0, &v);
+    EXPECT_EQ(encoding_of(bytes), GroupEncoding::cells) << g.key();
+    return decode_group(bytes);
+}
+
+void expect_round_trips(const std::vector<Group>& groups, const Volume& v,
+                        const std::string& what) {
+    ASSERT_FALSE(groups.empty()) << what;
+    for (const Group& g : groups) {
+        const Group back = round_trip(g, v);
+        EXPECT_EQ(back.key(), g.key());
+        expect_same_mesh(back.mesh, g.mesh, what + " group " + std::to_string(g.id));
+        if (testing::Test::HasFailure()) return;
+    }
+}
+
+TEST(RemoteCellCodec, CellsGiveTheServersTrianglesAndNormals) {
+    expect_round_trips(sample_groups(cells_phantom(), kPhantomSkinIso, 24, 2000), cells_phantom(), "level 0");
+}
+
+TEST(RemoteCellCodec, MetaCellsAndTheCellsAtTheBorderRoundTrip) {
+    for (int level : {1, 2, 3}) {
+        const auto groups =
+            sample_groups(cells_phantom(), kPhantomSkinIso, 24, 2000, uniform_levels(level));
+        bool mixed = false;
+        for (const Group& g : groups) mixed = mixed || !g.cell_levels.empty();
+        std::printf("level %d: %zu groups, %s\n", level, groups.size(),
+                    mixed ? "some with cells at the border" : "one level each");
+        expect_round_trips(groups, cells_phantom(), "level " + std::to_string(level));
+    }
+}
+
+TEST(RemoteCellCodec, RefinementsRoundTrip) {
+    auto ex = make_surface_extractor(cells_phantom());
+    ex->begin_frame(kPhantomSkinIso, uniform_levels(3));
+    const auto coarse = sample_groups(cells_phantom(), kPhantomSkinIso, 6, 200, uniform_levels(3));
+    PropagationParams params;
+    int refined = 0;
+    for (const Group& g : coarse)
+        for (std::size_t i = 0; i < g.cells.size() && refined < 40; i += 7) {
+            if (g.level_of_cell(i) != 3) continue;
+            const Group r = ex->refine(g.cells[i], 3, static_cast<std::uint32_t>(refined), params);
+            if (r.mesh.empty()) continue;
+            ++refined;
+            ASSERT_TRUE(r.refinement);
+            expect_same_mesh(round_trip(r, cells_phantom()).mesh, r.mesh,
+                             "refinement " + std::to_string(refined));
+        }
+    EXPECT_GE(refined, 10);
+}
+
+// Every shared volume's groups at its README isovalues: 16-bit and 8-bit voxels, anisotropic
+// spacing, a heavy noisy surface and a fragmented one.
+TEST(RemoteCellCodec, EverySharedVolumeRoundTrips) {
+    const auto data = test::shared_data_dir();
+    if (!data) GTEST_SKIP() << "../shared/data is absent: the shared volumes are not checked";
+    const std::vector<std::pair<std::string, double>> cases{
+        {"tooth", 620},   {"tooth", 1000},      {"cthead", 600},       {"cthead", 1650},
+        {"engine", 75},   {"engine", 190},      {"heptane", 50},       {"heptane", 200},
+        {"mrhead_t1", 112}, {"mrhead_t1", 490}, {"vhp_ct_head", 40},   {"vhp_ct_head", 105}};
+    for (const auto& [name, iso] : cases) {
+        const Volume v = load_volume(*data / (name + ".nhdr"), std::nullopt);
+        std::size_t bytes_cells = 0, bytes_compact = 0, triangles = 0;
+        for (int level : {0, 2}) {
+            const auto groups = sample_groups(v, iso, 16, 2000, uniform_levels(level));
+            expect_round_trips(groups, v, name + " " + std::to_string(iso));
+            if (testing::Test::HasFailure()) return;
+            if (level != 0) continue;
+            for (const Group& g : groups) {
+                bytes_cells += encode_group(g, GroupEncoding::cells, 0, &v).size();
+                bytes_compact += encode_group(g, GroupEncoding::compact_zstd).size();
+                triangles += g.mesh.triangle_count();
+            }
+        }
+        std::printf("%s at %g: %zu triangles, cells %.2f B/triangle, compact+zstd %.2f\n",
+                    name.c_str(), iso, triangles, double(bytes_cells) / double(triangles),
+                    double(bytes_compact) / double(triangles));
+    }
+}
+
+TEST(RemoteCellCodec, AGroupWhoseMeshIsNotItsUnitsGoesAsCompact) {
+    Group g = sample_groups(cells_phantom(), kPhantomSkinIso, 4, 30).at(0);
+    g.mesh.indices.resize(g.mesh.indices.size() - 3);  // one triangle fewer than its cells make
+    EXPECT_EQ(encoding_of(encode_group(g, GroupEncoding::cells, 0, &cells_phantom())),
+              GroupEncoding::compact_zstd);
+    EXPECT_EQ(encoding_of(encode_group(g, GroupEncoding::cells)), GroupEncoding::compact_zstd)
+        << "no volume";
+}
+
+// ---- hostile bodies --------------------------------------------------------------------------
+
+const Group& cells_group() {
+    static const Group g = sample_groups(cells_phantom(), kPhantomSkinIso, 4, 30).at(0);
+    return g;
+}
+
+Bytes cells_body() {
+    return encode_cell_body(cells_group(), cells_phantom()).value();
+}
+
+Mesh decode_body(const Bytes& b) {
+    ByteReader r(b, "cells");
+    Mesh m = decode_cell_body(r, cells_group().iso);
+    r.finish();
+    return m;
+}
+
+TEST(RemoteCellCodecMalformed, EveryTruncationThrows) {
+    const Bytes body = cells_body();
+    expect_same_mesh(decode_body(body), cells_group().mesh, "the clean body");
+    for (std::size_t n = 0; n < body.size(); ++n)
+        EXPECT_THROW(decode_body(Bytes(body.begin(), body.begin() + long(n))), WireError)
+            << "cut to " << n << " of " << body.size();
+    Bytes longer = body;
+    longer.push_back(0);
+    EXPECT_THROW(decode_body(longer), WireError) << "a trailing byte";
+}
+
+TEST(RemoteCellCodecMalformed, SeededMutationsDecodeOrThrow) {
+    const Bytes clean = cells_body();
+    std::mt19937 rng(3434);
+    std::uniform_int_distribution<std::size_t> at(0, clean.size() - 1);
+    std::uniform_int_distribution<int> byte(0, 255), flips(1, 4);
+    int decoded = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        Bytes b = clean;
+        for (int k = flips(rng); k > 0; --k) b[at(rng)] = static_cast<std::uint8_t>(byte(rng));
+        try {
+            const Mesh m = decode_body(b);
+            ++decoded;
+            ASSERT_EQ(m.normals.size(), m.positions.size());
+            for (std::uint32_t i : m.indices) ASSERT_LT(i, m.vertex_count());
+            for (const auto& p : m.positions) ASSERT_TRUE(std::isfinite(p.x + p.y + p.z));
+            for (const auto& n : m.normals) ASSERT_TRUE(std::isfinite(n.x + n.y + n.z));
+        } catch (const WireError&) {
+        }
+    }
+    std::printf("%d of 4000 mutated bodies decoded (the rest threw WireError)\n", decoded);
+}
+
+// Offsets in the body: type u8 at 0, dims at 1, spacing at 13, bucket count at 25, the first
+// bucket's level at 26 and unit count at 27, the first gap at 31.
+TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocating) {
+    const Bytes clean = cells_body();
+    auto put_u32 = [](Bytes& b, std::size_t at, std::uint32_t v) {
+        std::memcpy(b.data() + at, &v, sizeof v);
+    };
+    auto expect_refused = [&](const Bytes& b, const std::string& what) {
+        const std::size_t largest =
+            test::largest_allocation_in([&] { EXPECT_THROW(decode_body(b), WireError) << what; });
+        // The box's brick directory (at most kMaxCellBoxVoxels / 64 entries) is the one thing
+        // sized before the values are read; nothing is sized from a count past the bytes.
+        EXPECT_LT(largest, std::size_t{1} << 21) << what;
+    };
+    for (std::uint32_t claim : {0xffffffffu, kMaxGroupTriangles, 1u << 20, 5000u}) {
+        Bytes b = clean;
+        put_u32(b, 27, claim);
+        expect_refused(b, "unit count " + std::to_string(claim));
+    }
+    for (std::uint32_t dim : {0u, 1u, 0x7fffffffu, 0x80000000u}) {
+        Bytes b = clean;
+        put_u32(b, 1, dim);
+        expect_refused(b, "dims.x " + std::to_string(dim));
+    }
+    {
+        Bytes b = clean;
+        b[0] = 200;
+        expect_refused(b, "voxel type 200");
+    }
+    {
+        Bytes b = clean;
+        b[26] = 40;
+        expect_refused(b, "level 40");
+    }
+    {
+        // A first gap past every unit of the volume: ten LEB128 bytes of 0xff, then 0x01.
+        Bytes b(clean.begin(), clean.begin() + 31);
+        for (int k = 0; k < 9; ++k) b.push_back(0xff);
+        b.push_back(0x01);
+        b.insert(b.end(), clean.begin() + 32, clean.end());
+        expect_refused(b, "a unit past the volume");
+    }
+    {
+        // Two units at opposite corners of a large volume: a box past the limit.
+        Bytes b(clean.begin(), clean.begin() + 25);
+        put_u32(b, 1, 1u << 12);
+        put_u32(b, 5, 1u << 12);
+        put_u32(b, 9, 1u << 12);
+        b.push_back(1);  // one bucket
+        b.push_back(0);  // level 0
+        const std::uint32_t two = 2;
+        b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&two),
+                 reinterpret_cast<const std::uint8_t*>(&two) + 4);
+        b.push_back(0);  // the unit at (0, 0, 0)
+        std::uint64_t gap = (std::uint64_t{4094} * 4095 + 4094) * 4095 + 4093;
+        while (gap >= 0x80) {
+            b.push_back(static_cast<std::uint8_t>(gap | 0x80));
+            gap >>= 7;
+        }
+        b.push_back(static_cast<std::uint8_t>(gap));
+        for (int k = 0; k < 64; ++k) b.push_back(7);
+        expect_refused(b, "units spread past the box limit");
+    }
+}
+
+}  // namespace
+}  // namespace isowall::remote
