@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "common/extract/edge_cache.h"
@@ -83,7 +84,7 @@ VoxelBox box_of(const std::vector<Unit>& units, glm::ivec3 dims) {
 // client's marching cubes reads, in the volume's coordinates and with the volume's dims, so the
 // client's arithmetic is the server's to the bit (marching_cubes.h: a bricked() view is read
 // through at() alone; a voxel never named reads as 0, and marching cubes reads only named ones).
-// The server keeps only the marks (`values` false).
+// Both sides fill it as values are sent, in the same order, and predict each from those known.
 template <class T>
 class BoxVoxels {
   public:
@@ -91,13 +92,12 @@ class BoxVoxels {
     static constexpr int kSide = 1 << kLog2;
     static constexpr std::size_t kBrick = kSide * kSide * kSide;
 
-    BoxVoxels(const VoxelBox& box, glm::ivec3 volume_dims, glm::vec3 spacing_, bool values)
-        : dims(volume_dims), spacing(spacing_), origin_(box.origin),
+    BoxVoxels(const VoxelBox& box, glm::ivec3 volume_dims, glm::vec3 spacing_)
+        : dims(volume_dims), spacing(spacing_), origin_(box.origin), size_(box.size),
           grid_((box.size + (kSide - 1)) >> kLog2),
           directory_(static_cast<std::size_t>(grid_.x) * static_cast<std::size_t>(grid_.y) *
                          static_cast<std::size_t>(grid_.z),
-                     kNone),
-          values_(values) {}
+                     kNone) {}
 
     // VolumeView's members as marching_cubes.h reads them; coordinates are the volume's.
     const T* data = nullptr;
@@ -118,16 +118,27 @@ class BoxVoxels {
         if (b == kNone) {
             b = static_cast<std::uint32_t>(marks_.size());
             marks_.push_back(0);
-            if (values_) voxels_.resize(voxels_.size() + kBrick);
+            known_.push_back(0);
+            voxels_.resize(voxels_.size() + kBrick);
         }
         const std::uint64_t bit = std::uint64_t{1} << inner(p);
         if (marks_[b] & bit) return false;
         marks_[b] |= bit;
         return true;
     }
+    // The value of the named voxel at p: known from now on.
     void set(glm::ivec3 p, T value) {
         p -= origin_;
-        voxels_[directory_[brick_of(p)] * kBrick + inner(p)] = value;
+        const std::uint32_t b = directory_[brick_of(p)];
+        voxels_[b * kBrick + inner(p)] = value;
+        known_[b] |= std::uint64_t{1} << inner(p);
+    }
+    bool known(glm::ivec3 p) const {
+        p -= origin_;
+        if (p.x < 0 || p.y < 0 || p.z < 0 || p.x >= size_.x || p.y >= size_.y || p.z >= size_.z)
+            return false;
+        const std::uint32_t b = directory_[brick_of(p)];
+        return b != kNone && (known_[b] >> inner(p) & 1) != 0;
     }
 
   private:
@@ -143,12 +154,11 @@ class BoxVoxels {
         constexpr int m = kSide - 1;
         return static_cast<std::size_t>((p.z & m) << (2 * kLog2) | (p.y & m) << kLog2 | (p.x & m));
     }
-    glm::ivec3 origin_;
+    glm::ivec3 origin_, size_;
     glm::ivec3 grid_;
     std::vector<std::uint32_t> directory_;
-    std::vector<std::uint64_t> marks_;
+    std::vector<std::uint64_t> marks_, known_;  // per brick: a bit per voxel named, known
     std::vector<T> voxels_;
-    bool values_;
 };
 
 // Which voxels of the box a phase names: each once, in increasing index, none an earlier phase
@@ -345,20 +355,75 @@ std::vector<Unit> get_units(ByteReader& r, glm::ivec3 dims) {
     return units;
 }
 
-// ---- voxel values as byte planes ---------------------------------------------------------------
+// ---- voxel values: predicted, the residuals as byte planes ------------------------------------
+
+// Integer voxels go as the difference to a prediction from the voxels already known (both sides
+// know the same ones at each step): the mean of the known face neighbours, else the value sent
+// just before. The difference is taken modulo 2^bits and zigzagged, so small ones of either sign
+// are small numbers and every value round-trips. Floating-point voxels go as they are.
+template <class T>
+T predict(const BoxVoxels<T>& held, glm::ivec3 p, T previous) {
+    if constexpr (!std::is_integral_v<T>) {
+        return T{};
+    } else {
+        std::int64_t sum = 0;
+        std::int64_t n = 0;
+        for (int a = 0; a < 3; ++a)
+            for (int d : {-1, 1}) {
+                glm::ivec3 q = p;
+                q[a] += d;
+                if (!held.known(q)) continue;
+                sum += static_cast<std::int64_t>(held.at(q.x, q.y, q.z));
+                ++n;
+            }
+        if (n == 0) return previous;
+        return static_cast<T>(sum >= 0 ? (sum + n / 2) / n : -((-sum + n / 2) / n));
+    }
+}
 
 template <class T>
-void put_values(ByteWriter& w, const VolumeView<T>& v, const VoxelBox& box,
+auto residual(T value, T predicted) {
+    if constexpr (!std::is_integral_v<T>) {
+        return value;
+    } else {
+        using U = std::make_unsigned_t<T>;
+        using S = std::make_signed_t<T>;
+        const auto d = static_cast<S>(static_cast<U>(static_cast<U>(value) - static_cast<U>(predicted)));
+        return static_cast<U>(static_cast<U>(static_cast<U>(d) << 1) ^
+                              static_cast<U>(d >> (8 * sizeof(T) - 1)));
+    }
+}
+
+template <class T, class R>
+T from_residual(R r, T predicted) {
+    if constexpr (!std::is_integral_v<T>) {
+        return r;
+    } else {
+        using U = std::make_unsigned_t<T>;
+        const auto d = static_cast<U>(static_cast<U>(r >> 1) ^ static_cast<U>(-static_cast<U>(r & 1)));
+        return static_cast<T>(static_cast<U>(static_cast<U>(predicted) + d));
+    }
+}
+
+template <class T>
+using Residual = decltype(residual(T{}, T{}));
+
+template <class T>
+void put_values(ByteWriter& w, BoxVoxels<T>& held, const VolumeView<T>& v, const VoxelBox& box,
                 const std::vector<std::uint32_t>& at) {
-    std::vector<T> values(at.size());
+    std::vector<Residual<T>> out(at.size());
+    T previous{};
     for (std::size_t i = 0; i < at.size(); ++i) {
         const glm::ivec3 p = box.origin + unlinear(at[i], box.size);
-        values[i] = v.at(p.x, p.y, p.z);
+        const T value = v.at(p.x, p.y, p.z);
+        out[i] = residual(value, predict(held, p, previous));
+        held.set(p, value);
+        previous = value;
     }
     std::vector<std::uint8_t> plane(at.size());
     for (std::size_t b = 0; b < sizeof(T); ++b) {
         for (std::size_t i = 0; i < at.size(); ++i)
-            plane[i] = reinterpret_cast<const std::uint8_t*>(&values[i])[b];
+            plane[i] = reinterpret_cast<const std::uint8_t*>(&out[i])[b];
         w.put_raw(std::span<const std::uint8_t>(plane));
     }
 }
@@ -367,14 +432,19 @@ template <class T>
 void get_values(ByteReader& r, BoxVoxels<T>& held, const VoxelBox& box,
                 const std::vector<std::uint32_t>& at) {
     r.need_elements(at.size(), sizeof(T), "voxel values");
-    std::vector<T> values(at.size());
+    std::vector<Residual<T>> in(at.size());
     for (std::size_t b = 0; b < sizeof(T); ++b) {
         const auto plane = r.get_span(at.size());
         for (std::size_t i = 0; i < at.size(); ++i)
-            reinterpret_cast<std::uint8_t*>(&values[i])[b] = plane[i];
+            reinterpret_cast<std::uint8_t*>(&in[i])[b] = plane[i];
     }
-    for (std::size_t i = 0; i < at.size(); ++i)
-        held.set(box.origin + unlinear(at[i], box.size), values[i]);
+    T previous{};
+    for (std::size_t i = 0; i < at.size(); ++i) {
+        const glm::ivec3 p = box.origin + unlinear(at[i], box.size);
+        const T value = from_residual(in[i], predict(held, p, previous));
+        held.set(p, value);
+        previous = value;
+    }
 }
 
 // ---- encoder and decoder, per voxel type -------------------------------------------------------
@@ -432,10 +502,10 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(h.dims[a]));
     for (int a = 0; a < 3; ++a) w.put(volume.spacing()[a]);
     put_units(w, *units, h.dims);
-    BoxVoxels<T> marks(box, h.dims, volume.spacing(), false);
-    PhaseVoxels<T> named(marks, box, nullptr);
+    BoxVoxels<T> sent(box, h.dims, volume.spacing());
+    PhaseVoxels<T> named(sent, box, nullptr);
     each_phase(h, named, *units,
-               [&](const std::vector<std::uint32_t>& at) { put_values(w, view, box, at); });
+               [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
     return w.take();
 }
 
@@ -449,7 +519,7 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     if (box.voxels() > kMaxCellBoxVoxels)
         r.fail("units: spread over " + std::to_string(box.voxels()) +
                " voxels, over the limit " + std::to_string(kMaxCellBoxVoxels));
-    BoxVoxels<T> held(box, dims, spacing, true);
+    BoxVoxels<T> held(box, dims, spacing);
     const Held<BoxVoxels<T>> h{held, dims, iso};
     PhaseVoxels<T> named(held, box, &r);
     each_phase(h, named, units,
