@@ -29,7 +29,9 @@ const Case kCases[] = {{"1 base", GroupEncoding::vertices, false, false},
                        {"2 indexed", GroupEncoding::indexed, false, false},
                        {"3 progressive LOD", GroupEncoding::indexed, true, false},
                        {"4 cached groups", GroupEncoding::indexed, true, true},
-                       {"5 compact+zstd", GroupEncoding::compact_zstd, true, true}};
+                       {"5 compact+zstd", GroupEncoding::compact_zstd, true, true},
+                       {"cells, new iso", GroupEncoding::cells, false, false},
+                       {"cells + LOD + cache", GroupEncoding::cells, true, true}};
 
 ClientHello hello_for(int port, GroupEncoding e) {
     ClientHello h;

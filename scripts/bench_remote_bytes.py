@@ -1,0 +1,115 @@
+#!/usr/bin/python3
+"""Bytes to C = 90% and 99% for a new isovalue with `isowall view` at its defaults (front view,
+800x600, no LOD, no cache), the `cells` encoding (the default since issue 34) against
+`compact-zstd` (the default before it), on every shared volume at its README isovalues.
+
+Usage: scripts/bench_remote_bytes.py [--isowall build/bin/isowall] [--data ../shared/data]
+                                     [--rate-mbps R] [--only NAME]
+
+One `isowall serve` on loopback holds every volume; each (volume, isovalue, encoding) is one
+`isowall view` run. Times are the client's wall clock (server and client share this machine's
+cores), bytes are what the protocol counted. Prints a Markdown table and one verdict line per row
+against issue 34's target: bytes to C = 99% at most 1/4 of compact-zstd's. Errors are one line on
+stderr and exit status 1; the server is always stopped.
+"""
+import argparse
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PROG = "bench_remote_bytes.py"
+# The README's suggested isovalues (../shared/data/README.md).
+CASES = [("vhp_ct_head", 40), ("vhp_ct_head", 105), ("cthead", 600), ("cthead", 1650),
+         ("mrhead_t1", 112), ("mrhead_t1", 490), ("engine", 75), ("engine", 190),
+         ("heptane", 50), ("heptane", 200), ("tooth", 620), ("tooth", 1000)]
+ENCODINGS = ["compact-zstd", "cells"]
+PORT = 7981
+
+
+def fail(msg):
+    print(f"{PROG}: error: {msg}", file=sys.stderr)
+    sys.exit(1)
+
+
+def start_server(isowall, data, names, rate):
+    args = [isowall, "serve", "--listen", f"127.0.0.1:{PORT}"]
+    for n in names:
+        args += ["--dataset", f"{n}={os.path.join(data, n + '.nhdr')}"]
+    if rate:
+        args += ["--rate-mbps", str(rate)]
+    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.time() + 300
+    for line in proc.stdout:
+        if "listening on" in line:
+            return proc
+        if time.time() > deadline:
+            break
+    proc.kill()
+    fail("isowall serve did not start listening")
+
+
+def view(isowall, name, iso, encoding):
+    out = subprocess.run(
+        [isowall, "view", "--connect", f"127.0.0.1:{PORT}", "--dataset", name, "--iso", str(iso),
+         "--encoding", encoding, "--out", f"/tmp/{PROG}-{name}-{iso}-{encoding}.png"],
+        capture_output=True, text=True, timeout=600)
+    if out.returncode != 0:
+        fail(f"isowall view {name} {iso} {encoding}: {out.stderr.strip()[-300:]}")
+    found = {}
+    for m in re.finditer(r"C >=\s+([\d.]+)%:\s+([\d.]+) s\s+(\d+) bytes", out.stdout):
+        found[float(m.group(1))] = (float(m.group(2)), int(m.group(3)))
+    tri = re.search(r"(\d+) triangles drawn", out.stdout)
+    if 90.0 not in found or 99.0 not in found or not tri:
+        fail(f"isowall view {name} {iso} {encoding}: no C figures in: {out.stdout[-300:]}")
+    return found, int(tri.group(1))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--isowall", default=os.path.join(ROOT, "build", "bin", "isowall"))
+    p.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
+    p.add_argument("--rate-mbps", type=float, default=0)
+    p.add_argument("--only", help="one volume's name")
+    a = p.parse_args()
+    cases = [c for c in CASES if not a.only or c[0] == a.only]
+    if not cases:
+        fail(f"--only: no volume named {a.only!r}")
+    names = sorted({n for n, _ in cases})
+    for n in names:
+        if not os.path.exists(os.path.join(a.data, n + ".nhdr")):
+            fail(f"--data: {os.path.join(a.data, n + '.nhdr')} does not exist")
+    server = start_server(a.isowall, a.data, names, a.rate_mbps)
+    rows = []
+    try:
+        for name, iso in cases:
+            got = {e: view(a.isowall, name, iso, e) for e in ENCODINGS}
+            rows.append((name, iso, got))
+    finally:
+        server.send_signal(signal.SIGINT)
+        try:
+            server.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+    rate = f"{a.rate_mbps:g} Mbit/s" if a.rate_mbps else "loopback, unpaced"
+    print(f"`isowall view` defaults (front view, 800x600, new isovalue), {rate}\n")
+    print("| volume | iso | triangles | compact-zstd bytes to C=99% | cells bytes to C=99% | ratio "
+          "| compact-zstd s to C=90% | cells s to C=90% | verdict (ratio <= 0.25) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    missed = 0
+    for name, iso, got in rows:
+        (c_found, tri), (n_found, _) = got["compact-zstd"], got["cells"]
+        ratio = n_found[99.0][1] / c_found[99.0][1]
+        ok = ratio <= 0.25
+        missed += 0 if ok else 1
+        print(f"| {name} | {iso} | {tri} | {c_found[99.0][1]} | {n_found[99.0][1]} | {ratio:.3f} "
+              f"| {c_found[90.0][0]:.3f} | {n_found[90.0][0]:.3f} | "
+              f"{'holds' if ok else 'MISSED'} |")
+    print(f"\n{len(rows) - missed} of {len(rows)} rows hold the 1/4 target")
+
+
+if __name__ == "__main__":
+    main()
