@@ -1,6 +1,7 @@
 #include "remote/cell_codec.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -119,6 +120,7 @@ class BoxVoxels {
             b = static_cast<std::uint32_t>(marks_.size());
             marks_.push_back(0);
             known_.push_back(0);
+            edges_.insert(edges_.end(), 3, 0);
             voxels_.resize(voxels_.size() + kBrick);
         }
         const std::uint64_t bit = std::uint64_t{1} << inner(p);
@@ -132,6 +134,15 @@ class BoxVoxels {
         const std::uint32_t b = directory_[brick_of(p)];
         voxels_[b * kBrick + inner(p)] = value;
         known_[b] |= std::uint64_t{1} << inner(p);
+    }
+    // True the first time it is asked of the cell edge from the named voxel pa along `axis`.
+    bool first_edge(glm::ivec3 pa, int axis) {
+        pa -= origin_;
+        std::uint64_t& bits = edges_[3 * directory_[brick_of(pa)] + static_cast<std::size_t>(axis)];
+        const std::uint64_t bit = std::uint64_t{1} << inner(pa);
+        if (bits & bit) return false;
+        bits |= bit;
+        return true;
     }
     bool known(glm::ivec3 p) const {
         p -= origin_;
@@ -158,6 +169,7 @@ class BoxVoxels {
     glm::ivec3 grid_;
     std::vector<std::uint32_t> directory_;
     std::vector<std::uint64_t> marks_, known_;  // per brick: a bit per voxel named, known
+    std::vector<std::uint64_t> edges_;          // per brick and axis: a bit per cell edge seen
     std::vector<T> voxels_;
 };
 
@@ -177,6 +189,7 @@ class PhaseVoxels {
             r_->fail("voxel values: more voxels named than the " +
                      std::to_string(r_->remaining()) + " bytes left hold");
     }
+    bool first_edge(glm::ivec3 pa, int axis) { return held_.first_edge(pa, axis); }
     // The voxels named since the last call, in increasing index.
     std::vector<std::uint32_t> take() {
         std::sort(fresh_.begin(), fresh_.end());
@@ -201,7 +214,10 @@ struct Held {
     void corners(const Unit& u, double c[8]) const { meta_cell_corners(view, u.base, u.level, c); }
 };
 
-bool crossed(const double c[8], int e, double iso) {
+// Each unit's corner values, read once phase 1's are in place.
+using Corners = std::vector<std::array<double, 8>>;
+
+bool crossed(const std::array<double, 8>& c, int e, double iso) {
     const auto& ends = mc::kEdgeCorners[static_cast<std::size_t>(e)];
     return (c[ends[0]] >= iso) != (c[ends[1]] >= iso);
 }
@@ -216,11 +232,12 @@ void phase_corners(const std::vector<Unit>& units, PhaseVoxels<T>& out) {
 
 // Phase 2: the inner voxels of each crossed edge of a meta-cell.
 template <class View, class T>
-void phase_edges(const Held<View>& h, const std::vector<Unit>& units, PhaseVoxels<T>& out) {
-    double c[8];
-    for (const Unit& u : units) {
+void phase_edges(const Held<View>& h, const std::vector<Unit>& units, const Corners& corners,
+                 PhaseVoxels<T>& out) {
+    for (std::size_t i = 0; i < units.size(); ++i) {
+        const Unit& u = units[i];
         if (u.level == 0) continue;
-        h.corners(u, c);
+        const auto& c = corners[i];
         for (int e = 0; e < 12; ++e) {
             if (!crossed(c, e, h.iso)) continue;
             glm::ivec3 p = edge_start(u.base, u.level, e);
@@ -234,17 +251,20 @@ void phase_edges(const Held<View>& h, const std::vector<Unit>& units, PhaseVoxel
 }
 
 // Phase 3: the six neighbours (inside the volume) of the two voxels that bracket each crossing,
-// which central differences read for the vertex's normal.
+// which central differences read for the vertex's normal. A cell edge is looked at once, not by
+// each of the four cells around it.
 template <class View, class T>
-void phase_gradients(const Held<View>& h, const std::vector<Unit>& units, PhaseVoxels<T>& out) {
-    double c[8];
-    for (const Unit& u : units) {
-        h.corners(u, c);
+void phase_gradients(const Held<View>& h, const std::vector<Unit>& units, const Corners& corners,
+                     PhaseVoxels<T>& out) {
+    for (std::size_t i = 0; i < units.size(); ++i) {
+        const Unit& u = units[i];
+        const auto& c = corners[i];
         for (int e = 0; e < 12; ++e) {
             if (!crossed(c, e, h.iso)) continue;
             const auto& ends = mc::kEdgeCorners[static_cast<std::size_t>(e)];
             const glm::ivec3 pa = edge_start(u.base, u.level, e);
             const int axis = mc::kEdgeAxis[static_cast<std::size_t>(e)];
+            if (u.level == 0 && !out.first_edge(pa, axis)) continue;
             const EdgeCrossing x =
                 edge_crossing(h.view, pa, axis, u.level, h.iso, c[ends[0]], c[ends[1]]);
             glm::ivec3 q = pa;
@@ -267,15 +287,19 @@ void phase_gradients(const Held<View>& h, const std::vector<Unit>& units, PhaseV
 
 // The three phases in order, naming voxels in `named`; `take` is called with each phase's voxels
 // (box indices) once the earlier phases' values are in place (the client reads them there).
+// Returns each unit's corner values.
 template <class View, class T, class Take>
-void each_phase(const Held<View>& h, PhaseVoxels<T>& named, const std::vector<Unit>& units,
-                Take&& take) {
+Corners each_phase(const Held<View>& h, PhaseVoxels<T>& named, const std::vector<Unit>& units,
+                   Take&& take) {
     phase_corners(units, named);
     take(named.take());
-    phase_edges(h, units, named);
+    Corners corners(units.size());
+    for (std::size_t i = 0; i < units.size(); ++i) h.corners(units[i], corners[i].data());
+    phase_edges(h, units, corners, named);
     take(named.take());
-    phase_gradients(h, units, named);
+    phase_gradients(h, units, corners, named);
     take(named.take());
+    return corners;
 }
 
 // ---- units on the wire -----------------------------------------------------------------------
@@ -522,14 +546,14 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     BoxVoxels<T> held(box, dims, spacing);
     const Held<BoxVoxels<T>> h{held, dims, iso};
     PhaseVoxels<T> named(held, box, &r);
-    each_phase(h, named, units,
-               [&](const std::vector<std::uint32_t>& at) { get_values(r, held, box, at); });
+    const Corners corners = each_phase(
+        h, named, units,
+        [&](const std::vector<std::uint32_t>& at) { get_values(r, held, box, at); });
+    std::vector<int> cases(units.size());
     std::size_t triangles = 0;
-    double c[8];
-    for (const Unit& u : units) {
-        h.corners(u, c);
-        triangles += static_cast<std::size_t>(
-            mc::kTriangleCount[static_cast<std::size_t>(cell_case(c, iso))]);
+    for (std::size_t i = 0; i < units.size(); ++i) {
+        cases[i] = cell_case(corners[i].data(), iso);
+        triangles += static_cast<std::size_t>(mc::kTriangleCount[static_cast<std::size_t>(cases[i])]);
     }
     if (triangles > kMaxGroupTriangles)
         r.fail("units: " + std::to_string(triangles) + " triangles, over the limit " +
@@ -537,10 +561,9 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     Mesh mesh;
     mesh.indices.reserve(3 * triangles);
     HashEdgeCache cache(dims, 2 * units.size());
-    for (const Unit& u : units) {
-        h.corners(u, c);
-        emit_meta_cell(held, u.base, u.level, iso, cell_case(c, iso), c, cache, mesh);
-    }
+    for (std::size_t i = 0; i < units.size(); ++i)
+        emit_meta_cell(held, units[i].base, units[i].level, iso, cases[i], corners[i].data(), cache,
+                       mesh);
     return mesh;
 }
 
