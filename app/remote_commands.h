@@ -45,7 +45,7 @@ struct ViewCommand {
     bool tls = false;    // --tls: TLS, the server's certificate checked against the system's CAs
     std::string tls_ca;  // --tls-ca: TLS, trusting the authorities in this PEM file
     int test_case = 0;   // 1-5: the study's cases; 0: the options below
-    std::string encoding = "cells";
+    std::string encoding = "auto";
     bool lod = false, cache = false;
     std::optional<double> iso;
     std::string size = "800x600";

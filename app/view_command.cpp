@@ -35,6 +35,7 @@ constexpr CaseSetting kCases[] = {
     {GroupEncoding::compact_zstd, true, true}};  // 5 ours: compact + zstd
 
 GroupEncoding parse_encoding(const std::string& s) {
+    if (s == "auto") return GroupEncoding::cells;  // and the hello asks the server to choose
     for (GroupEncoding e : kAllGroupEncodings) {
         std::string name = to_string(e);
         for (char& ch : name)
@@ -42,7 +43,8 @@ GroupEncoding parse_encoding(const std::string& s) {
         if (name == s) return e;
     }
     throw InputError("--encoding", "value",
-                     "expected vertices, indexed, compact, compact-zstd or cells, got " + quote(s));
+                     "expected auto, vertices, indexed, compact, compact-zstd or cells, got " +
+                         quote(s));
 }
 
 struct Viewer {
@@ -157,9 +159,11 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
                   "below)")
         ->check(CLI::Range(1, 5));
     c->add_option("--encoding", o.encoding,
-                  "How groups travel: vertices, indexed, compact, compact-zstd, or cells (the "
-                  "units and the voxel values marching cubes needs; the client triangulates)")
-        ->check(CLI::IsMember({"vertices", "indexed", "compact", "compact-zstd", "cells"}))
+                  "How groups travel: auto (the server sends each group as cells or "
+                  "compact-zstd, whichever its link and CPU bring sooner), vertices, indexed, "
+                  "compact, compact-zstd, or cells (the units and the voxel values marching "
+                  "cubes needs; the client triangulates)")
+        ->check(CLI::IsMember({"auto", "vertices", "indexed", "compact", "compact-zstd", "cells"}))
         ->capture_default_str();
     c->add_flag("--lod", o.lod, "Progressive LOD: two coarser LOD levels first");
     c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");
@@ -271,6 +275,7 @@ int run_view(const ViewCommand& o) {
     if (o.tls || !o.tls_ca.empty())
         hello.tls = std::make_shared<const TlsContext>(TlsContext::client(o.tls_ca));
     hello.encoding = setting.encoding;
+    hello.adaptive = o.test_case == 0 && o.encoding == "auto";
     hello.connect_timeout_s = o.timeout_s;  // connecting and the hello's answer too (once 10 s)
     hello.role = !o.present.empty()  ? SessionRole::presenter
                  : !o.follow.empty() ? SessionRole::follower
@@ -279,7 +284,9 @@ int run_view(const ViewCommand& o) {
     ViewClient client(*renderer, hello);
     std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
                 o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
-                to_string(setting.encoding), setting.lod ? ", progressive LOD" : "",
+                hello.adaptive ? "auto (cells or compact+zstd per group)"
+                               : to_string(setting.encoding),
+                setting.lod ? ", progressive LOD" : "",
                 setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
     if (!o.follow.empty()) return follow_session(o, client, v);

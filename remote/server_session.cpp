@@ -7,6 +7,7 @@
 #include <glm/matrix.hpp>
 
 #include "common/core/ray.h"
+#include "common/core/util.h"
 #include "remote/view_framing.h"
 
 namespace isowall::remote {
@@ -49,12 +50,21 @@ class ServerSession::Sink final : public GroupSink {
         m.key = g.key();
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
+        const bool adaptive = s_.options_.adaptive;
+        const GroupEncoding e = adaptive ? s_.chooser_.next() : s_.options_.encoding;
+        const Stopwatch encoding;
         const std::vector<std::uint8_t> bytes =
-            encode_group(g, s_.options_.encoding, s_.grid_step_, &s_.prototype_.volume());
+            encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
+        const GroupEncoding went = encoding_of(bytes);  // cells may fall back to compact+zstd
+        if (adaptive)
+            s_.chooser_.encoded(went, g.mesh.triangle_count(), bytes.size(), encoding.seconds());
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
-        f_.bytes += s_.send_(m);
+        const Stopwatch sending;
+        const std::size_t sent = s_.send_(m);
+        if (adaptive) s_.chooser_.sent(went, sent, sending.seconds());
+        f_.bytes += sent;
         ++f_.groups;
         f_.triangles += g.mesh.triangle_count();
         if (s_.cache_gen_ == 0) return;

@@ -35,6 +35,7 @@
 
 #include "common/extract/surface_extractor.h"
 #include "engine/progressive_engine.h"
+#include "remote/encoding_choice.h"
 #include "remote/group_codec.h"
 #include "remote/view_protocol.h"
 
@@ -43,6 +44,9 @@ namespace isowall::remote {
 struct SessionOptions {
     EngineOptions engine;  // ray order, intersection, propagation; levels are set per level
     GroupEncoding encoding = GroupEncoding::compact_zstd;
+    // The server chooses cells or compact+zstd per group (remote/encoding_choice.h); `encoding`
+    // is then ignored.
+    bool adaptive = false;
     int lod_levels = 2;  // coarse levels of progressive LOD before the full resolution
     // Rays of each coarse level, as a share of the view's pixels (the text: 0.1% - 1%). Whole
     // levels of the ray order are cast, so a level may take up to about 4x this.
@@ -88,6 +92,7 @@ class ServerSession {
     const SurfaceExtractor& prototype_;
     SessionOptions options_;
     SendMessage send_;
+    EncodingChooser chooser_;  // options_.adaptive: which encoding each group goes in
     std::vector<std::unique_ptr<LodLevel>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;

@@ -1,5 +1,6 @@
 #include "remote/view_client.h"
 
+#include "remote/encoding_choice.h"
 #include "remote/net/endpoint.h"
 #include "remote/net/socket.h"
 
@@ -14,7 +15,7 @@ ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(rende
     HelloMsg hello;
     hello.dataset = h.dataset;
     hello.token = h.token;
-    hello.encoding = static_cast<std::uint8_t>(h.encoding);
+    hello.encoding = h.adaptive ? kAdaptiveEncoding : static_cast<std::uint8_t>(h.encoding);
     hello.role = h.role;
     hello.session = h.session;
     conn_->send(hello);

@@ -20,6 +20,9 @@ struct ClientHello {
     // TLS with this client context (the authorities trusted); null: plain TCP.
     std::shared_ptr<const TlsContext> tls;
     GroupEncoding encoding = GroupEncoding::compact_zstd;
+    // The server chooses cells or compact+zstd per group for the link it sees
+    // (remote/encoding_choice.h); `encoding` is then not sent.
+    bool adaptive = false;
     double connect_timeout_s = 10;
     // A shared session (remote/shared_session.h): present it, or follow it; none: a view of
     // one's own.

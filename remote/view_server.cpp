@@ -115,14 +115,16 @@ class ViewServer::Client {
             refuse(ErrorCode::bad_token, "hello: token: wrong token");
             return nullptr;
         }
-        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::cells)) {
+        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::cells) &&
+            h->encoding != kAdaptiveEncoding) {
             refuse(ErrorCode::malformed,
                    "hello: encoding: unknown group encoding " + std::to_string(h->encoding));
             return nullptr;
         }
         for (const Dataset& d : server_.datasets_)
             if (d.name == h->dataset) {
-                encoding_ = static_cast<GroupEncoding>(h->encoding);
+                adaptive_ = h->encoding == kAdaptiveEncoding;
+                encoding_ = adaptive_ ? GroupEncoding::cells : static_cast<GroupEncoding>(h->encoding);
                 if (h->role == SessionRole::none) return &d;
                 std::string why;
                 seat_ = server_.hub_.join(*h, conn_.peer(), why);
@@ -173,6 +175,7 @@ class ViewServer::Client {
         say("serve: %s: dataset %s%s\n", d.name);
         SessionOptions so = server_.options_.session;
         so.encoding = encoding_;
+        so.adaptive = adaptive_;
         session_ =
             std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
                 touch();             // the client's silence counts from the send's start
@@ -323,6 +326,7 @@ class ViewServer::Client {
     std::uint64_t status_seen_ = 0;
     std::atomic<bool> worker_done_{false};
     GroupEncoding encoding_ = GroupEncoding::compact_zstd;
+    bool adaptive_ = false;  // the hello asked the server to choose (kAdaptiveEncoding)
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
     NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes

@@ -1,0 +1,73 @@
+#include "remote/encoding_choice.h"
+
+#include <algorithm>
+
+namespace isowall::remote {
+namespace {
+
+// A send shorter than this did not wait for the link: its bytes went into buffers.
+constexpr double kBlockedS = 50e-6;
+
+void blend(double& mean, double sample, std::uint64_t samples) {
+    const double alpha = samples <= 1 ? 1.0 : 1.0 / EncodingChooser::kWindow;
+    mean += alpha * (sample - mean);
+}
+
+}  // namespace
+
+double EncodingChooser::bytes_per_s(GroupEncoding e) const {
+    const Estimate& s = slot(e);
+    return s.blocked_s > 0 ? s.sent_bytes / s.blocked_s : 0;
+}
+
+double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
+    const Estimate& s = slot(e);
+    if (s.groups == 0) return 0;
+    const double rate = bytes_per_s(e);
+    return s.seconds_per_triangle + (rate > 0 ? s.bytes_per_triangle / rate : 0);
+}
+
+GroupEncoding EncodingChooser::best() const {
+    // Unmeasured: cells first (fewer bytes on a link not yet seen), then compact once.
+    if (cells_.groups == 0) return GroupEncoding::cells;
+    if (compact_.groups == 0) return GroupEncoding::compact_zstd;
+    return cost_per_triangle(GroupEncoding::cells) <= cost_per_triangle(GroupEncoding::compact_zstd)
+               ? GroupEncoding::cells
+               : GroupEncoding::compact_zstd;
+}
+
+GroupEncoding EncodingChooser::next() {
+    const GroupEncoding b = best();
+    const GroupEncoding other =
+        b == GroupEncoding::cells ? GroupEncoding::compact_zstd : GroupEncoding::cells;
+    if (slot(other).groups == 0) return b;  // still measuring the first of each
+    const double mine = cost_per_triangle(b), theirs = cost_per_triangle(other);
+    const double dearer = mine > 0 ? std::clamp(theirs / mine, 1.0, 8.0) : 8.0;
+    if (++since_explored_ < static_cast<std::uint64_t>(static_cast<double>(kExploreEvery) * dearer))
+        return b;
+    since_explored_ = 0;
+    return other;
+}
+
+void EncodingChooser::encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes,
+                              double seconds) {
+    if (triangles == 0) return;
+    Estimate& s = slot(e);
+    ++s.groups;
+    const auto t = static_cast<double>(triangles);
+    blend(s.seconds_per_triangle, seconds / t, s.groups);
+    blend(s.bytes_per_triangle, static_cast<double>(bytes) / t, s.groups);
+}
+
+void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {
+    // Decayed sums: the recent sends weigh most, so a link that changes is followed.
+    constexpr double keep = 1.0 - 1.0 / (4 * kWindow);
+    Estimate& s = slot(e);
+    s.sent_bytes *= keep;
+    s.blocked_s *= keep;
+    if (seconds < kBlockedS) return;
+    s.sent_bytes += static_cast<double>(bytes);
+    s.blocked_s += seconds;
+}
+
+}  // namespace isowall::remote

@@ -1,0 +1,63 @@
+#pragma once
+// Which encoding a server sends the next group in, when the client lets it choose (issue 34; the
+// dissertation's 5.2.3: tune compression to whichever of server and network is the bottleneck).
+// `cells` sends about a quarter of compact+zstd's bytes and costs several times its CPU a
+// triangle; which brings the picture sooner depends on the link. The chooser keeps, for each of
+// the two, a running mean of the server's seconds a triangle (encoding) and of bytes a triangle,
+// and the rate its sends went at: bytes over the seconds the sends blocked. A group goes in the
+// encoding whose seconds a triangle plus bytes a triangle over that rate is the smaller. The rate
+// is kept per encoding because a send blocks for whichever is slower, the link or the client
+// taking the bytes: a client decoding cells (it runs marching cubes) takes their bytes more
+// slowly than compact+zstd's, and on a fast link that is what the server sees. While sends
+// return at once (buffers absorb them), bytes cost no time and the cheaper encoding wins.
+// The client's decoding is seen only through the sends: on a link slower than the client it does
+// not count, which is right, as the link is then the bottleneck. A group in the encoding not
+// chosen goes out every kExploreEvery groups times how many times dearer it was (at most 8x), so
+// both estimates follow the surface and the machine without a slow link paying much for the
+// exploring. Pure: no clock, no I/O; the session measures and reports.
+#include <cstddef>
+#include <cstdint>
+
+#include "remote/group_codec.h"
+
+namespace isowall::remote {
+
+// The hello's encoding value for "the server chooses per group" (not a codec's id).
+inline constexpr std::uint8_t kAdaptiveEncoding = 255;
+
+class EncodingChooser {
+  public:
+    static constexpr std::uint64_t kExploreEvery = 16;
+    // Running means weigh the last this many groups most (exponential, alpha = 1 / kWindow).
+    static constexpr double kWindow = 16;
+
+    // The encoding for the next group.
+    GroupEncoding next();
+    // What a group cost: its triangles, the bytes it encoded to and the server's seconds for it.
+    void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds);
+    // One send of a group in `e`: its bytes on the wire and the seconds the call blocked.
+    void sent(GroupEncoding e, std::size_t bytes, double seconds);
+
+    // Seconds a triangle costs in `e` at the rate seen; 0 until `e` was measured.
+    double cost_per_triangle(GroupEncoding e) const;
+    // Bytes a second the sends of `e` went at while they blocked; 0 while none has blocked.
+    double bytes_per_s(GroupEncoding e) const;
+    std::uint64_t chosen(GroupEncoding e) const { return slot(e).groups; }
+
+  private:
+    struct Estimate {
+        double seconds_per_triangle = 0, bytes_per_triangle = 0;
+        std::uint64_t groups = 0;
+        double sent_bytes = 0, blocked_s = 0;  // decayed sums over the recent sends
+    };
+    Estimate& slot(GroupEncoding e) { return e == GroupEncoding::cells ? cells_ : compact_; }
+    const Estimate& slot(GroupEncoding e) const {
+        return e == GroupEncoding::cells ? cells_ : compact_;
+    }
+    GroupEncoding best() const;
+
+    Estimate cells_, compact_;
+    std::uint64_t since_explored_ = 0;
+};
+
+}  // namespace isowall::remote

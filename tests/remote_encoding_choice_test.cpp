@@ -1,0 +1,79 @@
+// Issue 34's adaptive server (remote/encoding_choice.h): which encoding the chooser picks for a
+// fast link, a slow one, and a client that takes cells more slowly than the link could, and how
+// rarely it explores the dearer one. Pure: the costs are fed in, as a session measures them.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "remote/encoding_choice.h"
+
+namespace isowall::remote {
+namespace {
+
+// One group of 2000 triangles: cells 1.2 B and 0.35 us a triangle to encode, compact+zstd 6.5 B
+// and 0.13 us (the codec benchmark's figures on the shared head). A send of n bytes blocks for
+// n / rate seconds (rate 0: never blocks).
+struct Link {
+    double cells_rate = 0, compact_rate = 0;
+};
+
+std::uint64_t run(EncodingChooser& c, const Link& link, int groups) {
+    std::uint64_t cells = 0;
+    for (int i = 0; i < groups; ++i) {
+        const GroupEncoding e = c.next();
+        const bool is_cells = e == GroupEncoding::cells;
+        cells += is_cells ? 1 : 0;
+        const std::size_t bytes = is_cells ? 2400 : 13000;
+        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6));
+        const double rate = is_cells ? link.cells_rate : link.compact_rate;
+        c.sent(e, bytes, rate > 0 ? double(bytes) / rate : 0);
+    }
+    return cells;
+}
+
+TEST(EncodingChoice, AFastLinkGetsTheCheaperEncodingASlowOneTheSmaller) {
+    EncodingChooser fast;
+    const auto fast_cells = run(fast, {}, 400);
+    EncodingChooser slow;
+    const auto slow_cells = run(slow, {125e3, 125e3}, 400);  // 1 Mbit/s
+    std::printf("cells chosen for 400 groups: %llu on a link that never blocks, %llu at 1 Mbit/s\n",
+                (unsigned long long)fast_cells, (unsigned long long)slow_cells);
+    EXPECT_LT(fast_cells, 400u / 8);
+    EXPECT_GT(slow_cells, 400u - 400u / 8);
+    EXPECT_GT(fast.cost_per_triangle(GroupEncoding::cells),
+              fast.cost_per_triangle(GroupEncoding::compact_zstd));
+    EXPECT_NEAR(slow.bytes_per_s(GroupEncoding::cells), 125e3, 1.0);
+}
+
+TEST(EncodingChoice, AClientSlowAtCellsIsSeenThroughItsSends) {
+    // 100 Mbit/s, but the client takes cells' bytes at 3 MB/s (its marching cubes): compact wins.
+    EncodingChooser c;
+    const auto cells = run(c, {3e6, 12.5e6}, 400);
+    EXPECT_LT(cells, 400u / 8);
+    // The same client on a 10 Mbit/s link: the link is the bottleneck, cells win.
+    EncodingChooser ten;
+    EXPECT_GT(run(ten, {1.25e6, 1.25e6}, 400), 400u - 400u / 8);
+}
+
+TEST(EncodingChoice, ExploresTheOtherRarelyButAlways) {
+    EncodingChooser c;
+    const auto cells = run(c, {125e3, 125e3}, 1000);
+    const std::uint64_t compact = 1000 - cells;
+    // Compact is about 5x dearer at 1 Mbit/s: explored every 16 x 5 = 80 groups or so.
+    std::printf("1000 groups at 1 Mbit/s: %llu sent as compact+zstd\n", (unsigned long long)compact);
+    EXPECT_GE(compact, 5u);
+    EXPECT_LE(compact, 1000u / 40);
+    EXPECT_EQ(c.chosen(GroupEncoding::compact_zstd), compact);
+}
+
+TEST(EncodingChoice, ALinkThatSlowsDownIsFollowed) {
+    EncodingChooser c;
+    run(c, {}, 200);  // fast: compact
+    const auto cells = run(c, {125e3, 125e3}, 400);
+    std::printf("after the link fell to 1 Mbit/s: %llu of 400 groups as cells\n",
+                (unsigned long long)cells);
+    EXPECT_GT(cells, 300u);
+}
+
+}  // namespace
+}  // namespace isowall::remote
