@@ -1,5 +1,5 @@
 // Harness: the group decoder (remote/group_codec.h). The bytes are one encoded group, in any of
-// the four encodings (the second byte picks it). A group that decodes must be drawable: every
+// the five encodings (the second byte picks it). A group that decodes must be drawable: every
 // index below the vertex count, every float finite, at most kMaxGroupTriangles triangles. It is
 // then encoded again in its own encoding and decoded again:
 //   vertices, indexed          the bytes come back exactly, and so does the decoded group;
@@ -111,6 +111,9 @@ void check_group(std::span<const std::uint8_t> bytes) {
     const Group g = decode_group(bytes);
     check_drawable(g);
     const GroupEncoding encoding = encoding_of(bytes);
+    // cells: its round trips need the volume (tests/remote_cell_codec_test.cpp); here the decoded
+    // mesh must be drawable, and the body's own harness (cell_body) explores it past zstd.
+    if (encoding == GroupEncoding::cells) return;
     if (encoding == GroupEncoding::compact || encoding == GroupEncoding::compact_zstd) {
         check_compact_round_trip(g, encoding);
         return;

@@ -18,7 +18,7 @@ HARNESSES=("$@")
 # library is one InputError, not a finding. A finding is then anything that escapes the child:
 # a crash, hang or leak of the reading process itself. Coverage guidance stops at the fork, so
 # these two check the boundary on mutations of their corpus rather than explore the libraries.
-[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd store wall script wire view_protocol group_codec wall_page nifti metaimage tiff dicom hdf5)
+[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd store wall script wire view_protocol group_codec cell_body wall_page nifti metaimage tiff dicom hdf5)
 BUILD=${ISOWALL_FUZZ_BUILD_DIR:-build-fuzz}
 
 cmake -S . -B "$BUILD" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \

@@ -115,9 +115,16 @@ test('every truncation and trailing byte is an error naming the group', () => {
   for (const name of readdirSync(dir)) {
     const b = read(dir, name);
     for (let n = 0; n < b.length; ++n) assert.throws(() => decodeGroup(b.subarray(0, n)), /^WireError: group: /, `${name} cut at ${n}`);
-    if (!name.startsWith('compact_zstd'))
+    if (!name.startsWith('compact_zstd') && !name.startsWith('cells'))
       assert.throws(() => decodeGroup(new Uint8Array([...b, 0])), /group: 1 trailing bytes/, name);
   }
+});
+
+// The page asks for compact+zstd (its hello), never for cells, which needs marching cubes on the
+// client (issue 34: not in the page yet); a cells group is refused by name, not misread.
+test('a cells group is refused by its encoding', () => {
+  for (const name of readdirSync(dir).filter((n) => n.startsWith('cells')))
+    assert.throws(() => decodeGroup(read(dir, name)), /group: encoding: expected 0..3, got 4/, name);
 });
 
 test('fields are checked and named', () => {
