@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 
@@ -52,11 +53,15 @@ bool complete(const Unit& u, glm::ivec3 dims) {
 
 // Sorted by level, then by index in that level's grid of units: the order both sides triangulate.
 void sort_units(std::vector<Unit>& units, glm::ivec3 dims) {
-    std::sort(units.begin(), units.end(), [dims](const Unit& a, const Unit& b) {
-        if (a.level != b.level) return a.level < b.level;
-        return linear(a.base >> a.level, unit_grid(dims, a.level)) <
-               linear(b.base >> b.level, unit_grid(dims, b.level));
-    });
+    std::vector<std::tuple<int, std::uint64_t, std::size_t>> keys(units.size());
+    for (std::size_t i = 0; i < units.size(); ++i) {
+        const Unit& u = units[i];
+        keys[i] = {u.level, linear(u.base >> u.level, unit_grid(dims, u.level)), i};
+    }
+    std::sort(keys.begin(), keys.end());
+    std::vector<Unit> sorted(units.size());
+    for (std::size_t i = 0; i < keys.size(); ++i) sorted[i] = units[std::get<2>(keys[i])];
+    units = std::move(sorted);
 }
 
 // ---- the voxels a side holds -----------------------------------------------------------------
@@ -144,12 +149,15 @@ class BoxVoxels {
         bits |= bit;
         return true;
     }
-    bool known(glm::ivec3 p) const {
+    // The value at p when it is known (set), through one directory lookup.
+    bool known(glm::ivec3 p, T& value) const {
         p -= origin_;
         if (p.x < 0 || p.y < 0 || p.z < 0 || p.x >= size_.x || p.y >= size_.y || p.z >= size_.z)
             return false;
         const std::uint32_t b = directory_[brick_of(p)];
-        return b != kNone && (known_[b] >> inner(p) & 1) != 0;
+        if (b == kNone || (known_[b] >> inner(p) & 1) == 0) return false;
+        value = voxels_[b * kBrick + inner(p)];
+        return true;
     }
 
   private:
@@ -396,8 +404,9 @@ T predict(const BoxVoxels<T>& held, glm::ivec3 p, T previous) {
             for (int d : {-1, 1}) {
                 glm::ivec3 q = p;
                 q[a] += d;
-                if (!held.known(q)) continue;
-                sum += static_cast<std::int64_t>(held.at(q.x, q.y, q.z));
+                T value;
+                if (!held.known(q, value)) continue;
+                sum += static_cast<std::int64_t>(value);
                 ++n;
             }
         if (n == 0) return previous;

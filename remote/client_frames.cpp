@@ -83,6 +83,9 @@ void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, doubl
     if (!current) return;
     now_.bytes += wire_bytes;
     ++now_.groups;
+    if (g.encoded.size() > 1 &&
+        g.encoded[1] == std::byte{static_cast<std::uint8_t>(GroupEncoding::cells)})
+        ++now_.cells;
     if (!g.draw_from_next_frame) draw(mesh, g.key.level);
     sample(now_s, false);
 }
