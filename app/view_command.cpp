@@ -42,9 +42,9 @@ GroupEncoding parse_encoding(const std::string& s) {
             if (ch == '_' || ch == '+') ch = '-';
         if (name == s) return e;
     }
-    throw InputError("--encoding", "value",
-                     "expected auto, vertices, indexed, compact, compact-zstd or cells, got " +
-                         quote(s));
+    throw InputError(
+        "--encoding", "value",
+        "expected auto, vertices, indexed, compact, compact-zstd or cells, got " + quote(s));
 }
 
 struct Viewer {
@@ -70,8 +70,8 @@ struct Viewer {
             "view: frame %d done in %.3f s: %llu bytes, %llu groups (%llu as cells), %llu named, "
             "%llu triangles drawn\n",
             frames, last.time_s, (unsigned long long)last.bytes, (unsigned long long)last.groups,
-            (unsigned long long)last.cells,
-            (unsigned long long)last.named, (unsigned long long)last.triangles);
+            (unsigned long long)last.cells, (unsigned long long)last.named,
+            (unsigned long long)last.triangles);
         for (double th : {0.90, 0.99, 0.999, 1.0}) {
             const ClientSample* hit = nullptr;
             for (const ClientSample& s : r.timeline)
@@ -283,12 +283,11 @@ int run_view(const ViewCommand& o) {
                                      : SessionRole::none;
     hello.session = !o.present.empty() ? o.present : o.follow;
     ViewClient client(*renderer, hello);
-    std::printf("view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
-                o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
-                hello.adaptive ? "auto (cells or compact+zstd per group)"
-                               : to_string(setting.encoding),
-                setting.lod ? ", progressive LOD" : "",
-                setting.cache ? ", cached groups" : "");
+    std::printf(
+        "view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
+        o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
+        hello.adaptive ? "auto (cells or compact+zstd per group)" : to_string(setting.encoding),
+        setting.lod ? ", progressive LOD" : "", setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
     if (!o.follow.empty()) return follow_session(o, client, v);
     const float aspect = float(size->x) / float(size->y);

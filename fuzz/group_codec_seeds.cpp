@@ -7,8 +7,8 @@
 // Run: fuzz_group_codec_seeds fuzz/corpus/group_codec fuzz/corpus/cell_body (the files there are
 // its output, committed).
 #include <algorithm>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>

@@ -54,7 +54,8 @@ Row measure(const std::vector<Group>& groups, GroupEncoding e, const Volume& vol
     Row row{e};
     std::vector<std::vector<std::uint8_t>> encoded(groups.size());
     row.encode_ms = best_ms([&] {
-        for (std::size_t i = 0; i < groups.size(); ++i) encoded[i] = encode_group(groups[i], e, 0, &volume);
+        for (std::size_t i = 0; i < groups.size(); ++i)
+            encoded[i] = encode_group(groups[i], e, 0, &volume);
         keep(encoded);
     });
     for (const auto& b : encoded) {

@@ -2,7 +2,8 @@
 find_package(meshoptimizer REQUIRED)
 # PkgConfig::ZSTD: found in common/CMakeLists.txt (the stores use it too).
 
-add_library(isowall_remote_codec group_codec.cpp compact_mesh.cpp cell_codec.cpp encoding_choice.cpp)
+add_library(isowall_remote_codec group_codec.cpp compact_mesh.cpp cell_codec.cpp cell_units.cpp
+    encoding_choice.cpp)
 target_include_directories(isowall_remote_codec PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_codec
     PUBLIC isowall_core isowall_extract

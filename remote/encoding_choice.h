@@ -24,6 +24,15 @@ namespace isowall::remote {
 
 // The hello's encoding value for "the server chooses per group" (not a codec's id).
 inline constexpr std::uint8_t kAdaptiveEncoding = 255;
+// A hello may ask for a codec's id or kAdaptiveEncoding.
+inline bool known_hello_encoding(std::uint8_t e) {
+    return e <= static_cast<std::uint8_t>(GroupEncoding::cells) || e == kAdaptiveEncoding;
+}
+// What a known hello encoding means for a session: one encoding, or the chooser's.
+inline void apply_hello_encoding(std::uint8_t e, GroupEncoding& encoding, bool& adaptive) {
+    adaptive = e == kAdaptiveEncoding;
+    encoding = adaptive ? GroupEncoding::cells : static_cast<GroupEncoding>(e);
+}
 
 class EncodingChooser {
   public:

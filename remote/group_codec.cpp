@@ -216,8 +216,8 @@ float position_grid_step(float extent) {
     return std::exp2(std::ceil(std::log2(double{extent} / 65534.0)));
 }
 
-std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
-                                       float grid_step, const Volume* volume) {
+std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding, float grid_step,
+                                       const Volume* volume) {
     check_encodable(group);
     if (encoding == GroupEncoding::cells) {
         const auto body = volume ? encode_cell_body(group, *volume) : std::nullopt;

@@ -115,16 +115,14 @@ class ViewServer::Client {
             refuse(ErrorCode::bad_token, "hello: token: wrong token");
             return nullptr;
         }
-        if (h->encoding > static_cast<std::uint8_t>(GroupEncoding::cells) &&
-            h->encoding != kAdaptiveEncoding) {
+        if (!known_hello_encoding(h->encoding)) {
             refuse(ErrorCode::malformed,
                    "hello: encoding: unknown group encoding " + std::to_string(h->encoding));
             return nullptr;
         }
         for (const Dataset& d : server_.datasets_)
             if (d.name == h->dataset) {
-                adaptive_ = h->encoding == kAdaptiveEncoding;
-                encoding_ = adaptive_ ? GroupEncoding::cells : static_cast<GroupEncoding>(h->encoding);
+                hello_encoding_ = h->encoding;
                 if (h->role == SessionRole::none) return &d;
                 std::string why;
                 seat_ = server_.hub_.join(*h, conn_.peer(), why);
@@ -174,8 +172,7 @@ class ViewServer::Client {
         if (server_.options_.rate_bits_per_s > 0) conn_.set_rate(server_.options_.rate_bits_per_s);
         say("serve: %s: dataset %s%s\n", d.name);
         SessionOptions so = server_.options_.session;
-        so.encoding = encoding_;
-        so.adaptive = adaptive_;
+        apply_hello_encoding(hello_encoding_, so.encoding, so.adaptive);
         session_ =
             std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
                 touch();             // the client's silence counts from the send's start
@@ -325,8 +322,7 @@ class ViewServer::Client {
     std::unique_ptr<SessionSeat> seat_;  // in a shared session
     std::uint64_t status_seen_ = 0;
     std::atomic<bool> worker_done_{false};
-    GroupEncoding encoding_ = GroupEncoding::compact_zstd;
-    bool adaptive_ = false;  // the hello asked the server to choose (kAdaptiveEncoding)
+    std::uint8_t hello_encoding_ = 0;  // what the hello asked for (apply_hello_encoding)
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
     NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes

@@ -60,7 +60,8 @@ TEST(EncodingChoice, ExploresTheOtherRarelyButAlways) {
     const auto cells = run(c, {125e3, 125e3}, 1000);
     const std::uint64_t compact = 1000 - cells;
     // Compact is about 5x dearer at 1 Mbit/s: explored every 16 x 5 = 80 groups or so.
-    std::printf("1000 groups at 1 Mbit/s: %llu sent as compact+zstd\n", (unsigned long long)compact);
+    std::printf("1000 groups at 1 Mbit/s: %llu sent as compact+zstd\n",
+                (unsigned long long)compact);
     EXPECT_GE(compact, 5u);
     EXPECT_LE(compact, 1000u / 40);
     EXPECT_EQ(c.chosen(GroupEncoding::compact_zstd), compact);

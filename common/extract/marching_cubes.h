@@ -200,8 +200,8 @@ inline double crossing_fraction(double iso, double va, double vb) {
 }
 
 template <class View>
-inline EdgeCrossing edge_crossing(const View& v, glm::ivec3 pa, int axis, int level,
-                                  double iso, double va, double vb) {
+inline EdgeCrossing edge_crossing(const View& v, glm::ivec3 pa, int axis, int level, double iso,
+                                  double va, double vb) {
     EdgeCrossing best;
     best.frac = static_cast<float>(crossing_fraction(iso, va, vb));
     if (level == 0) return best;
