@@ -44,7 +44,7 @@ struct ViewCommand {
     std::string token;
     bool tls = false;    // --tls: TLS, the server's certificate checked against the system's CAs
     std::string tls_ca;  // --tls-ca: TLS, trusting the authorities in this PEM file
-    int test_case = 0;   // 1-5: the study's cases; 0: the options below
+    int test_case = 0;   // 1-7: the study's cases; 0: the options below
     std::string encoding = "auto";
     bool lod = false, cache = false;
     std::optional<double> iso;

@@ -26,13 +26,16 @@ using namespace remote;
 struct CaseSetting {
     GroupEncoding encoding;
     bool lod, cache;
+    bool adaptive = false;  // the server chooses cells or compact+zstd per group
 };
 constexpr CaseSetting kCases[] = {
-    {GroupEncoding::vertices, false, false},     // 1 base
-    {GroupEncoding::indexed, false, false},      // 2 primitive compression
-    {GroupEncoding::indexed, true, false},       // 3 + progressive LOD
-    {GroupEncoding::indexed, true, true},        // 4 + cached primitives
-    {GroupEncoding::compact_zstd, true, true}};  // 5 ours: compact + zstd
+    {GroupEncoding::vertices, false, false},    // 1 base
+    {GroupEncoding::indexed, false, false},     // 2 primitive compression
+    {GroupEncoding::indexed, true, false},      // 3 + progressive LOD
+    {GroupEncoding::indexed, true, true},       // 4 + cached primitives
+    {GroupEncoding::compact_zstd, true, true},  // 5 ours: compact + zstd
+    {GroupEncoding::cells, true, true},         // 6 issue 34: cells
+    {GroupEncoding::cells, true, true, true}};  // 7 issue 34: the server chooses (auto)
 
 GroupEncoding parse_encoding(const std::string& s) {
     if (s == "auto") return GroupEncoding::cells;  // and the hello asks the server to choose
@@ -156,9 +159,9 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
                   "server certificate may be its own)");
     c->add_option("--case", o.test_case,
                   "The study's cases: 1 base, 2 indexed, 3 indexed + progressive LOD, 4 indexed "
-                  "+ LOD + cache, 5 compact+zstd + LOD + cache (overrides the three options "
-                  "below)")
-        ->check(CLI::Range(1, 5));
+                  "+ LOD + cache, 5 compact+zstd + LOD + cache, 6 cells + LOD + cache, 7 auto + "
+                  "LOD + cache (overrides the three options below)")
+        ->check(CLI::Range(1, 7));
     c->add_option("--encoding", o.encoding,
                   "How groups travel: auto (the server sends each group as cells or "
                   "compact-zstd, whichever its link and CPU bring sooner), vertices, indexed, "
@@ -264,7 +267,7 @@ int run_view(const ViewCommand& o) {
     std::vector<ScriptLine> script;
     if (!o.script.empty()) script = load_script(o.script);
     const Endpoint ep = parse_endpoint(o.connect, "--connect", "HOST:PORT");
-    CaseSetting setting{parse_encoding(o.encoding), o.lod, o.cache};
+    CaseSetting setting{parse_encoding(o.encoding), o.lod, o.cache, o.encoding == "auto"};
     if (o.test_case > 0) setting = kCases[o.test_case - 1];
 
     auto renderer = make_renderer(o.gl);
@@ -276,7 +279,7 @@ int run_view(const ViewCommand& o) {
     if (o.tls || !o.tls_ca.empty())
         hello.tls = std::make_shared<const TlsContext>(TlsContext::client(o.tls_ca));
     hello.encoding = setting.encoding;
-    hello.adaptive = o.test_case == 0 && o.encoding == "auto";
+    hello.adaptive = setting.adaptive;
     hello.connect_timeout_s = o.timeout_s;  // connecting and the hello's answer too (once 10 s)
     hello.role = !o.present.empty()  ? SessionRole::presenter
                  : !o.follow.empty() ? SessionRole::follower

@@ -13,7 +13,8 @@ one `isowall view --case K` against it:
   1 base (separate vertices), 2 indexed face sets, 3 + progressive LOD: a new isovalue, the
   front view; 4 + cached groups: the front view, then the view turned by --turn degrees, which
   is measured; 5 ours (quantised, index-coded, zstd + LOD + cache), measured as 4 (its first
-  frame is also reported, as "5 new").
+  frame is also reported, as "5 new"); 6 as 5 in the cells encoding of issue 34, and 7 as 5 with
+  the server choosing cells or compact+zstd per group (view --encoding auto), both measured as 5.
 Times are the client's wall clock from sending the request (server and client share this
 machine's two cores). Each case runs once at each rate: every figure is from 1 run, no median.
 Writes study.json, study.md (the tables, beside the text's, with the targets of issue 12),
@@ -48,7 +49,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PROG = "remote_study.py"
 THRESHOLDS = [0.90, 0.99, 0.999, 1.0]
 CASE_NAMES = {"1": "1 base", "2": "2 indexed", "3": "3 + LOD", "4": "4 + cache",
-              "5new": "5 ours, new iso", "5": "5 ours + cache"}
+              "5new": "5 ours, new iso", "5": "5 ours + cache",
+              "6new": "6 cells, new iso", "6": "6 cells + cache",
+              "7new": "7 auto, new iso", "7": "7 auto + cache"}
+# The cases measured twice: the front view at a new isovalue, then the turned view from the cache.
+CACHED = ("4", "5", "6", "7")
 
 # The dissertation's Tables 4.1-4.4 (rows C = 90, 99, 99.9, 100%; columns cases 1-4).
 TEXT_BYTES = {"1": [16.7e6, 24.2e6, 24.3e6, 24.3e6], "2": [4.0e6, 6.4e6, 6.4e6, 6.4e6],
@@ -65,7 +70,8 @@ TEXT_DIMS = (256, 256, 209)  # the text's Visible Woman head
 # The text's cases each of ours is judged against, the smallest of them at each C: case 5 with
 # cache shows the turned view of case 4; a new isovalue in our encoding against the text's best
 # for a new isovalue.
-AGAINST = {"1": ["1"], "2": ["2"], "3": ["3"], "4": ["4"], "5": ["4"], "5new": ["1", "2", "3"]}
+AGAINST = {"1": ["1"], "2": ["2"], "3": ["3"], "4": ["4"], "5": ["4"], "5new": ["1", "2", "3"],
+           "6": ["4"], "6new": ["1", "2", "3"], "7": ["4"], "7new": ["1", "2", "3"]}
 
 
 class StudyError(Exception):
@@ -180,7 +186,7 @@ def run_case(a, port, rate, case, out_dir):
            "--size", a.size, "-o", png, "--timeline", csv_path, "--timeout", "600"]
     cmd += ["--dataset", "phantom"] if a.volume == "phantom" else ["--dataset", "study"]
     cmd += ["--iso", str(a.iso)]
-    if case in ("4", "5"):
+    if case in CACHED:
         script = os.path.join(out_dir, "turn.txt")
         with open(script, "w") as f:
             f.write(f"wait done\norbit {a.turn} 0\nwait done\n")
@@ -188,10 +194,10 @@ def run_case(a, port, rate, case, out_dir):
     run(cmd, f"isowall view --case {case} at {rate} Mbit/s")
     frames = read_frames(csv_path)
     results = {}
-    if case in ("4", "5"):
+    if case in CACHED:
         results[case] = summarise(frames[max(frames)])
-        if case == "5":
-            results["5new"] = summarise(frames[min(frames)])
+        if case != "4":
+            results[case + "new"] = summarise(frames[min(frames)])
     else:
         results[case] = summarise(frames[min(frames)])
     return results
@@ -353,9 +359,9 @@ def parse_args(argv):
     if not a.rates or min(a.rates) <= 0:
         raise StudyError(f"--rates: each rate must be above 0 Mbit/s, got {a.rates}")
     a.cases = a.cases.split(",")
-    bad = [c for c in a.cases if c not in ("1", "2", "3", "4", "5")]
+    bad = [c for c in a.cases if c not in ("1", "2", "3", "4", "5", "6", "7")]
     if bad:
-        raise StudyError(f"--cases: expected cases among 1..5, got {','.join(bad)}")
+        raise StudyError(f"--cases: expected cases among 1..7, got {','.join(bad)}")
     if not os.access(a.isowall, os.X_OK):
         raise StudyError(f"--isowall: {a.isowall} is not an executable (build first)")
     if a.volume is None:
@@ -385,7 +391,7 @@ def main(argv):
                       f"({time.monotonic() - t0:.0f} s run)", flush=True)
         finally:
             server.stop()
-    cols = [c for c in ["1", "2", "3", "4", "5new", "5"]
+    cols = [c for c in ["1", "2", "3", "4", "5new", "5", "6new", "6", "7new", "7"]
             if any(c in res[str(r)] for r in a.rates)]
     lines = [f"Volume {a.volume}, iso {a.iso:g}, {a.size}, turn {a.turn:g} degrees for 4 and 5.",
              ""] + report(res, a.rates, cols, dims)
