@@ -11,18 +11,14 @@
 #include <span>
 
 #include "fuzz/fuzz_check.h"
+#include "fuzz/fuzz_mesh.h"
 #include "remote/cell_codec.h"
 #include "remote/group_codec.h"
 
 namespace {
 
-using isowall::fuzz::check;
 using namespace isowall;
 using namespace isowall::remote;
-
-bool finite(glm::vec3 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 void check_body(std::span<const std::uint8_t> bytes) {
     double iso = 0;
@@ -32,12 +28,7 @@ void check_body(std::span<const std::uint8_t> bytes) {
     ByteReader r(bytes.subspan(sizeof iso), "cells");
     const Mesh m = decode_cell_body(r, iso);
     r.finish();
-    check(m.normals.size() == m.positions.size(), "one normal a position");
-    check(m.indices.size() % 3 == 0, "three indices a triangle");
-    check(m.triangle_count() <= kMaxGroupTriangles, "at most kMaxGroupTriangles triangles");
-    for (std::uint32_t i : m.indices) check(i < m.vertex_count(), "every index < vertex count");
-    for (const glm::vec3& p : m.positions) check(finite(p), "every position is finite");
-    for (const glm::vec3& n : m.normals) check(finite(n), "every normal is finite");
+    isowall::fuzz::check_drawable_mesh(m);
 }
 
 }  // namespace

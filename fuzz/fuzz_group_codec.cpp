@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "fuzz/fuzz_check.h"
+#include "fuzz/fuzz_mesh.h"
 #include "remote/group_codec.h"
 
 namespace {
@@ -26,19 +27,9 @@ using isowall::fuzz::check;
 using namespace isowall;
 using namespace isowall::remote;
 
-bool finite(glm::vec3 v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 void check_drawable(const Group& g) {
-    const Mesh& m = g.mesh;
     check(std::isfinite(g.iso), "iso is finite");
-    check(m.normals.size() == m.positions.size(), "one normal a position");
-    check(m.indices.size() % 3 == 0, "three indices a triangle");
-    check(m.triangle_count() <= kMaxGroupTriangles, "at most kMaxGroupTriangles triangles");
-    for (std::uint32_t i : m.indices) check(i < m.vertex_count(), "every index < vertex count");
-    for (const glm::vec3& p : m.positions) check(finite(p), "every position is finite");
-    for (const glm::vec3& n : m.normals) check(finite(n), "every normal is finite");
+    isowall::fuzz::check_drawable_mesh(g.mesh);
 }
 
 bool same_header(const Group& a, const Group& b) {
