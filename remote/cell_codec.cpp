@@ -5,6 +5,7 @@
 
 #include "common/extract/edge_cache.h"
 #include "remote/cell_voxels.h"
+#include "remote/group_codec.h"
 
 namespace isowall::remote {
 namespace {

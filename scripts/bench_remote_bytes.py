@@ -5,11 +5,12 @@ issue 34), `cells` and `auto` (the default since: the server picks cells or comp
 for the link it sees), on every shared volume at its README isovalues.
 
 Usage: scripts/bench_remote_bytes.py [--isowall build/bin/isowall] [--data ../shared/data]
-                                     [--rate-mbps R] [--only NAME]
+                                     [--rate-mbps R] [--only NAME] [--pin]
 
 One `isowall serve` on loopback holds every volume; each (volume, isovalue, encoding) is one
 `isowall view` run. Times are the client's wall clock (server and client share this machine's
-cores), bytes are what the protocol counted. Prints a Markdown table and one verdict line per row
+cores, or with --pin the server on CPU 0 and the client on CPU 1, as on two machines with a core
+each), bytes are what the protocol counted. Prints a Markdown table and one verdict line per row
 against issue 34's target: bytes to C = 99% of cells at most 1/4 of compact-zstd's. Errors are one line on
 stderr and exit status 1; the server is always stopped.
 """
@@ -36,13 +37,18 @@ def fail(msg):
     sys.exit(1)
 
 
-def start_server(isowall, data, names, rate):
+def pinned(cpu, args):
+    return ["taskset", "-c", str(cpu)] + args if cpu is not None else args
+
+
+def start_server(isowall, data, names, rate, cpu):
     args = [isowall, "serve", "--listen", f"127.0.0.1:{PORT}"]
     for n in names:
         args += ["--dataset", f"{n}={os.path.join(data, n + '.nhdr')}"]
     if rate:
         args += ["--rate-mbps", str(rate)]
-    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.Popen(pinned(cpu, args), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
     deadline = time.time() + 300
     for line in proc.stdout:
         if "listening on" in line:
@@ -53,10 +59,11 @@ def start_server(isowall, data, names, rate):
     fail("isowall serve did not start listening")
 
 
-def view(isowall, name, iso, encoding):
+def view(isowall, name, iso, encoding, cpu):
     out = subprocess.run(
-        [isowall, "view", "--connect", f"127.0.0.1:{PORT}", "--dataset", name, "--iso", str(iso),
-         "--encoding", encoding, "--out", f"/tmp/{PROG}-{name}-{iso}-{encoding}.png"],
+        pinned(cpu, [isowall, "view", "--connect", f"127.0.0.1:{PORT}", "--dataset", name,
+                     "--iso", str(iso), "--encoding", encoding,
+                     "--out", f"/tmp/{PROG}-{name}-{iso}-{encoding}.png"]),
         capture_output=True, text=True, timeout=600)
     if out.returncode != 0:
         fail(f"isowall view {name} {iso} {encoding}: {out.stderr.strip()[-300:]}")
@@ -76,6 +83,8 @@ def main():
     p.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
     p.add_argument("--rate-mbps", type=float, default=0)
     p.add_argument("--only", help="one volume's name")
+    p.add_argument("--pin", action="store_true",
+                   help="the server on CPU 0, each client on CPU 1 (taskset)")
     a = p.parse_args()
     cases = [c for c in CASES if not a.only or c[0] == a.only]
     if not cases:
@@ -84,11 +93,11 @@ def main():
     for n in names:
         if not os.path.exists(os.path.join(a.data, n + ".nhdr")):
             fail(f"--data: {os.path.join(a.data, n + '.nhdr')} does not exist")
-    server = start_server(a.isowall, a.data, names, a.rate_mbps)
+    server = start_server(a.isowall, a.data, names, a.rate_mbps, 0 if a.pin else None)
     rows = []
     try:
         for name, iso in cases:
-            got = {e: view(a.isowall, name, iso, e) for e in ENCODINGS}
+            got = {e: view(a.isowall, name, iso, e, 1 if a.pin else None) for e in ENCODINGS}
             rows.append((name, iso, got))
     finally:
         server.send_signal(signal.SIGINT)
@@ -97,6 +106,7 @@ def main():
         except subprocess.TimeoutExpired:
             server.kill()
     rate = f"{a.rate_mbps:g} Mbit/s" if a.rate_mbps else "loopback, unpaced"
+    rate += ", server on CPU 0 and client on CPU 1" if a.pin else ""
     print(f"`isowall view` (front view, 800x600, new isovalue), {rate}; bytes to C = 99% and "
           f"seconds to C = 90% for each --encoding (auto is the default)\n")
     print("| volume | iso | triangles | " +
