@@ -247,27 +247,32 @@ Corners each_phase(const Held<View>& h, PhaseVoxels<T>& named, const std::vector
 // ---- voxel values: predicted, the residuals as byte planes ------------------------------------
 
 // Integer voxels go as the difference to a prediction from the voxels already known (both sides
-// know the same ones at each step): the mean of the known face neighbours, else the value sent
-// just before. The difference is taken modulo 2^bits and zigzagged, so small ones of either sign
-// are small numbers and every value round-trips. Floating-point voxels go as they are.
+// know the same ones at each step): the mean of the known face neighbours at the nearest of 1, 2
+// and 4 voxels that has any, else the value sent just before. The difference is taken modulo
+// 2^bits and zigzagged, so small ones of either sign are small numbers and every value
+// round-trips. Floating-point voxels go as they are.
 template <class T>
 T predict(const BoxVoxels<T>& held, glm::ivec3 p, T previous) {
     if constexpr (!std::is_integral_v<T>) {
         return T{};
     } else {
-        std::int64_t sum = 0;
-        std::int64_t n = 0;
-        for (int a = 0; a < 3; ++a)
-            for (int d : {-1, 1}) {
-                glm::ivec3 q = p;
-                q[a] += d;
-                T value;
-                if (!held.known(q, value)) continue;
-                sum += static_cast<std::int64_t>(value);
-                ++n;
-            }
-        if (n == 0) return previous;
-        return static_cast<T>(sum >= 0 ? (sum + n / 2) / n : -((-sum + n / 2) / n));
+        // The nearest ring that holds a known voxel: 1 voxel away, else 2, else 4 (a coarse
+        // level's corners lie 2^level apart, and their neighbours there are its other corners).
+        for (int step = 1; step <= 4; step *= 2) {
+            std::int64_t sum = 0;
+            std::int64_t n = 0;
+            for (int a = 0; a < 3; ++a)
+                for (int d : {-step, step}) {
+                    glm::ivec3 q = p;
+                    q[a] += d;
+                    T value;
+                    if (!held.known(q, value)) continue;
+                    sum += static_cast<std::int64_t>(value);
+                    ++n;
+                }
+            if (n > 0) return static_cast<T>(sum >= 0 ? (sum + n / 2) / n : -((-sum + n / 2) / n));
+        }
+        return previous;
     }
 }
 

@@ -227,7 +227,13 @@ std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encodin
         w.put(static_cast<std::uint8_t>(encoding));
         put_header(w, group);
         put_zstd(w, *body);
-        return w.take();
+        std::vector<std::uint8_t> cells = w.take();
+        // A coarse pass's corners lie 2^level apart, where neighbours predict them poorly: cells
+        // may then be the larger (on cthead's meta-cells of 4, 8.8 bytes a triangle against 6.7).
+        if (group.level == 0 || group.refinement) return cells;
+        std::vector<std::uint8_t> compact =
+            encode_group(group, GroupEncoding::compact_zstd, grid_step);
+        return compact.size() < cells.size() ? compact : cells;
     }
     if (encoding == GroupEncoding::compact_zstd) {
         const auto compact = encode_group(group, GroupEncoding::compact, grid_step);

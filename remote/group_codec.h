@@ -73,8 +73,9 @@ inline constexpr std::uint64_t kMaxZstdExpansion = 64;
 inline constexpr double kOctNormalMaxErrorDeg = 0.01;
 
 // `volume` (cells): the volume the group was extracted from. A group `cells` cannot carry (see
-// remote/cell_codec.h), or any group when `volume` is null, goes as compact_zstd instead: the
-// encoding byte of the result says which.
+// remote/cell_codec.h), or any group when `volume` is null, goes as compact_zstd instead, and so
+// does a coarse pass (level >= 1) whose compact_zstd bytes are fewer: the encoding byte of the
+// result says which.
 // grid_step (compact encodings): 0 quantises each group in its own box, so a vertex two groups
 // share may decode to two points a quantum apart, and a pixel may see through the crack between
 // them. A step > 0 (a power of two, at least the whole volume's extent / 65534, see
