@@ -1,10 +1,13 @@
 #include "remote/cell_codec.h"
 
+#include <array>
 #include <cmath>
+#include <span>
 #include <string>
 
 #include "common/extract/edge_cache.h"
 #include "remote/cell_voxels.h"
+#include "remote/compact_mesh.h"
 #include "remote/group_codec.h"
 
 namespace isowall::remote {
@@ -13,6 +16,46 @@ namespace {
 using namespace cells;
 
 constexpr std::uint32_t kMaxUnits = kMaxGroupTriangles;
+
+// How a body's normals travel (its `normals` byte).
+enum class Normals : std::uint8_t { gradients = 0, octahedral = 1 };
+
+// A unit normal as two bytes: the octahedral code of compact_mesh.h, kept to 8 bits a coordinate
+// (about half a degree).
+std::array<std::int8_t, 2> oct8(glm::vec3 n) {
+    const auto c = oct_encode(n);
+    return {static_cast<std::int8_t>(std::lround(c[0] * 127.0 / 32767.0)),
+            static_cast<std::int8_t>(std::lround(c[1] * 127.0 / 32767.0))};
+}
+
+glm::vec3 from_oct8(std::int8_t a, std::int8_t b) {
+    return oct_decode({static_cast<std::int16_t>(std::lround(a * 32767.0 / 127.0)),
+                       static_cast<std::int16_t>(std::lround(b * 32767.0 / 127.0))});
+}
+
+// The units' triangles, as both sides emit them: the same order, the same vertex per edge.
+template <class View>
+Mesh triangulate(const View& v, const std::vector<Unit>& units, const Corners& corners,
+                 const std::vector<int>& cases, double iso, std::size_t triangles) {
+    Mesh mesh;
+    mesh.indices.reserve(3 * triangles);
+    HashEdgeCache cache(v.dims, 2 * units.size());
+    for (std::size_t i = 0; i < units.size(); ++i)
+        emit_meta_cell(v, units[i].base, units[i].level, iso, cases[i], corners[i].data(), cache,
+                       mesh);
+    return mesh;
+}
+
+std::vector<int> cases_of(const Corners& corners, double iso, std::size_t& triangles) {
+    std::vector<int> cases(corners.size());
+    triangles = 0;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+        cases[i] = cell_case(corners[i].data(), iso);
+        triangles +=
+            static_cast<std::size_t>(mc::kTriangleCount[static_cast<std::size_t>(cases[i])]);
+    }
+    return cases;
+}
 
 // ---- encoder and decoder, per voxel type -------------------------------------------------------
 
@@ -63,20 +106,38 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     if (triangles != g.mesh.triangle_count()) return std::nullopt;
     const VoxelBox box = box_of(*units, h.dims);
     if (box.voxels() > kMaxCellBoxVoxels) return std::nullopt;
+    // A coarse pass's vertices lie 2^level apart, so their gradients share few voxels: its
+    // normals go as such (it is drawn only until the full resolution replaces it).
+    const Normals normals =
+        g.level >= 1 && !g.refinement ? Normals::octahedral : Normals::gradients;
     ByteWriter w;
     w.put(static_cast<std::uint8_t>(volume.type()));
     for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(h.dims[a]));
     for (int a = 0; a < 3; ++a) w.put(volume.spacing()[a]);
+    w.put(static_cast<std::uint8_t>(normals));
     put_units(w, *units, h.dims);
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
     PhaseVoxels<T> named(sent, box, nullptr);
-    each_phase(h, named, *units,
-               [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
+    const Corners corners = each_phase(
+        h, named, *units, normals == Normals::gradients,
+        [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
+    if (normals == Normals::octahedral) {
+        const std::vector<int> cases = cases_of(corners, g.iso, triangles);
+        const Mesh m = triangulate(view, *units, corners, cases, g.iso, triangles);
+        std::vector<std::int8_t> a(m.vertex_count()), b(m.vertex_count());
+        for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+            const auto code = oct8(m.normals[i]);
+            a[i] = code[0];
+            b[i] = code[1];
+        }
+        w.put_raw(std::span<const std::int8_t>(a));
+        w.put_raw(std::span<const std::int8_t>(b));
+    }
     return w.take();
 }
 
 template <class T>
-Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
+Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso, Normals normals,
                   const std::vector<Unit>& units, T) {
     // Every unit's corners are voxels no other phase sends, and each voxel is a corner of at
     // most eight units: the values of at least one voxel a unit must follow.
@@ -88,25 +149,24 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     BoxVoxels<T> held(box, dims, spacing);
     const Held<BoxVoxels<T>> h{held, dims, iso};
     PhaseVoxels<T> named(held, box, &r);
-    const Corners corners = each_phase(h, named, units, [&](const std::vector<std::uint32_t>& at) {
-        get_values(r, held, box, at);
-    });
-    std::vector<int> cases(units.size());
+    const Corners corners =
+        each_phase(h, named, units, normals == Normals::gradients,
+                   [&](const std::vector<std::uint32_t>& at) { get_values(r, held, box, at); });
     std::size_t triangles = 0;
-    for (std::size_t i = 0; i < units.size(); ++i) {
-        cases[i] = cell_case(corners[i].data(), iso);
-        triangles +=
-            static_cast<std::size_t>(mc::kTriangleCount[static_cast<std::size_t>(cases[i])]);
-    }
+    const std::vector<int> cases = cases_of(corners, iso, triangles);
     if (triangles > kMaxGroupTriangles)
         r.fail("units: " + std::to_string(triangles) + " triangles, over the limit " +
                std::to_string(kMaxGroupTriangles));
-    Mesh mesh;
-    mesh.indices.reserve(3 * triangles);
-    HashEdgeCache cache(dims, 2 * units.size());
-    for (std::size_t i = 0; i < units.size(); ++i)
-        emit_meta_cell(held, units[i].base, units[i].level, iso, cases[i], corners[i].data(), cache,
-                       mesh);
+    // Without the gradients' voxels the normals emitted are placeholders, replaced below.
+    Mesh mesh = triangulate(held, units, corners, cases, iso, triangles);
+    if (normals == Normals::octahedral) {
+        r.need_elements(mesh.vertex_count(), 2, "octahedral normals");
+        const auto a = r.get_span(mesh.vertex_count());
+        const auto b = r.get_span(mesh.vertex_count());
+        for (std::size_t i = 0; i < mesh.vertex_count(); ++i)
+            mesh.normals[i] =
+                from_oct8(static_cast<std::int8_t>(a[i]), static_cast<std::int8_t>(b[i]));
+    }
     return mesh;
 }
 
@@ -137,9 +197,12 @@ Mesh decode_cell_body(ByteReader& r, double iso) {
         if (!(spacing[a] > 0) || !std::isfinite(spacing[a]))
             r.fail("spacing: expected a positive finite number, got " + std::to_string(spacing[a]));
     }
+    const auto normals = r.get<std::uint8_t>();
+    if (normals > static_cast<std::uint8_t>(Normals::octahedral))
+        r.fail("normals: expected 0 (gradients) or 1 (octahedral), got " + std::to_string(normals));
     const std::vector<Unit> units = get_units(r, dims, kMaxUnits);
     return dispatch_voxel_type(static_cast<VoxelType>(type), [&](auto t) {
-        return decode_typed(r, dims, spacing, iso, units, t);
+        return decode_typed(r, dims, spacing, iso, static_cast<Normals>(normals), units, t);
     });
 }
 

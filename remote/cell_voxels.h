@@ -227,18 +227,19 @@ void phase_gradients(const Held<View>& h, const std::vector<Unit>& units, const 
     }
 }
 
-// The three phases in order, naming voxels in `named`; `take` is called with each phase's voxels
-// (box indices) once the earlier phases' values are in place (the client reads them there).
-// Returns each unit's corner values.
+// The three phases in order (the third only with `gradients`), naming voxels in `named`; `take`
+// is called with each phase's voxels (box indices) once the earlier phases' values are in place
+// (the client reads them there). Returns each unit's corner values.
 template <class View, class T, class Take>
 Corners each_phase(const Held<View>& h, PhaseVoxels<T>& named, const std::vector<Unit>& units,
-                   Take&& take) {
+                   bool gradients, Take&& take) {
     phase_corners(units, named);
     take(named.take());
     Corners corners(units.size());
     for (std::size_t i = 0; i < units.size(); ++i) h.corners(units[i], corners[i].data());
     phase_edges(h, units, corners, named);
     take(named.take());
+    if (!gradients) return corners;  // the normals travel as such (cell_codec.h)
     phase_gradients(h, units, corners, named);
     take(named.take());
     return corners;

@@ -40,13 +40,14 @@ const Volume& cells_phantom() {
 using Corner = std::array<float, 6>;
 using Triangle = std::array<Corner, 3>;
 
-std::vector<Triangle> triangles_of(const Mesh& m) {
+// with_normals false: the normals left out (0).
+std::vector<Triangle> triangles_of(const Mesh& m, bool with_normals = true) {
     std::vector<Triangle> out;
     for (std::size_t t = 0; t < m.indices.size(); t += 3) {
         Triangle tri;
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t i = m.indices[t + static_cast<std::size_t>(k)];
-            const glm::vec3 p = m.positions[i], n = m.normals[i];
+            const glm::vec3 p = m.positions[i], n = with_normals ? m.normals[i] : glm::vec3(0);
             tri[static_cast<std::size_t>(k)] = {p.x, p.y, p.z, n.x, n.y, n.z};
         }
         const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
@@ -57,16 +58,41 @@ std::vector<Triangle> triangles_of(const Mesh& m) {
     return out;
 }
 
-// `got` has the triangles of `want`, corner by corner, with the same winding, positions and
-// normals to the bit: the client runs the server's arithmetic on the server's voxel values.
-void expect_same_mesh(const Mesh& got, const Mesh& want, const std::string& what) {
+// In doubles and through atan2: acos of a float dot product alone errs near 0.
+double normal_angle_deg(glm::vec3 a, glm::vec3 b) {
+    const glm::dvec3 da(a), db(b);
+    return std::atan2(glm::length(glm::cross(da, db)), glm::dot(da, db)) * 180.0 / M_PI;
+}
+
+// `got` has the triangles of `want`, corner by corner, with the same winding and positions to the
+// bit: the client runs the server's arithmetic on the server's voxel values. Normals: to the bit
+// too when normal_tol_deg is 0 (full resolution: from the voxels), else within that angle of
+// the normal of a server vertex at the same place (a coarse pass: octahedral, 8 bits a
+// coordinate).
+void expect_same_mesh(const Mesh& got, const Mesh& want, const std::string& what,
+                      double normal_tol_deg = 0) {
     ASSERT_EQ(got.triangle_count(), want.triangle_count()) << what;
-    const std::vector<Triangle> a = triangles_of(got), b = triangles_of(want);
+    const bool exact = normal_tol_deg == 0;
+    const std::vector<Triangle> a = triangles_of(got, exact), b = triangles_of(want, exact);
     std::vector<Triangle> only_a;
     std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(only_a));
     EXPECT_TRUE(only_a.empty()) << what << ": " << only_a.size() << " of " << a.size()
                                 << " triangles differ from the server's";
+    if (exact) return;
+    std::map<std::array<float, 3>, glm::vec3> at;
+    for (std::size_t i = 0; i < want.vertex_count(); ++i)
+        at[{want.positions[i].x, want.positions[i].y, want.positions[i].z}] = want.normals[i];
+    double worst = 0;
+    for (std::size_t i = 0; i < got.vertex_count(); ++i) {
+        const auto it = at.find({got.positions[i].x, got.positions[i].y, got.positions[i].z});
+        ASSERT_NE(it, at.end()) << what << ": a vertex where the server has none";
+        worst = std::max(worst, normal_angle_deg(got.normals[i], it->second));
+    }
+    EXPECT_LE(worst, normal_tol_deg) << what << ": the largest normal error";
 }
+
+// The largest error of an 8-bit octahedral normal, with margin (about 0.5 degree measured).
+constexpr double kOct8Deg = 1.0;
 
 // The group through its cells body; and encode_group's choice: cells at full resolution, and for
 // a coarse pass the smaller of cells and compact+zstd.
@@ -77,8 +103,9 @@ Group round_trip(const Group& g, const Volume& v) {
     if (!body) return {};
     if (g.level == 0 || g.refinement) {
         EXPECT_EQ(encoding_of(bytes), GroupEncoding::cells) << g.key();
-    } else if (encoding_of(bytes) == GroupEncoding::compact_zstd) {
-        EXPECT_LT(bytes.size(), body->size()) << g.key() << ": compact+zstd only when smaller";
+    } else {
+        EXPECT_LE(bytes.size(), encode_group(g, GroupEncoding::compact_zstd).size())
+            << g.key() << ": a coarse pass goes in the smaller";
     }
     Group back = decode_group(bytes);
     ByteReader r(*body, "cells");
@@ -93,7 +120,8 @@ void expect_round_trips(const std::vector<Group>& groups, const Volume& v,
     for (const Group& g : groups) {
         const Group back = round_trip(g, v);
         EXPECT_EQ(back.key(), g.key());
-        expect_same_mesh(back.mesh, g.mesh, what + " group " + std::to_string(g.id));
+        expect_same_mesh(back.mesh, g.mesh, what + " group " + std::to_string(g.id),
+                         g.level >= 1 && !g.refinement ? kOct8Deg : 0);
         if (testing::Test::HasFailure()) return;
     }
 }
@@ -223,51 +251,68 @@ TEST(RemoteCellCodecMalformed, SeededMutationsDecodeOrThrow) {
     std::printf("%d of 4000 mutated bodies decoded (the rest threw WireError)\n", decoded);
 }
 
-// Offsets in the body: type u8 at 0, dims at 1, spacing at 13, bucket count at 25, the first
-// bucket's level at 26 and unit count at 27, the first gap at 31.
+// Offsets in the body: type u8 at 0, dims at 1, spacing at 13, normals at 25, bucket count at 26,
+// the first bucket's level at 27 and unit count at 28, the first gap at 32.
 TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocating) {
     const Bytes clean = cells_body();
     auto put_u32 = [](Bytes& b, std::size_t at, std::uint32_t v) {
         std::memcpy(b.data() + at, &v, sizeof v);
     };
-    auto expect_refused = [&](const Bytes& b, const std::string& what) {
-        const std::size_t largest =
-            test::largest_allocation_in([&] { EXPECT_THROW(decode_body(b), WireError) << what; });
+    // Throws WireError whose message holds `why`.
+    auto expect_refused = [&](const Bytes& b, const std::string& what, const std::string& why) {
+        std::string message;
+        const std::size_t largest = test::largest_allocation_in([&] {
+            try {
+                decode_body(b);
+            } catch (const WireError& e) {
+                message = e.what();
+            }
+        });
+        EXPECT_NE(message.find(why), std::string::npos)
+            << what << ": expected a WireError saying \"" << why << "\", got \"" << message << "\"";
         // The box's brick directory (at most kMaxCellBoxVoxels / 64 entries) is the one thing
         // sized before the values are read; nothing is sized from a count past the bytes.
         EXPECT_LT(largest, std::size_t{1} << 21) << what;
     };
     for (std::uint32_t claim : {0xffffffffu, kMaxGroupTriangles, 1u << 20, 5000u}) {
         Bytes b = clean;
-        put_u32(b, 27, claim);
-        expect_refused(b, "unit count " + std::to_string(claim));
+        put_u32(b, 28, claim);
+        expect_refused(
+            b, "unit count " + std::to_string(claim),
+            claim > kMaxGroupTriangles ? "over the limit" : "longer than the bytes left");
     }
     for (std::uint32_t dim : {0u, 1u, 0x7fffffffu, 0x80000000u}) {
         Bytes b = clean;
         put_u32(b, 1, dim);
-        expect_refused(b, "dims.x " + std::to_string(dim));
+        expect_refused(b, "dims.x " + std::to_string(dim), "volume dims");
     }
     {
         Bytes b = clean;
         b[0] = 200;
-        expect_refused(b, "voxel type 200");
+        expect_refused(b, "voxel type 200", "voxel type");
     }
     {
         Bytes b = clean;
-        b[26] = 40;
-        expect_refused(b, "level 40");
+        ASSERT_EQ(b[25], 0) << "a full-resolution pass's normals come from its voxels";
+        b[25] = 2;
+        expect_refused(b, "normals 2", "normals");
+    }
+    {
+        Bytes b = clean;
+        b[27] = 40;
+        expect_refused(b, "level 40", "unit level 40");
     }
     {
         // A first gap past every unit of the volume: ten LEB128 bytes of 0xff, then 0x01.
-        Bytes b(clean.begin(), clean.begin() + 31);
+        Bytes b(clean.begin(), clean.begin() + 32);
         for (int k = 0; k < 9; ++k) b.push_back(0xff);
         b.push_back(0x01);
-        b.insert(b.end(), clean.begin() + 32, clean.end());
-        expect_refused(b, "a unit past the volume");
+        b.insert(b.end(), clean.begin() + 33, clean.end());
+        expect_refused(b, "a unit past the volume", "past the volume");
     }
     {
         // Two units at opposite corners of a large volume: a box past the limit.
-        Bytes b(clean.begin(), clean.begin() + 25);
+        Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
         put_u32(b, 1, 1u << 12);
         put_u32(b, 5, 1u << 12);
         put_u32(b, 9, 1u << 12);
@@ -284,7 +329,7 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
         }
         b.push_back(static_cast<std::uint8_t>(gap));
         for (int k = 0; k < 64; ++k) b.push_back(7);
-        expect_refused(b, "units spread past the box limit");
+        expect_refused(b, "units spread past the box limit", "spread over");
     }
 }
 

@@ -137,7 +137,7 @@ inline glm::vec3 gradient(const View& v, glm::ivec3 p, glm::vec3 inv_step) {
     const std::size_t step[3] = {
         1, static_cast<std::size_t>(v.dims.x),
         static_cast<std::size_t>(v.dims.x) * static_cast<std::size_t>(v.dims.y)};
-    glm::vec3 g;
+    glm::vec3 g(0.0f);  // every axis is set below (GCC 12 cannot always tell)
     for (int a = 0; a < 3; ++a) {
         const bool has_lo = p[a] > 0, has_hi = p[a] < v.dims[a] - 1;
         const std::size_t lo = has_lo ? i - step[a] : i, hi = has_hi ? i + step[a] : i;
