@@ -2,8 +2,11 @@
 // The body of the `cells` group encoding (remote/group_codec.h; issue 34, the dissertation's
 // open problem 5.2.3): a group sent as what marching cubes needs, not what it made. The client
 // runs the project's own marching cubes (common/extract/marching_cubes.h) on what it receives and
-// gets the server's triangles: the same positions (to float rounding) and the same normals, the
-// interpolated central-difference gradients, with nothing quantised.
+// gets the server's triangles: the same positions and the same normals, the interpolated
+// central-difference gradients, to the bit, with nothing quantised. A coarse pass (level >= 1:
+// drawn only until the full resolution replaces it) sends its normals instead, as 8-bit
+// octahedral codes (about half a degree), since its vertices lie 2^level apart and their
+// gradients share few voxels.
 //
 // What travels: the group's units (the cells, or meta-cells of a level, whose triangles the mesh
 // is) and the values of the voxels marching cubes reads to triangulate them, in three phases, each
@@ -12,14 +15,17 @@
 //   2. the inner voxels of every crossed edge of a meta-cell (level >= 1): a long edge's vertex is
 //      the crossing between fine voxels nearest the linear estimate (edge_crossing);
 //   3. the six neighbours of the two voxels that bracket each crossing: the gradients there give
-//      the vertex's normal.
+//      the vertex's normal (not for a coarse pass).
 // Each phase's voxels go in increasing linear index (z, then y, then x), without those of an
-// earlier phase, as byte planes (every value's low byte, then the next byte, ...).
+// earlier phase. Integer values go as the difference to the mean of their known face neighbours
+// (at 1, else 2, else 4 voxels), zigzagged; all as byte planes (every value's low byte, then the
+// next byte, ...).
 //
-// Byte layout: voxel type u8, volume dims 3 x i32, spacing 3 x f32, bucket count u8; per bucket
-// level u8, unit count u32 and the units as LEB128 gaps between their increasing indices in the
-// grid of units of that level; then the three phases' values. group_codec.cpp sends it through
-// zstd.
+// Byte layout: voxel type u8, volume dims 3 x i32, spacing 3 x f32, normals u8 (0 from the
+// gradients, 1 octahedral), bucket count u8; per bucket level u8, unit count u32 and the units as
+// LEB128 gaps between their increasing indices in the grid of units of that level; then the
+// phases' values; with octahedral normals, one i8 code x per vertex in the order marching cubes
+// emits them, then the y codes. group_codec.cpp sends it through zstd.
 //
 // A group whose mesh is not the marching cubes of its units (a mesh from elsewhere, units past the
 // volume) or whose units spread over more than kMaxCellBoxVoxels has no cells body: the encoder

@@ -24,7 +24,8 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
     const Estimate& s = slot(e);
     if (s.groups == 0) return 0;
     const double rate = bytes_per_s(e);
-    return s.seconds_per_triangle + (rate > 0 ? s.bytes_per_triangle / rate : 0);
+    const double server = making_per_triangle_ + s.seconds_per_triangle;
+    return std::max(server, rate > 0 ? s.bytes_per_triangle / rate : 0.0);
 }
 
 GroupEncoding EncodingChooser::best() const {
@@ -50,11 +51,12 @@ GroupEncoding EncodingChooser::next() {
 }
 
 void EncodingChooser::encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes,
-                              double seconds) {
+                              double seconds, double making_seconds) {
     if (triangles == 0) return;
     Estimate& s = slot(e);
     ++s.groups;
     const auto t = static_cast<double>(triangles);
+    blend(making_per_triangle_, making_seconds / t, ++made_);
     blend(s.seconds_per_triangle, seconds / t, s.groups);
     blend(s.bytes_per_triangle, static_cast<double>(bytes) / t, s.groups);
 }

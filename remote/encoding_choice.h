@@ -4,8 +4,12 @@
 // `cells` sends about a quarter of compact+zstd's bytes and costs several times its CPU a
 // triangle; which brings the picture sooner depends on the link. The chooser keeps, for each of
 // the two, a running mean of the server's seconds a triangle (encoding) and of bytes a triangle,
-// and the rate its sends went at: bytes over the seconds the sends blocked. A group goes in the
-// encoding whose seconds a triangle plus bytes a triangle over that rate is the smaller. The rate
+// and the rate its sends went at: bytes over the seconds the sends blocked; and, for both, the
+// seconds a triangle the server spent making groups (extraction). A group goes in the encoding
+// whose time a triangle is the smaller, taken as the slower of the server (extraction and
+// encoding) and the link (bytes over the rate): the two overlap, as the kernel sends one group
+// while the engine makes the next (a sum would charge compact+zstd for link time it hides). The
+// rate
 // is kept per encoding because a send blocks for whichever is slower, the link or the client
 // taking the bytes: a client decoding cells (it runs marching cubes) takes their bytes more
 // slowly than compact+zstd's, and on a fast link that is what the server sees. While sends
@@ -42,8 +46,10 @@ class EncodingChooser {
 
     // The encoding for the next group.
     GroupEncoding next();
-    // What a group cost: its triangles, the bytes it encoded to and the server's seconds for it.
-    void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds);
+    // What a group cost: its triangles, the bytes it encoded to, the server's seconds to encode it
+    // and to make it (from the end of the previous send to the start of encoding).
+    void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds,
+                 double making_seconds = 0);
     // One send of a group in `e`: its bytes on the wire and the seconds the call blocked.
     void sent(GroupEncoding e, std::size_t bytes, double seconds);
 
@@ -66,6 +72,8 @@ class EncodingChooser {
     GroupEncoding best() const;
 
     Estimate cells_, compact_;
+    double making_per_triangle_ = 0;  // extraction, the same in either encoding
+    std::uint64_t made_ = 0;
     std::uint64_t since_explored_ = 0;
 };
 

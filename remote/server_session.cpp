@@ -42,7 +42,9 @@ struct ServerSession::LodLevel {
 class ServerSession::Sink final : public GroupSink {
   public:
     Sink(ServerSession& s, LodLevel& lv, const RequestMsg& r, bool keep, RequestFigures& f)
-        : s_(s), lv_(lv), r_(r), keep_(keep), f_(f) {}
+        : s_(s), lv_(lv), r_(r), keep_(keep), f_(f) {
+        s_.since_sent_.restart();  // the time before this pass's first group is its making
+    }
 
     void add(const Group& g) override {
         GroupMsg m;
@@ -52,18 +54,21 @@ class ServerSession::Sink final : public GroupSink {
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const bool adaptive = s_.options_.adaptive;
         const GroupEncoding e = adaptive ? s_.chooser_.next() : s_.options_.encoding;
+        const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
         const Stopwatch encoding;
         const std::vector<std::uint8_t> bytes =
             encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
         const GroupEncoding went = encoding_of(bytes);  // cells may fall back to compact+zstd
         if (adaptive)
-            s_.chooser_.encoded(went, g.mesh.triangle_count(), bytes.size(), encoding.seconds());
+            s_.chooser_.encoded(went, g.mesh.triangle_count(), bytes.size(), encoding.seconds(),
+                                making_s);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
         const Stopwatch sending;
         const std::size_t sent = s_.send_(m);
         if (adaptive) s_.chooser_.sent(went, sent, sending.seconds());
+        s_.since_sent_.restart();
         f_.bytes += sent;
         ++f_.groups;
         f_.triangles += g.mesh.triangle_count();

@@ -33,6 +33,7 @@
 #include <memory>
 #include <vector>
 
+#include "common/core/util.h"
 #include "common/extract/surface_extractor.h"
 #include "engine/progressive_engine.h"
 #include "remote/encoding_choice.h"
@@ -93,6 +94,7 @@ class ServerSession {
     SessionOptions options_;
     SendMessage send_;
     EncodingChooser chooser_;  // options_.adaptive: which encoding each group goes in
+    Stopwatch since_sent_;     // since the last group's send: the engine making the next
     std::vector<std::unique_ptr<LodLevel>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;
