@@ -8,10 +8,7 @@ namespace {
 // A send shorter than this did not wait for the link: its bytes went into buffers.
 constexpr double kBlockedS = 50e-6;
 
-void blend(double& mean, double sample, std::uint64_t samples) {
-    const double alpha = samples <= 1 ? 1.0 : 1.0 / EncodingChooser::kWindow;
-    mean += alpha * (sample - mean);
-}
+constexpr double kKeep = 1.0 - 1.0 / EncodingChooser::kWindow;
 
 }  // namespace
 
@@ -24,8 +21,9 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
     const Estimate& s = slot(e);
     if (s.groups == 0) return 0;
     const double rate = bytes_per_s(e);
-    const double server = making_per_triangle_ + s.seconds_per_triangle;
-    return std::max(server, rate > 0 ? s.bytes_per_triangle / rate : 0.0);
+    const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
+    const double server = making + s.seconds / s.triangles;
+    return std::max(server, rate > 0 ? s.bytes / s.triangles / rate : 0.0);
 }
 
 GroupEncoding EncodingChooser::best() const {
@@ -55,10 +53,11 @@ void EncodingChooser::encoded(GroupEncoding e, std::size_t triangles, std::size_
     if (triangles == 0) return;
     Estimate& s = slot(e);
     ++s.groups;
-    const auto t = static_cast<double>(triangles);
-    blend(making_per_triangle_, making_seconds / t, ++made_);
-    blend(s.seconds_per_triangle, seconds / t, s.groups);
-    blend(s.bytes_per_triangle, static_cast<double>(bytes) / t, s.groups);
+    s.triangles = s.triangles * kKeep + static_cast<double>(triangles);
+    s.seconds = s.seconds * kKeep + seconds;
+    s.bytes = s.bytes * kKeep + static_cast<double>(bytes);
+    made_triangles_ = made_triangles_ * kKeep + static_cast<double>(triangles);
+    making_s_ = making_s_ * kKeep + making_seconds;
 }
 
 void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {

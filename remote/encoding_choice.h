@@ -41,7 +41,9 @@ inline void apply_hello_encoding(std::uint8_t e, GroupEncoding& encoding, bool& 
 class EncodingChooser {
   public:
     static constexpr std::uint64_t kExploreEvery = 16;
-    // Running means weigh the last this many groups most (exponential, alpha = 1 / kWindow).
+    // The estimates are ratios of decayed sums (seconds or bytes over triangles), which weigh
+    // the last this many groups most and each group by its triangles: a pass of a few triangles
+    // (its header, the time to find it) says little of the next thousand.
     static constexpr double kWindow = 16;
 
     // The encoding for the next group.
@@ -61,7 +63,7 @@ class EncodingChooser {
 
   private:
     struct Estimate {
-        double seconds_per_triangle = 0, bytes_per_triangle = 0;
+        double triangles = 0, seconds = 0, bytes = 0;  // decayed sums over its groups
         std::uint64_t groups = 0;
         double sent_bytes = 0, blocked_s = 0;  // decayed sums over the recent sends
     };
@@ -72,8 +74,7 @@ class EncodingChooser {
     GroupEncoding best() const;
 
     Estimate cells_, compact_;
-    double making_per_triangle_ = 0;  // extraction, the same in either encoding
-    std::uint64_t made_ = 0;
+    double made_triangles_ = 0, making_s_ = 0;  // extraction, the same in either encoding
     std::uint64_t since_explored_ = 0;
 };
 

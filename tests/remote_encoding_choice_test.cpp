@@ -87,5 +87,19 @@ TEST(EncodingChoice, TheServerAndTheLinkOverlap) {
     EXPECT_NEAR(c.cost_per_triangle(GroupEncoding::cells), 0.65e-6, 0.01e-6);
 }
 
+// Passes of a few triangles (a header each, and a while to find them) weigh by their triangles:
+// they do not swamp what thousands of triangles showed.
+TEST(EncodingChoice, TinyPassesWeighByTheirTriangles) {
+    EncodingChooser c;
+    run(c, {}, 100);
+    for (int i = 0; i < 20; ++i) {
+        const GroupEncoding e = c.next();
+        c.encoded(e, 2, 200, 20e-6, 1e-3);  // 2 triangles: 100 B and 500 us a triangle to make
+        c.sent(e, 200, 0);
+    }
+    EXPECT_LT(c.cost_per_triangle(GroupEncoding::compact_zstd), 10e-6);
+    EXPECT_EQ(c.next(), GroupEncoding::compact_zstd);
+}
+
 }  // namespace
 }  // namespace isowall::remote
