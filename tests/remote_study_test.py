@@ -74,7 +74,7 @@ class RemoteStudy(unittest.TestCase):
     def test_bad_options_give_one_line_and_status_1(self):
         with tempfile.TemporaryDirectory() as out:
             for args, field in [(["--rates", "0"], "--rates"), (["--rates", "x"], "--rates"),
-                                (["--cases", "1,7"], "--cases"),
+                                (["--cases", "1,8"], "--cases"),
                                 (["--volume", "/nonexistent.nhdr"], "--volume")]:
                 p = study("--out", out, *args)
                 self.assertEqual(p.returncode, 1, args)
