@@ -68,8 +68,13 @@ class BenchStore(unittest.TestCase):
             self.assertNotIn("| file |", again.stdout)
             m = re.search(r"coverage IoU ([0-9.]+), ([0-9.]+)% of pixels within 1/255", again.stdout)
             self.assertTrue(m, again.stdout)
-            self.assertEqual(float(m.group(1)), 1.0)
-            self.assertEqual(float(m.group(2)), 100.0)
+            # The same picture, up to the pixels that depend on the screen cast's ray order (a
+            # pixel whose own ray misses the surface is drawn only when a neighbouring cell's
+            # triangle covers it; wall_run_test names the same): the store and the file run 40-56
+            # groups each, as their threads happen to run. One pixel of about 4,000 differed in
+            # CI (99.98%), none in 50 runs here.
+            self.assertGreaterEqual(float(m.group(1)), 0.999)
+            self.assertGreaterEqual(float(m.group(2)), 99.9)
 
     def test_an_emulated_disk_throttles_the_run_and_leaves_no_cgroup(self):
         if os.geteuid() != 0:
