@@ -41,7 +41,8 @@ std::vector<RemoteMessage> samples() {
         EndOfFrameMsg{3, 480000, 120, 90000, 2400000},
         make_error(ErrorCode::bad_token, "wrong token"),
         ByeMsg{},
-        SessionMsg{"class 3b", "10.0.0.7:51234", 12}};
+        SessionMsg{"class 3b", "10.0.0.7:51234", 12},
+        DecodeRateMsg{{{3, 120000, 0.0125}, {4, 30000, 0.01}}}};
 }
 
 bool write(const std::filesystem::path& path, const std::vector<std::byte>& bytes) {

@@ -5,6 +5,7 @@
 #include <string>
 #include <type_traits>
 
+#include "common/core/util.h"
 #include "common/core/wire.h"
 #include "remote/group_codec.h"
 
@@ -72,7 +73,12 @@ void ClientFrames::sample(double now_s, bool force) {
 void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, double now_s) {
     const bool current = active_ && g.request_id == request_.request_id;
     if (!current && g.cache_gen == 0) return;
+    const Stopwatch decoding;
     auto mesh = decode_mesh(g);
+    // decode_mesh checked the encoding byte.
+    DecodeRateMsg::Entry& d = decoded_[static_cast<std::size_t>(g.encoded[1])];
+    d.triangles += mesh->triangle_count();
+    d.seconds += decoding.seconds();
     if (g.cache_gen != 0) {
         if (g.cache_gen != cache_gen_) {
             cache_.clear();
@@ -111,6 +117,20 @@ void ClientFrames::handle_visible(const VisibleMsg& v, std::size_t wire_bytes, d
         draw(c->mesh, c->level);
     }
     sample(now_s, false);
+}
+
+std::optional<DecodeRateMsg> ClientFrames::decode_report(double now_s) {
+    if (now_s - last_report_s_ < kReportEveryS) return std::nullopt;
+    DecodeRateMsg m;
+    for (std::size_t e = 0; e < decoded_.size(); ++e) {
+        if (decoded_[e].triangles == 0) continue;
+        m.entries.push_back(
+            {static_cast<std::uint8_t>(e), decoded_[e].triangles, decoded_[e].seconds});
+        decoded_[e] = {};
+    }
+    if (m.entries.empty()) return std::nullopt;
+    last_report_s_ = now_s;
+    return m;
 }
 
 bool ClientFrames::handle(const RemoteMessage& m, std::size_t wire_bytes, double now_s) {

@@ -20,8 +20,10 @@
 // one of another generation first drops the cache. Groups arrive in the order the server gave
 // them slots, so a group's slot is its index. The cache is kept while requests do not cache: the
 // server may have skipped such a request and still name the generation's slots.
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,6 +72,10 @@ class ClientFrames {
     void measure();
     // What is on screen now.
     void read_back(Image& out) { renderer_.read_back(out); }
+    // What decoding groups cost since the last report, per encoding, once kReportEveryS has
+    // passed since it (at `now_s`) and something was decoded; nullopt otherwise.
+    std::optional<DecodeRateMsg> decode_report(double now_s);
+    static constexpr double kReportEveryS = 0.05;
 
   private:
     struct Cached {
@@ -99,6 +105,9 @@ class ClientFrames {
     std::vector<Cached> cache_;                        // index = slot in generation cache_gen_
     std::uint64_t cache_gen_ = 0;                      // 0: none yet
     ClientFrameResult result_;
+    // Decoded since the last report, by encoding id (DecodeRateMsg).
+    std::array<DecodeRateMsg::Entry, kDecodeRateEncodings> decoded_{};
+    double last_report_s_ = 0;
 };
 
 // The server's ErrorMsg, as an exception: the text names the server's complaint.

@@ -23,7 +23,8 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
     const double rate = bytes_per_s(e);
     const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
     const double server = making + s.seconds / s.triangles;
-    return std::max(server, rate > 0 ? s.bytes / s.triangles / rate : 0.0);
+    const double client = s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0;
+    return std::max({server, rate > 0 ? s.bytes / s.triangles / rate : 0.0, client});
 }
 
 GroupEncoding EncodingChooser::best() const {
@@ -69,6 +70,14 @@ void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {
     if (seconds < kBlockedS) return;
     s.sent_bytes += static_cast<double>(bytes);
     s.blocked_s += seconds;
+}
+
+void EncodingChooser::decoded(GroupEncoding e, std::uint64_t triangles, double seconds) {
+    if (e != GroupEncoding::cells && e != GroupEncoding::compact_zstd) return;
+    if (triangles == 0 || !(seconds >= 0)) return;
+    Estimate& s = slot(e);
+    s.decoded_triangles = s.decoded_triangles * kKeep + static_cast<double>(triangles);
+    s.decoded_s = s.decoded_s * kKeep + seconds;
 }
 
 }  // namespace isowall::remote

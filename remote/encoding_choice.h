@@ -14,8 +14,11 @@
 // taking the bytes: a client decoding cells (it runs marching cubes) takes their bytes more
 // slowly than compact+zstd's, and on a fast link that is what the server sees. While sends
 // return at once (buffers absorb them), bytes cost no time and the cheaper encoding wins.
-// The client's decoding is seen only through the sends: on a link slower than the client it does
-// not count, which is right, as the link is then the bottleneck. A group in the encoding not
+// The client's decoding is seen through its reports (DecodeRateMsg: seconds a triangle, per
+// encoding) and counts as a third stage beside the server and the link: the slowest of the three
+// sets the pace. Through the sends alone it showed only once the socket buffers between the two
+// were full (megabytes on a fast link), so the server kept sending cells to a client that decoded
+// them ten times slower than compact+zstd. A group in the encoding not
 // chosen goes out every kExploreEvery groups times how many times dearer it was (at most 8x), so
 // both estimates follow the surface and the machine without a slow link paying much for the
 // exploring. Pure: no clock, no I/O; the session measures and reports.
@@ -54,6 +57,9 @@ class EncodingChooser {
                  double making_seconds = 0);
     // One send of a group in `e`: its bytes on the wire and the seconds the call blocked.
     void sent(GroupEncoding e, std::size_t bytes, double seconds);
+    // The client's report: it decoded `triangles` of groups in `e` in `seconds`. Encodings the
+    // chooser does not pick between are ignored.
+    void decoded(GroupEncoding e, std::uint64_t triangles, double seconds);
 
     // Seconds a triangle costs in `e` at the rate seen; 0 until `e` was measured.
     double cost_per_triangle(GroupEncoding e) const;
@@ -65,7 +71,8 @@ class EncodingChooser {
     struct Estimate {
         double triangles = 0, seconds = 0, bytes = 0;  // decayed sums over its groups
         std::uint64_t groups = 0;
-        double sent_bytes = 0, blocked_s = 0;  // decayed sums over the recent sends
+        double sent_bytes = 0, blocked_s = 0;         // decayed sums over the recent sends
+        double decoded_triangles = 0, decoded_s = 0;  // decayed sums over the client's reports
     };
     Estimate& slot(GroupEncoding e) { return e == GroupEncoding::cells ? cells_ : compact_; }
     const Estimate& slot(GroupEncoding e) const {

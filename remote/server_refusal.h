@@ -1,6 +1,7 @@
 #pragma once
-// Two pieces of the server's connections (view_server.cpp): a bounded wait on a channel, and a
-// connection turned away (max_clients) that still hears why.
+// Pieces of the server's connections (view_server.cpp): a bounded wait on a channel, the error
+// code a broken stream is refused with, and a connection turned away (max_clients) that still
+// hears why.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -34,6 +35,9 @@ inline void within(MessageChannel& conn, double timeout_s, F&& f) {
     changed.notify_all();
     watchdog.join();
 }
+
+// The error code of a broken stream: the framing's and decoders' WireError texts name the field.
+ErrorCode code_of(const WireError& e);
 
 // How long a connection turned away may take to open and hear why.
 inline constexpr double kRefusalTimeoutS = 2;

@@ -53,6 +53,7 @@ class ServerSession::Sink final : public GroupSink {
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const bool adaptive = s_.options_.adaptive;
+        if (adaptive) s_.take_reports();
         const GroupEncoding e = adaptive ? s_.chooser_.next() : s_.options_.encoding;
         const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
         const Stopwatch encoding;
@@ -110,6 +111,25 @@ ServerSession::ServerSession(const SurfaceExtractor& prototype, SessionOptions o
 }
 
 ServerSession::~ServerSession() = default;
+
+static_assert(kDecodeRateEncodings == static_cast<unsigned>(GroupEncoding::cells) + 1,
+              "DecodeRateMsg names every group encoding");
+
+void ServerSession::client_decoded(const DecodeRateMsg& report) {
+    const std::lock_guard<std::mutex> lock(reports_mutex_);
+    if (reports_.size() < kMaxPendingReports) reports_.push_back(report);
+}
+
+void ServerSession::take_reports() {
+    std::vector<DecodeRateMsg> reports;
+    {
+        const std::lock_guard<std::mutex> lock(reports_mutex_);
+        reports.swap(reports_);
+    }
+    for (const DecodeRateMsg& r : reports)
+        for (const DecodeRateMsg::Entry& e : r.entries)
+            chooser_.decoded(static_cast<GroupEncoding>(e.encoding), e.triangles, e.seconds);
+}
 
 ServerSession::LodLevel& ServerSession::lod_level(int l) {
     while (levels_.size() <= static_cast<std::size_t>(l)) {

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "common/core/util.h"
@@ -80,11 +81,18 @@ class ServerSession {
     RequestFigures run(const RequestMsg& request, const std::atomic<bool>& stop);
     // The next cached request begins a new generation (a shared session's follower joined).
     void restart_cache() { cache_valid_ = false; }
+    // The client's decoding report (adaptive sessions); any thread: the chooser takes it before
+    // its next group.
+    void client_decoded(const DecodeRateMsg& report);
 
   private:
     struct LodLevel;
     class Sink;
     LodLevel& lod_level(int l);
+    void take_reports();
+    // Reports held while the worker sends no group (a client may report faster than a stalled
+    // worker takes them); past this they are dropped, as the chooser weighs the recent most.
+    static constexpr std::size_t kMaxPendingReports = 64;
     void begin_cached(LodLevel& lv, const RequestMsg& r, bool keep);
     void name_by_seed_rays(const RequestMsg& r, RequestFigures& f);
     bool cast_level(int l, const RequestMsg& r, bool drawn, const std::atomic<bool>& stop,
@@ -94,7 +102,9 @@ class ServerSession {
     SessionOptions options_;
     SendMessage send_;
     EncodingChooser chooser_;  // options_.adaptive: which encoding each group goes in
-    Stopwatch since_sent_;     // since the last group's send: the engine making the next
+    std::mutex reports_mutex_;
+    std::vector<DecodeRateMsg> reports_;  // the client's, not yet taken by the chooser
+    Stopwatch since_sent_;                // since the last group's send: the engine making the next
     std::vector<std::unique_ptr<LodLevel>> levels_;  // index = level of detail (0 = full)
     bool cache_valid_ = false;
     double cache_iso_ = 0;

@@ -19,6 +19,7 @@ ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(rende
     hello.role = h.role;
     hello.session = h.session;
     conn_->send(hello);
+    reports_ = h.adaptive && h.role != SessionRole::follower;
     std::optional<RemoteMessage> m = conn_->receive(h.connect_timeout_s);
     if (!m)
         throw NetError(conn_->peer() + ": no answer to hello within " +
@@ -59,6 +60,9 @@ bool ViewClient::receive_one(double timeout_s) {
     } else if (frames_.handle(*m, bytes, now_s())) {
         active_ = false;
     }
+    if (reports_)
+        if (const std::optional<DecodeRateMsg> report = frames_.decode_report(now_s()))
+            conn_->send(*report);
     return true;
 }
 

@@ -21,7 +21,8 @@ struct ClientHello {
     std::shared_ptr<const TlsContext> tls;
     GroupEncoding encoding = GroupEncoding::compact_zstd;
     // The server chooses cells or compact+zstd per group for the link it sees
-    // (remote/encoding_choice.h); `encoding` is then not sent.
+    // (remote/encoding_choice.h); `encoding` is then not sent, and the client (unless it
+    // follows a session) reports what decoding costs it (DecodeRateMsg).
     bool adaptive = false;
     double connect_timeout_s = 10;
     // A shared session (remote/shared_session.h): present it, or follow it; none: a view of
@@ -66,6 +67,7 @@ class ViewClient {
     std::optional<SessionMsg> session_;
     std::uint64_t next_id_ = 1;
     bool active_ = false;
+    bool reports_ = false;  // the server chooses encodings: tell it what decoding costs here
     std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 

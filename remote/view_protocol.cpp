@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -42,9 +43,7 @@ std::string get_text(MessageReader& r, const char* field, std::size_t max_bytes,
 
 glm::vec3 get_finite_vec3(MessageReader& r, const std::string& field) {
     glm::vec3 v;
-    v.x = get_finite<float>(r, (field + ".x").c_str());
-    v.y = get_finite<float>(r, (field + ".y").c_str());
-    v.z = get_finite<float>(r, (field + ".z").c_str());
+    for (int a = 0; a < 3; ++a) v[a] = get_finite<float>(r, (field + "." + "xyz"[a]).c_str());
     return v;
 }
 
@@ -58,10 +57,7 @@ std::int32_t get_int_in(MessageReader& r, const std::string& field, std::int32_t
 }
 
 void put_group_key(MessageWriter& w, const GroupKey& k) {
-    w.put(static_cast<std::int32_t>(k.seed.x));
-    w.put(static_cast<std::int32_t>(k.seed.y));
-    w.put(static_cast<std::int32_t>(k.seed.z));
-    w.put(static_cast<std::int32_t>(k.level));
+    for (const int v : {k.seed.x, k.seed.y, k.seed.z, k.level}) w.put(static_cast<std::int32_t>(v));
     w.put(k.iso);
     w.put(static_cast<std::uint8_t>(k.refinement));
 }
@@ -280,6 +276,44 @@ static EndOfFrameMsg decode_end_of_frame(std::span<const std::byte> bytes) {
     return m;
 }
 
+static std::vector<std::byte> encode(const DecodeRateMsg& m) {
+    MessageWriter w(DecodeRateMsg::kVersion);
+    w.put(static_cast<std::uint8_t>(m.entries.size()));
+    for (const DecodeRateMsg::Entry& e : m.entries) {
+        w.put(e.encoding);
+        w.put(e.triangles);
+        w.put(e.seconds);
+    }
+    return w.take();
+}
+
+static DecodeRateMsg decode_decode_rate(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, DecodeRateMsg::kVersion, "decode_rate message");
+    const auto at_most = [&](const char* field, auto v, auto max) {
+        if (v > max)
+            r.fail(field + (": " + std::to_string(v)) + ", expected at most " +
+                   std::to_string(max));
+    };
+    DecodeRateMsg m;
+    const auto count = r.get<std::uint8_t>();
+    at_most("entries", count, kDecodeRateEncodings);  // one per encoding
+    for (unsigned i = 0; i < count; ++i) {
+        DecodeRateMsg::Entry e;
+        e.encoding = r.get<std::uint8_t>();
+        at_most("entries.encoding", e.encoding, kDecodeRateEncodings - 1);
+        if (!m.entries.empty() && e.encoding <= m.entries.back().encoding)
+            r.fail("entries.encoding: " + std::to_string(e.encoding) + " after " +
+                   std::to_string(m.entries.back().encoding) + ", expected ascending");
+        e.triangles = r.get<std::uint64_t>();
+        e.seconds = get_finite<double>(r, "entries.seconds");
+        if (e.seconds < 0)
+            r.fail("entries.seconds: " + std::to_string(e.seconds) + ", expected >= 0");
+        m.entries.push_back(e);
+    }
+    r.finish();
+    return m;
+}
+
 static std::vector<std::byte> encode(const ErrorMsg& m) {
     MessageWriter w(ErrorMsg::kVersion);
     w.put(static_cast<std::uint16_t>(m.code));
@@ -320,27 +354,12 @@ ErrorMsg make_error(ErrorCode code, std::string_view text) {
 }
 
 const char* to_string(RemoteTag type) {
-    switch (type) {
-        case RemoteTag::hello:
-            return "hello";
-        case RemoteTag::ready:
-            return "ready";
-        case RemoteTag::request:
-            return "request";
-        case RemoteTag::group:
-            return "group";
-        case RemoteTag::visible:
-            return "visible";
-        case RemoteTag::end_of_frame:
-            return "end_of_frame";
-        case RemoteTag::error:
-            return "error";
-        case RemoteTag::bye:
-            return "bye";
-        case RemoteTag::session:
-            return "session";
-    }
-    return "unknown";
+    static constexpr const char* kNames[] = {"hello",   "ready",        "request", "group",
+                                             "visible", "end_of_frame", "error",   "bye",
+                                             "session", "decode_rate"};
+    static_assert(std::size(kNames) == kLastRemoteTag, "a name for every message type");
+    const auto t = static_cast<std::size_t>(type);
+    return t >= 1 && t <= kLastRemoteTag ? kNames[t - 1] : "unknown";
 }
 
 std::vector<std::byte> encode_payload(const RemoteMessage& m) {
@@ -371,6 +390,8 @@ RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload)
             return decode_bye(payload);
         case RemoteTag::session:
             return decode_session(payload);
+        case RemoteTag::decode_rate:
+            return decode_decode_rate(payload);
     }
     throw WireError("view protocol: unknown message type " +
                     std::to_string(static_cast<unsigned>(type)));

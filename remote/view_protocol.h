@@ -31,8 +31,9 @@ enum class RemoteTag : std::uint16_t {
     error = 7,         // either way: what was wrong; the sender closes the connection after it
     bye = 8,           // either way: the sender closes the connection, nothing was wrong
     session = 9,       // server -> a shared session's members: its name, presenter and size
+    decode_rate = 10,  // client -> server: what decoding groups cost the client (adaptive only)
 };
-inline constexpr std::uint16_t kLastRemoteTag = 9;
+inline constexpr std::uint16_t kLastRemoteTag = 10;
 const char* to_string(RemoteTag type);
 
 // ---- limits: each is checked by the decoder before anything is sized from the bytes -----------
@@ -154,13 +155,29 @@ struct ErrorMsg {
 // every byte outside printable ASCII (a newline, UTF-8) replaced by '?'.
 ErrorMsg make_error(ErrorCode code, std::string_view text);
 
+// What decoding the groups cost the client since its last report, per encoding (issue 34: the
+// adaptive server weighs the client's decoding beside its own work and the link). Sent by a
+// client that asked for the server's choice (hello encoding kAdaptiveEncoding), every few groups.
+struct DecodeRateMsg {
+    static constexpr RemoteTag kTag = RemoteTag::decode_rate;
+    static constexpr std::uint8_t kVersion = 1;
+    struct Entry {
+        std::uint8_t encoding = 0;    // a group codec's id, < kDecodeRateEncodings; ascending
+        std::uint64_t triangles = 0;  // decoded
+        double seconds = 0;           // spent decoding them: finite, >= 0
+    };
+    std::vector<Entry> entries;  // at most one per encoding
+};
+// The group codecs (remote/group_codec.h: GroupEncoding's count; encoding_choice.h checks it).
+inline constexpr unsigned kDecodeRateEncodings = 5;
+
 struct ByeMsg {
     static constexpr RemoteTag kTag = RemoteTag::bye;
     static constexpr std::uint8_t kVersion = 1;
 };
 
 using RemoteMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
-                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg>;
+                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg, DecodeRateMsg>;
 
 // The payload of a message (what follows the frame header).
 std::vector<std::byte> encode_payload(const RemoteMessage& m);

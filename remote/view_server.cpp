@@ -35,14 +35,6 @@ std::string seconds_text(double s) {
     return buf;
 }
 
-// The error code of a broken stream: the framing's and decoders' WireError texts name the field.
-ErrorCode code_of(const WireError& e) {
-    const std::string_view what = e.what();
-    if (what.find("version") != std::string_view::npos) return ErrorCode::unsupported_version;
-    if (what.find("over the limit") != std::string_view::npos) return ErrorCode::too_large;
-    return ErrorCode::malformed;
-}
-
 }  // namespace
 
 struct ViewServer::Impl {
@@ -208,6 +200,10 @@ class ViewServer::Client {
     // One message after the hello: false when the connection ends (a bye, or an error sent).
     bool take(const RemoteMessage& m, const Dataset& d) {
         if (std::holds_alternative<ByeMsg>(m)) return false;
+        if (const auto* d = std::get_if<DecodeRateMsg>(&m)) {
+            session_->client_decoded(*d);  // weighed only when the server chooses
+            return true;
+        }
         const auto* r = std::get_if<RequestMsg>(&m);
         if (!r) {
             refuse(ErrorCode::malformed,
@@ -297,6 +293,7 @@ class ViewServer::Client {
             std::optional<RemoteMessage> m = conn_.receive(0.5);
             if (!m) continue;
             if (std::holds_alternative<ByeMsg>(*m)) return;
+            if (std::holds_alternative<DecodeRateMsg>(*m)) continue;  // the presenter's choice
             refuse(ErrorCode::session,
                    std::holds_alternative<RequestMsg>(*m)
                        ? "a follower asks for no views: the presenter's come by themselves"

@@ -146,5 +146,33 @@ TEST(ClientFrames, TheCacheFollowsTheServersGenerationsAndDrawsNamedSlotsCoarseF
     }
 }
 
+// What an adaptive client tells the server (DecodeRateMsg): the triangles it decoded per
+// encoding since its last report, at most every kReportEveryS, and nothing when it decoded none.
+TEST(ClientFrames, DecodeReportsCountTheTrianglesOfEachEncoding) {
+    const Box3 bounds{glm::vec3(-1), glm::vec3(1)};
+    Camera cam = fit_depth_range(front_full_view(bounds, 4.0f / 3), bounds);
+    RequestMsg req;
+    req.request_id = 1;
+    req.view = {cam, cam.frustum(4.0f / 3), 32, 24, 7.0};
+    auto renderer = make_renderer("osmesa");
+    ClientFrames frames(*renderer);
+    EXPECT_FALSE(frames.decode_report(1.0)) << "nothing decoded yet";
+    frames.begin(req, 1.0);
+    const Mesh box = box_mesh(glm::vec3(-0.5f), glm::vec3(0.5f));
+    frames.handle(group_msg(1, box, 0, 0, 7.0), 100, 1.0);
+    frames.handle(group_msg(1, box, 0, 1, 7.0), 100, 1.0);
+    const auto report = frames.decode_report(1.0);
+    ASSERT_TRUE(report);
+    ASSERT_EQ(report->entries.size(), 1u);
+    EXPECT_EQ(report->entries[0].encoding, static_cast<std::uint8_t>(GroupEncoding::indexed));
+    EXPECT_EQ(report->entries[0].triangles, 24u);
+    EXPECT_GE(report->entries[0].seconds, 0.0);
+    frames.handle(group_msg(1, box, 0, 2, 7.0), 100, 1.01);
+    EXPECT_FALSE(frames.decode_report(1.01)) << "too soon after the last";
+    const auto next = frames.decode_report(1.0 + ClientFrames::kReportEveryS);
+    ASSERT_TRUE(next);
+    EXPECT_EQ(next->entries[0].triangles, 12u) << "counted since the last report";
+}
+
 }  // namespace
 }  // namespace isowall::test

@@ -89,6 +89,22 @@ TEST(RemoteProtocolMalformed, SessionFields) {
          {"presenter: byte 0 is 127", [](SessionMsg& m) { m.presenter.assign(1, char(0x7f)); }}});
 }
 
+TEST(RemoteProtocolMalformed, DecodeRateFields) {
+    using E = DecodeRateMsg::Entry;
+    expect_faults<DecodeRateMsg>(
+        sample_decode_rate(),
+        {{"entries: 6, expected at most 5", [](DecodeRateMsg& m) { m.entries.assign(6, E{}); }},
+         {"entries.encoding: 5, expected at most 4",
+          [](DecodeRateMsg& m) { m.entries[1].encoding = 5; }},
+         {"entries.encoding: 3 after 3, expected ascending",
+          [](DecodeRateMsg& m) { m.entries[1].encoding = 3; }},
+         {"entries.seconds: expected a finite number",
+          [](DecodeRateMsg& m) { m.entries[1].seconds = kNaN; }},
+         {"entries.seconds: -1.000000, expected >= 0",
+          [](DecodeRateMsg& m) { m.entries[0].seconds = -1; }}});
+    EXPECT_NO_THROW(decode_payload(RemoteTag::decode_rate, encode_payload(DecodeRateMsg{})));
+}
+
 TEST(RemoteProtocolMalformed, ReadyFields) {
     expect_faults<ReadyMsg>(
         sample_ready(),

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,13 @@ inline bool operator==(const ErrorMsg& a, const ErrorMsg& b) {
 }
 inline bool operator==(const ByeMsg&, const ByeMsg&) {
     return true;
+}
+inline bool operator==(const DecodeRateMsg& a, const DecodeRateMsg& b) {
+    return std::equal(a.entries.begin(), a.entries.end(), b.entries.begin(), b.entries.end(),
+                      [](const DecodeRateMsg::Entry& x, const DecodeRateMsg::Entry& y) {
+                          return x.encoding == y.encoding && x.triangles == y.triangles &&
+                                 x.seconds == y.seconds;
+                      });
 }
 
 namespace remote_testing {
@@ -109,10 +117,14 @@ inline ErrorMsg sample_error() {
     return {ErrorCode::unknown_dataset, "no dataset named \"ct_hed\""};
 }
 
+inline DecodeRateMsg sample_decode_rate() {
+    return {{{3, 120000, 0.0125}, {4, 0x1000000001, 2.5}}};
+}
+
 inline std::vector<RemoteMessage> samples() {
-    return {sample_hello(), sample_ready(),   sample_request(),
-            sample_group(), sample_visible(), sample_end_of_frame(),
-            sample_error(), ByeMsg{},         sample_session()};
+    return {sample_hello(),   sample_ready(),        sample_request(), sample_group(),
+            sample_visible(), sample_end_of_frame(), sample_error(),   ByeMsg{},
+            sample_session(), sample_decode_rate()};
 }
 
 // decode_payload(type, bytes) throws a WireError naming the message and `field`.

@@ -24,6 +24,7 @@ struct Case {
     const char* name;
     GroupEncoding encoding;
     bool lod, cache;
+    bool adaptive = false;  // the server chooses (view's default), told the client's decoding
 };
 const Case kCases[] = {{"1 base", GroupEncoding::vertices, false, false},
                        {"2 indexed", GroupEncoding::indexed, false, false},
@@ -31,12 +32,14 @@ const Case kCases[] = {{"1 base", GroupEncoding::vertices, false, false},
                        {"4 cached groups", GroupEncoding::indexed, true, true},
                        {"5 compact+zstd", GroupEncoding::compact_zstd, true, true},
                        {"cells, new iso", GroupEncoding::cells, false, false},
-                       {"cells + LOD + cache", GroupEncoding::cells, true, true}};
+                       {"cells + LOD + cache", GroupEncoding::cells, true, true},
+                       {"auto + LOD + cache", GroupEncoding::cells, true, true, true}};
 
-ClientHello hello_for(int port, GroupEncoding e) {
+ClientHello hello_for(int port, GroupEncoding e, bool adaptive = false) {
     ClientHello h;
     h.port = port;
     h.encoding = e;
+    h.adaptive = adaptive;
     return h;
 }
 
@@ -46,7 +49,7 @@ TEST(RemoteView, EveryCaseEndsWithTheLocalImageOfTheViewAlsoAfterARotation) {
     const Image want_front = local_image(front), want_turned = local_image(turned);
     for (const Case& c : kCases) {
         auto renderer = make_renderer("osmesa");
-        ViewClient client(*renderer, hello_for(server.port(), c.encoding));
+        ViewClient client(*renderer, hello_for(server.port(), c.encoding, c.adaptive));
         client.request(front, c.lod, c.cache);
         const ClientFrameResult& a = client.wait_done(kTimeout);
         ASSERT_TRUE(a.completed) << c.name;
