@@ -17,7 +17,7 @@ PACKAGES=(
     libgdcm-dev libnifti2-dev libhdf5-dev
     python3 python3-numpy python3-matplotlib python3-zarr
     libx11-dev libxext-dev xvfb xdotool x11-apps x11-utils iproute2
-    nodejs chromium
+    nodejs chromium emscripten
 )
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
