@@ -1,22 +1,29 @@
-// Decoding of the four group encodings of remote/group_codec.h:
+// Decoding of the five group encodings of remote/group_codec.h:
 //   0 vertices      three separate float32 vertices (position + normal) a triangle
 //   1 indexed       float32 positions and normals, uint16 indices (uint32 past 65536 vertices)
 //   2 compact       positions quantised to 16 bits in a box, octahedral snorm16 normals,
 //                   indices through meshoptimizer's index codec
 //   3 compact_zstd  the whole compact message in one zstd frame
+//   4 cells         the units and voxel values marching cubes triangulates, in one zstd frame
+//                   (cells.js: the server's C++ decoder in WebAssembly)
 // Bytes: [version u8 = 2][encoding u8][header: id u32, seed 3 x i32, level i32, iso f64,
-// refinement u8][body]; compact_zstd's body is the u64 size of the compact message, then the
-// frame. Decoding is for hostile input: every count is checked against the limits and the bytes
-// left before anything is allocated, indices against the vertex count, floats must be finite;
-// anything else throws an Error "group: <field>: <why>".
+// refinement u8][body]; compact_zstd has no header of its own: after the encoding byte come the
+// u64 size of the compact message, then the frame holding it; a cells body is the u64 size of the
+// cells body, then its frame. Decoding is for hostile input: every count is checked against the
+// limits and the bytes left before anything is allocated, indices against the vertex count,
+// floats must be finite; anything else throws an Error "group: <field>: <why>".
 //
 // A decoded group: { id, seed: [x, y, z], level, iso, refinement, positions: Float32Array(3V),
 // normals: Float32Array(3V), indices: Uint32Array(3T) }.
 import { ZSTDDecoder } from 'zstddec';
 import { MeshoptDecoder } from 'meshoptimizer/decoder';
 import { ByteReader } from './wire.js';
+import { ready as cellsReady, decodeCellBody } from './cells.js';
 
-export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd: 3 };
+export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd: 3, cells: 4 };
+// The hello's encoding for "the server chooses per group" between cells and compact+zstd
+// (remote/encoding_choice.h); not a codec's id.
+export const kAdaptiveEncoding = 255;
 export const kGroupCodecVersion = 2;
 export const kMaxNarrowIndexedVertices = 65536;
 export const kMaxGroupTriangles = 1 << 22;
@@ -24,17 +31,31 @@ export const kMaxGroupVertices = 3 * kMaxGroupTriangles;
 export const kMaxZstdExpansion = 64;
 const kMaxLevel = 30;
 const kMaxCompactBytes = kMaxGroupVertices * 10 + kMaxGroupTriangles * 16 + 256;
+// The largest cells body (group_codec.cpp): every voxel of the largest box (kMaxCellBoxVoxels,
+// cell_codec.h) as a float64, and the units' gaps.
+const kMaxCellBytes = (1 << 24) * 8 + kMaxGroupTriangles * 10 + 256;
 const WHAT = 'group';
 const f = Math.fround;
 
-// meshoptimizer's decoder is WebAssembly: await this once before decoding a compact group.
-// zstd is the reference decoder compiled to WebAssembly (zstddec): 7-10x faster than a decoder in
-// JavaScript on the head's groups (fzstd: 65-135 ms a frame against 9-53 ms, in node).
+// The decoders are WebAssembly: await this once before decoding a group. meshoptimizer's for
+// compact indices; zstd is the reference decoder (zstddec): 7-10x faster than a decoder in
+// JavaScript on the head's groups (fzstd: 65-135 ms a frame against 9-53 ms, in node); cells.js's.
 const zstd = new ZSTDDecoder();
-export const ready = Promise.all([MeshoptDecoder.ready, zstd.init()]);
+export const ready = Promise.all([MeshoptDecoder.ready, zstd.init(), cellsReady]);
 
 export function encodingName(e) {
-  return ['vertices', 'indexed', 'compact', 'compact+zstd'][e] ?? 'unknown';
+  if (e === kAdaptiveEncoding) return 'auto';
+  return ['vertices', 'indexed', 'compact', 'compact+zstd', 'cells'][e] ?? 'unknown';
+}
+
+// The encoding a hello asks for, from a URL's text: a codec's id (0..4) or name as `isowall view
+// --encoding` takes it (compact-zstd for compact+zstd), or auto / 255 (kAdaptiveEncoding);
+// null for anything else.
+export function helloEncoding(text) {
+  if (text === 'auto' || text === String(kAdaptiveEncoding)) return kAdaptiveEncoding;
+  if (/^[0-4]$/.test(text)) return Number(text);
+  const e = ['vertices', 'indexed', 'compact', 'compact-zstd', 'cells'].indexOf(text);
+  return e >= 0 ? e : null;
 }
 
 function getHeader(r) {
@@ -190,11 +211,13 @@ export function zstdFrameContentSize(b) {
   return fcsBytes === 2 ? v + 256 : v;
 }
 
-function getZstd(r) {
+// The message inside the frame; its size is checked against `limit`, the frame's own claim and the
+// expansion cap before anything is allocated.
+function getZstd(r, limit) {
   const lo = r.u32(), hi = r.u32();
   const size = hi * 4294967296 + lo;
   const frame = r.span(r.remaining());
-  if (size > kMaxCompactBytes || size > frame.length * kMaxZstdExpansion)
+  if (size > limit || size > frame.length * kMaxZstdExpansion)
     r.fail(`zstd: ${size} bytes claimed from a frame of ${frame.length}`);
   if (zstdFrameContentSize(frame) !== size) r.fail(`zstd: the frame's content size is not the ${size} bytes claimed`);
   let out;
@@ -215,7 +238,7 @@ export function encodingOf(bytes) {
   const version = r.u8();
   if (version !== kGroupCodecVersion) r.fail(`version ${version}, expected ${kGroupCodecVersion}`);
   const e = r.u8();
-  if (e > GroupEncoding.compact_zstd) r.fail(`encoding: expected 0..3, got ${e}`);
+  if (e > GroupEncoding.cells) r.fail(`encoding: expected 0..4, got ${e}`);
   return e;
 }
 
@@ -223,13 +246,14 @@ export function decodeGroup(bytes) {
   const encoding = encodingOf(bytes);
   const r = new ByteReader(bytes.subarray(2), WHAT);
   if (encoding === GroupEncoding.compact_zstd) {
-    const compact = getZstd(r);
+    const compact = getZstd(r, kMaxCompactBytes);
     const inner = encodingOf(compact);
     if (inner !== GroupEncoding.compact)
       r.fail(`zstd: the frame holds a ${encodingName(inner)} group, expected compact`);
     return decodeGroup(compact);
   }
   const g = getHeader(r);
+  if (encoding === GroupEncoding.cells) return Object.assign(g, decodeCellBody(getZstd(r, kMaxCellBytes), g.iso));
   const mesh = encoding === GroupEncoding.vertices ? getVertices(r)
     : encoding === GroupEncoding.indexed ? getIndexed(r) : getCompact(r);
   r.finish();

@@ -24,6 +24,9 @@ async function bundle(entry, out) {
     sourcemap: false,
     legalComments: 'eof',
     logLevel: 'warning',
+    // src/cells_wasm.js (emscripten's ES module) reads import.meta.url to find its .wasm file; its
+    // WebAssembly is inlined, so the empty import.meta of a script is no loss.
+    logOverride: { 'empty-import-meta': 'silent' },
   });
 }
 async function style(entry, out) {

@@ -1,0 +1,40 @@
+// The body of the `cells` group encoding (remote/cell_codec.h): the units and voxel values a group
+// was triangulated from. The decoder is the server's own C++ (remote/cell_codec.cpp, with
+// web/wasm/cells_wasm.cpp as its C API) compiled to WebAssembly by web/wasm/build.sh, so the page
+// runs the project's marching cubes and gets the server's triangles and normals to the bit.
+import createCellsModule from './cells_wasm.js';
+import { WireError } from './wire.js';
+
+let wasm = null;
+// Resolves once the module is compiled; decodeCellBody needs it.
+export const ready = createCellsModule().then((m) => { wasm = m; });
+
+// The mesh of a cells body (the bytes inside the group's zstd frame) at `iso`, as
+// { positions: Float32Array(3V), normals: Float32Array(3V), indices: Uint32Array(3T) }. Throws a
+// WireError with the C++ decoder's message ("group: <field>: <why>") for a malformed body.
+export function decodeCellBody(body, iso) {
+  const at = wasm._cells_alloc(body.length);
+  if (at === 0 && body.length > 0) throw new WireError(`group: cells: no memory for a body of ${body.length} bytes`);
+  // A trap (a bug, never a malformed body: those are WireErrors the C API catches) leaves the
+  // module's stack pointer where it stopped; restoring it keeps the module usable.
+  const stack = wasm.stackSave();
+  let status;
+  try {
+    wasm.HEAPU8.set(body, at);
+    status = wasm._cells_decode(at, body.length, iso);
+  } catch (e) {
+    wasm.stackRestore(stack);
+    throw new WireError(`group: cells: the decoder failed (${e.message})`);
+  } finally {
+    wasm._cells_free(at);
+  }
+  if (status !== 0) throw new WireError(wasm.UTF8ToString(wasm._cells_error()));
+  // Copies: the next decode reuses the memory, and growing it detaches every view.
+  const v = wasm._cells_vertex_count(), n = wasm._cells_index_count();
+  const f32 = (p, count) => new Float32Array(wasm.HEAPU8.buffer, p, count).slice();
+  return {
+    positions: f32(wasm._cells_positions(), 3 * v),
+    normals: f32(wasm._cells_normals(), 3 * v),
+    indices: new Uint32Array(wasm.HEAPU8.buffer, wasm._cells_indices(), n).slice(),
+  };
+}
