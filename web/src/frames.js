@@ -12,7 +12,7 @@
 // generation (of any request) is appended to the cache; one of another generation first drops
 // the cache. A group's slot is its index in the generation. The cache is kept while requests do
 // not cache.
-import { decodeGroup, triangleCount } from './group_codec.js';
+import { decodeGroup, triangleCount, GroupEncoding } from './group_codec.js';
 import { WireError } from './wire.js';
 import { viewMatrix, projectionMatrix } from './camera.js';
 
@@ -39,9 +39,13 @@ export function decodeMesh(m) {
 export function emptyStats() {
   // Where a frame's time goes: main-thread time decoding groups and issuing GL calls, and waiting
   // in finish() for the GL to draw what was issued (at the first group and the end of the frame).
-  return { bytes: 0, groups: 0, named: 0, triangles: 0, first_group_ms: null, frame_ms: null,
+  // cells: of the groups, those in the cells encoding (the adaptive server's choice).
+  return { bytes: 0, groups: 0, cells: 0, named: 0, triangles: 0, first_group_ms: null, frame_ms: null,
            decode_ms: 0, draw_ms: 0, gl_wait_ms: 0 };
 }
+
+// How often decodeReport gives what decoding cost (ClientFrames::kReportEveryS).
+export const kReportEveryMs = 50;
 
 export class ClientFrames {
   // renderer: clear(), clearDepth(), draw(mesh, view, projection), resize(w, h), collect(live).
@@ -61,6 +65,9 @@ export class ClientFrames {
     this.cache = [];   // { mesh, level }; index = slot in generation cacheGen
     this.cacheGen = 0;
     this.lastEnd = null;
+    // Decoded since the last report, by encoding id: { triangles, ms } (decodeReport).
+    this.decoded = new Map();
+    this.lastReportMs = -Infinity;
   }
 
   // A request was sent: a new frame of its view (the previous one is abandoned).
@@ -105,7 +112,14 @@ export class ClientFrames {
     if (!current && g.cache_gen === 0) return;
     const t0 = this.now();
     const mesh = this.decode(g);
-    this.stats.decode_ms += this.now() - t0;
+    const ms = this.now() - t0;
+    this.stats.decode_ms += ms;
+    // decode checked the encoding byte.
+    const e = g.encoded[1];
+    const d = this.decoded.get(e) ?? { triangles: 0, ms: 0 };
+    d.triangles += triangleCount(mesh);
+    d.ms += ms;
+    this.decoded.set(e, d);
     if (g.cache_gen !== 0) {
       if (g.cache_gen !== this.cacheGen) {
         this.cache = [];
@@ -117,6 +131,7 @@ export class ClientFrames {
     if (!current) return;
     this.stats.bytes += wireBytes;
     ++this.stats.groups;
+    if (g.encoded[1] === GroupEncoding.cells) ++this.stats.cells;
     if (!g.draw_from_next_frame) this.draw(mesh, g.key.level);
   }
 
@@ -136,6 +151,19 @@ export class ClientFrames {
       ++this.stats.named;
       this.draw(c.mesh, c.level);
     }
+  }
+
+  // What decoding groups cost since the last report, as a decode_rate message (the adaptive server
+  // weighs it, remote/encoding_choice.h), once kReportEveryMs has passed since that report (at
+  // `nowMs`) and something was decoded; null otherwise.
+  decodeReport(nowMs) {
+    if (nowMs - this.lastReportMs < kReportEveryMs) return null;
+    const entries = [...this.decoded].filter(([, d]) => d.triangles > 0).sort(([a], [b]) => a - b)
+      .map(([encoding, d]) => ({ encoding, triangles: d.triangles, seconds: d.ms / 1e3 }));
+    this.decoded.clear();
+    if (entries.length === 0) return null;
+    this.lastReportMs = nowMs;
+    return { entries };
   }
 
   // A decoded frame { name, msg } of `wireBytes` bytes. True when it ended the current frame.

@@ -3,7 +3,7 @@
 // (frames.js), and keeps window.isowall up to date for tests and the bench (the contract of
 // issue 13).
 import { MsgType, encodeFrame, decodeFrame, ErrorCode } from './protocol.js';
-import { ready as codecReady, encodingName } from './group_codec.js';
+import { ready as codecReady, helloEncoding, kAdaptiveEncoding } from './group_codec.js';
 import { viewCamera, cameraProblem } from './camera.js';
 import { Renderer } from './renderer.js';
 import { ClientFrames, RemoteError, emptyStats } from './frames.js';
@@ -46,11 +46,22 @@ function sizeParam() {
   return [+m[1], +m[2]];
 }
 
+// How groups travel (the hello's encoding): by default the server chooses cells or compact+zstd
+// per group, whichever its CPU and the link bring sooner (remote/encoding_choice.h).
+function encodingParam() {
+  const s = params.get('encoding');
+  if (s === null || s === '') return kAdaptiveEncoding;
+  const e = helloEncoding(s);
+  if (e !== null) return e;
+  warnings.push(`URL parameter encoding=${s}: expected auto, 0..4 or vertices, indexed, compact, compact-zstd, cells`);
+  return kAdaptiveEncoding;
+}
+
 const fixedSize = sizeParam();
 const settings = {
   lod: intParam('lod', 0, 1, 1) === 1,
   cache: intParam('cache', 0, 1, 1) === 1,
-  encoding: intParam('encoding', 0, 3, 3),
+  encoding: encodingParam(),
 };
 const urlIso = numberParam('iso', null);
 const kMinZoom = 1e-3, kMaxZoom = 1e3;
@@ -60,6 +71,7 @@ const api = {
   error: '',
   dataset: '',
   range: [0, 0],
+  encoding: settings.encoding,  // what the hello asks for: a codec's id, or 255 for the server's choice
   view: {
     yaw: numberParam('yaw', 0), pitch: numberParam('pitch', 0),
     zoom: numberParam('zoom', 1, (v) => v >= kMinZoom && v <= kMaxZoom, `a zoom in [${kMinZoom}, ${kMaxZoom}]`),
@@ -265,6 +277,11 @@ function connect(name) {
     if (kind === 'error') throw new RemoteError(msg.code, msg.text);
     if (!frames) return;
     const done = frames.handle(kind, msg, wireBytes);
+    // The server chooses the encodings: tell it what decoding costs here (view_client.cpp).
+    if (settings.encoding === kAdaptiveEncoding) {
+      const report = frames.decodeReport(performance.now());
+      if (report) sendFrame(MsgType.decode_rate, report);
+    }
     api.stats = frames.stats;
     countersDirty = true;
     if (done) {
@@ -469,7 +486,7 @@ async function start() {
   try {
     await codecReady;
   } catch (e) {
-    fail(`cannot start the ${encodingName(2)} decoder (WebAssembly): ${e.message}`);
+    fail(`cannot start the group decoders (WebAssembly): ${e.message}`);
     return;
   }
   const name = params.get('dataset') ?? '';

@@ -9,8 +9,9 @@ import { cameraProblem } from './camera.js';
 
 export const MsgType = {
   hello: 1, ready: 2, request: 3, group: 4, visible: 5, end_of_frame: 6, error: 7, bye: 8, session: 9,
+  decode_rate: 10,
 };
-export const kLastMsgType = 9;
+export const kLastMsgType = 10;
 const typeNames = Object.fromEntries(Object.entries(MsgType).map(([k, v]) => [v, k]));
 export function typeName(type) {
   return typeNames[type] ?? 'unknown';
@@ -32,10 +33,14 @@ export const kMaxPeerNameBytes = 128;
 export const kMaxGroupBytes = 32 * 1024 * 1024;
 export const kMaxGroupLevel = 30;
 export const kMaxImageSide = 32768;
+// decode_rate: one entry at most per group codec (GroupEncoding's count).
+export const kDecodeRateEncodings = 5;
 const MAGIC = [0x49, 0x57, 0x56, 0x50];
 
 // hello: 1 without a shared session, 2 with one (role and session); both decode.
-const VERSION = { hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1 };
+const VERSION = {
+  hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1, decode_rate: 1,
+};
 
 // ---- text ----------------------------------------------------------------------------------
 
@@ -193,6 +198,18 @@ const encoders = {
     putSlots(w, m.slots);
     return w.take();
   },
+  // What decoding groups cost the client since its last report, per encoding: entries
+  // { encoding, triangles, seconds }, ascending by encoding (a client of the adaptive server sends it).
+  decode_rate(m) {
+    const w = new Writer(VERSION.decode_rate);
+    w.u8(m.entries.length);
+    for (const e of m.entries) {
+      w.u8(e.encoding);
+      w.u64(e.triangles);
+      w.f64(e.seconds);
+    }
+    return w.take();
+  },
   end_of_frame(m) {
     const w = new Writer(VERSION.end_of_frame);
     for (const k of ['request_id', 'rays', 'groups', 'triangles', 'bytes']) w.u64(m[k]);
@@ -296,6 +313,23 @@ const decoders = {
   },
   bye() {
     return {};
+  },
+  decode_rate(r) {
+    const count = r.u8();
+    if (count > kDecodeRateEncodings) r.fail(`entries: ${count}, expected at most ${kDecodeRateEncodings}`);
+    const entries = [];
+    for (let i = 0; i < count; ++i) {
+      const encoding = r.u8();
+      if (encoding > kDecodeRateEncodings - 1)
+        r.fail(`entries.encoding: ${encoding}, expected at most ${kDecodeRateEncodings - 1}`);
+      if (entries.length && encoding <= entries[entries.length - 1].encoding)
+        r.fail(`entries.encoding: ${encoding} after ${entries[entries.length - 1].encoding}, expected ascending`);
+      const triangles = r.u64('entries.triangles');
+      const seconds = r.finiteF64('entries.seconds');
+      if (seconds < 0) r.fail(`entries.seconds: ${seconds}, expected >= 0`);
+      entries.push({ encoding, triangles, seconds });
+    }
+    return { entries };
   },
 };
 

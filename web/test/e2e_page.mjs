@@ -87,6 +87,9 @@ try {
   check(s.stats.groups > 0 && s.stats.triangles > 0 && s.stats.first_group_ms !== null && s.stats.frame_ms !== null,
     `front view stats ${JSON.stringify(s.stats)}`);
   check(s.requests.length === 1 && s.requests[0].iso === iso, `one request (lod ${s.requests[0].lod}, cache ${s.requests[0].cache})`);
+  // Without an encoding in the URL the server chooses (cells or compact+zstd per group).
+  const chosen = process.env.ISOWALL_EXTRA?.includes('encoding=') ? null : 255;
+  check(chosen === null || s.encoding === chosen, `hello encoding ${s.encoding} (255: the server's choice)`);
   const front = { ...s.view, stats: s.stats, png: await savePng('front.png'), mid_png: mid };
 
   // The snapshot button downloads the canvas as a PNG of the canvas's size.
@@ -153,6 +156,12 @@ try {
   s = await waitDone();
   check(s.state === 'done' && s.dataset === 'phantom' && s.stats.named === 0 && s.stats.groups > 0,
     `picker: phantom again, frame ${s.done_request_id} done (${s.stats.groups} groups, ${s.stats.named} named)`);
+
+  // The server's choice starts with cells, and explores it while compact+zstd wins (the chooser's
+  // rule): the page's cells decoder drew some of these frames' groups.
+  const cellsGroups = [front, isoView, dragged, zoomed].reduce((n, v) => n + v.stats.cells, 0);
+  check(chosen === null || cellsGroups > 0, `cells groups decoded and drawn: ${cellsGroups} of ` +
+    `${[front, isoView, dragged, zoomed].reduce((n, v) => n + v.stats.groups, 0)}`);
 
   writeFileSync(join(out, 'views.json'), JSON.stringify({ dataset: 'phantom', front, iso2: isoView, dragged, zoomed }, null, 2));
   console.log(`e2e_page: wrote ${join(out, 'views.json')}`);

@@ -44,7 +44,7 @@ test('progressive LOD: a depth clear when a finer level begins, coarser groups s
   assert.deepEqual(r.ops, ['resize 4x4', 'clear', 'draw a2', 'draw b2', 'depth', 'draw c1', 'depth', 'draw e0', 'draw f0',
     'clear', 'draw e0', 'draw f0']);
   assert.deepEqual({ ...f.stats, first_group_ms: 0, frame_ms: 0, decode_ms: 0, draw_ms: 0, gl_wait_ms: 0 },
-    { bytes: 750, groups: 7, named: 0, triangles: 6, first_group_ms: 0, frame_ms: 0, decode_ms: 0, draw_ms: 0, gl_wait_ms: 0 });
+    { bytes: 750, groups: 7, cells: 0, named: 0, triangles: 6, first_group_ms: 0, frame_ms: 0, decode_ms: 0, draw_ms: 0, gl_wait_ms: 0 });
   assert.ok(f.stats.first_group_ms > 0 && f.stats.frame_ms > f.stats.first_group_ms);
 });
 
@@ -107,4 +107,25 @@ test('a group whose encoded key is another group is refused', async () => {
   const key = { seed: [4, -5, 6], level: 0, iso: 105.5, refinement: false };
   assert.equal(decodeMesh({ key, encoded }).indices.length, 12);
   assert.throws(() => decodeMesh({ key: { ...key, level: 1 }, encoded }), /group message: key: the encoded group is another group/);
+});
+
+test('decode reports: triangles and seconds per encoding, at most every 50 ms, cells groups counted', () => {
+  const r = new Recorder();
+  let t = 0;
+  // A clock that moves 2 ms for each reading: each decode takes 2 ms.
+  const f = new ClientFrames(r, () => (t += 2), (m) => m.mesh);
+  const g = (e, tris, gen = 0, id = 1) => ({ request_id: id, key: { seed: [0, 0, 0], level: 0, iso: 1, refinement: false },
+    draw_from_next_frame: false, cache_gen: gen, encoded: new Uint8Array([2, e]), mesh: { name: `e${e}`, indices: new Uint32Array(3 * tris) } });
+  assert.equal(f.decodeReport(0), null, 'nothing decoded');
+  f.begin(request(1));
+  f.handle('group', g(4, 10), 10);
+  f.handle('group', g(3, 5), 10);
+  f.handle('group', g(4, 2), 10);
+  f.handle('group', g(3, 1, 7, 99), 10);  // another request's, cached: decoded, so it counts
+  assert.equal(f.stats.cells, 2);
+  assert.deepEqual(f.decodeReport(1000), { entries: [{ encoding: 3, triangles: 6, seconds: 0.004 }, { encoding: 4, triangles: 12, seconds: 0.004 }] });
+  f.handle('group', g(4, 1), 10);
+  assert.equal(f.decodeReport(1049), null, 'within 50 ms of the last report');
+  assert.deepEqual(f.decodeReport(1050), { entries: [{ encoding: 4, triangles: 1, seconds: 0.002 }] });
+  assert.equal(f.decodeReport(2000), null, 'nothing decoded since');
 });

@@ -12,7 +12,7 @@ const read = (dir, name) => new Uint8Array(readFileSync(new URL(name, dir)));
 
 test('corpus payloads decode, and encode back to their bytes', () => {
   const names = readdirSync(corpus).filter((n) => n.startsWith('payload-'));
-  assert.equal(names.length, 9);
+  assert.equal(names.length, 10);
   for (const name of names) {
     const b = read(corpus, name);
     assert.equal(b[0] % 2, 0, name);
@@ -53,16 +53,19 @@ test('corpus values are the seeds\' (fuzz/view_protocol_seeds.cpp)', () => {
   assert.deepEqual(msg('error'), { code: 3, text: 'wrong token' });
   assert.deepEqual(msg('bye'), {});
   assert.deepEqual(msg('session'), { session: 'class 3b', presenter: '10.0.0.7:51234', members: 12 });
+  assert.deepEqual(msg('decode_rate'), { entries: [{ encoding: 3, triangles: 120000, seconds: 0.0125 },
+    { encoding: 4, triangles: 30000, seconds: 0.01 }] });
 });
 
-test('stream-all splits into its nine frames, whatever the chunks', () => {
+test('stream-all splits into its ten frames, whatever the chunks', () => {
   const stream = read(corpus, 'stream-all').subarray(2);
   for (const chunk of [1, 5, 13, 1000]) {
     const s = new FrameSplitter();
     const frames = [];
     for (let i = 0; i < stream.length; i += chunk) frames.push(...s.push(stream.subarray(i, i + chunk)));
     assert.deepEqual(frames.map((f) => decodeFrame(f).name),
-      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye', 'session'], `chunks of ${chunk}`);
+      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye', 'session', 'decode_rate'],
+      `chunks of ${chunk}`);
   }
 });
 
@@ -84,10 +87,13 @@ function sampleRequest() {
     progressive_lod: true, cached_groups: false };
 }
 
-test('round trips of what the page sends: hello, request, bye', () => {
+test('round trips of what the page sends: hello, request, decode_rate, bye', () => {
   for (const [type, m] of [
     [MsgType.hello, { protocol_version: 1, dataset: 'phantom', token: 'tok en', encoding: 3 }],
     [MsgType.hello, { protocol_version: 1, dataset: 'head', token: '', encoding: 0 }],
+    [MsgType.hello, { protocol_version: 1, dataset: 'head', token: '', encoding: 255 }],
+    [MsgType.decode_rate, { entries: [] }],
+    [MsgType.decode_rate, { entries: [{ encoding: 0, triangles: 1, seconds: 0 }, { encoding: 4, triangles: 2 ** 40, seconds: 1.5e-3 }] }],
     [MsgType.request, sampleRequest()],
     [MsgType.bye, {}],
   ]) {
@@ -122,7 +128,14 @@ test('decoders name the message and the field', () => {
   assert.throws(() => decodePayload(MsgType.ready, ready), /ready message: value_max: expected >= value_min/);
   const mirrored = encodePayload(MsgType.ready, { bounds: { min: [0, 0, 0], max: [1, 1, 1] }, value_min: 0, value_max: 1, dims: [2, 2, 2], spacing: [1, 1, 1], axes: [[-1, 0, 0], [0, 1, 0], [0, 0, 1]] });
   assert.throws(() => decodePayload(MsgType.ready, mirrored), /ready message: axes: expected a rotation/);
-  assert.throws(() => decodePayload(10, new Uint8Array([1])), /view protocol: unknown message type 10/);
+  const rate = (entries) => encodePayload(MsgType.decode_rate, { entries });
+  const one = { encoding: 4, triangles: 10, seconds: 0.5 };
+  assert.throws(() => decodePayload(MsgType.decode_rate, rate(Array(6).fill(one))), /^WireError: decode_rate message: entries: 6, expected at most 5$/);
+  assert.throws(() => decodePayload(MsgType.decode_rate, rate([{ ...one, encoding: 5 }])), /decode_rate message: entries.encoding: 5, expected at most 4/);
+  assert.throws(() => decodePayload(MsgType.decode_rate, rate([one, { ...one, encoding: 3 }])), /entries.encoding: 3 after 4, expected ascending/);
+  assert.throws(() => decodePayload(MsgType.decode_rate, rate([{ ...one, seconds: -1 }])), /entries.seconds: -1, expected >= 0/);
+  assert.throws(() => decodePayload(MsgType.decode_rate, rate([{ ...one, seconds: NaN }])), /entries.seconds: expected a finite number, got NaN/);
+  assert.throws(() => decodePayload(11, new Uint8Array([1])), /view protocol: unknown message type 11/);
 });
 
 test('headers are checked before the payload', () => {
@@ -130,7 +143,7 @@ test('headers are checked before the payload', () => {
   const h = (patch) => { const b = f.slice(); patch(b); return b; };
   assert.throws(() => decodeHeader(h((b) => { b[0] = 0x58; })), /view protocol header: magic: expected 49 57 56 50 \("IWVP"\), got 58 57 56 50/);
   assert.throws(() => decodeHeader(h((b) => { b[4] = 2; })), /header: version: expected 1, got 2/);
-  assert.throws(() => decodeHeader(h((b) => { b[6] = 10; })), /header: type: expected 1..9, got 10/);
+  assert.throws(() => decodeHeader(h((b) => { b[6] = 11; })), /header: type: expected 1..10, got 11/);
   assert.throws(() => decodeHeader(h((b) => { b[11] = 0x10; })), /header: length: 268435457 bytes is over the limit of 67108864 \(bye message\)/);
   assert.throws(() => decodeFrame(new Uint8Array([...f, 0])), /header: length: the header says 1 payload bytes, the frame holds 2/);
 });
