@@ -24,8 +24,8 @@ try {
     process.exit(1);
   }
   if (!readFileSync(out).equals(readFileSync(join(root, 'src/cells_wasm.js')))) {
-    console.error('check_wasm: src/cells_wasm.js differs from a fresh build of the C++: run web/wasm/build.sh, ' +
-      'then `npm run build` in web/, and commit src/cells_wasm.js and dist/');
+    console.error('check_wasm: src/cells_wasm.js differs from a fresh build of the C++: run web/wasm/refresh.sh ' +
+      '(the decoder, the test groups, dist/), then npm test in web/, and commit what it wrote');
     process.exit(1);
   }
   console.log('check_wasm: src/cells_wasm.js is what web/wasm/build.sh makes of the C++ now');
