@@ -6,13 +6,23 @@ import createCellsModule from './cells_wasm.js';
 import { WireError } from './wire.js';
 
 let wasm = null;
-// Resolves once the module is compiled; decodeCellBody needs it.
-export const ready = createCellsModule().then((m) => { wasm = m; });
+let failure = null;
+// Settles once the module is compiled, or could not be: a browser without WebAssembly exceptions
+// (before Chrome 95, Firefox 100, Safari 15.2) cannot run it, and the page then asks for
+// compact+zstd, which does not need it (cellsProblem).
+export const ready = createCellsModule().then((m) => { wasm = m; }, (e) => { failure = e; });
+
+// Why this browser cannot decode cells bodies, or null when it can (after `ready`).
+export function cellsProblem() {
+  if (wasm) return null;
+  return `the cells decoder (WebAssembly) did not start: ${failure?.message ?? 'not yet loaded'}`;
+}
 
 // The mesh of a cells body (the bytes inside the group's zstd frame) at `iso`, as
 // { positions: Float32Array(3V), normals: Float32Array(3V), indices: Uint32Array(3T) }. Throws a
 // WireError with the C++ decoder's message ("group: <field>: <why>") for a malformed body.
 export function decodeCellBody(body, iso) {
+  if (!wasm) throw new WireError(`group: cells: ${cellsProblem()}`);
   const at = wasm._cells_alloc(body.length);
   if (at === 0 && body.length > 0) throw new WireError(`group: cells: no memory for a body of ${body.length} bytes`);
   // A trap (a bug, never a malformed body: those are WireErrors the C API catches) leaves the

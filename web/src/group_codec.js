@@ -19,6 +19,7 @@ import { ZSTDDecoder } from 'zstddec';
 import { MeshoptDecoder } from 'meshoptimizer/decoder';
 import { ByteReader } from './wire.js';
 import { ready as cellsReady, decodeCellBody } from './cells.js';
+export { cellsProblem } from './cells.js';
 
 export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd: 3, cells: 4 };
 // The hello's encoding for "the server chooses per group" between cells and compact+zstd

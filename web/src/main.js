@@ -3,7 +3,7 @@
 // (frames.js), and keeps window.isowall up to date for tests and the bench (the contract of
 // issue 13).
 import { MsgType, encodeFrame, decodeFrame, ErrorCode } from './protocol.js';
-import { ready as codecReady, helloEncoding, kAdaptiveEncoding } from './group_codec.js';
+import { ready as codecReady, helloEncoding, kAdaptiveEncoding, GroupEncoding, cellsProblem } from './group_codec.js';
 import { viewCamera, cameraProblem } from './camera.js';
 import { Renderer } from './renderer.js';
 import { ClientFrames, RemoteError, emptyStats } from './frames.js';
@@ -488,6 +488,13 @@ async function start() {
   } catch (e) {
     fail(`cannot start the group decoders (WebAssembly): ${e.message}`);
     return;
+  }
+  // Without the cells decoder, groups come as compact+zstd: a server left to choose would send
+  // cells too.
+  const problem = cellsProblem();
+  if (problem && (settings.encoding === kAdaptiveEncoding || settings.encoding === GroupEncoding.cells)) {
+    warnings.push(`${problem}: groups come as compact+zstd`);
+    settings.encoding = api.encoding = GroupEncoding.compact_zstd;
   }
   const name = params.get('dataset') ?? '';
   if (name) {

@@ -166,3 +166,24 @@ test('the hello\'s encoding from the URL: a codec, auto by name or 255, nothing 
   assert.equal(encodingName(4), 'cells');
   assert.equal(encodingName(255), 'auto');
 });
+
+test('a browser that cannot run the cells decoder still decodes the other encodings', async () => {
+  // WebAssembly.instantiate refuses emscripten's cells module alone (its imports name
+  // emscripten_resize_heap), as a browser without WebAssembly exceptions would refuse it to compile.
+  const script = `
+    const instantiate = WebAssembly.instantiate;
+    WebAssembly.instantiate = (b, imports) => imports?.env?.emscripten_resize_heap
+      ? Promise.reject(new Error('no exception handling')) : instantiate(b, imports);
+    const { ready, cellsProblem, decodeGroup } = await import(${JSON.stringify(new URL('../src/group_codec.js', import.meta.url).href)});
+    const { readFileSync } = await import('node:fs');
+    const read = (n) => new Uint8Array(readFileSync(new URL('../../fuzz/corpus/group_codec/' + n, ${JSON.stringify(import.meta.url)})));
+    await ready;
+    let cells;
+    try { decodeGroup(read('cells-phantom-cells')); } catch (e) { cells = String(e); }
+    console.log(JSON.stringify({ problem: cellsProblem(), cells, compact: decodeGroup(read('compact_zstd-grid')).indices.length }));`;
+  const { execFileSync } = await import('node:child_process');
+  const out = JSON.parse(execFileSync(process.execPath, ['--input-type=module', '-e', script], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] }));
+  assert.match(out.problem, /^the cells decoder \(WebAssembly\) did not start: .*no exception handling/);
+  assert.match(out.cells, /^WireError: group: cells: the cells decoder \(WebAssembly\) did not start/);
+  assert.equal(out.compact, 54);
+});
