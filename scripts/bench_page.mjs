@@ -4,7 +4,10 @@
 // loopback. One `isowall serve --http 0` serves both clients; each run is a fresh connection (a
 // fresh page, a fresh `isowall view` process) asking for the front view with progressive LOD and
 // the cache (the study's case 5, compact + zstd), so neither client starts with cached groups.
-// Runs alternate page / view, so load on this 2-core machine falls on both alike.
+// The page runs twice: asking for compact+zstd as case 5 does (the page's default until issue 34),
+// and at its default since (auto: the server chooses cells or compact+zstd per group, the page
+// decodes cells in WebAssembly). Runs alternate page / page auto / view, so load on this 2-core
+// machine falls on all alike.
 //
 //   node scripts/bench_page.mjs [--isowall build/bin/isowall] [--runs 5] [--size 800x600]
 //                               [--head ../shared/data/vhp_ct_head.nhdr] [--out out/bench-page]
@@ -68,7 +71,7 @@ function startServer(o, datasets) {
     return startServe(o.isowall, extra, { timeoutS: 120 });
 }
 
-async function pageRun(browser, server, d, o) {
+async function pageRun(browser, server, d, o, encoding) {
     const url = server.url;
     const [w, h] = o.size.split('x').map(Number);
     // The browser's processes are this script's children, beside the server.
@@ -76,7 +79,8 @@ async function pageRun(browser, server, d, o) {
     const cpu0 = { client: browserCpu(), server: cpuOfTree(server.proc.pid) };
     const page = await browser.newPage({ viewport: { width: w + 400, height: h + 200 } });
     try {
-        const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1`;
+        const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1` +
+                  (encoding === undefined ? '' : `&encoding=${encoding}`);
         await page.goto(new URL(q, url).href);
         await page.waitForFunction(
             () => window.isowall && (window.isowall.state === 'done' || window.isowall.state === 'error'),
@@ -85,7 +89,7 @@ async function pageRun(browser, server, d, o) {
                                                error: window.isowall.error }));
         if (s.state === 'error') throw new Error(`page: ${s.error}`);
         const cpu = { client_s: browserCpu() - cpu0.client, server_s: cpuOfTree(server.proc.pid) - cpu0.server };
-        return { ...cpu, first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes,
+        return { ...cpu, first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes, cells: s.cells,
                  triangles: s.triangles, groups: s.groups, decode_ms: s.decode_ms, draw_ms: s.draw_ms, gl_wait_ms: s.gl_wait_ms };
     } finally {
         await page.close();
@@ -187,18 +191,21 @@ async function main() {
     const results = {};
     try {
         for (const d of datasets) {
-            const page = [], view = [];
+            const page = [], auto = [], view = [];
             // One warm-up of each: the server's first request on a dataset pages in its octree.
+            await pageRun(browser, server, d, o, 3);
             await pageRun(browser, server, d, o);
             viewRun(server, d, o, o.out);
             for (let i = 0; i < o.runs; ++i) {
-                page.push(await pageRun(browser, server, d, o));
+                page.push(await pageRun(browser, server, d, o, 3));
+                auto.push(await pageRun(browser, server, d, o));
                 view.push(viewRun(server, d, o, o.out));
                 process.stdout.write(`bench_page: ${d.name} run ${i + 1}/${o.runs}: page ` +
-                    `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms, view ` +
-                    `${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms\n`);
+                    `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms, page auto ` +
+                    `${auto[i].first_ms.toFixed(1)} / ${auto[i].frame_ms.toFixed(1)} ms (${auto[i].cells} ` +
+                    `groups as cells), view ${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms\n`);
             }
-            results[d.name] = { iso: d.iso, page: summarise(page), view: summarise(view) };
+            results[d.name] = { iso: d.iso, page: summarise(page), page_auto: summarise(auto), view: summarise(view) };
         }
     } finally {
         await browser.close();
@@ -206,20 +213,25 @@ async function main() {
     }
     const rows = [`| dataset | client | first group ms (median, fastest) | end of frame ms (median, fastest) | client CPU s | server CPU s | bytes | triangles | page / view, end of frame |`,
                   '|---|---|---|---|---|---|---|---|---|'];
+    const names = { page: 'browser page, compact+zstd', page_auto: 'browser page, auto (its default)', view: 'isowall view' };
+    const verdicts = [];
     for (const [name, r] of Object.entries(results)) {
-        for (const who of ['page', 'view']) {
+        const ratio = r.page_auto.frame_ms / r.page.frame_ms;
+        verdicts.push(`${name}: the page's end of frame at its default (auto) is ${ratio.toFixed(2)}x ` +
+                      `its compact+zstd one (${ratio <= 1 ? 'no worse' : 'WORSE'})`);
+        for (const who of ['page', 'page_auto', 'view']) {
             const s = r[who];
-            rows.push(`| ${name} (iso ${r.iso}) | ${who === 'page' ? 'browser page' : 'isowall view'} | ` +
+            rows.push(`| ${name} (iso ${r.iso}) | ${names[who]} | ` +
                 `${s.first_ms.toFixed(1)}, ${s.first_min_ms.toFixed(1)} | ${s.frame_ms.toFixed(1)}, ` +
                 `${s.frame_min_ms.toFixed(1)} | ${s.client_cpu_s.toFixed(2)} | ${s.server_cpu_s.toFixed(2)} | ${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
-                `${who === 'page' ? (s.frame_ms / r.view.frame_ms).toFixed(2) : ''} |`);
+                `${who !== 'view' ? (s.frame_ms / r.view.frame_ms).toFixed(2) : ''} |`);
         }
     }
-    const header = `Front view ${o.size}, case 5 (compact + zstd, LOD, cache), fresh connection each run, ` +
+    const header = `Front view ${o.size}, case 5 (LOD, cache; view in compact + zstd), fresh connection each run, ` +
                    `${o.runs} runs after one warm-up, loopback, ${new Date().toISOString()}`;
-    console.log(`\n${header}\n\n${rows.join('\n')}`);
+    console.log(`\n${header}\n\n${rows.join('\n')}\n\n${verdicts.join('\n')}`);
     writeFileSync(path.join(o.out, 'bench.json'), JSON.stringify({ size: o.size, runs: o.runs, results }, null, 1));
-    writeFileSync(path.join(o.out, 'bench.md'), `${header}\n\n${rows.join('\n')}\n`);
+    writeFileSync(path.join(o.out, 'bench.md'), `${header}\n\n${rows.join('\n')}\n\n${verdicts.join('\n')}\n`);
 }
 
 main().catch((e) => fail(e.message));
