@@ -7,7 +7,6 @@
 
 #include "common/extract/edge_cache.h"
 #include "remote/cell_voxels.h"
-#include "remote/compact_mesh.h"
 #include "remote/group_codec.h"
 
 namespace isowall::remote {
@@ -17,21 +16,9 @@ using namespace cells;
 
 constexpr std::uint32_t kMaxUnits = kMaxGroupTriangles;
 
-// How a body's normals travel (its `normals` byte).
-enum class Normals : std::uint8_t { gradients = 0, octahedral = 1 };
-
-// A unit normal as two bytes: the octahedral code of compact_mesh.h, kept to 8 bits a coordinate
-// (about half a degree).
-std::array<std::int8_t, 2> oct8(glm::vec3 n) {
-    const auto c = oct_encode(n);
-    return {static_cast<std::int8_t>(std::lround(c[0] * 127.0 / 32767.0)),
-            static_cast<std::int8_t>(std::lround(c[1] * 127.0 / 32767.0))};
-}
-
-glm::vec3 from_oct8(std::int8_t a, std::int8_t b) {
-    return oct_decode({static_cast<std::int16_t>(std::lround(a * 32767.0 / 127.0)),
-                       static_cast<std::int16_t>(std::lround(b * 32767.0 / 127.0))});
-}
+// How a body's normals come (its `normals` byte): from the gradients' voxels, or from the faces
+// around each vertex (nothing sent).
+enum class Normals : std::uint8_t { gradients = 0, faces = 1 };
 
 // The units' triangles, as both sides emit them: the same order, the same vertex per edge.
 template <class View>
@@ -108,8 +95,7 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     if (box.voxels() > kMaxCellBoxVoxels) return std::nullopt;
     // A coarse pass's vertices lie 2^level apart, so their gradients share few voxels: its
     // normals go as such (it is drawn only until the full resolution replaces it).
-    const Normals normals =
-        g.level >= 1 && !g.refinement ? Normals::octahedral : Normals::gradients;
+    const Normals normals = g.level >= 1 && !g.refinement ? Normals::faces : Normals::gradients;
     ByteWriter w;
     w.put(static_cast<std::uint8_t>(volume.type()));
     for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(h.dims[a]));
@@ -118,21 +104,8 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     put_units(w, *units, h.dims);
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
     PhaseVoxels<T> named(sent, box, nullptr);
-    const Corners corners = each_phase(
-        h, named, *units, normals == Normals::gradients,
-        [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
-    if (normals == Normals::octahedral) {
-        const std::vector<int> cases = cases_of(corners, g.iso, triangles);
-        const Mesh m = triangulate(view, *units, corners, cases, g.iso, triangles);
-        std::vector<std::int8_t> a(m.vertex_count()), b(m.vertex_count());
-        for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-            const auto code = oct8(m.normals[i]);
-            a[i] = code[0];
-            b[i] = code[1];
-        }
-        w.put_raw(std::span<const std::int8_t>(a));
-        w.put_raw(std::span<const std::int8_t>(b));
-    }
+    each_phase(h, named, *units, normals == Normals::gradients,
+               [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
     return w.take();
 }
 
@@ -159,14 +132,7 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
                std::to_string(kMaxGroupTriangles));
     // Without the gradients' voxels the normals emitted are placeholders, replaced below.
     Mesh mesh = triangulate(held, units, corners, cases, iso, triangles);
-    if (normals == Normals::octahedral) {
-        r.need_elements(mesh.vertex_count(), 2, "octahedral normals");
-        const auto a = r.get_span(mesh.vertex_count());
-        const auto b = r.get_span(mesh.vertex_count());
-        for (std::size_t i = 0; i < mesh.vertex_count(); ++i)
-            mesh.normals[i] =
-                from_oct8(static_cast<std::int8_t>(a[i]), static_cast<std::int8_t>(b[i]));
-    }
+    if (normals == Normals::faces) normals_from_faces(mesh);
     return mesh;
 }
 
@@ -198,8 +164,8 @@ Mesh decode_cell_body(ByteReader& r, double iso) {
             r.fail("spacing: expected a positive finite number, got " + std::to_string(spacing[a]));
     }
     const auto normals = r.get<std::uint8_t>();
-    if (normals > static_cast<std::uint8_t>(Normals::octahedral))
-        r.fail("normals: expected 0 (gradients) or 1 (octahedral), got " + std::to_string(normals));
+    if (normals > static_cast<std::uint8_t>(Normals::faces))
+        r.fail("normals: expected 0 (gradients) or 1 (faces), got " + std::to_string(normals));
     const std::vector<Unit> units = get_units(r, dims, kMaxUnits);
     return dispatch_voxel_type(static_cast<VoxelType>(type), [&](auto t) {
         return decode_typed(r, dims, spacing, iso, static_cast<Normals>(normals), units, t);

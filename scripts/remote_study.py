@@ -4,7 +4,7 @@ and 100% for each test case, over links paced to 100, 10 and 1 Mbit/s.
 
 Usage: scripts/remote_study.py [--isowall build/bin/isowall] [--volume PATH|phantom]
                                [--iso 40] [--size 800x600] [--turn 30] [--rates 100,10,1]
-                               [--cases 1,2,3,4,5] [--out out/remote-study]
+                               [--cases 1,2,3,4,5,6,7] [--out out/remote-study]
 
 The volume defaults to the shared CT head resampled to 256 voxels a side (256x256x117, made once
 by scripts/resample_volume.py into build/data), the nearest to the text's 256x256x209 Visible
@@ -349,7 +349,7 @@ def parse_args(argv):
     p.add_argument("--size", default="800x600")
     p.add_argument("--turn", type=float, default=30.0, help="the rotation of cases 4 and 5")
     p.add_argument("--rates", default="100,10,1", help="Mbit/s, comma-separated")
-    p.add_argument("--cases", default="1,2,3,4,5")
+    p.add_argument("--cases", default="1,2,3,4,5,6,7")
     p.add_argument("--out", default=os.path.join(ROOT, "out", "remote-study"))
     a = p.parse_args(argv)
     try:

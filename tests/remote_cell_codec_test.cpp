@@ -64,35 +64,38 @@ double normal_angle_deg(glm::vec3 a, glm::vec3 b) {
     return std::atan2(glm::length(glm::cross(da, db)), glm::dot(da, db)) * 180.0 / M_PI;
 }
 
-// `got` has the triangles of `want`, corner by corner, with the same winding and positions to the
-// bit: the client runs the server's arithmetic on the server's voxel values. Normals: to the bit
-// too when normal_tol_deg is 0 (full resolution: from the voxels), else within that angle of
-// the normal of a server vertex at the same place (a coarse pass: octahedral, 8 bits a
-// coordinate).
+// `got` has the triangles of `want`, corner by corner, with the same winding, positions and
+// normals to the bit: the client runs the server's arithmetic on the server's voxel values. A
+// coarse pass's normals come from its faces (cell_codec.h): `want`'s are taken so first.
 void expect_same_mesh(const Mesh& got, const Mesh& want, const std::string& what,
-                      double normal_tol_deg = 0) {
+                      bool coarse = false) {
     ASSERT_EQ(got.triangle_count(), want.triangle_count()) << what;
-    const bool exact = normal_tol_deg == 0;
-    const std::vector<Triangle> a = triangles_of(got, exact), b = triangles_of(want, exact);
+    const std::vector<Triangle> a = triangles_of(got, !coarse), b = triangles_of(want, !coarse);
     std::vector<Triangle> only_a;
     std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(only_a));
     EXPECT_TRUE(only_a.empty()) << what << ": " << only_a.size() << " of " << a.size()
                                 << " triangles differ from the server's";
-    if (exact) return;
+    if (!coarse) return;
+    // Its normals are its faces' (the client's vertices, shared through one edge cache)...
+    Mesh faces = got;
+    normals_from_faces(faces);
+    EXPECT_TRUE(faces.normals == got.normals) << what << ": normals not from the faces";
+    // ...and face the side the server's gradients do: 28 degrees apart on average on the head's
+    // coarse passes, up to 50 on cthead's small ones (noisy 16-bit gradients at the crossings);
+    // normals turned inside out would be over 90.
     std::map<std::array<float, 3>, glm::vec3> at;
     for (std::size_t i = 0; i < want.vertex_count(); ++i)
         at[{want.positions[i].x, want.positions[i].y, want.positions[i].z}] = want.normals[i];
-    double worst = 0;
+    double angle = 0;
     for (std::size_t i = 0; i < got.vertex_count(); ++i) {
         const auto it = at.find({got.positions[i].x, got.positions[i].y, got.positions[i].z});
         ASSERT_NE(it, at.end()) << what << ": a vertex where the server has none";
-        worst = std::max(worst, normal_angle_deg(got.normals[i], it->second));
+        angle += normal_angle_deg(got.normals[i], it->second);
     }
-    EXPECT_LE(worst, normal_tol_deg) << what << ": the largest normal error";
+    if (got.vertex_count() > 0) {
+        EXPECT_LT(angle / double(got.vertex_count()), 75.0) << what << ": mean normal angle";
+    }
 }
-
-// The largest error of an 8-bit octahedral normal, with margin (about 0.5 degree measured).
-constexpr double kOct8Deg = 1.0;
 
 // The group through its cells body; and encode_group's choice: cells at full resolution, and for
 // a coarse pass the smaller of cells and compact+zstd.
@@ -121,7 +124,7 @@ void expect_round_trips(const std::vector<Group>& groups, const Volume& v,
         const Group back = round_trip(g, v);
         EXPECT_EQ(back.key(), g.key());
         expect_same_mesh(back.mesh, g.mesh, what + " group " + std::to_string(g.id),
-                         g.level >= 1 && !g.refinement ? kOct8Deg : 0);
+                         g.level >= 1 && !g.refinement);
         if (testing::Test::HasFailure()) return;
     }
 }

@@ -17,7 +17,9 @@ struct Link {
     double cells_rate = 0, compact_rate = 0;
 };
 
-std::uint64_t run(EncodingChooser& c, const Link& link, int groups) {
+// With `cells_decode_s` > 0 the client reports its decoding too: that many seconds a triangle for
+// cells, 0.026 us for compact+zstd (39 M triangles/s, the codec benchmark on the head).
+std::uint64_t run(EncodingChooser& c, const Link& link, int groups, double cells_decode_s = 0) {
     std::uint64_t cells = 0;
     for (int i = 0; i < groups; ++i) {
         const GroupEncoding e = c.next();
@@ -27,6 +29,7 @@ std::uint64_t run(EncodingChooser& c, const Link& link, int groups) {
         c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
         const double rate = is_cells ? link.cells_rate : link.compact_rate;
         c.sent(e, bytes, rate > 0 ? double(bytes) / rate : 0);
+        if (cells_decode_s > 0) c.decoded(e, 2000, 2000 * (is_cells ? cells_decode_s : 0.026e-6));
     }
     return cells;
 }
@@ -55,34 +58,18 @@ TEST(EncodingChoice, AClientSlowAtCellsIsSeenThroughItsSends) {
     EXPECT_GT(run(ten, {1.25e6, 1.25e6}, 400), 400u - 400u / 8);
 }
 
-// As run(), with the client reporting its decoding: `cells_decode_s` a triangle for cells, 0.026
-// us for compact+zstd (39 M triangles/s, the codec benchmark on the head); 0: no reports.
-std::uint64_t run_reported(EncodingChooser& c, double rate, double cells_decode_s, int groups) {
-    std::uint64_t cells = 0;
-    for (int i = 0; i < groups; ++i) {
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
-        cells += is_cells ? 1 : 0;
-        const std::size_t bytes = is_cells ? 2400 : 13000;
-        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
-        c.sent(e, bytes, double(bytes) / rate);
-        if (cells_decode_s > 0) c.decoded(e, 2000, 2000 * (is_cells ? cells_decode_s : 0.026e-6));
-    }
-    return cells;
-}
-
 TEST(EncodingChoice, AClientsDecodeReportCounts) {
     // 30 Mbit/s: compact+zstd's 6.5 B a triangle take 1.7 us on the link, cells' 1.2 B 0.3 us,
     // and the server makes and encodes cells in 0.65 us: cells win...
     EncodingChooser blind;
-    EXPECT_GT(run_reported(blind, 3.75e6, 0, 400), 400u - 400u / 8);
+    EXPECT_GT(run(blind, {3.75e6, 3.75e6}, 400), 400u - 400u / 8);
     // ...unless the client decodes them at 0.5 M triangles/s (2 us), slower than compact's link.
     EncodingChooser told;
-    EXPECT_LT(run_reported(told, 3.75e6, 2e-6, 400), 400u / 8);
+    EXPECT_LT(run(told, {3.75e6, 3.75e6}, 400, 2e-6), 400u / 8);
     EXPECT_NEAR(told.cost_per_triangle(GroupEncoding::cells), 2e-6, 1e-9);
     // The same client at 1 Mbit/s: the link is the bottleneck (cells 9.6 us, compact 52), cells.
     EncodingChooser slow;
-    EXPECT_GT(run_reported(slow, 125e3, 2e-6, 400), 400u - 400u / 8);
+    EXPECT_GT(run(slow, {125e3, 125e3}, 400, 2e-6), 400u - 400u / 8);
     // Reports of encodings the chooser does not pick between change nothing.
     EncodingChooser quiet;
     quiet.decoded(GroupEncoding::vertices, 2000, 1.0);

@@ -25,4 +25,8 @@ struct Mesh {
     void append(const Mesh& other);
 };
 
+// Sets each vertex's normal to the area-weighted mean of its faces' (counter-clockwise: outward);
+// a vertex of no face, or of faces that cancel, keeps its normal.
+void normals_from_faces(Mesh& mesh);
+
 }  // namespace isowall

@@ -74,7 +74,7 @@ test('the groups cover every voxel type, coarse passes and refinements', () => {
     assert.ok(names.includes(`${type}-cells`), `${type}-cells`);
   for (const g of groups.filter((g) => /level2|refinement/.test(g.name) && !g.name.startsWith('corpus')))
     assert.ok(g.cells[1] === 3 || g.cells[1] === 4, g.name);
-  assert.ok(cellsGroups.some((g) => g.name.endsWith('-level2')), 'a coarse pass as cells (octahedral normals)');
+  assert.ok(cellsGroups.some((g) => g.name.endsWith('-level2')), 'a coarse pass as cells (normals from its faces)');
   assert.ok(cellsGroups.length >= 20, `${cellsGroups.length} groups as cells`);
 });
 
@@ -128,7 +128,7 @@ test('a cells body\'s fields are checked and named as the C++ names them', () =>
   fails(patch(5, 0, 0, 0, 0x80), /^WireError: group: volume dims: expected 2..1048576, got -2147483648$/);
   fails(patch(13, 0, 0, 0x80, 0xbf), /^WireError: group: spacing: expected a positive finite number, got -1.000000$/);
   fails(patch(17, 0, 0, 0xc0, 0x7f), /^WireError: group: spacing: expected a positive finite number, got nan$/);
-  fails(patch(25, 2), /^WireError: group: normals: expected 0 \(gradients\) or 1 \(octahedral\), got 2$/);
+  fails(patch(25, 2), /^WireError: group: normals: expected 0 \(gradients\) or 1 \(faces\), got 2$/);
   fails(patch(26, 0), /^WireError: group: /);
 });
 

@@ -21,12 +21,11 @@ command -v emcc > /dev/null || {
 inc=$(mktemp -d)
 trap 'rm -rf "$inc"' EXIT
 ln -s /usr/include/glm "$inc/glm"
-ln -s /usr/include/meshoptimizer.h "$inc/meshoptimizer.h"
 
-# The decoder and what it calls: the units' gaps, and the octahedral codes of a coarse pass's
-# normals (compact_mesh.cpp's oct_decode; its meshoptimizer calls are the encoder's, never linked).
+# The decoder and what it calls: the units' gaps, and a coarse pass's normals from its faces
+# (common/core/mesh.cpp).
 sources=("$here/cells_wasm.cpp" "$root/remote/cell_codec.cpp" "$root/remote/cell_units.cpp"
-    "$root/remote/compact_mesh.cpp")
+    "$root/common/core/mesh.cpp")
 # -fwasm-exceptions: WireError unwinds through the decoder at no cost while nothing throws (the
 # JavaScript-based -fexceptions routes each call that may throw through JavaScript).
 # ENVIRONMENT web: node (the tests, the bench) runs it too, as it has atob and WebAssembly; the
