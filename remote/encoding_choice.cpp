@@ -12,15 +12,14 @@ constexpr double kKeep = 1.0 - 1.0 / EncodingChooser::kWindow;
 
 }  // namespace
 
-double EncodingChooser::bytes_per_s(GroupEncoding e) const {
-    const Estimate& s = slot(e);
-    return s.blocked_s > 0 ? s.sent_bytes / s.blocked_s : 0;
+double EncodingChooser::bytes_per_s() const {
+    return blocked_s_ > 0 ? sent_bytes_ / blocked_s_ : 0;
 }
 
 double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
     const Estimate& s = slot(e);
     if (s.groups == 0) return 0;
-    const double rate = bytes_per_s(e);
+    const double rate = bytes_per_s();
     const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
     const double server = making + s.seconds / s.triangles;
     const double client = s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0;
@@ -28,8 +27,10 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
 }
 
 GroupEncoding EncodingChooser::best() const {
-    // Unmeasured: cells first (fewer bytes on a link not yet seen), then compact once.
+    // Unmeasured, or a link not yet seen: cells (fewer bytes); compact once if only sending it
+    // can measure it (the session measures both while measuring()).
     if (cells_.groups == 0) return GroupEncoding::cells;
+    if (cells_.sends + compact_.sends < kProbeSends) return GroupEncoding::cells;
     if (compact_.groups == 0) return GroupEncoding::compact_zstd;
     return cost_per_triangle(GroupEncoding::cells) <= cost_per_triangle(GroupEncoding::compact_zstd)
                ? GroupEncoding::cells
@@ -64,12 +65,12 @@ void EncodingChooser::encoded(GroupEncoding e, std::size_t triangles, std::size_
 void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {
     // Decayed sums: the recent sends weigh most, so a link that changes is followed.
     constexpr double keep = 1.0 - 1.0 / (4 * kWindow);
-    Estimate& s = slot(e);
-    s.sent_bytes *= keep;
-    s.blocked_s *= keep;
+    ++slot(e).sends;
+    sent_bytes_ *= keep;
+    blocked_s_ *= keep;
     if (seconds < kBlockedS) return;
-    s.sent_bytes += static_cast<double>(bytes);
-    s.blocked_s += seconds;
+    sent_bytes_ += static_cast<double>(bytes);
+    blocked_s_ += seconds;
 }
 
 void EncodingChooser::decoded(GroupEncoding e, std::uint64_t triangles, double seconds) {

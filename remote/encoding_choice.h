@@ -3,25 +3,21 @@
 // dissertation's 5.2.3: tune compression to whichever of server and network is the bottleneck).
 // `cells` sends about a quarter of compact+zstd's bytes and costs several times its CPU a
 // triangle; which brings the picture sooner depends on the link. The chooser keeps, for each of
-// the two, a running mean of the server's seconds a triangle (encoding) and of bytes a triangle,
-// and the rate its sends went at: bytes over the seconds the sends blocked; and, for both, the
-// seconds a triangle the server spent making groups (extraction). A group goes in the encoding
-// whose time a triangle is the smaller, taken as the slower of the server (extraction and
-// encoding) and the link (bytes over the rate): the two overlap, as the kernel sends one group
-// while the engine makes the next (a sum would charge compact+zstd for link time it hides). The
-// rate
-// is kept per encoding because a send blocks for whichever is slower, the link or the client
-// taking the bytes: a client decoding cells (it runs marching cubes) takes their bytes more
-// slowly than compact+zstd's, and on a fast link that is what the server sees. While sends
-// return at once (buffers absorb them), bytes cost no time and the cheaper encoding wins.
-// The client's decoding is seen through its reports (DecodeRateMsg: seconds a triangle, per
-// encoding) and counts as a third stage beside the server and the link: the slowest of the three
-// sets the pace. Through the sends alone it showed only once the socket buffers between the two
-// were full (megabytes on a fast link), so the server kept sending cells to a client that decoded
-// them ten times slower than compact+zstd. A group in the encoding not
-// chosen goes out every kExploreEvery groups times how many times dearer it was (at most 8x), so
-// both estimates follow the surface and the machine without a slow link paying much for the
-// exploring. Pure: no clock, no I/O; the session measures and reports.
+// the two, a running mean of the server's seconds a triangle (encoding), of bytes a triangle and
+// of the client's seconds a triangle decoding (its DecodeRateMsg reports); for both, the seconds
+// a triangle the server spent making groups (extraction); and the link's rate: bytes over the
+// seconds the sends blocked. A group goes in the encoding whose time a triangle is the smaller,
+// taken as the slowest of three stages that overlap: the server (extraction and encoding), the
+// link (bytes over the rate) and the client (decoding). While sends return at once (buffers
+// absorb them), bytes cost no time and the cheaper encoding wins.
+// The rate is the link's, one for both encodings: a paced link's send waits for the bytes sent
+// before it, so a rate kept per encoding charged a cells group for the compact+zstd group ahead
+// of it. The client's decoding counts through its reports: through the sends alone it showed only
+// once the socket buffers between the two were full (megabytes on a fast link), so the server
+// kept sending cells to a client that decoded them ten times slower than compact+zstd. A group in
+// the encoding not chosen goes out every kExploreEvery groups times how many times dearer it was
+// (at most 8x), so both estimates follow the surface and the machine without a slow link paying
+// much for the exploring. Pure: no clock, no I/O; the session measures and reports.
 #include <cstddef>
 #include <cstdint>
 
@@ -51,6 +47,17 @@ class EncodingChooser {
 
     // The encoding for the next group.
     GroupEncoding next();
+    // True until both encodings were measured once: the session then encodes the group both ways
+    // and reports both (encoded), so neither has to be sent to be known. Exploring by sending
+    // compact+zstd's first group cost a slow link five times its bytes just when C climbs fastest
+    // (the 256 head at 1 Mbit/s: C = 90% at 0.385 s against cells' 0.281).
+    bool measuring() const { return cells_.groups == 0 || compact_.groups == 0; }
+    // The first this many groups go as cells (the smaller), while the link is unknown: a paced
+    // link's first send goes at once and the next waits for it, so one send's rate says little
+    // (the 256 head at 1 Mbit/s sent its second group as compact+zstd in some runs, 20.6 KB
+    // against 7.8). After them a link whose sends never blocked costs nothing and the CPU
+    // decides.
+    static constexpr std::uint64_t kProbeSends = 4;
     // What a group cost: its triangles, the bytes it encoded to, the server's seconds to encode it
     // and to make it (from the end of the previous send to the start of encoding).
     void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds,
@@ -63,16 +70,17 @@ class EncodingChooser {
 
     // Seconds a triangle costs in `e` at the rate seen; 0 until `e` was measured.
     double cost_per_triangle(GroupEncoding e) const;
-    // Bytes a second the sends of `e` went at while they blocked; 0 while none has blocked.
-    double bytes_per_s(GroupEncoding e) const;
-    std::uint64_t chosen(GroupEncoding e) const { return slot(e).groups; }
+    // Bytes a second the sends went at while they blocked; 0 while none has blocked.
+    double bytes_per_s() const;
+    // Groups sent in `e`.
+    std::uint64_t chosen(GroupEncoding e) const { return slot(e).sends; }
 
   private:
     struct Estimate {
         double triangles = 0, seconds = 0, bytes = 0;  // decayed sums over its groups
-        std::uint64_t groups = 0;
-        double sent_bytes = 0, blocked_s = 0;         // decayed sums over the recent sends
-        double decoded_triangles = 0, decoded_s = 0;  // decayed sums over the client's reports
+        std::uint64_t groups = 0, sends = 0;           // measured, sent
+        double sent_bytes = 0, blocked_s = 0;          // decayed sums over the recent sends
+        double decoded_triangles = 0, decoded_s = 0;   // decayed sums over the client's reports
     };
     Estimate& slot(GroupEncoding e) { return e == GroupEncoding::cells ? cells_ : compact_; }
     const Estimate& slot(GroupEncoding e) const {
@@ -82,6 +90,7 @@ class EncodingChooser {
 
     Estimate cells_, compact_;
     double made_triangles_ = 0, making_s_ = 0;  // extraction, the same in either encoding
+    double sent_bytes_ = 0, blocked_s_ = 0;     // decayed sums over the recent sends
     std::uint64_t since_explored_ = 0;
 };
 

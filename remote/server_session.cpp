@@ -53,16 +53,33 @@ class ServerSession::Sink final : public GroupSink {
         m.draw_from_next_frame = keep_ && lv_.lod > 0;
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const bool adaptive = s_.options_.adaptive;
-        if (adaptive) s_.take_reports();
-        const GroupEncoding e = adaptive ? s_.chooser_.next() : s_.options_.encoding;
         const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
-        const Stopwatch encoding;
-        const std::vector<std::uint8_t> bytes =
-            encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
-        const GroupEncoding went = encoding_of(bytes);  // cells may fall back to compact+zstd
-        if (adaptive)
-            s_.chooser_.encoded(went, g.mesh.triangle_count(), bytes.size(), encoding.seconds(),
-                                making_s);
+        // Encodes in `e` and tells the chooser what it cost; cells may fall back to compact+zstd.
+        const auto encode = [&](GroupEncoding e) {
+            const Stopwatch encoding;
+            std::vector<std::uint8_t> b =
+                encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
+            if (adaptive)
+                s_.chooser_.encoded(encoding_of(b), g.mesh.triangle_count(), b.size(),
+                                    encoding.seconds(), making_s);
+            return b;
+        };
+        std::vector<std::uint8_t> bytes;
+        if (adaptive) {
+            s_.take_reports();
+            if (s_.chooser_.measuring()) {  // both ways, so neither is sent to be measured
+                std::vector<std::uint8_t> cells = encode(GroupEncoding::cells);
+                if (encoding_of(cells) != GroupEncoding::cells) {
+                    bytes = std::move(cells);  // fell back: compact+zstd whichever is chosen
+                } else {
+                    std::vector<std::uint8_t> compact = encode(GroupEncoding::compact_zstd);
+                    bytes = s_.chooser_.next() == GroupEncoding::cells ? std::move(cells)
+                                                                       : std::move(compact);
+                }
+            }
+        }
+        if (bytes.empty()) bytes = encode(adaptive ? s_.chooser_.next() : s_.options_.encoding);
+        const GroupEncoding went = encoding_of(bytes);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
