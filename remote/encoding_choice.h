@@ -45,6 +45,9 @@ class EncodingChooser {
     // (its header, the time to find it) says little of the next thousand.
     static constexpr double kWindow = 16;
 
+    // The link is no faster than this (the server's own pacing, `serve --rate-mbps`): the rate
+    // until one is seen, and the most one may be. Without it the link is probed (kProbeSends).
+    void set_link_cap(double bytes_per_s) { link_cap_ = bytes_per_s; }
     // The encoding for the next group.
     GroupEncoding next();
     // True until both encodings were measured once: the session then encodes the group both ways
@@ -52,12 +55,11 @@ class EncodingChooser {
     // compact+zstd's first group cost a slow link five times its bytes just when C climbs fastest
     // (the 256 head at 1 Mbit/s: C = 90% at 0.385 s against cells' 0.281).
     bool measuring() const { return cells_.groups == 0 || compact_.groups == 0; }
-    // The first this many groups go as cells (the smaller), while the link is unknown: a paced
-    // link's first send goes at once and the next waits for it, so one send's rate says little
-    // (the 256 head at 1 Mbit/s sent its second group as compact+zstd in some runs, 20.6 KB
-    // against 7.8). After them a link whose sends never blocked costs nothing and the CPU
-    // decides.
-    static constexpr std::uint64_t kProbeSends = 4;
+    // Groups go as cells (the smaller) while the link is unknown: until two sends have waited
+    // for it, or this many went without any waiting (buffers absorb them: a fast link). A paced
+    // link's burst and a socket's buffer make the first sends look fast (the 256 head at
+    // 1 Mbit/s sent its fifth group as compact+zstd in some runs, 23.7 KB against 5.8).
+    static constexpr std::uint64_t kProbeSends = 8;
     // What a group cost: its triangles, the bytes it encoded to, the server's seconds to encode it
     // and to make it (from the end of the previous send to the start of encoding).
     void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds,
@@ -91,6 +93,8 @@ class EncodingChooser {
     Estimate cells_, compact_;
     double made_triangles_ = 0, making_s_ = 0;  // extraction, the same in either encoding
     double sent_bytes_ = 0, blocked_s_ = 0;     // decayed sums over the recent sends
+    std::uint64_t blocked_sends_ = 0;           // sends that waited for the link
+    double link_cap_ = 0;                       // bytes a second; 0: none known
     std::uint64_t since_explored_ = 0;
 };
 

@@ -125,6 +125,7 @@ ServerSession::ServerSession(const SurfaceExtractor& prototype, SessionOptions o
     const Box3 b = prototype.volume().bounds();
     const glm::vec3 far = glm::max(glm::abs(b.min), glm::abs(b.max));
     grid_step_ = position_grid_step(2 * std::max({far.x, far.y, far.z}));
+    if (options_.link_cap_bytes_per_s > 0) chooser_.set_link_cap(options_.link_cap_bytes_per_s);
 }
 
 ServerSession::~ServerSession() = default;

@@ -53,6 +53,9 @@ struct SessionOptions {
     // Rays of each coarse level, as a share of the view's pixels (the text: 0.1% - 1%). Whole
     // levels of the ray order are cast, so a level may take up to about 4x this.
     double lod_ray_share = 0.0025;
+    // The server paces its sends to this (serve --rate-mbps); 0: unpaced. The adaptive chooser
+    // takes it as the link's rate until it sees one.
+    double link_cap_bytes_per_s = 0;
 };
 
 // Sends one message; returns its bytes on the wire. Throws when the connection is gone.

@@ -165,6 +165,7 @@ class ViewServer::Client {
         say("serve: %s: dataset %s%s\n", d.name);
         SessionOptions so = server_.options_.session;
         apply_hello_encoding(hello_encoding_, so.encoding, so.adaptive);
+        so.link_cap_bytes_per_s = server_.options_.rate_bits_per_s / 8;
         session_ =
             std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
                 touch();             // the client's silence counts from the send's start

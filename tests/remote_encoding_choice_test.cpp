@@ -104,6 +104,23 @@ TEST(EncodingChoice, MeasuredBothWaysNeitherIsSentToBeKnown) {
     EXPECT_LT(cells, 200u / 8);
 }
 
+TEST(EncodingChoice, AServersOwnPacingIsTheLinkUntilOneIsSeen) {
+    // serve --rate-mbps 100: the CPU decides from the first group, for compact+zstd; at 1 Mbit/s
+    // cells from the first. Without the cap the first groups probe the link as cells.
+    EncodingChooser fast, slow;
+    fast.set_link_cap(12.5e6);
+    slow.set_link_cap(125e3);
+    std::uint64_t cells = 0;
+    EXPECT_EQ(run_measuring_first(fast, 12.5e6, 200, cells), 1u) << "compact+zstd from the first";
+    EXPECT_LT(cells, 200u / 8);
+    EXPECT_GE(run_measuring_first(slow, 125e3, 200, cells), 40u);
+    // A link slower than the cap (a client that reads slowly) is what counts once seen.
+    EncodingChooser capped;
+    capped.set_link_cap(12.5e6);
+    EXPECT_GT(run(capped, 125e3, 400), 400u - 400u / 8);
+    EXPECT_NEAR(capped.bytes_per_s(), 125e3, 1.0);
+}
+
 TEST(EncodingChoice, ExploresTheOtherRarelyButAlways) {
     EncodingChooser c;
     const auto cells = run(c, 125e3, 1000);
