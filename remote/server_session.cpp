@@ -54,38 +54,37 @@ class ServerSession::Sink final : public GroupSink {
         m.cache_gen = s_.cache_gen_;  // 0 unless this request caches
         const bool adaptive = s_.options_.adaptive;
         const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
-        // Encodes in `e` and tells the chooser what it cost; cells may fall back to compact+zstd.
+        // Encodes in `e` and tells the chooser what asking for `e` cost: cells fall back to
+        // compact+zstd where that is smaller (a coarse pass), and the chooser learns it so.
         const auto encode = [&](GroupEncoding e) {
             const Stopwatch encoding;
             std::vector<std::uint8_t> b =
                 encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
             if (adaptive)
-                s_.chooser_.encoded(encoding_of(b), g.mesh.triangle_count(), b.size(),
-                                    encoding.seconds(), making_s);
+                s_.chooser_.encoded(e, g.mesh.triangle_count(), b.size(), encoding.seconds(),
+                                    making_s);
             return b;
         };
+        GroupEncoding asked = s_.options_.encoding;
         std::vector<std::uint8_t> bytes;
         if (adaptive) {
             s_.take_reports();
             if (s_.chooser_.measuring()) {  // both ways, so neither is sent to be measured
                 std::vector<std::uint8_t> cells = encode(GroupEncoding::cells);
-                if (encoding_of(cells) != GroupEncoding::cells) {
-                    bytes = std::move(cells);  // fell back: compact+zstd whichever is chosen
-                } else {
-                    std::vector<std::uint8_t> compact = encode(GroupEncoding::compact_zstd);
-                    bytes = s_.chooser_.next() == GroupEncoding::cells ? std::move(cells)
-                                                                       : std::move(compact);
-                }
+                std::vector<std::uint8_t> compact = encode(GroupEncoding::compact_zstd);
+                asked = s_.chooser_.next();
+                bytes = std::move(asked == GroupEncoding::cells ? cells : compact);
+            } else {
+                asked = s_.chooser_.next();
             }
         }
-        if (bytes.empty()) bytes = encode(adaptive ? s_.chooser_.next() : s_.options_.encoding);
-        const GroupEncoding went = encoding_of(bytes);
+        if (bytes.empty()) bytes = encode(asked);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
         const Stopwatch sending;
         const std::size_t sent = s_.send_(m);
-        if (adaptive) s_.chooser_.sent(went, sent, sending.seconds());
+        if (adaptive) s_.chooser_.sent(asked, sent, sending.seconds());
         s_.since_sent_.restart();
         f_.bytes += sent;
         ++f_.groups;
