@@ -1,8 +1,6 @@
 #include "remote/cell_codec.h"
 
-#include <array>
 #include <cmath>
-#include <span>
 #include <string>
 
 #include "common/extract/edge_cache.h"
