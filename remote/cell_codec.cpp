@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/extract/edge_cache.h"
+#include "remote/cell_values.h"
 #include "remote/cell_voxels.h"
 #include "remote/group_codec.h"
 
@@ -101,28 +102,34 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     w.put(static_cast<std::uint8_t>(normals));
     put_units(w, *units, h.dims);
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
-    PhaseVoxels<T> named(sent, box, nullptr);
+    PhaseVoxels<T> named(sent, box);
+    ValueWriter<T> values(w, g.iso);
     each_phase(h, named, *units, normals == Normals::gradients,
-               [&](const std::vector<std::uint32_t>& at) { put_values(w, sent, view, box, at); });
+               [&](const std::vector<std::uint32_t>& at) { values.phase(sent, view, box, at); });
+    values.finish();
     return w.take();
 }
 
 template <class T>
 Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso, Normals normals,
                   const std::vector<Unit>& units, T) {
+    ValueReader<T> values(r, iso);
     // Every unit's corners are voxels no other phase sends, and each voxel is a corner of at
-    // most eight units: the values of at least one voxel a unit must follow.
-    r.need_elements(units.size(), sizeof(T), "units' corner values");
+    // most eight units: the values of at least one voxel for every eight units must follow.
+    if (units.size() > 8 * values.max_named())
+        r.fail("units: " + std::to_string(units.size()) + " units, more than the voxel values "
+               "received can name");
     const VoxelBox box = box_of(units, dims);
     if (box.voxels() > kMaxCellBoxVoxels)
         r.fail("units: spread over " + std::to_string(box.voxels()) + " voxels, over the limit " +
                std::to_string(kMaxCellBoxVoxels));
     BoxVoxels<T> held(box, dims, spacing);
     const Held<BoxVoxels<T>> h{held, dims, iso};
-    PhaseVoxels<T> named(held, box, &r);
+    PhaseVoxels<T> named(held, box, &r, values.max_named());
     const Corners corners =
         each_phase(h, named, units, normals == Normals::gradients,
-                   [&](const std::vector<std::uint32_t>& at) { get_values(r, held, box, at); });
+                   [&](const std::vector<std::uint32_t>& at) { values.phase(held, box, at); });
+    values.finish();
     std::size_t triangles = 0;
     const std::vector<int> cases = cases_of(corners, iso, triangles);
     if (triangles > kMaxGroupTriangles)

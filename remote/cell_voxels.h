@@ -1,8 +1,8 @@
 #pragma once
 // The voxels of a `cells` group (remote/cell_codec.h) on either side: the sparse store the client
 // triangulates from, which voxels each of the three phases names, and how their values travel
-// (predicted, the residuals zigzagged in byte planes). Templates over the voxel type, so the
-// server's encoder and the client's decoder run the same code; internal to the codec.
+// (remote/cell_values.h). Templates over the voxel type, so the server's encoder and the
+// client's decoder run the same code; internal to the codec.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -117,19 +117,21 @@ class BoxVoxels {
 
 // Which voxels of the box a phase names: each once, in increasing index, none an earlier phase
 // named. Box indices run z, y, x like the volume's, so the order is the volume's too. On the
-// client (`r` set) every voxel named must have its value in the bytes left, checked as it is
-// named, so the bricks held stay within 64 voxels per byte received.
+// client (`r` set) the voxels named in all must stay within `max_named`, what the bytes received
+// can hold values for (remote/cell_values.h), checked as each is named, so the bricks held stay
+// within 64 voxels of that.
 template <class T>
 class PhaseVoxels {
   public:
-    PhaseVoxels(BoxVoxels<T>& held, const VoxelBox& box, const ByteReader* r)
-        : held_(held), box_(box), r_(r) {}
+    PhaseVoxels(BoxVoxels<T>& held, const VoxelBox& box, const ByteReader* r = nullptr,
+                std::uint64_t max_named = 0)
+        : held_(held), box_(box), r_(r), max_named_(max_named) {}
     void add(glm::ivec3 p) {
         if (!held_.name(p)) return;
         fresh_.push_back(static_cast<std::uint32_t>(linear(p - box_.origin, box_.size)));
-        if (r_ && fresh_.size() > r_->remaining() / sizeof(T))
-            r_->fail("voxel values: more voxels named than the " + std::to_string(r_->remaining()) +
-                     " bytes left hold");
+        if (r_ && ++named_ > max_named_)
+            r_->fail("voxel values: more voxels named than the bytes of values can hold (" +
+                     std::to_string(max_named_) + ")");
     }
     bool first_edge(glm::ivec3 pa, int axis) { return held_.first_edge(pa, axis); }
     // The voxels named since the last call, in increasing index.
@@ -142,6 +144,7 @@ class PhaseVoxels {
     BoxVoxels<T>& held_;
     VoxelBox box_;
     const ByteReader* r_;
+    std::uint64_t max_named_, named_ = 0;
     std::vector<std::uint32_t> fresh_;
 };
 
@@ -243,106 +246,6 @@ Corners each_phase(const Held<View>& h, PhaseVoxels<T>& named, const std::vector
     phase_gradients(h, units, corners, named);
     take(named.take());
     return corners;
-}
-
-// ---- voxel values: predicted, the residuals as byte planes ------------------------------------
-
-// Integer voxels go as the difference to a prediction from the voxels already known (both sides
-// know the same ones at each step): the mean of the known face neighbours at the nearest of 1, 2
-// and 4 voxels that has any, else the value sent just before. The difference is taken modulo
-// 2^bits and zigzagged, so small ones of either sign are small numbers and every value
-// round-trips. Floating-point voxels go as they are.
-template <class T>
-T predict(const BoxVoxels<T>& held, glm::ivec3 p, T previous) {
-    if constexpr (!std::is_integral_v<T>) {
-        return T{};
-    } else {
-        // The nearest ring that holds a known voxel: 1 voxel away, else 2, else 4 (a coarse
-        // level's corners lie 2^level apart, and their neighbours there are its other corners).
-        for (int step = 1; step <= 4; step *= 2) {
-            std::int64_t sum = 0;
-            std::int64_t n = 0;
-            for (int a = 0; a < 3; ++a)
-                for (int d : {-step, step}) {
-                    glm::ivec3 q = p;
-                    q[a] += d;
-                    T value;
-                    if (!held.known(q, value)) continue;
-                    sum += static_cast<std::int64_t>(value);
-                    ++n;
-                }
-            if (n > 0) return static_cast<T>(sum >= 0 ? (sum + n / 2) / n : -((-sum + n / 2) / n));
-        }
-        return previous;
-    }
-}
-
-template <class T>
-auto residual(T value, T predicted) {
-    if constexpr (!std::is_integral_v<T>) {
-        return value;
-    } else {
-        using U = std::make_unsigned_t<T>;
-        using S = std::make_signed_t<T>;
-        const auto d =
-            static_cast<S>(static_cast<U>(static_cast<U>(value) - static_cast<U>(predicted)));
-        return static_cast<U>(static_cast<U>(static_cast<U>(d) << 1) ^
-                              static_cast<U>(d >> (8 * sizeof(T) - 1)));
-    }
-}
-
-template <class T, class R>
-T from_residual(R r, T predicted) {
-    if constexpr (!std::is_integral_v<T>) {
-        return r;
-    } else {
-        using U = std::make_unsigned_t<T>;
-        const auto d =
-            static_cast<U>(static_cast<U>(r >> 1) ^ static_cast<U>(-static_cast<U>(r & 1)));
-        return static_cast<T>(static_cast<U>(static_cast<U>(predicted) + d));
-    }
-}
-
-template <class T>
-using Residual = decltype(residual(T{}, T{}));
-
-template <class T>
-void put_values(ByteWriter& w, BoxVoxels<T>& held, const VolumeView<T>& v, const VoxelBox& box,
-                const std::vector<std::uint32_t>& at) {
-    std::vector<Residual<T>> out(at.size());
-    T previous{};
-    for (std::size_t i = 0; i < at.size(); ++i) {
-        const glm::ivec3 p = box.origin + unlinear(at[i], box.size);
-        const T value = v.at(p.x, p.y, p.z);
-        out[i] = residual(value, predict(held, p, previous));
-        held.set(p, value);
-        previous = value;
-    }
-    std::vector<std::uint8_t> plane(at.size());
-    for (std::size_t b = 0; b < sizeof(T); ++b) {
-        for (std::size_t i = 0; i < at.size(); ++i)
-            plane[i] = reinterpret_cast<const std::uint8_t*>(&out[i])[b];
-        w.put_raw(std::span<const std::uint8_t>(plane));
-    }
-}
-
-template <class T>
-void get_values(ByteReader& r, BoxVoxels<T>& held, const VoxelBox& box,
-                const std::vector<std::uint32_t>& at) {
-    r.need_elements(at.size(), sizeof(T), "voxel values");
-    std::vector<Residual<T>> in(at.size());
-    for (std::size_t b = 0; b < sizeof(T); ++b) {
-        const auto plane = r.get_span(at.size());
-        for (std::size_t i = 0; i < at.size(); ++i)
-            reinterpret_cast<std::uint8_t*>(&in[i])[b] = plane[i];
-    }
-    T previous{};
-    for (std::size_t i = 0; i < at.size(); ++i) {
-        const glm::ivec3 p = box.origin + unlinear(at[i], box.size);
-        const T value = from_residual(in[i], predict(held, p, previous));
-        held.set(p, value);
-        previous = value;
-    }
 }
 
 }  // namespace isowall::remote::cells

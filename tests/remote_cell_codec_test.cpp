@@ -331,6 +331,9 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
             gap >>= 7;
         }
         b.push_back(static_cast<std::uint8_t>(gap));
+        const std::uint32_t stream = 64;  // the values' coded stream: its length, its bytes
+        b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&stream),
+                 reinterpret_cast<const std::uint8_t*>(&stream) + 4);
         for (int k = 0; k < 64; ++k) b.push_back(7);
         expect_refused(b, "units spread past the box limit", "spread over");
     }
