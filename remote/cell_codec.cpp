@@ -117,7 +117,8 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     // Every unit's corners are voxels no other phase sends, and each voxel is a corner of at
     // most eight units: the values of at least one voxel for every eight units must follow.
     if (units.size() > 8 * values.max_named())
-        r.fail("units: " + std::to_string(units.size()) + " units, more than the voxel values "
+        r.fail("units: " + std::to_string(units.size()) +
+               " units, more than the voxel values "
                "received can name");
     const VoxelBox box = box_of(units, dims);
     if (box.voxels() > kMaxCellBoxVoxels)

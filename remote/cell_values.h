@@ -167,7 +167,8 @@ class ValueModel {
     std::size_t context(int phase, const Prediction<T>& p) const {
         const double off = std::abs(static_cast<double>(p.value) - iso_);
         const std::uint64_t whole = off < 0x1p62 ? static_cast<std::uint64_t>(off) : ~0ull;
-        const int distance = std::min(static_cast<int>(std::bit_width(whole)) >> 2, kDistanceClasses - 1);
+        const int distance =
+            std::min(static_cast<int>(std::bit_width(whole)) >> 2, kDistanceClasses - 1);
         return static_cast<std::size_t>((phase * kSpreadClasses + p.spread) * kDistanceClasses +
                                         distance);
     }
@@ -226,7 +227,8 @@ class ValueWriter {
 template <class T>
 class ValueReader {
   public:
-    ValueReader(ByteReader& r, double iso) : r_(r), model_(iso), coder_(std::span<const std::uint8_t>{}) {
+    ValueReader(ByteReader& r, double iso)
+        : r_(r), model_(iso), coder_(std::span<const std::uint8_t>{}) {
         if constexpr (std::is_integral_v<T>) {
             const auto n = r.get<std::uint32_t>();
             coder_ = RangeDecoder(r.get_span(n));

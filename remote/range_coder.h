@@ -35,7 +35,8 @@ class RangeEncoder {
         const std::uint32_t bound = (range_ >> range::kProbabilityBits) * prob.p;
         if (b == 0) {
             range_ = bound;
-            prob.p = static_cast<std::uint16_t>(prob.p + ((range::kOne - prob.p) >> range::kMoveBits));
+            prob.p =
+                static_cast<std::uint16_t>(prob.p + ((range::kOne - prob.p) >> range::kMoveBits));
         } else {
             low_ += bound;
             range_ -= bound;
@@ -96,7 +97,8 @@ class RangeDecoder {
         unsigned b;
         if (code_ < bound) {
             range_ = bound;
-            prob.p = static_cast<std::uint16_t>(prob.p + ((range::kOne - prob.p) >> range::kMoveBits));
+            prob.p =
+                static_cast<std::uint16_t>(prob.p + ((range::kOne - prob.p) >> range::kMoveBits));
             b = 0;
         } else {
             code_ -= bound;

@@ -54,8 +54,8 @@ bool decodes(const std::vector<std::uint8_t>& bytes, const std::vector<Symbol>& 
     std::vector<BitProbability> p(8);
     bool same = true;
     for (const Symbol& s : symbols) {
-        const std::uint32_t v = s.context < 0 ? d.direct(s.bits)
-                                              : d.bit(p[static_cast<std::size_t>(s.context)]);
+        const std::uint32_t v =
+            s.context < 0 ? d.direct(s.bits) : d.bit(p[static_cast<std::size_t>(s.context)]);
         same = same && v == s.value;
     }
     if (out) *out = d;
