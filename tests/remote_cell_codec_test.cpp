@@ -254,13 +254,39 @@ TEST(RemoteCellCodecMalformed, SeededMutationsDecodeOrThrow) {
     std::printf("%d of 4000 mutated bodies decoded (the rest threw WireError)\n", decoded);
 }
 
+void put_u32(Bytes& b, std::size_t at, std::uint32_t v) {
+    std::memcpy(b.data() + at, &v, sizeof v);
+}
+
+// Two units at opposite corners of a large volume: a box past the limit.
+Bytes spread_units_body(const Bytes& clean) {
+    Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
+    put_u32(b, 1, 1u << 12);
+    put_u32(b, 5, 1u << 12);
+    put_u32(b, 9, 1u << 12);
+    b.push_back(1);  // one bucket
+    b.push_back(0);  // level 0
+    const std::uint32_t two = 2;
+    b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&two),
+             reinterpret_cast<const std::uint8_t*>(&two) + 4);
+    b.push_back(0);  // the unit at (0, 0, 0)
+    std::uint64_t gap = (std::uint64_t{4094} * 4095 + 4094) * 4095 + 4093;
+    while (gap >= 0x80) {
+        b.push_back(static_cast<std::uint8_t>(gap | 0x80));
+        gap >>= 7;
+    }
+    b.push_back(static_cast<std::uint8_t>(gap));
+    const std::uint32_t stream = 64;  // the values' coded stream: its length, its bytes
+    b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&stream),
+             reinterpret_cast<const std::uint8_t*>(&stream) + 4);
+    for (int k = 0; k < 64; ++k) b.push_back(7);
+    return b;
+}
+
 // Offsets in the body: type u8 at 0, dims at 1, spacing at 13, normals at 25, bucket count at 26,
 // the first bucket's level at 27 and unit count at 28, the first gap at 32.
 TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocating) {
     const Bytes clean = cells_body();
-    auto put_u32 = [](Bytes& b, std::size_t at, std::uint32_t v) {
-        std::memcpy(b.data() + at, &v, sizeof v);
-    };
     // Throws WireError whose message holds `why`.
     auto expect_refused = [&](const Bytes& b, const std::string& what, const std::string& why) {
         std::string message;
@@ -313,30 +339,7 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
         b.insert(b.end(), clean.begin() + 33, clean.end());
         expect_refused(b, "a unit past the volume", "past the volume");
     }
-    {
-        // Two units at opposite corners of a large volume: a box past the limit.
-        Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
-        put_u32(b, 1, 1u << 12);
-        put_u32(b, 5, 1u << 12);
-        put_u32(b, 9, 1u << 12);
-        b.push_back(1);  // one bucket
-        b.push_back(0);  // level 0
-        const std::uint32_t two = 2;
-        b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&two),
-                 reinterpret_cast<const std::uint8_t*>(&two) + 4);
-        b.push_back(0);  // the unit at (0, 0, 0)
-        std::uint64_t gap = (std::uint64_t{4094} * 4095 + 4094) * 4095 + 4093;
-        while (gap >= 0x80) {
-            b.push_back(static_cast<std::uint8_t>(gap | 0x80));
-            gap >>= 7;
-        }
-        b.push_back(static_cast<std::uint8_t>(gap));
-        const std::uint32_t stream = 64;  // the values' coded stream: its length, its bytes
-        b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&stream),
-                 reinterpret_cast<const std::uint8_t*>(&stream) + 4);
-        for (int k = 0; k < 64; ++k) b.push_back(7);
-        expect_refused(b, "units spread past the box limit", "spread over");
-    }
+    expect_refused(spread_units_body(clean), "units spread past the box limit", "spread over");
 }
 
 }  // namespace
