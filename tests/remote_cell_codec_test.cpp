@@ -254,16 +254,16 @@ TEST(RemoteCellCodecMalformed, SeededMutationsDecodeOrThrow) {
     std::printf("%d of 4000 mutated bodies decoded (the rest threw WireError)\n", decoded);
 }
 
-void put_u32(Bytes& b, std::size_t at, std::uint32_t v) {
+void overwrite_u32(Bytes& b, std::size_t at, std::uint32_t v) {
     std::memcpy(b.data() + at, &v, sizeof v);
 }
 
 // Two units at opposite corners of a large volume: a box past the limit.
 Bytes spread_units_body(const Bytes& clean) {
     Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
-    put_u32(b, 1, 1u << 12);
-    put_u32(b, 5, 1u << 12);
-    put_u32(b, 9, 1u << 12);
+    overwrite_u32(b, 1, 1u << 12);
+    overwrite_u32(b, 5, 1u << 12);
+    overwrite_u32(b, 9, 1u << 12);
     b.push_back(1);  // one bucket
     b.push_back(0);  // level 0
     const std::uint32_t two = 2;
@@ -305,14 +305,14 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
     };
     for (std::uint32_t claim : {0xffffffffu, kMaxGroupTriangles, 1u << 20, 5000u}) {
         Bytes b = clean;
-        put_u32(b, 28, claim);
+        overwrite_u32(b, 28, claim);
         expect_refused(
             b, "unit count " + std::to_string(claim),
             claim > kMaxGroupTriangles ? "over the limit" : "longer than the bytes left");
     }
     for (std::uint32_t dim : {0u, 1u, 0x7fffffffu, 0x80000000u}) {
         Bytes b = clean;
-        put_u32(b, 1, dim);
+        overwrite_u32(b, 1, dim);
         expect_refused(b, "dims.x " + std::to_string(dim), "volume dims");
     }
     {
