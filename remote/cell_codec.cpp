@@ -1,5 +1,6 @@
 #include "remote/cell_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -41,6 +42,30 @@ std::vector<int> cases_of(const Corners& corners, double iso, std::size_t& trian
             static_cast<std::size_t>(mc::kTriangleCount[static_cast<std::size_t>(cases[i])]);
     }
     return cases;
+}
+
+// A coarse pass's values travel to a step of an eighth of the median difference its crossed
+// edges span (cells::Bins; a power of two, 4 or more, else exact): its vertices then move by at
+// most a sixteenth of such an edge, far under the error of the level itself, and a value costs
+// log2(step) bits less. Its normals come from its faces, which need no exact values.
+constexpr double kCoarseStepOfEdge = 1.0 / 8;
+
+template <class View>
+int coarse_shift(const Held<View>& h, const std::vector<Unit>& units, int bits) {
+    std::vector<double> spans;
+    double c[8];
+    for (const Unit& u : units) {
+        h.corners(u, c);
+        for (const auto& ends : mc::kEdgeCorners)
+            if ((c[ends[0]] >= h.iso) != (c[ends[1]] >= h.iso))
+                spans.push_back(std::abs(c[ends[0]] - c[ends[1]]));
+    }
+    if (spans.empty()) return 0;
+    auto mid = spans.begin() + static_cast<long>(spans.size() / 2);
+    std::nth_element(spans.begin(), mid, spans.end());
+    const double step = *mid * kCoarseStepOfEdge;
+    const int shift = step >= 1 ? std::ilogb(step) : 0;
+    return shift < 2 ? 0 : std::min(shift, bits - 2);
 }
 
 // ---- encoder and decoder, per voxel type -------------------------------------------------------
@@ -103,7 +128,10 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     put_units(w, *units, h.dims);
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
     PhaseVoxels<T> named(sent, box);
-    ValueWriter<T> values(w, g.iso);
+    const int shift = normals == Normals::faces && std::is_integral_v<T>
+                          ? coarse_shift(h, *units, 8 * static_cast<int>(sizeof(T)))
+                          : 0;
+    ValueWriter<T> values(w, g.iso, shift);
     each_phase(h, named, *units, normals == Normals::gradients,
                [&](const std::vector<std::uint32_t>& at) { values.phase(sent, view, box, at); });
     values.finish();

@@ -17,11 +17,13 @@
 //
 // Floating-point voxels go as they are, as byte planes (zstd compresses the body outside).
 //
-// Byte layout after the units: integers, the stream's length u32 and the range coder's stream;
-// floating point, each phase's values as planes (every value's low byte, then the next, ...).
+// Byte layout after the units: the value step's shift u8 (Bins: 0, or 2 and up on a coarse pass
+// of integer voxels), then for integers the stream's length u32 and the range coder's stream, for
+// floating point each phase's values as planes (every value's low byte, then the next, ...).
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -176,11 +178,46 @@ class ValueModel {
     std::vector<BitProbability> tree_, first_, second_;
 };
 
+// A coarse pass's values to a step of 2^shift (cell_codec.h): bins aligned on the isovalue, so
+// every value keeps its side of it, and every unit its case and crossed edges; only where the
+// surface cuts an edge moves, by at most half a step over the edge's difference. A value goes as
+// its bin's difference to the predicted value's bin; both sides then hold the bin's middle.
+template <class T>
+struct Bins {
+    double iso = 0;
+    int shift = 0;  // 0: the values exact; else at least 2 (a difference of bins then fits T)
+
+    std::int64_t of(T v) const {
+        const double k = std::floor((static_cast<double>(v) - iso) / step());
+        constexpr double kFar = 0x1p62;  // past any bin of a 32-bit voxel's values
+        return static_cast<std::int64_t>(k < -kFar ? -kFar : k > kFar ? kFar : k);
+    }
+    // The bin's middle, rounded half up: on the isovalue's side of the bin (the step is 2 or
+    // more), and clamped into T, which keeps it in any bin a value of T was in.
+    T middle(std::int64_t k) const {
+        const double x = std::floor(iso + (static_cast<double>(k) + 0.5) * step() + 0.5);
+        const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+        const double hi = static_cast<double>(std::numeric_limits<T>::max());
+        return static_cast<T>(x < lo ? lo : x > hi ? hi : x);
+    }
+    double step() const { return std::ldexp(1.0, shift); }
+};
+
+inline std::uint64_t zigzag(std::int64_t d) {
+    return static_cast<std::uint64_t>(d) << 1 ^ static_cast<std::uint64_t>(d >> 63);
+}
+inline std::int64_t unzigzag(std::uint64_t z) {
+    return static_cast<std::int64_t>(z >> 1) ^ -static_cast<std::int64_t>(z & 1);
+}
+
 // The server's side: each phase's values as each_phase names them, then finish().
 template <class T>
 class ValueWriter {
   public:
-    ValueWriter(ByteWriter& w, double iso) : w_(w), model_(iso) {}
+    // `shift`: a coarse pass's step (Bins), 0 for exact values; integer voxels only.
+    ValueWriter(ByteWriter& w, double iso, int shift) : w_(w), model_(iso), bins_{iso, shift} {
+        w_.put(static_cast<std::uint8_t>(shift));
+    }
     void phase(BoxVoxels<T>& held, const VolumeView<T>& v, const VoxelBox& box,
                const std::vector<std::uint32_t>& at) {
         std::vector<Residual<T>> planes;
@@ -189,12 +226,19 @@ class ValueWriter {
             const glm::ivec3 p = box.origin + unlinear(i, box.size);
             const T value = v.at(p.x, p.y, p.z);
             const Prediction<T> guess = predict(held, p, previous);
-            if constexpr (std::is_integral_v<T>)
-                model_.put(coder_, phase_, guess, residual(value, guess.value));
-            else
+            T kept = value;
+            if constexpr (!std::is_integral_v<T>) {
                 planes.push_back(value);
-            held.set(p, value);
-            previous = value;
+            } else if (bins_.shift == 0) {
+                model_.put(coder_, phase_, guess, residual(value, guess.value));
+            } else {
+                const std::int64_t k = bins_.of(value);
+                model_.put(coder_, phase_, guess,
+                           static_cast<Residual<T>>(zigzag(k - bins_.of(guess.value))));
+                kept = bins_.middle(k);
+            }
+            held.set(p, kept);
+            previous = kept;
         }
         ++phase_;
         if constexpr (!std::is_integral_v<T>) put_planes(planes);
@@ -218,6 +262,7 @@ class ValueWriter {
     }
     ByteWriter& w_;
     ValueModel<T> model_;
+    Bins<T> bins_;
     RangeEncoder coder_;
     int phase_ = 0;
 };
@@ -228,7 +273,15 @@ template <class T>
 class ValueReader {
   public:
     ValueReader(ByteReader& r, double iso)
-        : r_(r), model_(iso), coder_(std::span<const std::uint8_t>{}) {
+        : r_(r),
+          model_(iso),
+          bins_{iso, r.get<std::uint8_t>()},
+          coder_(std::span<const std::uint8_t>{}) {
+        const int most = std::is_integral_v<T> ? 8 * static_cast<int>(sizeof(T)) - 2 : 0;
+        if (bins_.shift == 1 || bins_.shift > most)
+            r.fail("value step: expected 0" +
+                   (most >= 2 ? " or 2.." + std::to_string(most) : std::string()) + ", got " +
+                   std::to_string(bins_.shift));
         if constexpr (std::is_integral_v<T>) {
             const auto n = r.get<std::uint32_t>();
             coder_ = RangeDecoder(r.get_span(n));
@@ -250,7 +303,8 @@ class ValueReader {
             if constexpr (std::is_integral_v<T>) {
                 const auto got = model_.get(coder_, phase_, guess);
                 if (!got) r_.fail("voxel values: a residual longer than the voxel type");
-                value = from_residual(*got, guess.value);
+                value = bins_.shift == 0 ? from_residual(*got, guess.value)
+                                         : bins_.middle(bins_.of(guess.value) + unzigzag(*got));
             } else {
                 value = values[k];
             }
@@ -279,6 +333,7 @@ class ValueReader {
     }
     ByteReader& r_;
     ValueModel<T> model_;
+    Bins<T> bins_;
     RangeDecoder coder_;
     std::uint64_t max_named_ = 0;
     int phase_ = 0;
