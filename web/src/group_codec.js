@@ -18,8 +18,9 @@
 import { ZSTDDecoder } from 'zstddec';
 import { MeshoptDecoder } from 'meshoptimizer/decoder';
 import { ByteReader } from './wire.js';
-import { ready as cellsReady, decodeCellBody } from './cells.js';
-export { cellsProblem } from './cells.js';
+import { ready as cellsReady, decodeCellBody, cellsProblem } from './cells.js';
+import { warmGroups } from './cells_warm.js';
+export { cellsProblem };
 
 export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd: 3, cells: 4 };
 // The hello's encoding for "the server chooses per group" between cells and compact+zstd
@@ -41,8 +42,22 @@ const f = Math.fround;
 // The decoders are WebAssembly: await this once before decoding a group. meshoptimizer's for
 // compact indices; zstd is the reference decoder (zstddec): 7-10x faster than a decoder in
 // JavaScript on the head's groups (fzstd: 65-135 ms a frame against 9-53 ms, in node); cells.js's.
+// Once they are, the cells decoder runs on two small groups: the engine compiles a WebAssembly
+// function when it is first called, which put 30-35 ms on the first cells group in node (8 ms
+// after the warm-up, against 4.5 once warm: web/tools/bench_decode.mjs's groups, in order).
 const zstd = new ZSTDDecoder();
-export const ready = Promise.all([MeshoptDecoder.ready, zstd.init(), cellsReady]);
+export const ready = Promise.all([MeshoptDecoder.ready, zstd.init(), cellsReady]).then(warmCells);
+
+function warmCells() {
+  if (cellsProblem()) return;
+  for (const bytes of warmGroups) {
+    try {
+      decodeGroup(bytes);
+    } catch (e) {
+      console.warn(`isowall: the cells decoder's warm-up group failed: ${e.message}`);
+    }
+  }
+}
 
 export function encodingName(e) {
   if (e === kAdaptiveEncoding) return 'auto';

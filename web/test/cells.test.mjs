@@ -9,6 +9,7 @@ import { readFileSync, readdirSync } from 'node:fs';
 import { decodeGroup, encodingOf, encodingName, helloEncoding, kAdaptiveEncoding, ready } from '../src/group_codec.js';
 import { decodeCellBody } from '../src/cells.js';
 import { readCellsGroups } from './cells_groups.mjs';
+import { warmGroups } from '../src/cells_warm.js';
 
 await ready;
 const groups = readCellsGroups(new URL('data/cells_groups.bin', import.meta.url));
@@ -101,6 +102,16 @@ test('the seed corpus\'s cell bodies decode to their groups\' meshes', () => {
   for (const s of seeds) {
     const g = groups.find((x) => x.name === `corpus-cells-${s.name}`);
     assertSameMesh(decodeCellBody(s.body, s.iso), g.mesh, s.name);
+  }
+});
+
+test('the warm-up groups are the seed corpus\'s, as the C++ encodes them now, and decode as cells', () => {
+  const corpus = new URL('../../fuzz/corpus/group_codec/', import.meta.url);
+  for (const [i, name] of ['cells-phantom-cells', 'cells-phantom-level2'].entries()) {
+    assert.ok(bytesOf(warmGroups[i]).equals(readFileSync(new URL(name, corpus))),
+      `${name}: src/cells_warm.js is stale (web/wasm/refresh.sh makes it again)`);
+    assert.equal(encodingOf(warmGroups[i]), 4, name);
+    assertSameMesh(decodeGroup(warmGroups[i]), groups.find((x) => x.name === `corpus-${name}`).mesh, name);
   }
 });
 

@@ -5,7 +5,9 @@
 #      (test/data/cells_probe.cpp, linked against that build's libraries, which it brings up to
 #      date; the seed corpus's cells groups are read from fuzz/corpus/group_codec there);
 #   2. src/cells_wasm.js (build.sh, from the same sources);
-#   3. dist/ (npm run build).
+#   3. src/cells_warm.js: two of the seed corpus's cells groups, which the page decodes once as
+#      it starts (group_codec.js) so the browser compiles the decoder before the first group;
+#   4. dist/ (npm run build).
 # Then run `npm test` in web/ and commit the three.
 #   web/wasm/refresh.sh [BUILD_DIR]      (default: build/ of this checkout)
 set -euo pipefail
@@ -28,4 +30,20 @@ cthead=$root/../shared/data/cthead.nhdr
 "$tmp/cells_probe" reference "$web/test/data/cells_groups.bin" "$root/fuzz/corpus/group_codec" \
     ${cthead:+"$cthead"} | tail -1
 "$here/build.sh" "$web/src/cells_wasm.js" "$root"
+node - "$root/fuzz/corpus/group_codec" "$web/src/cells_warm.js" <<'JS'
+const { readFileSync, writeFileSync } = require('node:fs');
+const [corpus, out] = process.argv.slice(2);
+const bytes = (n) => `  new Uint8Array([${[...readFileSync(`${corpus}/${n}`)].join(', ')}]),`;
+writeFileSync(out, [
+  '// Made by web/wasm/refresh.sh from fuzz/corpus/group_codec (cells-phantom-cells and',
+  '// cells-phantom-level2); do not edit. Two small groups in the cells encoding, a full-resolution',
+  '// pass and a coarse one, that the page decodes once as it starts (group_codec.js: ready), so the',
+  '// browser compiles the decoder before the first group arrives rather than while it waits.',
+  '/* eslint-disable */',
+  'export const warmGroups = [',
+  bytes('cells-phantom-cells'),
+  bytes('cells-phantom-level2'),
+  '];',
+  ''].join('\n'));
+JS
 (cd "$web" && node tools/build.mjs)
