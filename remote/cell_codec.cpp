@@ -15,6 +15,8 @@ namespace {
 using namespace cells;
 
 constexpr std::uint32_t kMaxUnits = kMaxGroupTriangles;
+// A unit's place costs one decision, at least 0.022 bits (range_coder.h): at most 364 a byte.
+constexpr std::uint64_t kMaxPlacesPerByte = 384;
 
 // How a body's normals come (its `normals` byte): from the gradients' voxels, or from the faces
 // around each vertex (nothing sent).
@@ -125,13 +127,14 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     for (int a = 0; a < 3; ++a) w.put(static_cast<std::int32_t>(h.dims[a]));
     for (int a = 0; a < 3; ++a) w.put(volume.spacing()[a]);
     w.put(static_cast<std::uint8_t>(normals));
-    put_units(w, *units, h.dims);
+    RangeEncoder coder;
+    put_units(w, coder, *units);
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
     PhaseVoxels<T> named(sent, box);
     const int shift = normals == Normals::faces && std::is_integral_v<T>
                           ? coarse_shift(h, *units, 8 * static_cast<int>(sizeof(T)))
                           : 0;
-    ValueWriter<T> values(w, g.iso, shift);
+    ValueWriter<T> values(w, coder, g.iso, shift);
     each_phase(h, named, *units, normals == Normals::gradients,
                [&](const std::vector<std::uint32_t>& at) { values.phase(sent, view, box, at); });
     values.finish();
@@ -140,14 +143,15 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
 
 template <class T>
 Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso, Normals normals,
-                  const std::vector<Unit>& units, T) {
+                  const std::vector<UnitBucket>& buckets, T) {
     ValueReader<T> values(r, iso);
+    const std::vector<Unit> units =
+        get_units(r, values.coder(), buckets, dims, kMaxPlacesPerByte * values.stream_bytes());
     // Every unit's corners are voxels no other phase sends, and each voxel is a corner of at
     // most eight units: the values of at least one voxel for every eight units must follow.
     if (units.size() > 8 * values.max_named())
         r.fail("units: " + std::to_string(units.size()) +
-               " units, more than the voxel values "
-               "received can name");
+               " units, more than the voxel values received can name");
     const VoxelBox box = box_of(units, dims);
     if (box.voxels() > kMaxCellBoxVoxels)
         r.fail("units: spread over " + std::to_string(box.voxels()) + " voxels, over the limit " +
@@ -200,9 +204,9 @@ Mesh decode_cell_body(ByteReader& r, double iso) {
     const auto normals = r.get<std::uint8_t>();
     if (normals > static_cast<std::uint8_t>(Normals::faces))
         r.fail("normals: expected 0 (gradients) or 1 (faces), got " + std::to_string(normals));
-    const std::vector<Unit> units = get_units(r, dims, kMaxUnits);
+    const std::vector<UnitBucket> buckets = get_unit_buckets(r, dims, kMaxUnits);
     return dispatch_voxel_type(static_cast<VoxelType>(type), [&](auto t) {
-        return decode_typed(r, dims, spacing, iso, static_cast<Normals>(normals), units, t);
+        return decode_typed(r, dims, spacing, iso, static_cast<Normals>(normals), buckets, t);
     });
 }
 

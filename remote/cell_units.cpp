@@ -31,26 +31,86 @@ std::uint64_t get_leb128(ByteReader& r) {
     r.fail("unit gap: a LEB128 number longer than 64 bits");
 }
 
+// Each bucket's units as the occupancy of its box in that level's grid of units, z, then y, then
+// x, one bit a place through the range coder, its probability chosen by ten places before it: the
+// two along x, the three of the row below, the five nearest of the slice below. A surface's units
+// lie in sheets a unit or two thick, so a place beside, below or behind an occupied one tells a
+// lot: on one frame's groups of cthead at 600 and the 256 head at 40 the units took 40% fewer
+// bytes than as LEB128 gaps through zstd. The places coded are the boxes' volumes, several times
+// the units.
+//
+// A bucket's box of places with a border of empty ones (two before x, one after; one before and
+// after y; one before z), so the ten places a context reads need no bounds checks.
+class Occupancy {
+  public:
+    explicit Occupancy(glm::ivec3 size)
+        : n_(size),
+          sy_(static_cast<std::ptrdiff_t>(size.x) + 3),
+          sz_(sy_ * (static_cast<std::ptrdiff_t>(size.y) + 2)),
+          places_(static_cast<std::size_t>(sz_ * (static_cast<std::ptrdiff_t>(size.z) + 1)), 0) {}
+    std::uint8_t& at(glm::ivec3 p) { return places_[index(p.x, p.y, p.z)]; }
+
+    template <class Bit>
+    void code(std::vector<BitProbability>& context, Bit&& bit) {
+        for (int z = 0; z < n_.z; ++z)
+            for (int y = 0; y < n_.y; ++y) {
+                std::uint8_t* p = &places_[index(0, y, z)];
+                for (int x = 0; x < n_.x; ++x, ++p) {
+                    const unsigned c = p[-1] | p[-2] << 1 | p[-sy_ - 1] << 2 | p[-sy_] << 3 |
+                                       p[-sy_ + 1] << 4 | p[-sz_ - sy_] << 5 | p[-sz_ - 1] << 6 |
+                                       p[-sz_] << 7 | p[-sz_ + 1] << 8 | p[-sz_ + sy_] << 9;
+                    *p = static_cast<std::uint8_t>(bit(context[c], *p));
+                }
+            }
+    }
+
+  private:
+    std::size_t index(int x, int y, int z) const {
+        return static_cast<std::size_t>((z + 1) * sz_ + (y + 1) * sy_ + (x + 2));
+    }
+    glm::ivec3 n_;
+    std::ptrdiff_t sy_, sz_;
+    std::vector<std::uint8_t> places_;
+};
+
+constexpr std::size_t kOccupancyContexts = 1024;
+
 }  // namespace
 
-void put_units(ByteWriter& w, const std::vector<Unit>& units, glm::ivec3 dims) {
-    std::vector<int> levels;
-    for (const Unit& u : units)
-        if (levels.empty() || levels.back() != u.level) levels.push_back(u.level);
-    w.put(static_cast<std::uint8_t>(levels.size()));
-    std::size_t i = 0;
-    for (const int level : levels) {
-        std::size_t end = i;
-        while (end < units.size() && units[end].level == level) ++end;
-        w.put(static_cast<std::uint8_t>(level));
-        w.put(static_cast<std::uint32_t>(end - i));
-        const glm::ivec3 grid = unit_grid(dims, level);
-        std::uint64_t next = 0;  // gaps from one past the previous unit
-        for (; i < end; ++i) {
-            const std::uint64_t at = linear(units[i].base >> level, grid);
-            put_leb128(w, at - next);
-            next = at + 1;
+std::uint64_t UnitBucket::places() const {
+    return static_cast<std::uint64_t>(size.x) * static_cast<std::uint64_t>(size.y) *
+           static_cast<std::uint64_t>(size.z);
+}
+
+void put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units) {
+    std::vector<std::pair<UnitBucket, std::size_t>> buckets;  // and each one's first unit
+    for (std::size_t i = 0; i < units.size(); ++i) {
+        const glm::ivec3 p = units[i].base >> units[i].level;
+        if (buckets.empty() || buckets.back().first.level != units[i].level) {
+            buckets.push_back({{units[i].level, 0, p, p}, i});
         }
+        UnitBucket& b = buckets.back().first;
+        ++b.count;
+        b.origin = glm::min(b.origin, p);
+        b.size = glm::max(b.size, p);  // the far corner, for now
+    }
+    w.put(static_cast<std::uint8_t>(buckets.size()));
+    for (auto& [b, first] : buckets) {
+        b.size = b.size - b.origin + 1;
+        w.put(static_cast<std::uint8_t>(b.level));
+        w.put(b.count);
+        for (int a = 0; a < 3; ++a) put_leb128(w, static_cast<std::uint64_t>(b.origin[a]));
+        for (int a = 0; a < 3; ++a) put_leb128(w, static_cast<std::uint64_t>(b.size[a]));
+    }
+    std::vector<BitProbability> context(kOccupancyContexts);
+    for (const auto& [b, first] : buckets) {
+        Occupancy occupied(b.size);
+        for (std::size_t i = first; i < first + b.count; ++i)
+            occupied.at((units[i].base >> b.level) - b.origin) = 1;
+        occupied.code(context, [&](BitProbability& p, unsigned v) {
+            bits.bit(p, v);
+            return v;
+        });
     }
 }
 
@@ -101,39 +161,80 @@ VoxelBox box_of(const std::vector<Unit>& units, glm::ivec3 dims) {
     return {origin, glm::min(hi + 1, dims - 1) - origin + 1};
 }
 
-std::vector<Unit> get_units(ByteReader& r, glm::ivec3 dims, std::uint32_t max_units) {
-    std::vector<Unit> units;
-    const auto buckets = r.get<std::uint8_t>();
+std::vector<UnitBucket> get_unit_buckets(ByteReader& r, glm::ivec3 dims, std::uint32_t max_units) {
+    std::vector<UnitBucket> buckets;
+    std::uint64_t units = 0;
+    const auto n = r.get<std::uint8_t>();
     int last_level = -1;
-    for (int b = 0; b < buckets; ++b) {
-        const int level = r.get<std::uint8_t>();
-        if (level <= last_level || level > kMaxUnitLevel)
-            r.fail("unit level " + std::to_string(level) + ": expected " +
+    for (int k = 0; k < n; ++k) {
+        UnitBucket b;
+        b.level = r.get<std::uint8_t>();
+        if (b.level <= last_level || b.level > kMaxUnitLevel)
+            r.fail("unit level " + std::to_string(b.level) + ": expected " +
                    std::to_string(last_level + 1) + ".." + std::to_string(kMaxUnitLevel));
-        last_level = level;
-        const auto count = r.get<std::uint32_t>();
-        if (count > max_units - units.size())
-            r.fail("unit count " + std::to_string(count) + " over the limit " +
-                   std::to_string(max_units));
-        r.need_elements(count, 1, "units");  // at least one byte of gap each
-        const glm::ivec3 grid = unit_grid(dims, level);
-        const std::uint64_t cells = linear(grid - 1, grid) + 1;
-        std::uint64_t next = 0;
-        for (std::uint32_t k = 0; k < count; ++k) {
-            const std::uint64_t gap = get_leb128(r);
-            if (gap >= cells - next)
-                r.fail("unit " + std::to_string(units.size()) + ": past the volume's " +
-                       std::to_string(cells) + " units of level " + std::to_string(level));
-            const std::uint64_t at = next + gap;
-            next = at + 1;
-            const Unit u{unlinear(at, grid) << level, level};
-            if (!complete(u, dims))
-                r.fail("unit " + std::to_string(units.size()) + ": a meta-cell of level " +
-                       std::to_string(level) + " that reaches past the volume");
-            units.push_back(u);
+        last_level = b.level;
+        b.count = r.get<std::uint32_t>();
+        if (b.count == 0 || b.count > max_units - units)
+            r.fail("unit count " + std::to_string(b.count) + ": expected 1.." +
+                   std::to_string(max_units - units) + " (over the limit " +
+                   std::to_string(max_units) + " in all)");
+        units += b.count;
+        const glm::ivec3 grid = unit_grid(dims, b.level);
+        for (int a = 0; a < 3; ++a) {
+            const std::uint64_t o = get_leb128(r);
+            if (o >= static_cast<std::uint64_t>(grid[a]))
+                r.fail("units of level " + std::to_string(b.level) + ": a box past the volume's " +
+                       std::to_string(grid[a]) + " units along axis " + std::to_string(a));
+            b.origin[a] = static_cast<int>(o);
         }
+        for (int a = 0; a < 3; ++a) {
+            const std::uint64_t s = get_leb128(r);
+            if (s == 0 || s > static_cast<std::uint64_t>(grid[a] - b.origin[a]))
+                r.fail("units of level " + std::to_string(b.level) + ": a box past the volume's " +
+                       std::to_string(grid[a]) + " units along axis " + std::to_string(a));
+            b.size[a] = static_cast<int>(s);
+        }
+        if (b.places() > kMaxUnitBoxPlaces)
+            r.fail("units: spread over " + std::to_string(b.places()) + " places of level " +
+                   std::to_string(b.level) + ", over the limit " +
+                   std::to_string(kMaxUnitBoxPlaces));
+        if (b.count > b.places())
+            r.fail("unit count " + std::to_string(b.count) + ": more than the " +
+                   std::to_string(b.places()) + " places of its box");
+        buckets.push_back(b);
     }
-    if (units.empty()) r.fail("units: none");
+    if (buckets.empty()) r.fail("units: none");
+    return buckets;
+}
+
+std::vector<Unit> get_units(const ByteReader& r, RangeDecoder& bits,
+                            const std::vector<UnitBucket>& buckets, glm::ivec3 dims,
+                            std::uint64_t max_places) {
+    std::uint64_t places = 0;
+    for (const UnitBucket& b : buckets) places += b.places();
+    if (places > max_places)
+        r.fail("units: boxes of " + std::to_string(places) + " places, more than the coded " +
+               "stream can hold (" + std::to_string(max_places) + ")");
+    std::vector<Unit> units;
+    std::vector<BitProbability> context(kOccupancyContexts);
+    for (const UnitBucket& b : buckets) {
+        Occupancy occupied(b.size);
+        occupied.code(context, [&](BitProbability& p, unsigned) { return bits.bit(p); });
+        std::uint64_t set = 0;
+        for (int z = 0; z < b.size.z; ++z)
+            for (int y = 0; y < b.size.y; ++y)
+                for (int x = 0; x < b.size.x; ++x) {
+                    if (!occupied.at({x, y, z}) || ++set > b.count) continue;
+                    const Unit u{(b.origin + glm::ivec3(x, y, z)) << b.level, b.level};
+                    if (!complete(u, dims))
+                        r.fail("unit " + std::to_string(units.size()) + ": a meta-cell of level " +
+                               std::to_string(b.level) + " that reaches past the volume");
+                    units.push_back(u);
+                }
+        if (set != b.count)
+            r.fail("units of level " + std::to_string(b.level) + ": " + std::to_string(set) +
+                   " in the box's bits, " + std::to_string(b.count) + " in its count");
+    }
     return units;
 }
 

@@ -17,9 +17,10 @@
 //
 // Floating-point voxels go as they are, as byte planes (zstd compresses the body outside).
 //
-// Byte layout after the units: the value step's shift u8 (Bins: 0, or 2 and up on a coarse pass
-// of integer voxels), then for integers the stream's length u32 and the range coder's stream, for
-// floating point each phase's values as planes (every value's low byte, then the next, ...).
+// Byte layout after the units' boxes: the value step's shift u8 (Bins: 0, or 2 and up on a coarse
+// pass of integer voxels), the stream's length u32 and the range coder's stream (the units' bits,
+// then integer values), then floating-point values as planes, phase by phase (every value's low
+// byte, then the next, ...).
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -214,13 +215,15 @@ inline std::int64_t unzigzag(std::uint64_t z) {
 template <class T>
 class ValueWriter {
   public:
-    // `shift`: a coarse pass's step (Bins), 0 for exact values; integer voxels only.
-    ValueWriter(ByteWriter& w, double iso, int shift) : w_(w), model_(iso), bins_{iso, shift} {
+    // `shift`: a coarse pass's step (Bins), 0 for exact values; integer voxels only. The units'
+    // bits are in `coder` already (cell_units.h).
+    ValueWriter(ByteWriter& w, RangeEncoder& coder, double iso, int shift)
+        : w_(w), coder_(coder), model_(iso), bins_{iso, shift} {
         w_.put(static_cast<std::uint8_t>(shift));
     }
     void phase(BoxVoxels<T>& held, const VolumeView<T>& v, const VoxelBox& box,
                const std::vector<std::uint32_t>& at) {
-        std::vector<Residual<T>> planes;
+        std::vector<T> planes;
         T previous{};
         for (const std::uint32_t i : at) {
             const glm::ivec3 p = box.origin + unlinear(i, box.size);
@@ -243,27 +246,25 @@ class ValueWriter {
         ++phase_;
         if constexpr (!std::is_integral_v<T>) put_planes(planes);
     }
+    // The stream's length and the stream, then floating-point values' planes.
     void finish() {
-        if constexpr (std::is_integral_v<T>) {
-            const std::vector<std::uint8_t> stream = coder_.finish();
-            w_.put(static_cast<std::uint32_t>(stream.size()));
-            w_.put_raw(std::span<const std::uint8_t>(stream));
-        }
+        const std::vector<std::uint8_t> stream = coder_.finish();
+        w_.put(static_cast<std::uint32_t>(stream.size()));
+        w_.put_raw(std::span<const std::uint8_t>(stream));
+        w_.put_raw(std::span<const std::uint8_t>(planes_));
     }
 
   private:
     void put_planes(const std::vector<T>& values) {
-        std::vector<std::uint8_t> plane(values.size());
-        for (std::size_t b = 0; b < sizeof(T); ++b) {
+        for (std::size_t b = 0; b < sizeof(T); ++b)
             for (std::size_t i = 0; i < values.size(); ++i)
-                plane[i] = reinterpret_cast<const std::uint8_t*>(&values[i])[b];
-            w_.put_raw(std::span<const std::uint8_t>(plane));
-        }
+                planes_.push_back(reinterpret_cast<const std::uint8_t*>(&values[i])[b]);
     }
     ByteWriter& w_;
+    RangeEncoder& coder_;
     ValueModel<T> model_;
     Bins<T> bins_;
-    RangeEncoder coder_;
+    std::vector<std::uint8_t> planes_;
     int phase_ = 0;
 };
 
@@ -282,14 +283,16 @@ class ValueReader {
             r.fail("value step: expected 0" +
                    (most >= 2 ? " or 2.." + std::to_string(most) : std::string()) + ", got " +
                    std::to_string(bins_.shift));
-        if constexpr (std::is_integral_v<T>) {
-            const auto n = r.get<std::uint32_t>();
-            coder_ = RangeDecoder(r.get_span(n));
-            max_named_ = kMaxValuesPerByte * n;
-        } else {
+        stream_bytes_ = r.get<std::uint32_t>();
+        coder_ = RangeDecoder(r.get_span(stream_bytes_));
+        if constexpr (std::is_integral_v<T>)
+            max_named_ = kMaxValuesPerByte * stream_bytes_;
+        else
             max_named_ = r.remaining() / sizeof(T);
-        }
     }
+    // The units' bits come first in the stream (cell_units.h).
+    RangeDecoder& coder() { return coder_; }
+    std::uint64_t stream_bytes() const { return stream_bytes_; }
     // The most voxels the values received can name.
     std::uint64_t max_named() const { return max_named_; }
     void phase(BoxVoxels<T>& held, const VoxelBox& box, const std::vector<std::uint32_t>& at) {
@@ -312,12 +315,10 @@ class ValueReader {
             previous = value;
         }
         ++phase_;
-        if constexpr (std::is_integral_v<T>)
-            if (coder_.overrun() > 0) r_.fail("voxel values: the coded stream is cut short");
+        if (coder_.overrun() > 0) r_.fail("voxel values: the coded stream is cut short");
     }
     void finish() const {
-        if constexpr (std::is_integral_v<T>)
-            if (!coder_.at_end()) r_.fail("voxel values: the coded stream does not end there");
+        if (!coder_.at_end()) r_.fail("voxel values: the coded stream does not end there");
     }
 
   private:
@@ -335,7 +336,7 @@ class ValueReader {
     ValueModel<T> model_;
     Bins<T> bins_;
     RangeDecoder coder_;
-    std::uint64_t max_named_ = 0;
+    std::uint64_t max_named_ = 0, stream_bytes_ = 0;
     int phase_ = 0;
 };
 

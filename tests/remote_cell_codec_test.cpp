@@ -1,8 +1,10 @@
 // Issue 34's `cells` encoding (remote/cell_codec.h): a group sent as its units and the voxel values
 // marching cubes reads, triangulated again by the client. Round trips give the server's triangles
-// (same corners, same winding, positions to float rounding) and the very same normals: on the
-// phantom at full resolution, at meta-cell levels (with cells at the volume's border), for
-// refinements, and on every shared volume at its README isovalues. Hostile bodies (every
+// (same corners, same winding, positions to float rounding) and the very same normals at full
+// resolution and for refinements; a coarse pass's come with its vertices near the server's (its
+// values travel to a step) and normals from its faces: on the phantom, at meta-cell levels (with
+// cells at the volume's border), and on every shared volume at its README isovalues; the step's
+// bins keep every value's side of the isovalue. Hostile bodies (every
 // truncation, seeded mutations, huge counts, units past the volume) throw WireError, and a huge
 // claim throws before anything of its size is allocated.
 #include <gtest/gtest.h>
@@ -12,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
@@ -20,6 +23,7 @@
 
 #include "common/volume/phantom.h"
 #include "remote/cell_codec.h"
+#include "remote/cell_values.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
 #include "tests/largest_allocation.h"
@@ -227,6 +231,34 @@ TEST(RemoteCellCodec, EverySharedVolumeRoundTrips) {
     }
 }
 
+// What keeps a coarse pass's cases the server's: a value's bin's middle lies on the value's side
+// of the isovalue and in its bin, for every value of the type, at isovalues on and between
+// values, for every step.
+template <class T>
+void expect_bins_keep_sides(double iso) {
+    for (int shift = 2; shift <= 8 * int(sizeof(T)) - 2; shift += 3) {
+        const cells::Bins<T> bins{iso, shift};
+        const std::int64_t lo = std::numeric_limits<T>::lowest(),
+                           hi = std::numeric_limits<T>::max();
+        const std::int64_t stride = sizeof(T) == 1 ? 1 : 7;
+        for (std::int64_t v = lo; v <= hi; v += stride) {
+            const T middle = bins.middle(bins.of(static_cast<T>(v)));
+            ASSERT_EQ(middle >= iso, double(v) >= iso)
+                << "value " << v << ", iso " << iso << ", step 2^" << shift;
+            ASSERT_EQ(bins.of(middle), bins.of(static_cast<T>(v)))
+                << "value " << v << ", iso " << iso << ", step 2^" << shift;
+        }
+    }
+}
+
+TEST(RemoteCellCodec, AStepsBinsKeepEveryValuesSideOfTheIsovalue) {
+    for (double iso : {0.0, 1.0, 40.0, 40.5, 254.9, 255.0})
+        expect_bins_keep_sides<std::uint8_t>(iso);
+    for (double iso : {-128.0, -0.5, 0.0, 17.25, 127.0}) expect_bins_keep_sides<std::int8_t>(iso);
+    for (double iso : {0.0, 600.0, 1650.5, 65535.0}) expect_bins_keep_sides<std::uint16_t>(iso);
+    for (double iso : {-32768.0, -9000.5, 0.0, 32767.0}) expect_bins_keep_sides<std::int16_t>(iso);
+}
+
 TEST(RemoteCellCodec, AGroupWhoseMeshIsNotItsUnitsGoesAsCompact) {
     Group g = sample_groups(cells_phantom(), kPhantomSkinIso, 4, 30).at(0);
     g.mesh.indices.resize(g.mesh.indices.size() - 3);  // one triangle fewer than its cells make
@@ -291,8 +323,8 @@ void overwrite_u32(Bytes& b, std::size_t at, std::uint32_t v) {
     std::memcpy(b.data() + at, &v, sizeof v);
 }
 
-// Two units at opposite corners of a large volume: a box past the limit.
-Bytes spread_units_body(const Bytes& clean) {
+// Two units in a box of `side`^3 units of a 4096^3 volume, and 64 bytes of coded stream.
+Bytes spread_units_body(const Bytes& clean, std::uint32_t side) {
     Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
     overwrite_u32(b, 1, 1u << 12);
     overwrite_u32(b, 5, 1u << 12);
@@ -302,15 +334,13 @@ Bytes spread_units_body(const Bytes& clean) {
     const std::uint32_t two = 2;
     b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&two),
              reinterpret_cast<const std::uint8_t*>(&two) + 4);
-    b.push_back(0);  // the unit at (0, 0, 0)
-    std::uint64_t gap = (std::uint64_t{4094} * 4095 + 4094) * 4095 + 4093;
-    while (gap >= 0x80) {
-        b.push_back(static_cast<std::uint8_t>(gap | 0x80));
-        gap >>= 7;
+    for (int a = 0; a < 3; ++a) b.push_back(0);  // the box's origin
+    for (int a = 0; a < 3; ++a) {                // its size, LEB128
+        b.push_back(static_cast<std::uint8_t>(side | 0x80));
+        b.push_back(static_cast<std::uint8_t>(side >> 7));
     }
-    b.push_back(static_cast<std::uint8_t>(gap));
     b.push_back(0);                   // the values exact
-    const std::uint32_t stream = 64;  // the values' coded stream: its length, its bytes
+    const std::uint32_t stream = 64;  // the coded stream: its length, its bytes
     b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&stream),
              reinterpret_cast<const std::uint8_t*>(&stream) + 4);
     for (int k = 0; k < 64; ++k) b.push_back(7);
@@ -318,7 +348,7 @@ Bytes spread_units_body(const Bytes& clean) {
 }
 
 // Offsets in the body: type u8 at 0, dims at 1, spacing at 13, normals at 25, bucket count at 26,
-// the first bucket's level at 27 and unit count at 28, the first gap at 32.
+// the first bucket's level at 27 and unit count at 28, its box's origin at 32.
 TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocating) {
     const Bytes clean = cells_body();
     // Throws WireError whose message holds `why`.
@@ -340,9 +370,8 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
     for (std::uint32_t claim : {0xffffffffu, kMaxGroupTriangles, 1u << 20, 5000u}) {
         Bytes b = clean;
         overwrite_u32(b, 28, claim);
-        expect_refused(
-            b, "unit count " + std::to_string(claim),
-            claim > kMaxGroupTriangles ? "over the limit" : "longer than the bytes left");
+        expect_refused(b, "unit count " + std::to_string(claim),
+                       claim > kMaxGroupTriangles ? "over the limit" : "places of its box");
     }
     for (std::uint32_t dim : {0u, 1u, 0x7fffffffu, 0x80000000u}) {
         Bytes b = clean;
@@ -366,14 +395,18 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
         expect_refused(b, "level 40", "unit level 40");
     }
     {
-        // A first gap past every unit of the volume: ten LEB128 bytes of 0xff, then 0x01.
+        // A box origin past every unit of the volume: ten LEB128 bytes of 0xff, then 0x01.
         Bytes b(clean.begin(), clean.begin() + 32);
         for (int k = 0; k < 9; ++k) b.push_back(0xff);
         b.push_back(0x01);
         b.insert(b.end(), clean.begin() + 33, clean.end());
         expect_refused(b, "a unit past the volume", "past the volume");
     }
-    expect_refused(spread_units_body(clean), "units spread past the box limit", "spread over");
+    expect_refused(spread_units_body(clean, 4095), "units spread past the box limit",
+                   "spread over");
+    // 8 million places, which 64 bytes of stream cannot code (at most 364 a byte).
+    expect_refused(spread_units_body(clean, 200), "a box past what the stream can code",
+                   "more than the coded stream can hold");
 }
 
 }  // namespace
