@@ -29,14 +29,18 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
 }
 
 GroupEncoding EncodingChooser::best() const {
-    // Unmeasured, or a link not yet seen: cells (fewer bytes); compact once if only sending it
-    // can measure it (the session measures both while measuring()).
-    if (cells_.groups == 0) return GroupEncoding::cells;
     // The link is unknown until two sends waited (the first one's rate says little), or until
-    // kProbeSends went with none waiting (buffers absorb them: a fast link).
+    // kProbeSends went with none waiting (buffers absorb them: a fast link): cells, fewer bytes.
     const bool probing =
         blocked_sends_ == 0 ? cells_.sends + compact_.sends < kProbeSends : blocked_sends_ < 2;
     if (probing && link_cap_ <= 0) return GroupEncoding::cells;
+    // Nothing to weigh yet (the session measures both with the first group, after sending it):
+    // on a link the server paces itself, the prior decides; else cells. Then the one not yet
+    // measured, once, if only sending it can measure it.
+    if (cells_.groups == 0 && compact_.groups == 0)
+        return link_cap_ > 0 && link_cap_ >= kCellsPayBelow ? GroupEncoding::compact_zstd
+                                                            : GroupEncoding::cells;
+    if (cells_.groups == 0) return GroupEncoding::cells;
     if (compact_.groups == 0) return GroupEncoding::compact_zstd;
     return cost_per_triangle(GroupEncoding::cells) <= cost_per_triangle(GroupEncoding::compact_zstd)
                ? GroupEncoding::cells

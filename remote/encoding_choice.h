@@ -50,11 +50,20 @@ class EncodingChooser {
     void set_link_cap(double bytes_per_s) { link_cap_ = bytes_per_s; }
     // The encoding for the next group.
     GroupEncoding next();
-    // True until both encodings were measured once: the session then encodes the group both ways
-    // and reports both (encoded), so neither has to be sent to be known. Exploring by sending
-    // compact+zstd's first group cost a slow link five times its bytes just when C climbs fastest
-    // (the 256 head at 1 Mbit/s: C = 90% at 0.385 s against cells' 0.281).
+    // True until both encodings were measured once: the session then sends the group in next()'s
+    // encoding and, after the send, encodes it the other way too and reports both (encoded), so
+    // neither has to be sent to be known and the measuring costs the first group no time.
+    // Exploring by sending compact+zstd's first group cost a slow link five times its bytes just
+    // when C climbs fastest (the 256 head at 1 Mbit/s: C = 90% at 0.385 s against cells' 0.281);
+    // encoding both ways before the send put 8-25 ms on the head's first group at 100 Mbit/s.
     bool measuring() const { return cells_.groups == 0 || compact_.groups == 0; }
+    // The first group's encoding on a link the server paces (set_link_cap), before either is
+    // measured: cells below this rate. A triangle costs about 6.5 bytes as compact+zstd and 1 as
+    // cells; the stages overlap, and cells' slowest is about 1.1 us a triangle (the page's decoding
+    // at 0.9 M triangles/s; the server makes and encodes them in about as much), compact+zstd's
+    // about 0.7 (making and encoding): compact+zstd is sooner once 6.5 bytes take under 1.1 us,
+    // about 6 MB/s. Measured figures replace this from the second group on.
+    static constexpr double kCellsPayBelow = 5e6;
     // Groups go as cells (the smaller) while the link is unknown: until two sends have waited
     // for it, or this many went without any waiting (buffers absorb them: a fast link). A paced
     // link's burst and a socket's buffer make the first sends look fast (the 256 head at

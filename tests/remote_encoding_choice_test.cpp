@@ -62,8 +62,9 @@ TEST(EncodingChoice, AClientsDecodeReportCounts) {
     EXPECT_EQ(quiet.cost_per_triangle(GroupEncoding::compact_zstd), 0);
 }
 
-// As the session does: while measuring, each group is encoded both ways before the choice.
-// Returns the number of the first group sent as compact+zstd (0: none).
+// As the session does: each group goes in the chooser's encoding, and while measuring it is
+// encoded the other way too, after the send. Returns the number of the first group sent as
+// compact+zstd (0: none).
 std::uint64_t run_measuring_first(EncodingChooser& c, double rate, int groups,
                                   std::uint64_t& cells) {
     std::uint64_t first_compact = 0;
@@ -75,14 +76,12 @@ std::uint64_t run_measuring_first(EncodingChooser& c, double rate, int groups,
     };
     for (int i = 0; i < groups; ++i) {
         const bool both = c.measuring();
-        if (both) {
-            encoded(GroupEncoding::cells);
-            encoded(GroupEncoding::compact_zstd);
-        }
         const GroupEncoding e = c.next();
-        if (!both) encoded(e);
+        encoded(e);
         const std::size_t bytes = e == GroupEncoding::cells ? 2400 : 13000;
         c.sent(e, bytes, rate > 0 ? double(bytes) / rate : 0);
+        if (both)
+            encoded(e == GroupEncoding::cells ? GroupEncoding::compact_zstd : GroupEncoding::cells);
         cells += e == GroupEncoding::cells ? 1 : 0;
         if (e == GroupEncoding::compact_zstd && first_compact == 0) first_compact = i + 1;
     }
@@ -105,8 +104,9 @@ TEST(EncodingChoice, MeasuredBothWaysNeitherIsSentToBeKnown) {
 }
 
 TEST(EncodingChoice, AServersOwnPacingIsTheLinkUntilOneIsSeen) {
-    // serve --rate-mbps 100: the CPU decides from the first group, for compact+zstd; at 1 Mbit/s
-    // cells from the first. Without the cap the first groups probe the link as cells.
+    // serve --rate-mbps 100: compact+zstd from the first group (the prior, kCellsPayBelow), then
+    // the CPU decides, for compact+zstd; at 1 Mbit/s cells from the first. Without the cap the
+    // first groups probe the link as cells.
     EncodingChooser fast, slow;
     fast.set_link_cap(12.5e6);
     slow.set_link_cap(125e3);
