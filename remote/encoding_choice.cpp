@@ -34,6 +34,8 @@ GroupEncoding EncodingChooser::best() const {
     const bool probing =
         blocked_sends_ == 0 ? cells_.sends + compact_.sends < kProbeSends : blocked_sends_ < 2;
     if (probing && link_cap_ <= 0) return GroupEncoding::cells;
+    // Cells cannot pay on a link known to be fast: they are not even measured (wants_measure).
+    if (cells_.groups == 0 && fast_link()) return GroupEncoding::compact_zstd;
     // Nothing to weigh yet (the session measures both with the first group, after sending it):
     // on a link the server paces itself, the prior decides; else cells. Then the one not yet
     // measured, once, if only sending it can measure it.

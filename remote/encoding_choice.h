@@ -37,6 +37,11 @@ inline void apply_hello_encoding(std::uint8_t e, GroupEncoding& encoding, bool& 
     encoding = adaptive ? GroupEncoding::cells : static_cast<GroupEncoding>(e);
 }
 
+// The one of cells and compact+zstd that `e` is not.
+inline GroupEncoding other_encoding(GroupEncoding e) {
+    return e == GroupEncoding::cells ? GroupEncoding::compact_zstd : GroupEncoding::cells;
+}
+
 class EncodingChooser {
   public:
     static constexpr std::uint64_t kExploreEvery = 16;
@@ -50,13 +55,21 @@ class EncodingChooser {
     void set_link_cap(double bytes_per_s) { link_cap_ = bytes_per_s; }
     // The encoding for the next group.
     GroupEncoding next();
-    // True until both encodings were measured once: the session then sends the group in next()'s
-    // encoding and, after the send, encodes it the other way too and reports both (encoded), so
-    // neither has to be sent to be known and the measuring costs the first group no time.
-    // Exploring by sending compact+zstd's first group cost a slow link five times its bytes just
-    // when C climbs fastest (the 256 head at 1 Mbit/s: C = 90% at 0.385 s against cells' 0.281);
-    // encoding both ways before the send put 8-25 ms on the head's first group at 100 Mbit/s.
+    // True until both encodings were measured once.
     bool measuring() const { return cells_.groups == 0 || compact_.groups == 0; }
+    // Whether the session should encode a group it sent in the other encoding `e` too, after the
+    // send, for the chooser alone: while `e` is unmeasured, so neither has to be sent to be known
+    // and the measuring costs the group no time. Exploring by sending compact+zstd's first group
+    // cost a slow link five times its bytes just when C climbs fastest (the 256 head at 1 Mbit/s:
+    // C = 90% at 0.385 s against cells' 0.281); encoding both ways before the send put 8-25 ms on
+    // the head's first group at 100 Mbit/s. Not cells on a link known to be fast (fast_link()):
+    // there they cannot pay, and measuring them cost the engine's first groups 10-20% at
+    // 100 Mbit/s; they are measured once the link is seen slower.
+    bool wants_measure(GroupEncoding e) const {
+        return slot(e).groups == 0 && !(e == GroupEncoding::cells && fast_link());
+    }
+    // The link is the server's own pacing at kCellsPayBelow or more, and no slower rate was seen.
+    bool fast_link() const { return link_cap_ > 0 && bytes_per_s() >= kCellsPayBelow; }
     // The first group's encoding on a link the server paces (set_link_cap), before either is
     // measured: cells below this rate. A triangle costs about 6.5 bytes as compact+zstd and 1 as
     // cells; the stages overlap, and cells' slowest is about 1.1 us a triangle (the page's decoding

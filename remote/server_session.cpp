@@ -66,15 +66,13 @@ class ServerSession::Sink final : public GroupSink {
             return b;
         };
         GroupEncoding asked = s_.options_.encoding;
-        // While the chooser has not measured both encodings, a group goes in its first guess and
-        // is encoded the other way too, after it is sent, for the chooser alone: neither has to
-        // be sent to be measured, and the link and the client work on the group meanwhile (both
-        // ways before the send put 8-25 ms on the 256 head's first group at 100 Mbit/s).
+        // A group the chooser wants measured the other way too is encoded so after it is sent
+        // (EncodingChooser::wants_measure): the link and the client work on it meanwhile.
         bool measure_other = false;
         if (adaptive) {
             s_.take_reports();
-            measure_other = s_.chooser_.measuring();
             asked = s_.chooser_.next();
+            measure_other = s_.chooser_.wants_measure(other_encoding(asked));
         }
         const std::vector<std::uint8_t> bytes = encode(asked);
         m.encoded.resize(bytes.size());
@@ -83,9 +81,7 @@ class ServerSession::Sink final : public GroupSink {
         const Stopwatch sending;
         const std::size_t sent = s_.send_(m);
         if (adaptive) s_.chooser_.sent(asked, sent, sending.seconds());
-        if (measure_other)
-            encode(asked == GroupEncoding::cells ? GroupEncoding::compact_zstd
-                                                 : GroupEncoding::cells);
+        if (measure_other) encode(other_encoding(asked));
         s_.since_sent_.restart();
         f_.bytes += sent;
         ++f_.groups;
