@@ -3,12 +3,14 @@
 // open problem 5.2.3): a group sent as what marching cubes needs, not what it made. The client
 // runs the project's own marching cubes (common/extract/marching_cubes.h) on what it receives and
 // gets the server's triangles: the same positions and the same normals, the interpolated
-// central-difference gradients, to the bit, with nothing quantised. A coarse pass (level >= 1:
-// drawn only until the full resolution replaces it) sends no normals: its vertices lie 2^level
-// apart and their gradients share few voxels, so the client takes each vertex's normal from the
-// faces around it (the area-weighted mean). On the 256-wide head at 1 Mbit/s that reached C = 90%
-// in 0.283 s against 0.342 with 8-bit octahedral codes sent: these normals differ from the
-// gradients' by 28 degrees on average, and the bytes saved bring the finer passes sooner.
+// central-difference gradients, to the bit, with nothing quantised at full resolution. A coarse
+// pass (level >= 1: drawn only until the full resolution replaces it) is sent cheaper: no normals
+// (its vertices lie 2^level apart and their gradients share few voxels, so the client takes each
+// vertex's normal from the faces around it, the area-weighted mean; they differ from the
+// gradients' by 28 degrees on average on the head), and its values to a step (cell_values.h:
+// bins aligned on the isovalue keep every unit's case; only where the surface cuts an edge moves,
+// by 0.03 of an edge on average). On the 256-wide head at 1 Mbit/s, C = 90% came in 0.112 s
+// (stop 53, exact values through zstd: 0.283; with 8-bit normals sent too: 0.342).
 //
 // What travels: the group's units (the cells, or meta-cells of a level, whose triangles the mesh
 // is) and the values of the voxels marching cubes reads to triangulate them, in three phases, each
@@ -20,13 +22,15 @@
 //      the vertex's normal (not for a coarse pass).
 // Each phase's voxels go in increasing linear index (z, then y, then x), without those of an
 // earlier phase. Integer values go as the difference to the mean of their known face neighbours
-// (at 1, else 2, else 4 voxels), zigzagged; all as byte planes (every value's low byte, then the
-// next byte, ...).
+// (at 1, else 2, else 4 voxels), coded in context through a binary range coder (cell_values.h,
+// range_coder.h); floating-point values as they are, in byte planes.
 //
 // Byte layout: voxel type u8, volume dims 3 x i32, spacing 3 x f32, normals u8 (0 from the
-// gradients, 1 from the faces), bucket count u8; per bucket level u8, unit count u32 and the units
-// as LEB128 gaps between their increasing indices in the grid of units of that level; then the
-// phases' values. group_codec.cpp sends it through zstd.
+// gradients, 1 from the faces), bucket count u8; per bucket (a level's units) level u8, unit count
+// u32, and its box in that level's grid of units as origin and size, 3 + 3 LEB128 (cell_units.h);
+// the value step's shift u8; the range coder's stream, its length u32 first (the boxes'
+// occupancy, a bit a place, then the integer values); floating-point values' planes.
+// group_codec.cpp sends it through zstd.
 //
 // A group whose mesh is not the marching cubes of its units (a mesh from elsewhere, units past the
 // volume) or whose units spread over more than kMaxCellBoxVoxels has no cells body: the encoder

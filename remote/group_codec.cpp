@@ -229,7 +229,8 @@ std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encodin
         put_zstd(w, *body);
         std::vector<std::uint8_t> cells = w.take();
         // A coarse pass's corners lie 2^level apart, where neighbours predict them poorly: cells
-        // may then be the larger (on cthead's meta-cells of 4, 8.8 bytes a triangle against 6.7).
+        // may then be the larger, on a small pass (before coarse values went to a step, cthead's
+        // meta-cells of 4 took 8.8 bytes a triangle against 6.7).
         if (group.level == 0 || group.refinement) return cells;
         std::vector<std::uint8_t> compact =
             encode_group(group, GroupEncoding::compact_zstd, grid_step);
