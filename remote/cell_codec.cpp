@@ -128,7 +128,7 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
     for (int a = 0; a < 3; ++a) w.put(volume.spacing()[a]);
     w.put(static_cast<std::uint8_t>(normals));
     RangeEncoder coder;
-    put_units(w, coder, *units);
+    if (!put_units(w, coder, *units)) return std::nullopt;
     BoxVoxels<T> sent(box, h.dims, volume.spacing());
     PhaseVoxels<T> named(sent, box);
     const int shift = normals == Normals::faces && std::is_integral_v<T>

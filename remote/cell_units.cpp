@@ -48,6 +48,11 @@ class Occupancy {
           sy_(static_cast<std::ptrdiff_t>(size.x) + 3),
           sz_(sy_ * (static_cast<std::ptrdiff_t>(size.y) + 2)),
           places_(static_cast<std::size_t>(sz_ * (static_cast<std::ptrdiff_t>(size.z) + 1)), 0) {}
+    // What a box of `size` holds, its border included: what the limits count.
+    static std::uint64_t held(glm::ivec3 size) {
+        return (static_cast<std::uint64_t>(size.x) + 3) * (static_cast<std::uint64_t>(size.y) + 2) *
+               (static_cast<std::uint64_t>(size.z) + 1);
+    }
     std::uint8_t& at(glm::ivec3 p) { return places_[index(p.x, p.y, p.z)]; }
 
     template <class Bit>
@@ -82,7 +87,7 @@ std::uint64_t UnitBucket::places() const {
            static_cast<std::uint64_t>(size.z);
 }
 
-void put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units) {
+bool put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units) {
     std::vector<std::pair<UnitBucket, std::size_t>> buckets;  // and each one's first unit
     for (std::size_t i = 0; i < units.size(); ++i) {
         const glm::ivec3 p = units[i].base >> units[i].level;
@@ -94,9 +99,14 @@ void put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units
         b.origin = glm::min(b.origin, p);
         b.size = glm::max(b.size, p);  // the far corner, for now
     }
-    w.put(static_cast<std::uint8_t>(buckets.size()));
+    std::uint64_t held = 0;
     for (auto& [b, first] : buckets) {
         b.size = b.size - b.origin + 1;
+        held += Occupancy::held(b.size);
+    }
+    if (held > kMaxUnitBoxPlaces) return false;  // get_units would refuse it
+    w.put(static_cast<std::uint8_t>(buckets.size()));
+    for (const auto& [b, first] : buckets) {
         w.put(static_cast<std::uint8_t>(b.level));
         w.put(b.count);
         for (int a = 0; a < 3; ++a) put_leb128(w, static_cast<std::uint64_t>(b.origin[a]));
@@ -112,6 +122,7 @@ void put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units
             return v;
         });
     }
+    return true;
 }
 
 glm::ivec3 unit_grid(glm::ivec3 dims, int level) {
@@ -210,11 +221,17 @@ std::vector<UnitBucket> get_unit_buckets(ByteReader& r, glm::ivec3 dims, std::ui
 std::vector<Unit> get_units(const ByteReader& r, RangeDecoder& bits,
                             const std::vector<UnitBucket>& buckets, glm::ivec3 dims,
                             std::uint64_t max_places) {
-    std::uint64_t places = 0;
-    for (const UnitBucket& b : buckets) places += b.places();
+    std::uint64_t places = 0, held = 0;
+    for (const UnitBucket& b : buckets) {
+        places += b.places();
+        held += Occupancy::held(b.size);
+    }
     if (places > max_places)
         r.fail("units: boxes of " + std::to_string(places) + " places, more than the coded " +
                "stream can hold (" + std::to_string(max_places) + ")");
+    if (held > kMaxUnitBoxPlaces)
+        r.fail("units: boxes of " + std::to_string(held) + " places with their borders, over " +
+               "the limit " + std::to_string(kMaxUnitBoxPlaces));
     std::vector<Unit> units;
     std::vector<BitProbability> context(kOccupancyContexts);
     for (const UnitBucket& b : buckets) {

@@ -52,14 +52,17 @@ struct UnitBucket {
 inline constexpr std::uint64_t kMaxUnitBoxPlaces = std::uint64_t{1} << 24;
 
 // Sorted units (sort_units): bucket count u8, then per level its level u8, count u32, the box's
-// origin and size as 3 + 3 LEB128 numbers into `w`; the boxes' occupancy into `bits`.
-void put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units);
+// origin and size as 3 + 3 LEB128 numbers into `w`; the boxes' occupancy into `bits`. False, with
+// nothing written, when the boxes with their coding borders hold more than kMaxUnitBoxPlaces
+// places in all (a thin box's border is up to 12 times its places), which get_units refuses.
+bool put_units(ByteWriter& w, RangeEncoder& bits, const std::vector<Unit>& units);
 // The buckets; throws WireError on a level out of order or past kMaxUnitLevel, counts past
 // `max_units` in all or past a box, a box past the volume or over kMaxUnitBoxPlaces, no unit.
 std::vector<UnitBucket> get_unit_buckets(ByteReader& r, glm::ivec3 dims, std::uint32_t max_units);
 // The units, from the boxes' bits; throws WireError (through `r`) when the boxes hold more
-// places than `max_places` (what the stream can code: checked before anything is sized from
-// them), a box's bits set other than its count, or a meta-cell reaches past the volume.
+// places than `max_places` (what the stream can code) or, with their borders, more than
+// kMaxUnitBoxPlaces (both checked before anything is sized from them), a box's bits set other
+// than its count, or a meta-cell reaches past the volume.
 std::vector<Unit> get_units(const ByteReader& r, RangeDecoder& bits,
                             const std::vector<UnitBucket>& buckets, glm::ivec3 dims,
                             std::uint64_t max_places);

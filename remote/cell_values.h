@@ -125,12 +125,16 @@ class ValueModel {
     static constexpr int kBits = 8 * sizeof(T);
     // Bit lengths 0..kBits: a tree of 4 levels for 8 bits, 5 for 16, 6 for 32.
     static constexpr int kTreeBits = std::bit_width(static_cast<unsigned>(kBits));
+    static constexpr bool kIntegral = std::is_integral_v<T>;
 
+    // Floating-point voxels go as planes: their model holds nothing.
     explicit ValueModel(double iso)
         : iso_(iso),
-          tree_(std::size_t{kValuePhases * kSpreadClasses * kDistanceClasses} << kTreeBits),
-          first_(kValuePhases * (kBits + 1)),
-          second_(2 * kValuePhases * (kBits + 1)) {}
+          tree_(kIntegral
+                    ? std::size_t{kValuePhases * kSpreadClasses * kDistanceClasses} << kTreeBits
+                    : 0),
+          first_(kIntegral ? kValuePhases * (kBits + 1) : 0),
+          second_(kIntegral ? 2 * kValuePhases * (kBits + 1) : 0) {}
 
     void put(RangeEncoder& e, int phase, const Prediction<T>& p, R r) {
         const int width = static_cast<int>(std::bit_width(r));

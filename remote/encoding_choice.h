@@ -55,8 +55,6 @@ class EncodingChooser {
     void set_link_cap(double bytes_per_s) { link_cap_ = bytes_per_s; }
     // The encoding for the next group.
     GroupEncoding next();
-    // True until both encodings were measured once.
-    bool measuring() const { return cells_.groups == 0 || compact_.groups == 0; }
     // Whether the session should encode a group it sent in the other encoding `e` too, after the
     // send, for the chooser alone: while `e` is unmeasured, so neither has to be sent to be known
     // and the measuring costs the group no time. Exploring by sending compact+zstd's first group

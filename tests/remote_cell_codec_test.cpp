@@ -294,27 +294,28 @@ void overwrite_u32(Bytes& b, std::size_t at, std::uint32_t v) {
     std::memcpy(b.data() + at, &v, sizeof v);
 }
 
-// Two units in a box of `side`^3 units of a 4096^3 volume, and 64 bytes of coded stream.
-Bytes spread_units_body(const Bytes& clean, std::uint32_t side) {
+void put_leb128(Bytes& b, std::uint32_t v) {
+    for (; v >= 0x80; v >>= 7) b.push_back(static_cast<std::uint8_t>(v | 0x80));
+    b.push_back(static_cast<std::uint8_t>(v));
+}
+
+// Two units in a box of `size` units at the origin of a volume of `dims`, and `stream` bytes of
+// coded stream.
+Bytes spread_units_body(const Bytes& clean, glm::uvec3 dims, glm::uvec3 size,
+                        std::uint32_t stream) {
     Bytes b(clean.begin(), clean.begin() + 26);  // to the normals byte (gradients)
-    overwrite_u32(b, 1, 1u << 12);
-    overwrite_u32(b, 5, 1u << 12);
-    overwrite_u32(b, 9, 1u << 12);
+    for (int a = 0; a < 3; ++a) overwrite_u32(b, 1 + 4 * std::size_t(a), dims[a]);
     b.push_back(1);  // one bucket
     b.push_back(0);  // level 0
     const std::uint32_t two = 2;
     b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&two),
              reinterpret_cast<const std::uint8_t*>(&two) + 4);
     for (int a = 0; a < 3; ++a) b.push_back(0);  // the box's origin
-    for (int a = 0; a < 3; ++a) {                // its size, LEB128
-        b.push_back(static_cast<std::uint8_t>(side | 0x80));
-        b.push_back(static_cast<std::uint8_t>(side >> 7));
-    }
-    b.push_back(0);                   // the values exact
-    const std::uint32_t stream = 64;  // the coded stream: its length, its bytes
+    for (int a = 0; a < 3; ++a) put_leb128(b, size[a]);
+    b.push_back(0);  // the values exact
     b.insert(b.end(), reinterpret_cast<const std::uint8_t*>(&stream),
              reinterpret_cast<const std::uint8_t*>(&stream) + 4);
-    for (int k = 0; k < 64; ++k) b.push_back(7);
+    b.insert(b.end(), stream, 7);
     return b;
 }
 
@@ -373,11 +374,16 @@ TEST(RemoteCellCodecMalformed, HugeCountsAndUnitsPastTheVolumeThrowBeforeAllocat
         b.insert(b.end(), clean.begin() + 33, clean.end());
         expect_refused(b, "a unit past the volume", "past the volume");
     }
-    expect_refused(spread_units_body(clean, 4095), "units spread past the box limit",
-                   "spread over");
+    const glm::uvec3 big(4096);
+    expect_refused(spread_units_body(clean, big, glm::uvec3(4095), 64),
+                   "units spread past the box limit", "spread over");
     // 8 million places, which 64 bytes of stream cannot code (at most 364 a byte).
-    expect_refused(spread_units_body(clean, 200), "a box past what the stream can code",
-                   "more than the coded stream can hold");
+    expect_refused(spread_units_body(clean, big, glm::uvec3(200), 64),
+                   "a box past what the stream can code", "more than the coded stream can hold");
+    // 3.8 million places a 10 KB stream could code, but a thin box: with the border the coder
+    // reads around it, 17 million.
+    expect_refused(spread_units_body(clean, {4096, 4096, 300000}, {1, 16, 240000}, 10240),
+                   "a thin box whose border is past the limit", "with their borders");
 }
 
 }  // namespace

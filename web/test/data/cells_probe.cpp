@@ -5,7 +5,8 @@
 //   cells_probe reference OUT CORPUS [CTHEAD.nhdr]
 //       small groups: the cells groups of CORPUS (fuzz/corpus/group_codec), passes of the phantom
 //       in all eight voxel types (level 0, meta-cells of level 2 whose normals come from their
-//       faces, a refinement), and of the CT head when given (committed: cells_groups.bin)
+//       faces and integer values go to a step, a refinement), and of the CT head when given
+//       (committed: cells_groups.bin)
 //   cells_probe frame OUT [VOLUME ISO]
 //       one frame's groups, as isowall_bench_codec makes them (the phantom at iso 50 by default);
 //       prints the C++ decoder's triangles a second on them
