@@ -56,6 +56,9 @@ class FrameRun {
 
     bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink, std::size_t ray_limit) {
         settle(true);  // a present in flight belongs to the sink of the last cast
+        // The region's rays are intersection until a group, a coverage read or a present says
+        // otherwise (the caller may have been in any stage: a wall job starts in render).
+        stage(Stage::intersection);
         view_ = &view;
         sink_ = &sink;
         view_m_ = view.camera.view();

@@ -1,7 +1,9 @@
 // Correctness of an intermediate frame against the final one: final pixels and C = 1 - E.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -207,6 +209,59 @@ TEST(Correctness, MalformedBuffersThrow) {
     short_depth.depth.pop_back();
     EXPECT_THROW(measure_correctness(short_depth, background(2, 2)), std::invalid_argument);
     EXPECT_THROW(measure_correctness(background(2, 2), short_depth), std::invalid_argument);
+}
+
+// The tracker follows a frame drawn a rectangle at a time (some pixels drawn again in another
+// colour, some undrawn again): after every update it gives what measure_correctness gives for
+// the whole frame, to the bit for the counts and within rounding for C.
+TEST(CorrectnessTracker, FollowsRectangleUpdatesAsTheWholeFrameMeasureDoes) {
+    std::mt19937 rng(7);
+    const int w = 37, h = 23;
+    Image final_image = background(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if ((x * 7 + y * 3) % 5 != 0) draw(final_image, x, y, 200, std::uint8_t(x * 6), 90);
+    CorrectnessTracker tracker(final_image);
+    Image shown = background(w, h);
+    const Correctness empty = measure_correctness(shown, final_image);
+    EXPECT_EQ(tracker.now().significant, empty.significant);
+    EXPECT_EQ(tracker.now().c, 0.0);
+    for (int step = 0; step < 200; ++step) {
+        // Rectangles reach past the frame on every side: the tracker clips them.
+        const int x0 = int(rng() % (w + 8)) - 4, y0 = int(rng() % (h + 8)) - 4;
+        const PixelRect rect{x0, y0, int(rng() % 12), int(rng() % 12)};
+        for (int y = std::max(rect.y, 0); y < std::min(rect.y + rect.height, h); ++y)
+            for (int x = std::max(rect.x, 0); x < std::min(rect.x + rect.width, w); ++x) {
+                const unsigned kind = rng() % 4;
+                const std::size_t p = std::size_t(y) * w + x;
+                if (kind == 0) {
+                    shown.depth[p] = 1.0f;  // not drawn (any colour left there does not count)
+                } else {
+                    const std::size_t f = p * 4;
+                    const int off = kind == 1 ? 0 : kind == 2 ? 1 : int(rng() % 60);
+                    draw(shown, x, y, std::uint8_t(std::min(255, final_image.rgba[f] + off)),
+                         final_image.rgba[f + 1], final_image.rgba[f + 2]);
+                }
+            }
+        tracker.update(shown, rect);
+        const Correctness want = measure_correctness(shown, final_image);
+        const Correctness got = tracker.now();
+        ASSERT_EQ(got.significant, want.significant) << "step " << step;
+        ASSERT_EQ(got.final_pixels, want.final_pixels) << "step " << step;
+        ASSERT_NEAR(got.c, want.c, 1e-12) << "step " << step;
+        ASSERT_NEAR(tracker.error_squared_sum(),
+                    (1.0 - want.c) * (1.0 - want.c) * double(want.significant), 1e-9);
+    }
+    EXPECT_GT(tracker.now().c, 0.5);
+}
+
+TEST(CorrectnessTracker, RefusesAFrameOfAnotherSizeAndAMalformedFinalImage) {
+    CorrectnessTracker tracker(background(4, 3));
+    EXPECT_EQ(tracker.now().c, 1.0);  // nothing significant: trivially matched
+    EXPECT_THROW(tracker.update(background(3, 4), {0, 0, 3, 4}), std::invalid_argument);
+    Image short_depth = background(2, 2);
+    short_depth.depth.pop_back();
+    EXPECT_THROW(CorrectnessTracker{short_depth}, std::invalid_argument);
 }
 
 }  // namespace

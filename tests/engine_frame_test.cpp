@@ -9,6 +9,7 @@
 #include <set>
 #include <vector>
 
+#include "common/progressive/trace.h"
 #include "common/volume/phantom.h"
 #include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
@@ -106,6 +107,44 @@ TEST(EngineFrame, ARegionHearsOfTheEarlierGroupsItsRaysMeetAtEachRayOrAfterEachL
         else
             EXPECT_EQ(frame.workers().sum_s, workers0);
     }
+}
+
+// A wall job enters the engine from whatever stage its rank was in (a help job sets up its image
+// as render): the region's rays are intersection from the cast's first ray. They once went on in
+// the caller's stage until a group or a coverage read switched it, and the wall study read that
+// as render costs of help jobs.
+TEST(EngineFrame, ARegionsRaysAreIntersectionWhateverStageItWasEnteredFrom) {
+    const Volume p = make_phantom();
+    auto ex = make_surface_extractor(p);
+    TraceRecorder trace;
+    EngineOptions opt;
+    opt.trace = &trace;
+    opt.screen_box = opt.screen_mask = false;  // every ray is cast
+    ProgressiveEngine engine(*ex, opt);
+    // An isovalue above every voxel: the rays find nothing, so nothing in the cast draws.
+    const FrameView fv = test::make_view(p, 320, 240, 1e6);
+    std::atomic<bool> stop{false};
+    RecordingSink sink;
+    EngineFrame frame(engine, fv, stop);
+    RegionCursor c = frame.cursor(fv, fv.screen());
+    trace.switch_to(Stage::render);
+    const std::size_t entered = trace.spans().size();
+    ASSERT_TRUE(frame.cast(fv, c, sink));
+    ASSERT_TRUE(c.done);
+    ASSERT_EQ(c.rays, std::size_t(320 * 240));
+    ASSERT_TRUE(sink.groups.empty());
+    trace.close();
+    const auto& spans = trace.spans();
+    ASSERT_GT(spans.size(), entered + 1);
+    ASSERT_EQ(spans[entered].stage, std::uint8_t(Stage::render));  // the caller's
+    double render = 0, intersection = 0;
+    for (std::size_t i = entered; i < spans.size(); ++i) {
+        if (spans[i].stage == std::uint8_t(Stage::render)) render += spans[i].cpu_s;
+        if (spans[i].stage == std::uint8_t(Stage::intersection)) intersection += spans[i].cpu_s;
+    }
+    EXPECT_GT(intersection, 0.0);
+    EXPECT_LT(render, 0.2 * intersection) << "render " << render << " s, intersection "
+                                           << intersection << " s";
 }
 
 }  // namespace

@@ -182,6 +182,9 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     out.done.groups = after.groups - before.groups;
     out.done.triangles = after.triangles - before.triangles;
     if (out.completed && !own) {
+        // The engine leaves its trace in intersection: the result's drawing and read-back are
+        // render.
+        if (TraceRecorder* t = engine_.options().trace) t->switch_to(Stage::render);
         draw_seen_groups();
         Image img;
         help_sink_.read_back(img);
@@ -214,6 +217,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     last_draw_s_ = busy_cpu_s_;
     // The measurement's read-back is not part of the job (nor of the emulated clock).
     if (out.completed && own && measure_) {
+        if (TraceRecorder* t = engine_.options().trace) t->switch_to(Stage::setup);
         Image img;
         tile_sink_.read_back(img, job.rect);
         shots_.push_back({busy_cpu_s_, job.rect, std::move(img), true});
@@ -245,26 +249,46 @@ Image TileJobs::image() {
     return img;
 }
 
+namespace {
+
+// What the tile shows over `rect`: its own drawing with the landed results over it by depth
+// (image() for those pixels).
+void show_over(Image& shown, const Image& own, const Image& helped, const PixelRect& rect) {
+    const int x0 = std::max(rect.x, 0), x1 = std::min(rect.x + rect.width, shown.width);
+    const int y0 = std::max(rect.y, 0), y1 = std::min(rect.y + rect.height, shown.height);
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const std::size_t p = std::size_t(y) * std::size_t(shown.width) + std::size_t(x);
+            const Image& from = helped.depth[p] < own.depth[p] ? helped : own;
+            shown.depth[p] = from.depth[p];
+            std::copy_n(from.rgba.begin() + std::ptrdiff_t(4 * p), 4,
+                        shown.rgba.begin() + std::ptrdiff_t(4 * p));
+        }
+}
+
+}  // namespace
+
 std::vector<CurvePoint> TileJobs::curve(std::uint64_t& significant) {
-    const Image final_image = image();
     std::stable_sort(shots_.begin(), shots_.end(),
                      [](const Shot& a, const Shot& b) { return a.emulated_s < b.emulated_s; });
-    Image own, shown;
+    Image own;
     own.resize(own_.width, own_.height);
-    Image helped = own;
+    Image helped = own, shown = own;
+    // Each shot changes its rect only: the measure follows it there (CorrectnessTracker).
+    CorrectnessTracker tracker(image());
     std::vector<CurvePoint> out;
-    significant = measure_correctness(own, final_image).significant;
+    significant = tracker.now().significant;
     for (const Shot& s : shots_) {
         if (s.own)
             place(own, s.image, s.rect);
         else
             composite_by_depth(helped, s.image, s.rect);
-        shown = own;
-        composite_by_depth(shown, helped, own_.screen());
-        const Correctness c = measure_correctness(shown, final_image);
+        show_over(shown, own, helped, s.rect);
+        tracker.update(shown, s.rect);
+        const Correctness c = tracker.now();
         const double n = static_cast<double>(c.significant);
         out.push_back({s.emulated_s, static_cast<std::uint64_t>(std::llround(c.final_pixels * n)),
-                       (1.0 - c.c) * (1.0 - c.c) * n});
+                       tracker.error_squared_sum()});
     }
     // The crops above miss what later jobs drew outside their own regions; once this rank's last
     // job and the last helper's result are in, the tile shows its final image.

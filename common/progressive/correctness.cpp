@@ -1,9 +1,11 @@
 #include "common/progressive/correctness.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace isowall {
 namespace {
@@ -22,6 +24,40 @@ void check_buffers(const Image& image, const char* name) {
                                     " depth values");
 }
 
+// A significant pixel's error, e(P)^2 in units of 1 / (3 * 255^2), and whether each of R, G, B
+// is within the tolerance (final_pixels' test).
+struct PixelScore {
+    std::uint32_t units = 0;
+    bool within = false;
+};
+constexpr std::uint32_t kUndrawnUnits = 3 * 255 * 255;  // e(P) = 1: not drawn yet
+
+PixelScore score_pixel(const Image& intermediate, const Image& final_image, std::size_t p,
+                       bool drawn, int tolerance) {
+    if (!drawn) return {kUndrawnUnits, false};
+    PixelScore s{0, true};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const int d = int(final_image.rgba[p * 4 + k]) - int(intermediate.rgba[p * 4 + k]);
+        s.within = s.within && std::abs(d) <= tolerance;
+        s.units += static_cast<std::uint32_t>(d * d);
+    }
+    return s;
+}
+
+Correctness from_sums(std::size_t significant, std::size_t matching, std::uint64_t units) {
+    Correctness result;
+    result.significant = significant;
+    if (significant == 0) {
+        result.final_pixels = 1;
+        result.c = 1;
+        return result;
+    }
+    const double n = double(significant);
+    result.final_pixels = double(matching) / n;
+    result.c = 1.0 - std::sqrt(double(units) / kUndrawnUnits / n);
+    return result;
+}
+
 }  // namespace
 
 Correctness measure_correctness(const Image& intermediate, const Image& final_image, int tolerance,
@@ -37,42 +73,58 @@ Correctness measure_correctness(const Image& intermediate, const Image& final_im
                                     std::to_string(drawn_before.size()) + " entries for " +
                                     size_text(final_image) + " pixels");
 
-    std::size_t significant = 0;
-    std::size_t matching = 0;
-    double error_squared_sum = 0;  // sum of e(P)^2
+    std::size_t significant = 0, matching = 0;
+    std::uint64_t units = 0;
     for (std::size_t p = 0; p < final_image.pixel_count(); ++p) {
         if (!(final_image.depth[p] < 1.0f)) continue;
         ++significant;
         const bool drawn =
             intermediate.depth[p] < 1.0f || (!drawn_before.empty() && drawn_before[p]);
-        if (!drawn) {
-            error_squared_sum += 1.0;  // not drawn yet: no information, e(P) = 1
-            continue;
-        }
-        bool within = true;
-        double channel_squared_sum = 0;
-        for (std::size_t k = 0; k < 3; ++k) {
-            const int d = int(final_image.rgba[p * 4 + k]) - int(intermediate.rgba[p * 4 + k]);
-            within = within && std::abs(d) <= tolerance;
-            const double dn = d / 255.0;
-            channel_squared_sum += dn * dn;
-        }
-        if (within) ++matching;
-        // e(P)^2 = (dR^2 + dG^2 + dB^2) / 3; the square root cancels in the RMS.
-        error_squared_sum += channel_squared_sum / 3.0;
+        const PixelScore s = score_pixel(intermediate, final_image, p, drawn, tolerance);
+        matching += s.within;
+        units += s.units;
     }
+    return from_sums(significant, matching, units);
+}
 
-    Correctness result;
-    result.significant = significant;
-    if (significant == 0) {
-        result.final_pixels = 1;
-        result.c = 1;
-        return result;
+CorrectnessTracker::CorrectnessTracker(Image final_image, int tolerance)
+    : final_(std::move(final_image)), tolerance_(tolerance) {
+    check_buffers(final_, "final");
+    units_.assign(final_.pixel_count(), 0);
+    matching_pixel_.assign(final_.pixel_count(), 0);
+    for (std::size_t p = 0; p < final_.pixel_count(); ++p) {
+        if (!(final_.depth[p] < 1.0f)) continue;
+        ++significant_;
+        units_[p] = kUndrawnUnits;
+        units_sum_ += kUndrawnUnits;
     }
-    const double n = double(significant);
-    result.final_pixels = double(matching) / n;
-    result.c = 1.0 - std::sqrt(error_squared_sum / n);
-    return result;
+}
+
+void CorrectnessTracker::update(const Image& shown, const PixelRect& rect) {
+    if (shown.width != final_.width || shown.height != final_.height)
+        throw std::invalid_argument("CorrectnessTracker: the frame is " + size_text(shown) +
+                                    " but the final image is " + size_text(final_));
+    check_buffers(shown, "intermediate");
+    const int x0 = std::max(rect.x, 0), x1 = std::min(rect.x + rect.width, final_.width);
+    const int y0 = std::max(rect.y, 0), y1 = std::min(rect.y + rect.height, final_.height);
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const std::size_t p = std::size_t(y) * std::size_t(final_.width) + std::size_t(x);
+            if (!(final_.depth[p] < 1.0f)) continue;
+            const PixelScore s = score_pixel(shown, final_, p, shown.depth[p] < 1.0f, tolerance_);
+            units_sum_ = units_sum_ - units_[p] + s.units;
+            matching_ = matching_ - matching_pixel_[p] + s.within;
+            units_[p] = s.units;
+            matching_pixel_[p] = s.within;
+        }
+}
+
+Correctness CorrectnessTracker::now() const {
+    return from_sums(significant_, matching_, units_sum_);
+}
+
+double CorrectnessTracker::error_squared_sum() const {
+    return double(units_sum_) / kUndrawnUnits;
 }
 
 double coverage_iou(const Image& a, const Image& b) {
