@@ -143,8 +143,8 @@ TEST(EngineFrame, ARegionsRaysAreIntersectionWhateverStageItWasEnteredFrom) {
         if (spans[i].stage == std::uint8_t(Stage::intersection)) intersection += spans[i].cpu_s;
     }
     EXPECT_GT(intersection, 0.0);
-    EXPECT_LT(render, 0.2 * intersection) << "render " << render << " s, intersection "
-                                           << intersection << " s";
+    EXPECT_LT(render, 0.2 * intersection)
+        << "render " << render << " s, intersection " << intersection << " s";
 }
 
 }  // namespace

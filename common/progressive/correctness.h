@@ -56,8 +56,8 @@ class CorrectnessTracker {
     Image final_;
     int tolerance_;
     std::size_t significant_ = 0, matching_ = 0;
-    std::uint64_t units_sum_ = 0;        // e(P)^2 in units of 1 / (3 * 255^2)
-    std::vector<std::uint32_t> units_;   // each pixel's share of units_sum_
+    std::uint64_t units_sum_ = 0;       // e(P)^2 in units of 1 / (3 * 255^2)
+    std::vector<std::uint32_t> units_;  // each pixel's share of units_sum_
     std::vector<std::uint8_t> matching_pixel_;
 };
 
