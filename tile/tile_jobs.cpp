@@ -181,32 +181,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     out.done.rays = after.rays - before.rays;
     out.done.groups = after.groups - before.groups;
     out.done.triangles = after.triangles - before.triangles;
-    if (out.completed && !own) {
-        // The engine leaves its trace in intersection: the result's drawing and read-back are
-        // render.
-        if (TraceRecorder* t = engine_.options().trace) t->switch_to(Stage::render);
-        draw_seen_groups();
-        Image img;
-        help_sink_.read_back(img);
-        if (job.band == Band::coarse) {
-            std::vector<std::uint8_t>& cover = band_cover_[key];
-            cover.resize(img.depth.size());
-            for (std::size_t i = 0; i < cover.size(); ++i) cover[i] = img.depth[i] < 1.0f;
-        }
-        // Only what the job drew goes to the owner: the box of the pixels it covers (one
-        // background pixel when it covers none, as a region message is never empty). Pixels
-        // outside it are background, which compositing by depth leaves as they are.
-        PixelRect box = covered_box(img);
-        if (box.width <= 0 || box.height <= 0) box = {0, 0, 1, 1};
-        if (box.width != img.width || box.height != img.height) img = crop(img, box);
-        RegionMsg r;
-        r.generation = job.generation;
-        r.job = job.job;
-        r.rect = {job.rect.x + box.x, job.rect.y + box.y, box.width, box.height};
-        r.rgba = std::move(img.rgba);
-        r.depth = std::move(img.depth);
-        out.result = std::move(r);
-    }
+    if (out.completed && !own) out.result = help_result(job, key);
     // The emulated clock of a rank is its busy CPU: what it would have spent on a core of its own.
     out.done.cpu_s = job_cpu_s(thread_cpu_seconds());
     busy_cpu_s_ += out.done.cpu_s;
@@ -223,6 +198,33 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
         shots_.push_back({busy_cpu_s_, job.rect, std::move(img), true});
     }
     return out;
+}
+
+RegionMsg TileJobs::help_result(const JobMsg& job, const RegionKey& key) {
+    // The engine leaves its trace in intersection: the result's drawing and read-back are
+    // render.
+    if (TraceRecorder* t = engine_.options().trace) t->switch_to(Stage::render);
+    draw_seen_groups();
+    Image img;
+    help_sink_.read_back(img);
+    if (job.band == Band::coarse) {
+        std::vector<std::uint8_t>& cover = band_cover_[key];
+        cover.resize(img.depth.size());
+        for (std::size_t i = 0; i < cover.size(); ++i) cover[i] = img.depth[i] < 1.0f;
+    }
+    // Only what the job drew goes to the owner: the box of the pixels it covers (one
+    // background pixel when it covers none, as a region message is never empty). Pixels
+    // outside it are background, which compositing by depth leaves as they are.
+    PixelRect box = covered_box(img);
+    if (box.width <= 0 || box.height <= 0) box = {0, 0, 1, 1};
+    if (box.width != img.width || box.height != img.height) img = crop(img, box);
+    RegionMsg r;
+    r.generation = job.generation;
+    r.job = job.job;
+    r.rect = {job.rect.x + box.x, job.rect.y + box.y, box.width, box.height};
+    r.rgba = std::move(img.rgba);
+    r.depth = std::move(img.depth);
+    return r;
 }
 
 void TileJobs::land(RegionMsg m) {

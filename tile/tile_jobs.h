@@ -98,6 +98,9 @@ class TileJobs {
     // The groups whose cells the job's rays met (seen), into the help image, once each; not those
     // of the region's earlier band (in the owner's image already).
     void draw_seen_groups();
+    // A completed help job's result for the owner: its image drawn, read back and cropped to
+    // what it covers (and, after a coarse band, that coverage kept for the fine band).
+    RegionMsg help_result(const JobMsg& job, const RegionKey& key);
     // The help image's coverage of `rect`, with what the region's earlier band covered.
     void help_coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect);
     // Whether a group with these bounds may show in `view` (its projected box touches it).
