@@ -178,28 +178,31 @@ FramePlan plan_frame(std::span<const FrameView> views, std::span<const Box3> box
         for (const RegionCost& r : tile)
             if (r.estimated > 0 && r.measured > 0) measured += r.measured, estimated += r.estimated;
     const double wall_ratio = estimated > 0 ? measured / estimated : 0;
-    std::vector<WorkMap> maps(views.size());
+    std::vector<WorkMap> base(views.size()), maps(views.size());
     double total = 0;
     int workers = 0;
     for (std::size_t k = 0; k < views.size(); ++k) {
         const FrameView& v = views[k];
         if (v.width <= 0 || v.height <= 0) continue;
         ++workers;
-        maps[k] = projected_work(boxes, v.camera.view(), v.frustum, v.width, v.height);
-        if (k < last.size()) maps[k] = corrected(std::move(maps[k]), last[k], wall_ratio);
+        base[k] = projected_work(boxes, v.camera.view(), v.frustum, v.width, v.height);
+        maps[k] = k < last.size() ? corrected(base[k], last[k], wall_ratio) : base[k];
         total += maps[k].total();
     }
     const double target = region_target(total, workers);
     FramePlan p;
     p.regions.resize(views.size());
     p.work.resize(views.size());
+    p.base.resize(views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
         if (maps[k].cols == 0) continue;
         p.regions[k] = plan_regions(maps[k], target);
         const std::vector<double> px = estimated_rays(views[k], p.regions[k], bounds, screen_box);
-        for (std::size_t i = 0; i < px.size(); ++i)
-            p.work[k].push_back(px[i] > 0 ? maps[k].sum(p.regions[k][i]) + kEmptyPixelWork * px[i]
-                                          : 0.0);
+        for (std::size_t i = 0; i < px.size(); ++i) {
+            const double empty = kEmptyPixelWork * px[i];
+            p.work[k].push_back(px[i] > 0 ? maps[k].sum(p.regions[k][i]) + empty : 0.0);
+            p.base[k].push_back(px[i] > 0 ? base[k].sum(p.regions[k][i]) + empty : 0.0);
+        }
     }
     return p;
 }
@@ -217,7 +220,23 @@ FramePlan grid_plan(std::span<const FrameView> views, int region_w, int region_h
     return p;
 }
 
-std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::size_t ranks) {
+namespace {
+
+// The uncorrected estimate of `owner`'s region `rect` in `plan`, or -1 when it has none.
+double base_estimate(const FramePlan& plan, std::size_t owner, const PixelRect& rect) {
+    if (owner >= plan.regions.size() || owner >= plan.base.size()) return -1;
+    const auto& regions = plan.regions[owner];
+    for (std::size_t i = 0; i < regions.size() && i < plan.base[owner].size(); ++i)
+        if (regions[i].x == rect.x && regions[i].y == rect.y && regions[i].width == rect.width &&
+            regions[i].height == rect.height)
+            return plan.base[owner][i];
+    return -1;
+}
+
+}  // namespace
+
+std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::size_t ranks,
+                                                  const FramePlan* plan) {
     std::vector<std::vector<RegionCost>> out(ranks);
     for (std::uint32_t id = 0; id + 1 < board.size(); ++id) {
         const BoardJob& coarse = board.job(id);
@@ -227,7 +246,9 @@ std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::si
         const auto owner = static_cast<std::size_t>(coarse.owner);
         if (owner >= ranks) continue;
         const double cpu = fine.worker == fine.holder ? coarse.cpu + fine.cpu : fine.cpu;
-        out[owner].push_back({coarse.rect, coarse.rays + fine.rays, cpu});
+        const double estimated =
+            plan ? base_estimate(*plan, owner, coarse.rect) : coarse.rays + fine.rays;
+        if (estimated > 0) out[owner].push_back({coarse.rect, estimated, cpu});
     }
     return out;
 }
@@ -235,7 +256,7 @@ std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::si
 FramePlan RegionPlanner::next(std::span<const FrameView> views, double iso,
                               const JobBoard* previous, const Box3& bounds, bool screen_box) {
     if (previous) {
-        auto costs = region_costs(*previous, views.size());
+        auto costs = region_costs(*previous, views.size(), &planned_);
         if (std::any_of(costs.begin(), costs.end(), [](const auto& c) { return !c.empty(); }))
             last_ = std::move(costs);
     }
@@ -243,7 +264,8 @@ FramePlan RegionPlanner::next(std::span<const FrameView> views, double iso,
         boxes_ = boxes_of_(iso);
         boxes_iso_ = iso;
     }
-    return plan_frame(views, boxes_, last_, bounds, screen_box);
+    planned_ = plan_frame(views, boxes_, last_, bounds, screen_box);
+    return planned_;
 }
 
 }  // namespace isowall

@@ -91,6 +91,10 @@ inline constexpr double kEmptyPixelWork = 1e-3;
 struct FramePlan {
     std::vector<std::vector<PixelRect>> regions;  // by rank; [0], the master, has none
     std::vector<std::vector<double>> work;
+    // Each region's estimate before the last frame's costs corrected it: what its measured cost
+    // is set against in the next frame (set against `work`, a correction that was right would
+    // read as none, and the frame after would undo it).
+    std::vector<std::vector<double>> base;
 };
 
 // The plan of a frame seen through views[rank] (width 0: not a tile rank), with the active
@@ -108,8 +112,10 @@ FramePlan grid_plan(std::span<const FrameView> views, int region_w, int region_h
 
 // The regions of `board`'s frame whose coarse and fine jobs are both done, by owner rank, with
 // their estimated work and the CPU they took (a fine band a helper cast again from the first
-// level holds the whole region's cost).
-std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::size_t ranks);
+// level holds the whole region's cost). With `plan`, the plan the board was made from, a region's
+// estimate is its uncorrected one (FramePlan::base).
+std::vector<std::vector<RegionCost>> region_costs(const JobBoard& board, std::size_t ranks,
+                                                  const FramePlan* plan = nullptr);
 
 // The master's plans across frames: it keeps the costs of the last frame that measured any region
 // and the work boxes of the current isovalue (asked of `boxes` once per isovalue; unset, the
@@ -128,6 +134,7 @@ class RegionPlanner {
     std::optional<double> boxes_iso_;
     std::vector<Box3> boxes_;
     std::vector<std::vector<RegionCost>> last_;
+    FramePlan planned_;  // the plan of the frame `previous` will be the board of
 };
 
 }  // namespace isowall

@@ -152,6 +152,59 @@ TEST(RegionPlan, AMeasuredFrameMovesTheRegionsToWhereTheCostWas) {
     expect_tiling(second.regions[1], 640, 480);
 }
 
+// Runs `plan` on a board of ranks 1 and 2 in which every region costs its uncorrected estimate
+// (FramePlan::base) times the owner's factor: a fixed truth, whatever the plan's correction.
+JobBoard run_board(const FramePlan& plan, double factor1, double factor2) {
+    JobBoard board(plan.regions, plan.work, true, 1);
+    auto region_of = [&](const BoardJob& j) {
+        const auto& regions = plan.regions[std::size_t(j.owner)];
+        for (std::size_t i = 0; i < regions.size(); ++i)
+            if (regions[i].x == j.rect.x && regions[i].y == j.rect.y) return i;
+        ADD_FAILURE() << "a job outside its plan";
+        return std::size_t(0);
+    };
+    for (int round = 0; round < 1000 && !board.complete(); ++round)
+        for (int rank = 1; rank <= 2; ++rank)
+            if (auto id = board.next_for(rank)) {
+                const BoardJob& j = board.job(*id);
+                const std::size_t i = region_of(j);
+                const auto o = std::size_t(j.owner);
+                // The band's part of the region; a fine band on another rank than its coarse
+                // band's casts the region again from its first level (region_costs' rule).
+                const bool again = j.band == Band::fine && board.job(j.coarse).worker != rank;
+                const double share = again ? 1.0 : j.rays / plan.work[o][i];
+                board.done(*id, share * plan.base[o][i] * (j.owner == 1 ? factor1 : factor2));
+                if (j.worker != j.owner) board.landed(*id);
+            }
+    EXPECT_TRUE(board.complete());
+    return board;
+}
+
+// The next frame's correction is measured against the uncorrected estimate: a correction that
+// was right stays (the next plan is the same), instead of reading as "no error" and being
+// undone, which made every other frame of a turning wall plan from the bare estimate.
+TEST(RegionPlan, ARightCorrectionStaysFromFrameToFrame) {
+    const Box3 unit{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
+    const Camera cam = front_full_view(unit, glm::mat3(1.0f), 4.0f / 3.0f);
+    const Frustum f = cam.frustum(4.0f / 3.0f);
+    std::vector<FrameView> views(3);
+    views[1] = {cam, f, 640, 480, 0};
+    views[2] = {cam, f, 640, 480, 0};
+    const Box3 boxes[] = {unit};
+    RegionPlanner planner(
+        [&](double) { return std::vector<Box3>(std::begin(boxes), std::end(boxes)); });
+    const FramePlan first = planner.next(views, 0, nullptr, unit, true);
+    EXPECT_EQ(first.work, first.base) << "nothing measured yet: nothing corrected";
+    const JobBoard b1 = run_board(first, 8e-6, 1e-6);
+    const FramePlan second = planner.next(views, 0, &b1, unit, true);
+    ASSERT_GT(second.regions[1].size(), second.regions[2].size());
+    const JobBoard b2 = run_board(second, 8e-6, 1e-6);
+    const FramePlan third = planner.next(views, 0, &b2, unit, true);
+    EXPECT_EQ(third.regions[1].size(), second.regions[1].size());
+    EXPECT_EQ(third.regions[2].size(), second.regions[2].size());
+    EXPECT_GT(third.regions[1].size(), third.regions[2].size()) << "the correction was undone";
+}
+
 TEST(RegionPlan, AFixedGridIsTheOldCut) {
     const Box3 unit{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
     const Camera cam = front_full_view(unit, glm::mat3(1.0f), 4.0f / 3.0f);
