@@ -291,8 +291,11 @@ void WallMaster::wait(const WaitCmd& w) {
         return;
     }
     auto done = [&] {
-        // A wait for rays also ends when the frame is complete on every tile.
-        if (frame_done()) return true;
+        // A wait for rays also ends when the frame is complete on every tile. When measuring, a
+        // frame is done once its curves are in: the tiles measure it when it completes, and a
+        // next view sent meanwhile would find some tiles still measuring (late on 2 cores) and
+        // hand their regions to others: the measurement would change the next frame's figures.
+        if (frame_done() && (!o_.measure || curves_in())) return true;
         return w.until == WaitCmd::Until::rays && double(total_rays()) >= w.amount;
     };
     wait_until(done, o_.timeout_s);

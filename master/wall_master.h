@@ -102,6 +102,8 @@ class WallMaster {
     }
     // Every tile has finished the current frame.
     bool frame_done() const { return board_ && board_->complete(); }
+    // With --measure, every tile's curve of the finished frame has come in (ask_curves).
+    bool curves_in() const;
     double iso() const { return iso_; }
     double value_min() const { return lo_; }
     double value_max() const { return hi_; }

@@ -87,10 +87,14 @@ FrameFigures WallMaster::frame_figures() const {
     }
     const std::size_t ranks = frame_busy_s_.size() > 1 ? frame_busy_s_.size() - 1 : 1;
     if (most > 0) f.balance = sum / static_cast<double>(ranks) / most;
+    if (curves_in()) f.c99_s = time_to(wall_curve(frame_curves_), 0.99, false);
+    return f;
+}
+
+bool WallMaster::curves_in() const {
     bool all = curves_asked_;
     for (std::size_t r = 1; r < frame_curves_.size(); ++r) all = all && frame_curves_[r].frames;
-    if (all) f.c99_s = time_to(wall_curve(frame_curves_), 0.99, false);
-    return f;
+    return all;
 }
 
 }  // namespace isowall
