@@ -28,6 +28,7 @@ import argparse
 import csv
 import os
 import re
+import statistics
 import subprocess
 import sys
 
@@ -109,6 +110,9 @@ def median_run(runs):
     """The run with the median makespan (the lower median for an even count), whole."""
     out = dict(sorted(runs, key=lambda r: r["makespan"])[(len(runs) - 1) // 2])
     out["runs"] = len(runs)
+    # The total CPU's own median: the run picked by makespan can hold any of the runs' totals,
+    # which spread by 20-30% here, and the CPU target is a ratio of two of them.
+    out["total_median"] = statistics.median_low(r["total"] for r in runs)
     return out
 
 
@@ -160,8 +164,9 @@ def plot(rows, out_dir, volume):
 
 def target_figures(case, static, bal):
     """(figure, value, target, holds) for each of the issue's targets in a case; [] if none."""
-    cpu = bal["total"] / static["total"]
-    cpu_target = ("total CPU balanced/static", f"{cpu:.2f}", "<= 1.3", cpu <= 1.3)
+    cpu = bal["total_median"] / static["total_median"]
+    cpu_target = ("total CPU balanced/static (median totals of the runs)", f"{cpu:.2f}", "<= 1.3",
+                  cpu <= 1.3)
     comm_target = ("communication, the largest share of a working rank's busy CPU",
                    f"{bal['comm_pct']}%", "<= 10%", bal["comm_pct"] <= 10)
     if case == "1 tile":

@@ -114,18 +114,23 @@ TEST(RegionPlan, TheLastFramesCostsScaleItsRegionsCells) {
     EXPECT_DOUBLE_EQ(corrected(m, costs, 0).at(0, 0), 1);
 }
 
-// Two tiles side by side of one wall, both seeing the same box: the costs of a frame in which
-// rank 1's regions cost 8x rank 2's move the next frame's regions towards rank 1.
-TEST(RegionPlan, AMeasuredFrameMovesTheRegionsToWhereTheCostWas) {
-    const Box3 unit{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
-    const Camera cam = front_full_view(unit, glm::mat3(1.0f), 4.0f / 3.0f);
+// Two 640x480 tiles (ranks 1 and 2; rank 0 is the master) of one wall, both seeing `box` whole.
+std::vector<FrameView> two_tiles_seeing(const Box3& box) {
+    const Camera cam = front_full_view(box, glm::mat3(1.0f), 4.0f / 3.0f);
     const Frustum f = cam.frustum(4.0f / 3.0f);
     std::vector<FrameView> views(3);
     views[1] = {cam, f, 640, 480, 0};
     views[2] = {cam, f, 640, 480, 0};
-    const Box3 boxes[] = {unit};
-    RegionPlanner planner(
-        [&](double) { return std::vector<Box3>(std::begin(boxes), std::end(boxes)); });
+    return views;
+}
+const Box3 kUnitBox{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
+
+// Two tiles side by side of one wall, both seeing the same box: the costs of a frame in which
+// rank 1's regions cost 8x rank 2's move the next frame's regions towards rank 1.
+TEST(RegionPlan, AMeasuredFrameMovesTheRegionsToWhereTheCostWas) {
+    const Box3 unit = kUnitBox;
+    const std::vector<FrameView> views = two_tiles_seeing(unit);
+    RegionPlanner planner([&](double) { return std::vector<Box3>{unit}; });
     const FramePlan first = planner.next(views, 0, nullptr, unit, true);
     ASSERT_EQ(first.regions[1].size(), first.regions[2].size()) << "the same view, the same cut";
     EXPECT_TRUE(first.regions[0].empty()) << "the master has no regions";
@@ -184,15 +189,9 @@ JobBoard run_board(const FramePlan& plan, double factor1, double factor2) {
 // was right stays (the next plan is the same), instead of reading as "no error" and being
 // undone, which made every other frame of a turning wall plan from the bare estimate.
 TEST(RegionPlan, ARightCorrectionStaysFromFrameToFrame) {
-    const Box3 unit{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
-    const Camera cam = front_full_view(unit, glm::mat3(1.0f), 4.0f / 3.0f);
-    const Frustum f = cam.frustum(4.0f / 3.0f);
-    std::vector<FrameView> views(3);
-    views[1] = {cam, f, 640, 480, 0};
-    views[2] = {cam, f, 640, 480, 0};
-    const Box3 boxes[] = {unit};
-    RegionPlanner planner(
-        [&](double) { return std::vector<Box3>(std::begin(boxes), std::end(boxes)); });
+    const Box3 unit = kUnitBox;
+    const std::vector<FrameView> views = two_tiles_seeing(unit);
+    RegionPlanner planner([&](double) { return std::vector<Box3>{unit}; });
     const FramePlan first = planner.next(views, 0, nullptr, unit, true);
     EXPECT_EQ(first.work, first.base) << "nothing measured yet: nothing corrected";
     const JobBoard b1 = run_board(first, 8e-6, 1e-6);
