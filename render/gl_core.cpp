@@ -205,10 +205,17 @@ void GlCore::resize(int width, int height) {
     height_ = height;
     // The frame is the bottom-left width x height of its buffers (the viewport), so a smaller
     // frame reuses them: a wall rank resizes its help frame for every region it fills, and
-    // reallocating costs llvmpipe fresh pages each time.
-    if (width <= storage_width_ && height <= storage_height_) return;
-    storage_width_ = std::max(width, storage_width_);
-    storage_height_ = std::max(height, storage_height_);
+    // reallocating costs llvmpipe fresh pages each time. But a clear clears the whole buffers in
+    // a software rasteriser (and a scissored one is slower still), so a frame far smaller than
+    // them gets buffers of its own size: after one 1024x768 region, each 128x96 region's clear
+    // and read-back cost 650 us instead of 56 (llvmpipe, one thread).
+    const bool fits = width <= storage_width_ && height <= storage_height_;
+    const double area = double(width) * double(height);
+    const bool far_smaller =
+        area * kShrinkFactor <= double(storage_width_) * double(storage_height_);
+    if (fits && !far_smaller) return;
+    storage_width_ = fits ? width : std::max(width, storage_width_);
+    storage_height_ = fits ? height : std::max(height, storage_height_);
     gl_->BindRenderbuffer(GL_RENDERBUFFER, colour_buffer_);
     gl_->RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, storage_width_, storage_height_);
     gl_->BindRenderbuffer(GL_RENDERBUFFER, depth_buffer_);

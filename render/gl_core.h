@@ -49,6 +49,8 @@ class GlCore {
     bool finished(bool wait);
 
   private:
+    // A frame with under 1/kShrinkFactor of its buffers' area gets buffers of its own size.
+    static constexpr double kShrinkFactor = 8;
     [[noreturn]] void fail(std::string_view call, std::string_view detail) const;
     // Throws naming `call` when GL has recorded an error since the last check.
     void check(std::string_view call) const;
