@@ -237,6 +237,7 @@ void WallMaster::send_views() {
     order_.begin_frame();
     for (int rank = 1; rank < comm_.size(); ++rank) order_.ask(rank);
     dispatch();
+    ask_curves();  // a frame with no job (nothing of the volume on the wall) is complete at once
     frame_start_ = Stopwatch();
     trace_.switch_to(left);
 }

@@ -146,6 +146,23 @@ TEST(WallInProcess, ASnapshotAsTheFirstCommandShowsTheFirstFrame) {
     EXPECT_EQ(done.differing_pixels, 0u) << done;
 }
 
+// With --measure, `wait done` waits for every tile's curve of the frame as well; a frame with no
+// job at all (the volume panned off the wall) is complete at once and its curves are asked for at
+// once, so the wait ends instead of running into the timeout.
+TEST(WallInProcess, MeasuredWaitsEndOnFramesWithAndWithoutJobs) {
+    const auto dir = test::scratch_dir("inproc_measured_waits");
+    WallOptions o = small_wall(dir);
+    o.measure = true;
+    o.timeout_s = 20;
+    o.script = write_script(dir, "wait done\npan 10 0\nwait done\npan -10 0\nwait done\n").string();
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
+    EXPECT_LT(r.seconds, 15.0) << "a wait ran into the timeout";
+    // Each tile kept the curve of every frame it finished before the last one.
+    for (int rank = 1; rank <= 4; ++rank)
+        EXPECT_EQ(r.results[static_cast<std::size_t>(rank)].earlier.size(), 2u) << "rank " << rank;
+}
+
 TEST(WallInProcess, ASilentTileIsNamedAfterTheTimeoutAndEveryRankEnds) {
     const auto dir = test::scratch_dir("inproc_silent");
     WallOptions o = small_wall(dir);
