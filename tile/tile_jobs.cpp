@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/core/image_ops.h"
+#include "common/core/pixel_rect_ops.h"
 #include "common/core/ray.h"
 #include "common/core/wire.h"
 #include "common/progressive/correctness.h"
@@ -251,25 +252,6 @@ Image TileJobs::image() {
     return img;
 }
 
-namespace {
-
-// What the tile shows over `rect`: its own drawing with the landed results over it by depth
-// (image() for those pixels).
-void show_over(Image& shown, const Image& own, const Image& helped, const PixelRect& rect) {
-    const int x0 = std::max(rect.x, 0), x1 = std::min(rect.x + rect.width, shown.width);
-    const int y0 = std::max(rect.y, 0), y1 = std::min(rect.y + rect.height, shown.height);
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-            const std::size_t p = std::size_t(y) * std::size_t(shown.width) + std::size_t(x);
-            const Image& from = helped.depth[p] < own.depth[p] ? helped : own;
-            shown.depth[p] = from.depth[p];
-            std::copy_n(from.rgba.begin() + std::ptrdiff_t(4 * p), 4,
-                        shown.rgba.begin() + std::ptrdiff_t(4 * p));
-        }
-}
-
-}  // namespace
-
 std::vector<CurvePoint> TileJobs::curve(std::uint64_t& significant) {
     std::stable_sort(shots_.begin(), shots_.end(),
                      [](const Shot& a, const Shot& b) { return a.emulated_s < b.emulated_s; });
@@ -285,8 +267,13 @@ std::vector<CurvePoint> TileJobs::curve(std::uint64_t& significant) {
             place(own, s.image, s.rect);
         else
             composite_by_depth(helped, s.image, s.rect);
-        show_over(shown, own, helped, s.rect);
-        tracker.update(shown, s.rect);
+        // What the tile shows over the shot's rect: its own drawing with the landed results
+        // over it by depth, as image() composites them.
+        const PixelRect r = intersect(s.rect, own_.screen());
+        Image part = crop(own, r);
+        composite_by_depth(part, crop(helped, r), {0, 0, r.width, r.height});
+        place(shown, part, r);
+        tracker.update(shown, r);
         const Correctness c = tracker.now();
         const double n = static_cast<double>(c.significant);
         out.push_back({s.emulated_s, static_cast<std::uint64_t>(std::llround(c.final_pixels * n)),

@@ -1,11 +1,12 @@
 #include "common/progressive/correctness.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "common/core/pixel_rect_ops.h"
 
 namespace isowall {
 namespace {
@@ -105,10 +106,9 @@ void CorrectnessTracker::update(const Image& shown, const PixelRect& rect) {
         throw std::invalid_argument("CorrectnessTracker: the frame is " + size_text(shown) +
                                     " but the final image is " + size_text(final_));
     check_buffers(shown, "intermediate");
-    const int x0 = std::max(rect.x, 0), x1 = std::min(rect.x + rect.width, final_.width);
-    const int y0 = std::max(rect.y, 0), y1 = std::min(rect.y + rect.height, final_.height);
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
+    const PixelRect r = intersect(rect, {0, 0, final_.width, final_.height});
+    for (int y = r.y; y < r.y + r.height; ++y)
+        for (int x = r.x; x < r.x + r.width; ++x) {
             const std::size_t p = std::size_t(y) * std::size_t(final_.width) + std::size_t(x);
             if (!(final_.depth[p] < 1.0f)) continue;
             const PixelScore s = score_pixel(shown, final_, p, shown.depth[p] < 1.0f, tolerance_);
