@@ -47,6 +47,7 @@ struct ViewCommand {
     int test_case = 0;   // 1-7: the study's cases; 0: the options below
     std::string encoding = "auto";
     bool lod = false, cache = false;
+    bool exact_only = false;  // --exact-only: no cells group to a step first (ExactMsg)
     std::optional<double> iso;
     std::string size = "800x600";
     std::vector<double> orbit;

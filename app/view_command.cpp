@@ -171,6 +171,10 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
         ->capture_default_str();
     c->add_flag("--lod", o.lod, "Progressive LOD: two coarser LOD levels first");
     c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");
+    c->add_flag("--exact-only", o.exact_only,
+                "Every group exact in one message (otherwise a cells group the client does not "
+                "cache may come with the voxels that make only its normals to a step, and their "
+                "exact values once the frame's last group is out)");
     c->add_option("--iso", o.iso, "Isovalue (default for the phantom: skin, 50)")
         ->transform(number_in(limits::kAnyFinite));
     c->add_option("--size", o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
@@ -285,6 +289,7 @@ int run_view(const ViewCommand& o) {
                  : !o.follow.empty() ? SessionRole::follower
                                      : SessionRole::none;
     hello.session = !o.present.empty() ? o.present : o.follow;
+    hello.takes_exact = !o.exact_only;
     ViewClient client(*renderer, hello);
     std::printf(
         "view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),

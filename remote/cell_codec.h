@@ -25,10 +25,16 @@
 // (at 1, else 2, else 4 voxels), coded in context through a binary range coder (cell_values.h,
 // range_coder.h); floating-point values as they are, in byte planes.
 //
+// A full-resolution group may go in two messages on a slow link: first with its gradients'
+// voxels to a step (only the shading moves: C = 99.7-99.8% of the exact image on the shared 16-bit
+// volumes), then their exact offsets (remote/cell_exact.h; the view protocol's ExactMsg), after
+// which the client decodes the body again with them and has the server's triangles to the bit.
+//
 // Byte layout: voxel type u8, volume dims 3 x i32, spacing 3 x f32, normals u8 (0 from the
 // gradients, 1 from the faces), bucket count u8; per bucket (a level's units) level u8, unit count
 // u32, and its box in that level's grid of units as origin and size, 3 + 3 LEB128 (cell_units.h);
-// the value step's shift u8; the range coder's stream, its length u32 first (the boxes'
+// the value step's shift u8 (with face normals it steps every phase, with gradient normals only
+// phase 3); the range coder's stream, its length u32 first (the boxes'
 // occupancy, a bit a place, then the integer values); floating-point values' planes.
 // group_codec.cpp sends it through zstd.
 //
@@ -39,6 +45,7 @@
 // WireError naming the field.
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "common/core/mesh.h"
@@ -56,9 +63,21 @@ inline constexpr std::uint64_t kMaxCellBoxVoxels = std::uint64_t{1} << 24;
 inline constexpr int kMaxCellVolumeSide = 1 << 20;
 
 // The cells body of `group`, extracted from `volume` at group.iso; nullopt when the group cannot
-// be sent this way (see above).
-std::optional<std::vector<std::uint8_t>> encode_cell_body(const Group& group, const Volume& volume);
+// be sent this way (see above). With `exact`, a full-resolution group of integer voxels may send
+// its gradients' voxels to a step (the values that make only its normals: every vertex stays
+// where it is, the shading moves a little) and their exact offsets go to *exact (cell_exact.h),
+// for a later message; *exact is left empty when the body is exact as it is.
+std::optional<std::vector<std::uint8_t>> encode_cell_body(const Group& group, const Volume& volume,
+                                                          std::vector<std::uint8_t>* exact = nullptr);
+
+// What decoding a body may take and tell beside its mesh.
+struct CellExact {
+    // The exact offsets encode_cell_body gave for this body: the mesh is then the exact one.
+    // WireError when they do not fit the body's stepped values, or the body has none.
+    const std::span<const std::uint8_t>* exact = nullptr;
+    bool* stepped = nullptr;  // set: whether the body went to a step that exact offsets undo
+};
 // The mesh a cells body gives at `iso`; throws WireError on anything malformed or truncated.
-Mesh decode_cell_body(ByteReader& r, double iso);
+Mesh decode_cell_body(ByteReader& r, double iso, const CellExact& x = {});
 
 }  // namespace isowall::remote

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "remote/byte_io.h"
+#include "remote/cell_exact.h"
 #include "remote/cell_voxels.h"
 #include "remote/range_coder.h"
 
@@ -206,6 +207,10 @@ struct Bins {
         return static_cast<T>(x < lo ? lo : x > hi ? hi : x);
     }
     double step() const { return std::ldexp(1.0, shift); }
+    // The least integer in bin k: a value's exact offset in its bin counts from it.
+    std::int64_t low(std::int64_t k) const {
+        return static_cast<std::int64_t>(std::ceil(iso + static_cast<double>(k) * step()));
+    }
 };
 
 inline std::uint64_t zigzag(std::int64_t d) {
@@ -219,10 +224,17 @@ inline std::int64_t unzigzag(std::uint64_t z) {
 template <class T>
 class ValueWriter {
   public:
-    // `shift`: a coarse pass's step (Bins), 0 for exact values; integer voxels only. The units'
-    // bits are in `coder` already (cell_units.h).
-    ValueWriter(ByteWriter& w, RangeEncoder& coder, double iso, int shift)
-        : w_(w), coder_(coder), model_(iso), bins_{iso, shift} {
+    // `shift`: the step (Bins) of the phases from `first_stepped` on, 0 for exact values; integer
+    // voxels only. `exact`, if given, takes each stepped value's offset in its bin (cell_exact.h).
+    // The units' bits are in `coder` already (cell_units.h).
+    ValueWriter(ByteWriter& w, RangeEncoder& coder, double iso, int shift, int first_stepped = 0,
+                ExactBitsWriter* exact = nullptr)
+        : w_(w),
+          coder_(coder),
+          model_(iso),
+          bins_{iso, shift},
+          first_stepped_(first_stepped),
+          exact_(exact) {
         w_.put(static_cast<std::uint8_t>(shift));
     }
     void phase(BoxVoxels<T>& held, const VolumeView<T>& v, const VoxelBox& box,
@@ -236,13 +248,17 @@ class ValueWriter {
             T kept = value;
             if constexpr (!std::is_integral_v<T>) {
                 planes.push_back(value);
-            } else if (bins_.shift == 0) {
+            } else if (bins_.shift == 0 || phase_ < first_stepped_) {
                 model_.put(coder_, phase_, guess, residual(value, guess.value));
             } else {
                 const std::int64_t k = bins_.of(value);
                 model_.put(coder_, phase_, guess,
                            static_cast<Residual<T>>(zigzag(k - bins_.of(guess.value))));
                 kept = bins_.middle(k);
+                if (exact_)
+                    exact_->put(static_cast<std::uint64_t>(static_cast<std::int64_t>(value) -
+                                                           bins_.low(k)),
+                                bins_.shift);
             }
             held.set(p, kept);
             previous = kept;
@@ -268,6 +284,8 @@ class ValueWriter {
     RangeEncoder& coder_;
     ValueModel<T> model_;
     Bins<T> bins_;
+    int first_stepped_;
+    ExactBitsWriter* exact_;
     std::vector<std::uint8_t> planes_;
     int phase_ = 0;
 };
@@ -277,10 +295,12 @@ class ValueWriter {
 template <class T>
 class ValueReader {
   public:
-    ValueReader(ByteReader& r, double iso)
+    // `first_stepped`: the first phase the body's step applies to (as the writer's).
+    ValueReader(ByteReader& r, double iso, int first_stepped)
         : r_(r),
           model_(iso),
           bins_{iso, r.get<std::uint8_t>()},
+          first_stepped_(first_stepped),
           coder_(std::span<const std::uint8_t>{}) {
         const int most = std::is_integral_v<T> ? 8 * static_cast<int>(sizeof(T)) - 2 : 0;
         if (bins_.shift == 1 || bins_.shift > most)
@@ -310,8 +330,12 @@ class ValueReader {
             if constexpr (std::is_integral_v<T>) {
                 const auto got = model_.get(coder_, phase_, guess);
                 if (!got) r_.fail("voxel values: a residual longer than the voxel type");
-                value = bins_.shift == 0 ? from_residual(*got, guess.value)
-                                         : bins_.middle(bins_.of(guess.value) + unzigzag(*got));
+                if (bins_.shift == 0 || phase_ < first_stepped_) {
+                    value = from_residual(*got, guess.value);
+                } else {
+                    value = bins_.middle(bins_.of(guess.value) + unzigzag(*got));
+                    stepped_.push_back(p);
+                }
             } else {
                 value = values[k];
             }
@@ -323,6 +347,23 @@ class ValueReader {
     }
     void finish() const {
         if (!coder_.at_end()) r_.fail("voxel values: the coded stream does not end there");
+    }
+    // Whether values went to a step that exact bits could undo.
+    bool stepped() const { return !stepped_.empty(); }
+    // Puts every stepped value back at its exact value: its bin's least integer plus its offset
+    // from `exact` (cell_exact.h; WireError for bits that do not fit the values, or a value past T).
+    void apply_exact(BoxVoxels<T>& held, std::span<const std::uint8_t> exact) const {
+        if constexpr (std::is_integral_v<T>) {
+            ExactBitsReader bits(exact, stepped_.size(), bins_.shift, "exact values");
+            for (const glm::ivec3 p : stepped_) {
+                const std::int64_t k = bins_.of(held.at(p.x, p.y, p.z));
+                const std::int64_t v = bins_.low(k) + static_cast<std::int64_t>(bits.get(bins_.shift));
+                if (v < static_cast<std::int64_t>(std::numeric_limits<T>::lowest()) ||
+                    v > static_cast<std::int64_t>(std::numeric_limits<T>::max()))
+                    r_.fail("exact values: a value past the voxel type");
+                held.set(p, static_cast<T>(v));
+            }
+        }
     }
 
   private:
@@ -339,6 +380,8 @@ class ValueReader {
     ByteReader& r_;
     ValueModel<T> model_;
     Bins<T> bins_;
+    int first_stepped_;
+    std::vector<glm::ivec3> stepped_;  // where values went to the step, in their order
     RangeDecoder coder_;
     std::uint64_t max_named_ = 0, stream_bytes_ = 0;
     int phase_ = 0;

@@ -16,10 +16,13 @@ namespace {
 constexpr double kSampleBytesFactor = 1.01;
 constexpr double kSampleIntervalS = 0.01;
 
-std::shared_ptr<const Mesh> decode_mesh(const GroupMsg& m) {
-    std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(m.encoded.data()),
-                                        m.encoded.size());
-    Group g = decode_group(bytes);
+std::span<const std::uint8_t> as_bytes(const std::vector<std::byte>& b) {
+    return {reinterpret_cast<const std::uint8_t*>(b.data()), b.size()};
+}
+
+// The group's mesh; with `x`, exact values to decode it with, or where to say it was stepped.
+std::shared_ptr<const Mesh> decode_mesh(const GroupMsg& m, const CellExact& x) {
+    Group g = decode_group(as_bytes(m.encoded), x);
     if (!(g.key() == m.key))
         throw WireError("group message: key: the encoded group is another group");
     return std::make_shared<const Mesh>(std::move(g.mesh));
@@ -39,6 +42,8 @@ void ClientFrames::begin(const RequestMsg& request, double now_s) {
     redraw_op_ = SIZE_MAX;
     ops_.clear();
     finals_.clear();
+    stepped_.clear();
+    replaced_ = false;
     result_ = ClientFrameResult{};
     renderer_.resize(request.view.width, request.view.height);
     renderer_.clear();
@@ -74,7 +79,10 @@ void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, doubl
     const bool current = active_ && g.request_id == request_.request_id;
     if (!current && g.cache_gen == 0) return;
     const Stopwatch decoding;
-    auto mesh = decode_mesh(g);
+    bool stepped = false;
+    auto mesh = decode_mesh(g, {nullptr, &stepped});
+    if (stepped && g.cache_gen != 0)
+        throw WireError("group message: a group to cache came with its values to a step");
     // decode_mesh checked the encoding byte.
     DecodeRateMsg::Entry& d = decoded_[static_cast<std::size_t>(g.encoded[1])];
     d.triangles += mesh->triangle_count();
@@ -92,7 +100,38 @@ void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, doubl
     if (g.encoded.size() > 1 &&
         g.encoded[1] == std::byte{static_cast<std::uint8_t>(GroupEncoding::cells)})
         ++now_.cells;
+    const std::size_t finals_before = finals_.size();
     if (!g.draw_from_next_frame) draw(mesh, g.key.level);
+    if (stepped)
+        stepped_.push_back(
+            {g.key, g.encoded, finals_.size() > finals_before ? finals_before : SIZE_MAX});
+    sample(now_s, false);
+}
+
+void ClientFrames::handle_exact(const ExactMsg& x, std::size_t wire_bytes, double now_s) {
+    if (!active_ || x.request_id != request_.request_id) return;
+    const auto it = std::find_if(stepped_.begin(), stepped_.end(),
+                                 [&](const Stepped& s) { return s.key == x.key; });
+    if (it == stepped_.end())
+        throw WireError("exact message: key: no group of the request awaits exact values");
+    const Stopwatch decoding;
+    const std::span<const std::uint8_t> bits = as_bytes(x.bits);
+    GroupMsg g;
+    g.key = it->key;
+    g.encoded = std::move(it->encoded);
+    auto mesh = decode_mesh(g, {&bits, nullptr});
+    // The second decoding of a cells group is the client's work too (its triangles were counted).
+    decoded_[static_cast<std::size_t>(GroupEncoding::cells)].seconds += decoding.seconds();
+    now_.bytes += wire_bytes;
+    if (it->final_index != SIZE_MAX) {
+        finals_[it->final_index] = mesh;
+        // Over the stepped surface, which lies within a hair of it: the frame's end draws the
+        // full-resolution groups again alone.
+        renderer_.draw(*mesh, request_.view.camera.view(), request_.view.frustum.matrix());
+        ops_.push_back({mesh});
+        replaced_ = true;
+    }
+    stepped_.erase(it);
     sample(now_s, false);
 }
 
@@ -143,6 +182,10 @@ bool ClientFrames::handle(const RemoteMessage& m, std::size_t wire_bytes, double
         handle_visible(*v, wire_bytes, now_s);
         return false;
     }
+    if (const auto* x = std::get_if<ExactMsg>(&m)) {
+        handle_exact(*x, wire_bytes, now_s);
+        return false;
+    }
     if (const auto* e = std::get_if<EndOfFrameMsg>(&m)) {
         if (!active_ || e->request_id != request_.request_id) return false;
         now_.bytes += wire_bytes;
@@ -153,7 +196,10 @@ bool ClientFrames::handle(const RemoteMessage& m, std::size_t wire_bytes, double
 }
 
 void ClientFrames::finish_frame(const EndOfFrameMsg& end, double now_s) {
-    if (drew_coarse_) {
+    if (!stepped_.empty())
+        throw WireError("end of frame message: " + std::to_string(stepped_.size()) +
+                        " groups of the request never got their exact values");
+    if (drew_coarse_ || replaced_) {
         // The full-resolution groups alone: no coarse surface outside the fine one stays.
         renderer_.clear();
         redraw_op_ = ops_.size();

@@ -90,6 +90,7 @@ class ClientFrames {
     void finish_frame(const EndOfFrameMsg& end, double now_s);
     void handle_group(const GroupMsg& g, std::size_t wire_bytes, double now_s);
     void handle_visible(const VisibleMsg& v, std::size_t wire_bytes, double now_s);
+    void handle_exact(const ExactMsg& x, std::size_t wire_bytes, double now_s);
 
     Renderer& renderer_;
     RequestMsg request_;
@@ -102,6 +103,15 @@ class ClientFrames {
     std::size_t redraw_op_ = SIZE_MAX;  // where the end-of-frame redraw began, if any
     std::vector<Op> ops_;
     std::vector<std::shared_ptr<const Mesh>> finals_;  // full-resolution groups of the frame
+    // Groups of the frame whose gradients' voxels came to a step: their bytes, and where their
+    // mesh is in finals_, until their ExactMsg comes (remote/cell_codec.h).
+    struct Stepped {
+        GroupKey key;
+        std::vector<std::byte> encoded;
+        std::size_t final_index = 0;
+    };
+    std::vector<Stepped> stepped_;
+    bool replaced_ = false;  // an exact mesh took a stepped one's place: redraw at the end
     std::vector<Cached> cache_;                        // index = slot in generation cache_gen_
     std::uint64_t cache_gen_ = 0;                      // 0: none yet
     ClientFrameResult result_;

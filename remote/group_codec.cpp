@@ -217,10 +217,11 @@ float position_grid_step(float extent) {
 }
 
 std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding, float grid_step,
-                                       const Volume* volume) {
+                                       const Volume* volume, std::vector<std::uint8_t>* exact) {
     check_encodable(group);
+    if (exact) exact->clear();
     if (encoding == GroupEncoding::cells) {
-        const auto body = volume ? encode_cell_body(group, *volume) : std::nullopt;
+        const auto body = volume ? encode_cell_body(group, *volume, exact) : std::nullopt;
         if (!body) return encode_group(group, GroupEncoding::compact_zstd, grid_step);
         ByteWriter w;
         w.put(kGroupCodecVersion);
@@ -274,7 +275,8 @@ GroupEncoding encoding_of(std::span<const std::uint8_t> bytes) {
     return static_cast<GroupEncoding>(e);
 }
 
-Group decode_group(std::span<const std::uint8_t> bytes) {
+Group decode_group(std::span<const std::uint8_t> bytes, const CellExact& x) {
+    if (x.stepped) *x.stepped = false;
     const GroupEncoding encoding = encoding_of(bytes);
     ByteReader r(bytes.subspan(2), kWhat);
     if (encoding == GroupEncoding::compact_zstd) {
@@ -282,13 +284,16 @@ Group decode_group(std::span<const std::uint8_t> bytes) {
         if (encoding_of(compact) != GroupEncoding::compact)
             r.fail("zstd: the frame holds a " + std::string(to_string(encoding_of(compact))) +
                    " group, expected compact");
+        if (x.exact) r.fail("exact values: only a cells group takes them");
         return decode_group(compact);
     }
     Group g = get_header(r);
+    if (x.exact && encoding != GroupEncoding::cells)
+        r.fail("exact values: only a cells group takes them");
     if (encoding == GroupEncoding::cells) {
         const std::vector<std::uint8_t> body = get_zstd(r, kMaxCellBytes);
         ByteReader cells(body, kWhat);
-        g.mesh = decode_cell_body(cells, g.iso);
+        g.mesh = decode_cell_body(cells, g.iso, x);
         cells.finish();
         return g;
     }

@@ -36,6 +36,7 @@
 #include "common/core/wire.h"
 #include "common/extract/group.h"
 #include "common/volume/volume.h"
+#include "remote/cell_codec.h"
 
 namespace isowall::remote {
 
@@ -81,13 +82,16 @@ inline constexpr double kOctNormalMaxErrorDeg = 0.01;
 // them. A step > 0 (a power of two, at least the whole volume's extent / 65534, see
 // position_grid_step) puts every group's positions on one grid: a shared vertex decodes alike in
 // every group, and no crack opens. A group too large for 65535 steps falls back to its own box.
+// exact (cells): see encode_cell_body; empty unless the group went in two messages.
 std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encoding,
-                                       float grid_step = 0, const Volume* volume = nullptr);
+                                       float grid_step = 0, const Volume* volume = nullptr,
+                                       std::vector<std::uint8_t>* exact = nullptr);
 // The smallest power of two at least `extent` / 65534: the grid step for a volume of that largest
 // extent (object units).
 float position_grid_step(float extent);
 // Throws WireError on anything malformed, truncated, of another version, or with trailing bytes.
-Group decode_group(std::span<const std::uint8_t> bytes);
+// `x`: a cells group's exact offsets, and whether it was stepped (remote/cell_codec.h).
+Group decode_group(std::span<const std::uint8_t> bytes, const CellExact& x = {});
 // The encoding named by encoded bytes (their second byte), checked.
 GroupEncoding encoding_of(std::span<const std::uint8_t> bytes);
 

@@ -56,10 +56,13 @@ class ServerSession::Sink final : public GroupSink {
         const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
         // Encodes in `e` and tells the chooser what asking for `e` cost: cells fall back to
         // compact+zstd where that is smaller (a coarse pass), and the chooser learns it so.
-        const auto encode = [&](GroupEncoding e) {
+        // A group the client does not cache may go with its gradients' voxels to a step first.
+        const bool stepped_first = s_.options_.exact_after && s_.cache_gen_ == 0;
+        std::vector<std::uint8_t> exact;
+        const auto encode = [&](GroupEncoding e, std::vector<std::uint8_t>* x) {
             const Stopwatch encoding;
             std::vector<std::uint8_t> b =
-                encode_group(g, e, s_.grid_step_, &s_.prototype_.volume());
+                encode_group(g, e, s_.grid_step_, &s_.prototype_.volume(), x);
             if (adaptive)
                 s_.chooser_.encoded(e, g.mesh.triangle_count(), b.size(), encoding.seconds(),
                                     making_s);
@@ -74,14 +77,21 @@ class ServerSession::Sink final : public GroupSink {
             asked = s_.chooser_.next();
             measure_other = s_.chooser_.wants_measure(other_encoding(asked));
         }
-        const std::vector<std::uint8_t> bytes = encode(asked);
+        const std::vector<std::uint8_t> bytes = encode(asked, stepped_first ? &exact : nullptr);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
         const Stopwatch sending;
         const std::size_t sent = s_.send_(m);
         if (adaptive) s_.chooser_.sent(asked, sent, sending.seconds());
-        if (measure_other) encode(other_encoding(asked));
+        if (measure_other) encode(other_encoding(asked), nullptr);
+        if (!exact.empty()) {
+            ExactMsg x{r_.request_id, m.key, {}};
+            x.bits.resize(exact.size());
+            std::transform(exact.begin(), exact.end(), x.bits.begin(),
+                           [](std::uint8_t b) { return std::byte{b}; });
+            s_.exact_due_.push_back(std::move(x));
+        }
         s_.since_sent_.restart();
         f_.bytes += sent;
         ++f_.groups;
@@ -235,10 +245,17 @@ RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& 
         for (auto& lv : levels_) lv->sent.clear();
     }
     const int top = r.progressive_lod ? options_.lod_levels : 0;
+    exact_due_.clear();
     for (int l = top; l >= 0; --l) begin_cached(lod_level(l), r, keep);
     if (keep) name_by_seed_rays(r, f);
     for (int l = top; l >= 0; --l)
         if (stop.load() || !cast_level(l, r, keep, stop, f)) return f;
+    // The exact values, once every group is out: the picture is whole first, then exact.
+    for (const ExactMsg& x : exact_due_) {
+        if (stop.load()) return f;
+        f.bytes += send_(x);
+    }
+    exact_due_.clear();
     EndOfFrameMsg end;
     end.request_id = r.request_id;
     end.rays = f.rays;

@@ -56,6 +56,11 @@ struct SessionOptions {
     // The server paces its sends to this (serve --rate-mbps); 0: unpaced. The adaptive chooser
     // takes it as the link's rate until it sees one.
     double link_cap_bytes_per_s = 0;
+    // The client takes ExactMsg (its hello's takes_exact): a full-resolution cells group it does
+    // not cache then goes with its gradients' voxels to a step, and their exact values follow
+    // once the request's last group is out (remote/cell_codec.h). On the shared 16-bit volumes
+    // the image before them is 99.7-99.8% correct, for 10-13% fewer bytes.
+    bool exact_after = false;
 };
 
 // Sends one message; returns its bytes on the wire. Throws when the connection is gone.
@@ -109,6 +114,7 @@ class ServerSession {
     std::vector<DecodeRateMsg> reports_;  // the client's, not yet taken by the chooser
     Stopwatch since_sent_;                // since the last group's send: the engine making the next
     std::vector<std::unique_ptr<LodLevel>> levels_;  // index = level of detail (0 = full)
+    std::vector<ExactMsg> exact_due_;  // the request's exact values, sent after its last group
     bool cache_valid_ = false;
     double cache_iso_ = 0;
     std::uint64_t cache_gen_ = 0;  // the generation groups are sent in; 0 while not caching

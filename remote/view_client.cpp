@@ -18,6 +18,7 @@ ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(rende
     hello.encoding = h.adaptive ? kAdaptiveEncoding : static_cast<std::uint8_t>(h.encoding);
     hello.role = h.role;
     hello.session = h.session;
+    hello.takes_exact = h.takes_exact && h.role == SessionRole::none;
     conn_->send(hello);
     reports_ = h.adaptive && h.role != SessionRole::follower;
     std::optional<RemoteMessage> m = conn_->receive(h.connect_timeout_s);

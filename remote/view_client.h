@@ -29,6 +29,10 @@ struct ClientHello {
     // one's own.
     SessionRole role = SessionRole::none;
     std::string session;
+    // The client takes a cells group's gradient voxels to a step first and their exact values
+    // after (ExactMsg; a shared session's members get every group exact); false: every group
+    // exact in one message.
+    bool takes_exact = true;
 };
 
 class ViewClient {

@@ -12,10 +12,12 @@
 #include "common/core/wire_pieces.h"
 #include "remote/request_checks.h"
 #include "remote/slot_list.h"
+#include "remote/view_protocol_parts.h"
 
 namespace isowall::remote {
 
 using wire_pieces::get_finite;
+using namespace protocol_parts;
 
 namespace {
 
@@ -56,75 +58,50 @@ std::int32_t get_int_in(MessageReader& r, const std::string& field, std::int32_t
     return v;
 }
 
-void put_group_key(MessageWriter& w, const GroupKey& k) {
-    for (const int v : {k.seed.x, k.seed.y, k.seed.z, k.level}) w.put(static_cast<std::int32_t>(v));
-    w.put(k.iso);
-    w.put(static_cast<std::uint8_t>(k.refinement));
-}
-
-// A group key's fields; errors name them "key.level" and so on.
-GroupKey get_group_key(MessageReader& r) {
-    const auto name = [](const char* field) { return std::string("key.") + field; };
-    GroupKey k;
-    int* const ints[] = {&k.seed.x, &k.seed.y, &k.seed.z, &k.level};
-    const char* const fields[] = {"seed.x", "seed.y", "seed.z", "level"};
-    for (int i = 0; i < 4; ++i) {
-        const auto v = r.get<std::int32_t>();
-        const std::int32_t hi = i == 3 ? kMaxGroupLevel : std::numeric_limits<std::int32_t>::max();
-        if (v < 0 || v > hi)
-            r.fail(name(fields[i]) + ": expected 0.." + std::to_string(hi) + ", got " +
-                   std::to_string(v));
-        *ints[i] = v;
-    }
-    k.iso = r.get<double>();
-    if (!std::isfinite(k.iso))
-        r.fail(name("iso") + ": expected a finite number, got " + std::to_string(k.iso));
-    const auto refinement = r.get<std::uint8_t>();
-    if (refinement > 1)
-        r.fail(name("refinement") + ": expected 0 or 1, got " + std::to_string(refinement));
-    k.refinement = refinement == 1;
-    return k;
-}
-
-bool get_flag(MessageReader& r, const char* field) {
-    const auto v = r.get<std::uint8_t>();
-    if (v > 1) r.fail(std::string(field) + ": expected 0 or 1, got " + std::to_string(v));
-    return v == 1;
-}
-
 }  // namespace
 
 // ---- one encoder and its decoder per message ---------------------------------------------------
 
 static std::vector<std::byte> encode(const HelloMsg& m) {
     const bool shared = m.role != SessionRole::none;
-    MessageWriter w(shared ? HelloMsg::kVersion : 1);
+    const std::uint8_t version = m.takes_exact ? 3 : shared ? 2 : 1;
+    MessageWriter w(version);
     w.put(m.protocol_version);
     put_text(w, m.dataset);
     put_text(w, m.token);
     w.put(m.encoding);
-    if (shared) {
+    if (version >= 2) {
         w.put(static_cast<std::uint8_t>(m.role));
         put_text(w, m.session);
     }
+    if (version >= 3) w.put(static_cast<std::uint8_t>(m.takes_exact));
     return w.take();
 }
 
 static HelloMsg decode_hello(std::span<const std::byte> bytes) {
-    const bool v1 = !bytes.empty() && bytes[0] == std::byte{1};
-    MessageReader r(bytes, v1 ? 1 : HelloMsg::kVersion, "hello message");
+    const std::uint8_t version =
+        !bytes.empty() && bytes[0] >= std::byte{1} && bytes[0] <= std::byte{HelloMsg::kVersion}
+            ? static_cast<std::uint8_t>(bytes[0])
+            : HelloMsg::kVersion;
+    MessageReader r(bytes, version, "hello message");
     HelloMsg m;
     m.protocol_version = r.get<std::uint16_t>();
     m.dataset = get_text(r, "dataset", kMaxDatasetNameBytes, false);
     m.token = get_text(r, "token", kMaxTokenBytes, true);
     m.encoding = r.get<std::uint8_t>();
-    if (!v1) {
+    if (version >= 2) {
+        // Version 2 has a role; version 3 may have none (0), and then no session name.
         const auto role = r.get<std::uint8_t>();
-        if (role < 1 || role > 2)
-            r.fail("role: " + std::to_string(role) + ", expected 1 (presenter) or 2 (follower)");
+        const int least = version == 2 ? 1 : 0;
+        if (role < least || role > 2)
+            r.fail("role: " + std::to_string(role) + ", expected " +
+                   (least == 0 ? "0 (none), " : "") + "1 (presenter) or 2 (follower)");
         m.role = static_cast<SessionRole>(role);
-        m.session = get_text(r, "session", kMaxSessionNameBytes, false);
+        m.session = get_text(r, "session", kMaxSessionNameBytes, m.role == SessionRole::none);
+        if (m.role == SessionRole::none && !m.session.empty())
+            r.fail("session: a name without a role");
     }
+    if (version >= 3) m.takes_exact = get_flag(r, "takes_exact");
     r.finish();
     return m;
 }
@@ -215,48 +192,6 @@ static RequestMsg decode_request(std::span<const std::byte> bytes) {
         r.fail("view.frustum." + problem);
     m.progressive_lod = get_flag(r, "progressive_lod");
     m.cached_groups = get_flag(r, "cached_groups");
-    r.finish();
-    return m;
-}
-
-static std::vector<std::byte> encode(const GroupMsg& m) {
-    MessageWriter w(GroupMsg::kVersion);
-    w.put(m.request_id);
-    put_group_key(w, m.key);
-    w.put(static_cast<std::uint8_t>(m.draw_from_next_frame));
-    w.put(m.cache_gen);
-    w.put_bytes(m.encoded);
-    return w.take();
-}
-
-static GroupMsg decode_group(std::span<const std::byte> bytes) {
-    MessageReader r(bytes, GroupMsg::kVersion, "group message");
-    GroupMsg m;
-    m.request_id = r.get<std::uint64_t>();
-    m.key = get_group_key(r);
-    m.draw_from_next_frame = get_flag(r, "draw_from_next_frame");
-    m.cache_gen = r.get<std::uint64_t>();
-    const auto encoded = r.get_bytes();  // checked against the message: no allocation yet
-    if (encoded.size() > kMaxGroupBytes)
-        r.fail("encoded: " + std::to_string(encoded.size()) + " bytes, expected at most " +
-               std::to_string(kMaxGroupBytes));
-    m.encoded.assign(encoded.begin(), encoded.end());
-    r.finish();
-    return m;
-}
-
-static std::vector<std::byte> encode(const VisibleMsg& m) {
-    MessageWriter w(VisibleMsg::kVersion);
-    w.put(m.request_id);
-    put_slots(w, m.slots);
-    return w.take();
-}
-
-static VisibleMsg decode_visible(std::span<const std::byte> bytes) {
-    MessageReader r(bytes, VisibleMsg::kVersion, "visible message");
-    VisibleMsg m;
-    m.request_id = r.get<std::uint64_t>();
-    m.slots = get_slots(r);
     r.finish();
     return m;
 }
@@ -356,7 +291,7 @@ ErrorMsg make_error(ErrorCode code, std::string_view text) {
 const char* to_string(RemoteTag type) {
     static constexpr const char* kNames[] = {"hello",   "ready",        "request", "group",
                                              "visible", "end_of_frame", "error",   "bye",
-                                             "session", "decode_rate"};
+                                             "session", "decode_rate",  "exact"};
     static_assert(std::size(kNames) == kLastRemoteTag, "a name for every message type");
     const auto t = static_cast<std::size_t>(type);
     return t >= 1 && t <= kLastRemoteTag ? kNames[t - 1] : "unknown";
@@ -379,7 +314,7 @@ RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload)
         case RemoteTag::request:
             return decode_request(payload);
         case RemoteTag::group:
-            return decode_group(payload);
+            return decode_group_msg(payload);
         case RemoteTag::visible:
             return decode_visible(payload);
         case RemoteTag::end_of_frame:
@@ -392,6 +327,8 @@ RemoteMessage decode_payload(RemoteTag type, std::span<const std::byte> payload)
             return decode_session(payload);
         case RemoteTag::decode_rate:
             return decode_decode_rate(payload);
+        case RemoteTag::exact:
+            return decode_exact(payload);
     }
     throw WireError("view protocol: unknown message type " +
                     std::to_string(static_cast<unsigned>(type)));

@@ -32,8 +32,9 @@ enum class RemoteTag : std::uint16_t {
     bye = 8,           // either way: the sender closes the connection, nothing was wrong
     session = 9,       // server -> a shared session's members: its name, presenter and size
     decode_rate = 10,  // client -> server: what decoding groups cost the client (adaptive only)
+    exact = 11,        // server -> client: a group's exact values, after it went to a step
 };
-inline constexpr std::uint16_t kLastRemoteTag = 10;
+inline constexpr std::uint16_t kLastRemoteTag = 11;
 const char* to_string(RemoteTag type);
 
 // ---- limits: each is checked by the decoder before anything is sized from the bytes -----------
@@ -57,15 +58,20 @@ enum class SessionRole : std::uint8_t { none = 0, presenter = 1, follower = 2 };
 
 struct HelloMsg {
     static constexpr RemoteTag kTag = RemoteTag::hello;
-    // 2: session and role. Encoded as version 1 (without them) when the role is none, so a
-    // client that shares no session speaks to servers of version 1; both decode.
-    static constexpr std::uint8_t kVersion = 2;
+    // 2: session and role. 3: takes_exact too. Encoded in the oldest layout that holds what is
+    // set (1 without a role or takes_exact, 2 with a role alone), so a client that asks for
+    // neither speaks to servers of version 1; all three decode.
+    static constexpr std::uint8_t kVersion = 3;
     std::uint16_t protocol_version = 1;  // the newest the client speaks
     std::string dataset;                 // the name the server loaded the volume under
     std::string token;                   // empty unless the server asks for one (--token)
     std::uint8_t encoding = 0;           // the group encoding the client wants (remote codec's id)
     SessionRole role = SessionRole::none;
     std::string session;  // with a role: 1..kMaxSessionNameBytes printable ASCII; else empty
+    // The client takes ExactMsg: a cells group's gradient voxels may come to a step first and
+    // their exact values after (remote/cell_codec.h). A client that does not say so gets every
+    // group exact.
+    bool takes_exact = false;
 };
 
 // Sent to every member of a shared session when one joins or leaves.
@@ -171,13 +177,26 @@ struct DecodeRateMsg {
 // The group codecs (remote/group_codec.h: GroupEncoding's count; encoding_choice.h checks it).
 inline constexpr unsigned kDecodeRateEncodings = 5;
 
+// A cells group's exact values (remote/cell_exact.h), after its GroupMsg of the same request and
+// key sent its gradients' voxels to a step; only to a client whose hello said takes_exact, only
+// for a group it does not cache, before the request's EndOfFrameMsg. The client decodes the group
+// again with them, and draws the exact mesh in place of the stepped one.
+struct ExactMsg {
+    static constexpr RemoteTag kTag = RemoteTag::exact;
+    static constexpr std::uint8_t kVersion = 1;
+    std::uint64_t request_id = 0;
+    GroupKey key;                 // as GroupMsg's
+    std::vector<std::byte> bits;  // <= kMaxGroupBytes
+};
+
 struct ByeMsg {
     static constexpr RemoteTag kTag = RemoteTag::bye;
     static constexpr std::uint8_t kVersion = 1;
 };
 
 using RemoteMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
-                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg, DecodeRateMsg>;
+                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg, DecodeRateMsg,
+                                   ExactMsg>;
 
 // The payload of a message (what follows the frame header).
 std::vector<std::byte> encode_payload(const RemoteMessage& m);

@@ -115,6 +115,8 @@ class ViewServer::Client {
         for (const Dataset& d : server_.datasets_)
             if (d.name == h->dataset) {
                 hello_encoding_ = h->encoding;
+                // A shared session's groups go to every member alike: exact for all of them.
+                takes_exact_ = h->takes_exact && h->role == SessionRole::none;
                 if (h->role == SessionRole::none) return &d;
                 std::string why;
                 seat_ = server_.hub_.join(*h, conn_.peer(), why);
@@ -165,6 +167,7 @@ class ViewServer::Client {
         say("serve: %s: dataset %s%s\n", d.name);
         SessionOptions so = server_.options_.session;
         apply_hello_encoding(hello_encoding_, so.encoding, so.adaptive);
+        so.exact_after = takes_exact_;
         so.link_cap_bytes_per_s = server_.options_.rate_bits_per_s / 8;
         session_ =
             std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
@@ -321,6 +324,7 @@ class ViewServer::Client {
     std::uint64_t status_seen_ = 0;
     std::atomic<bool> worker_done_{false};
     std::uint8_t hello_encoding_ = 0;  // what the hello asked for (apply_hello_encoding)
+    bool takes_exact_ = false;         // the hello's takes_exact, for a client of its own
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
     NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes
