@@ -42,7 +42,8 @@ std::vector<RemoteMessage> samples() {
         make_error(ErrorCode::bad_token, "wrong token"),
         ByeMsg{},
         SessionMsg{"class 3b", "10.0.0.7:51234", 12},
-        DecodeRateMsg{{{3, 120000, 0.0125}, {4, 30000, 0.01}}}};
+        DecodeRateMsg{{{3, 120000, 0.0125}, {4, 30000, 0.01}}},
+        ExactMsg{3, key, {std::byte{0x5a}, std::byte{0x81}}}};
 }
 
 bool write(const std::filesystem::path& path, const std::vector<std::byte>& bytes) {

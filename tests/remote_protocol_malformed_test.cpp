@@ -81,6 +81,41 @@ TEST(RemoteProtocolMalformed, SharedHelloFields) {
                               [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
 }
 
+// A hello that takes exact values is version 3, with or without a role; its flag is 0 or 1, and
+// without a role it names no session.
+TEST(RemoteProtocolMalformed, ExactHelloFields) {
+    HelloMsg exact = sample_exact_hello();
+    EXPECT_EQ(encode_payload(exact)[0], std::byte{3});
+    EXPECT_EQ(std::get<HelloMsg>(decode_payload(RemoteTag::hello, encode_payload(exact))), exact);
+    HelloMsg presenter = sample_shared_hello();
+    presenter.takes_exact = true;
+    presenter.role = SessionRole::presenter;
+    EXPECT_EQ(std::get<HelloMsg>(decode_payload(RemoteTag::hello, encode_payload(presenter))),
+              presenter);
+    std::vector<std::byte> bytes = encode_payload(exact);
+    bytes.back() = std::byte{2};
+    std::string what;
+    try {
+        decode_payload(RemoteTag::hello, bytes);
+    } catch (const WireError& e) {
+        what = e.what();
+    }
+    EXPECT_NE(what.find("takes_exact: expected 0 or 1, got 2"), std::string::npos) << what;
+    expect_faults<HelloMsg>(exact, {{"session: a name without a role",
+                                     [](HelloMsg& m) { m.session.assign(1, 'x'); }},
+                                    {"role: 3, expected 0 (none), 1 (presenter) or 2 (follower)",
+                                     [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
+}
+
+TEST(RemoteProtocolMalformed, ExactFields) {
+    expect_faults<ExactMsg>(sample_exact(),
+                            {{"key.level: expected 0..30, got 31",
+                              [](ExactMsg& m) { m.key.level = 31; }},
+                             {"key.iso: expected a finite number",
+                              [](ExactMsg& m) { m.key.iso = kNaN; }}});
+    EXPECT_NO_THROW(decode_payload(RemoteTag::exact, encode_payload(ExactMsg{})));
+}
+
 TEST(RemoteProtocolMalformed, SessionFields) {
     expect_faults<SessionMsg>(
         sample_session(),

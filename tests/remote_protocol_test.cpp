@@ -106,9 +106,9 @@ TEST(RemoteProtocol, HeaderFaultsNameTheField) {
         {3, std::byte{0}, "magic"},
         {4, std::byte{2}, "version: expected 1, got 2"},
         {5, std::byte{1}, "version: expected 1, got 257"},
-        {6, std::byte{0}, "type: expected 1..10, got 0"},
-        {6, std::byte{11}, "type: expected 1..10, got 11"},
-        {7, std::byte{1}, "type: expected 1..10, got 260"},
+        {6, std::byte{0}, "type: expected 1..11, got 0"},
+        {6, std::byte{12}, "type: expected 1..11, got 12"},
+        {7, std::byte{1}, "type: expected 1..11, got 260"},
     };
     for (const Fault& f : faults) {
         Bytes bytes = good;

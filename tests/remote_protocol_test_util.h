@@ -17,7 +17,10 @@ namespace isowall::remote {
 inline bool operator==(const HelloMsg& a, const HelloMsg& b) {
     return a.protocol_version == b.protocol_version && a.dataset == b.dataset &&
            a.token == b.token && a.encoding == b.encoding && a.role == b.role &&
-           a.session == b.session;
+           a.session == b.session && a.takes_exact == b.takes_exact;
+}
+inline bool operator==(const ExactMsg& a, const ExactMsg& b) {
+    return a.request_id == b.request_id && a.key == b.key && a.bits == b.bits;
 }
 inline bool operator==(const SessionMsg& a, const SessionMsg& b) {
     return a.session == b.session && a.presenter == b.presenter && a.members == b.members;
@@ -65,6 +68,10 @@ inline HelloMsg sample_hello() {
 // A hello that joins a shared session (version 2 on the wire).
 inline HelloMsg sample_shared_hello() {
     return {7, "ct_head 256", "s3cret token", 3, SessionRole::follower, "class 3b"};
+}
+// A hello that takes exact values (version 3 on the wire), of a client of its own.
+inline HelloMsg sample_exact_hello() {
+    return {7, "ct_head 256", "s3cret token", 4, SessionRole::none, "", true};
 }
 inline SessionMsg sample_session() {
     return {"class 3b", "10.0.0.7:51234", 12};
@@ -121,10 +128,14 @@ inline DecodeRateMsg sample_decode_rate() {
     return {{{3, 120000, 0.0125}, {4, 0x1000000001, 2.5}}};
 }
 
+inline ExactMsg sample_exact() {
+    return {9, sample_key(1), {std::byte{0x5a}, std::byte{0}, std::byte{0x81}}};
+}
+
 inline std::vector<RemoteMessage> samples() {
     return {sample_hello(),   sample_ready(),        sample_request(), sample_group(),
             sample_visible(), sample_end_of_frame(), sample_error(),   ByeMsg{},
-            sample_session(), sample_decode_rate()};
+            sample_session(), sample_decode_rate(),  sample_exact()};
 }
 
 // decode_payload(type, bytes) throws a WireError naming the message and `field`.
