@@ -162,7 +162,7 @@ std::optional<std::vector<std::uint8_t>> encode_typed(const Group& g, const Volu
 template <class T>
 Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso, Normals normals,
                   const std::vector<UnitBucket>& buckets, const CellExact& x, T) {
-    ValueReader<T> values(r, iso, first_stepped_phase(normals));
+    ValueReader<T> values(r, iso, first_stepped_phase(normals), normals == Normals::gradients);
     const std::vector<Unit> units =
         get_units(r, values.coder(), buckets, dims, kMaxPlacesPerByte * values.stream_bytes());
     // Every unit's corners are voxels no other phase sends, and each voxel is a corner of at
@@ -181,9 +181,11 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
         each_phase(h, named, units, normals == Normals::gradients,
                    [&](const std::vector<std::uint32_t>& at) { values.phase(held, box, at); });
     values.finish();
-    if (x.stepped) *x.stepped = values.stepped();
+    // A coarse pass's values went to a step of their own, which nothing undoes.
+    const bool undoable = normals == Normals::gradients && values.stepped();
+    if (x.stepped) *x.stepped = undoable;
     if (x.exact) {
-        if (!values.stepped()) r.fail("exact values: the body's values are exact already");
+        if (!undoable) r.fail("exact values: the body has no values to make exact");
         values.apply_exact(held, *x.exact);
     }
     std::size_t triangles = 0;

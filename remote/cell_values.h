@@ -295,12 +295,14 @@ class ValueWriter {
 template <class T>
 class ValueReader {
   public:
-    // `first_stepped`: the first phase the body's step applies to (as the writer's).
-    ValueReader(ByteReader& r, double iso, int first_stepped)
+    // `first_stepped`: the first phase the body's step applies to (as the writer's);
+    // `undoable`: whether exact offsets may follow for its stepped values (apply_exact).
+    ValueReader(ByteReader& r, double iso, int first_stepped, bool undoable)
         : r_(r),
           model_(iso),
           bins_{iso, r.get<std::uint8_t>()},
           first_stepped_(first_stepped),
+          undoable_(undoable),
           coder_(std::span<const std::uint8_t>{}) {
         const int most = std::is_integral_v<T> ? 8 * static_cast<int>(sizeof(T)) - 2 : 0;
         if (bins_.shift == 1 || bins_.shift > most)
@@ -334,7 +336,8 @@ class ValueReader {
                     value = from_residual(*got, guess.value);
                 } else {
                     value = bins_.middle(bins_.of(guess.value) + unzigzag(*got));
-                    stepped_.push_back(p);
+                    any_stepped_ = true;
+                    if (undoable_) stepped_.push_back(p);
                 }
             } else {
                 value = values[k];
@@ -349,11 +352,12 @@ class ValueReader {
         if (!coder_.at_end()) r_.fail("voxel values: the coded stream does not end there");
     }
     // Whether values went to a step that exact bits could undo.
-    bool stepped() const { return !stepped_.empty(); }
+    bool stepped() const { return any_stepped_; }
     // Puts every stepped value back at its exact value: its bin's least integer plus its offset
     // from `exact` (cell_exact.h; WireError for bits that do not fit the values, or a value past T).
     void apply_exact(BoxVoxels<T>& held, std::span<const std::uint8_t> exact) const {
         if constexpr (std::is_integral_v<T>) {
+            if (!undoable_) r_.fail("exact values: the body's step is not one they undo");
             ExactBitsReader bits(exact, stepped_.size(), bins_.shift, "exact values");
             for (const glm::ivec3 p : stepped_) {
                 const std::int64_t k = bins_.of(held.at(p.x, p.y, p.z));
@@ -381,7 +385,8 @@ class ValueReader {
     ValueModel<T> model_;
     Bins<T> bins_;
     int first_stepped_;
-    std::vector<glm::ivec3> stepped_;  // where values went to the step, in their order
+    bool undoable_, any_stepped_ = false;
+    std::vector<glm::ivec3> stepped_;  // undoable: where values went to the step, in their order
     RangeDecoder coder_;
     std::uint64_t max_named_ = 0, stream_bytes_ = 0;
     int phase_ = 0;

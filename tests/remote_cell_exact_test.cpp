@@ -97,8 +97,13 @@ TEST(RemoteCellExact, ACoarsePassIsNeverSteppedForOffsets) {
     const Volume v = make_phantom();
     for (const Group& g : sample_groups(v, kPhantomSkinIso, 24, 2000, uniform_levels(2))) {
         Bytes exact{1, 2, 3};
-        encode_group(g, GroupEncoding::cells, 0, &v, &exact);
+        const Bytes bytes = encode_group(g, GroupEncoding::cells, 0, &v, &exact);
         EXPECT_TRUE(exact.empty()) << g.key() << ": its values go to a step of their own";
+        if (encoding_of(bytes) != GroupEncoding::cells) continue;
+        bool stepped = true;
+        decode_two(bytes, nullptr, &stepped);
+        EXPECT_FALSE(stepped) << g.key() << ": nothing undoes a coarse pass's step";
+        EXPECT_THROW(decode_two(bytes, &exact), WireError) << g.key();
     }
 }
 
