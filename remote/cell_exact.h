@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "common/core/wire.h"
 
 namespace isowall::remote::cells {
 
@@ -31,23 +30,24 @@ class ExactBitsWriter {
     std::uint64_t used_ = 0;
 };
 
+// What is wrong with `bytes` as `count` values of `bits` each, or empty: they must be exactly as
+// many bytes as the values take, and the last byte's unused bits zero.
+inline std::string exact_bits_problem(std::span<const std::uint8_t> bytes, std::uint64_t count,
+                                      int bits) {
+    const std::uint64_t need = (count * static_cast<std::uint64_t>(bits) + 7) / 8;
+    if (bytes.size() != need)
+        return std::to_string(bytes.size()) + " bytes of exact values, expected " +
+               std::to_string(need) + " for " + std::to_string(count) + " values of " +
+               std::to_string(bits) + " bits";
+    const std::uint64_t tail = count * static_cast<std::uint64_t>(bits) % 8;
+    if (tail != 0 && (bytes.back() >> tail) != 0) return "the exact values' unused bits are not zero";
+    return {};
+}
+
 class ExactBitsReader {
   public:
-    // For `count` values of `bits` each: the bytes must be exactly as many as they take, and the
-    // last byte's unused bits zero (WireError otherwise, naming `what`).
-    ExactBitsReader(std::span<const std::uint8_t> bytes, std::uint64_t count, int bits,
-                    const char* what)
-        : bytes_(bytes) {
-        const std::uint64_t need = (count * static_cast<std::uint64_t>(bits) + 7) / 8;
-        if (bytes.size() != need)
-            throw WireError(std::string(what) + ": " + std::to_string(bytes.size()) +
-                            " bytes of exact values, expected " + std::to_string(need) + " for " +
-                            std::to_string(count) + " values of " + std::to_string(bits) +
-                            " bits");
-        const std::uint64_t tail = count * static_cast<std::uint64_t>(bits) % 8;
-        if (tail != 0 && (bytes.back() >> tail) != 0)
-            throw WireError(std::string(what) + ": the exact values' unused bits are not zero");
-    }
+    // Over bytes exact_bits_problem finds nothing wrong with.
+    explicit ExactBitsReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
     std::uint64_t get(int bits) {
         std::uint64_t v = 0;
         for (int b = 0; b < bits; ++b, ++used_)

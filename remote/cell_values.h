@@ -358,7 +358,10 @@ class ValueReader {
     void apply_exact(BoxVoxels<T>& held, std::span<const std::uint8_t> exact) const {
         if constexpr (std::is_integral_v<T>) {
             if (!undoable_) r_.fail("exact values: the body's step is not one they undo");
-            ExactBitsReader bits(exact, stepped_.size(), bins_.shift, "exact values");
+            if (const std::string p = exact_bits_problem(exact, stepped_.size(), bins_.shift);
+                !p.empty())
+                r_.fail("exact values: " + p);
+            ExactBitsReader bits(exact);
             for (const glm::ivec3 p : stepped_) {
                 const std::int64_t k = bins_.of(held.at(p.x, p.y, p.z));
                 const std::int64_t v = bins_.low(k) + static_cast<std::int64_t>(bits.get(bins_.shift));

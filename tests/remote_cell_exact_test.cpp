@@ -165,10 +165,10 @@ TEST(RemoteCellExactMalformed, OffsetsOfTheWrongLengthOrWithStrayBitsThrow) {
     exact_expect_wire_error(s->group, longer, "a byte over");
     // Three values of 3 bits fill 9 bits of 2 bytes: the second byte's bits 1-7 are unused.
     const Bytes nine{0xff, 0x01};
-    EXPECT_NO_THROW(cells::ExactBitsReader(nine, 3, 3, "test"));
+    EXPECT_EQ(cells::exact_bits_problem(nine, 3, 3), "");
     for (int bit = 1; bit < 8; ++bit)
-        EXPECT_THROW(cells::ExactBitsReader(Bytes{0xff, std::uint8_t(1u | 1u << bit)}, 3, 3, "test"),
-                     WireError)
+        EXPECT_EQ(cells::exact_bits_problem(Bytes{0xff, std::uint8_t(1u | 1u << bit)}, 3, 3),
+                  "the exact values' unused bits are not zero")
             << "unused bit " << bit;
 }
 
@@ -206,7 +206,8 @@ TEST(RemoteCellExact, BitsRoundTripAtEveryWidth) {
             w.put(x, bits);
         }
         const Bytes b = w.take();
-        cells::ExactBitsReader r(b, values.size(), bits, "test");
+        ASSERT_EQ(cells::exact_bits_problem(b, values.size(), bits), "");
+        cells::ExactBitsReader r(b);
         for (const auto x : values) ASSERT_EQ(r.get(bits), x) << bits << " bits";
     }
 }

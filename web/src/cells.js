@@ -19,19 +19,24 @@ export function cellsProblem() {
 }
 
 // The mesh of a cells body (the bytes inside the group's zstd frame) at `iso`, as
-// { positions: Float32Array(3V), normals: Float32Array(3V), indices: Uint32Array(3T) }. Throws a
-// WireError with the C++ decoder's message ("group: <field>: <why>") for a malformed body.
-export function decodeCellBody(body, iso) {
+// { positions: Float32Array(3V), normals: Float32Array(3V), indices: Uint32Array(3T), stepped }.
+// With `exact` (an exact message's bits), the mesh of its gradients' exact values; `stepped` says
+// whether the body had them to a step. Throws a WireError with the C++ decoder's message
+// ("group: <field>: <why>") for a malformed body or exact values that do not fit it.
+export function decodeCellBody(body, iso, exact = null) {
   if (!wasm) throw new WireError(`group: cells: ${cellsProblem()}`);
-  const at = wasm._cells_alloc(body.length);
-  if (at === 0 && body.length > 0) throw new WireError(`group: cells: no memory for a body of ${body.length} bytes`);
+  const bits = exact ?? new Uint8Array(0);
+  const at = wasm._cells_alloc(body.length + bits.length);
+  if (at === 0 && body.length + bits.length > 0)
+    throw new WireError(`group: cells: no memory for a body of ${body.length + bits.length} bytes`);
   // A trap (a bug, never a malformed body: those are WireErrors the C API catches) leaves the
   // module's stack pointer where it stopped; restoring it keeps the module usable.
   const stack = wasm.stackSave();
   let status;
   try {
     wasm.HEAPU8.set(body, at);
-    status = wasm._cells_decode(at, body.length, iso);
+    wasm.HEAPU8.set(bits, at + body.length);
+    status = wasm._cells_decode(at, body.length, iso, at + body.length, bits.length, exact ? 1 : 0);
   } catch (e) {
     wasm.stackRestore(stack);
     throw new WireError(`group: cells: the decoder failed (${e.message})`);
@@ -46,5 +51,6 @@ export function decodeCellBody(body, iso) {
     positions: f32(wasm._cells_positions(), 3 * v),
     normals: f32(wasm._cells_normals(), 3 * v),
     indices: new Uint32Array(wasm.HEAPU8.buffer, wasm._cells_indices(), n).slice(),
+    stepped: wasm._cells_stepped() !== 0,
   };
 }

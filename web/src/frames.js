@@ -7,7 +7,11 @@
 //   - a visible message names cached groups by slot: the client must hold each (a protocol error
 //     if not) and draws them coarse levels first;
 //   - at the end of a frame that drew any coarse group, the frame is drawn again from its
-//     full-resolution groups alone, so the final image equals the image without LOD.
+//     full-resolution groups alone, so the final image equals the image without LOD;
+//   - a cells group whose gradients' voxels came to a step is drawn as it comes; its exact message
+//     (before the frame's end) decodes it again exact, and the frame's end draws the exact groups
+//     alone; an exact message for no awaiting group, a frame that ends with one still stepped, and
+//     a stepped group to cache are protocol errors.
 // The cache follows the server's stream, not the client's requests: a group with a cache
 // generation (of any request) is appended to the cache; one of another generation first drops
 // the cache. A group's slot is its index in the generation. The cache is kept while requests do
@@ -30,8 +34,9 @@ function sameKey(g, k) {
     g.level === k.level && g.iso === k.iso && g.refinement === k.refinement;
 }
 
-export function decodeMesh(m) {
-  const g = decodeGroup(m.encoded);
+// `exact`: the group's exact values (an exact message's bits), or null.
+export function decodeMesh(m, exact = null) {
+  const g = decodeGroup(m.encoded, exact);
   if (!sameKey(g, m.key)) throw new WireError('group message: key: the encoded group is another group');
   return g;
 }
@@ -62,6 +67,8 @@ export class ClientFrames {
     this.drewCoarse = false;
     this.drewAny = false;
     this.finals = [];  // full-resolution groups of the frame
+    this.stepped = [];
+    this.replaced = false;
     this.cache = [];   // { mesh, level }; index = slot in generation cacheGen
     this.cacheGen = 0;
     this.lastEnd = null;
@@ -80,6 +87,8 @@ export class ClientFrames {
     this.drewCoarse = false;
     this.drewAny = false;
     this.finals = [];
+    this.stepped = [];  // { key, encoded, finalIndex }: groups awaiting their exact values
+    this.replaced = false;
     this.viewM = viewMatrix(request.view.camera);
     this.projM = projectionMatrix(request.view.frustum);
     this.renderer.resize(request.view.width, request.view.height);
@@ -128,11 +137,41 @@ export class ClientFrames {
       }
       this.cache.push({ mesh, level: g.key.level });
     }
+    if (mesh.stepped && g.cache_gen !== 0)
+      throw new WireError('group message: a group to cache came with its values to a step');
     if (!current) return;
     this.stats.bytes += wireBytes;
     ++this.stats.groups;
     if (g.encoded[1] === GroupEncoding.cells) ++this.stats.cells;
+    const before = this.finals.length;
     if (!g.draw_from_next_frame) this.draw(mesh, g.key.level);
+    if (mesh.stepped)
+      this.stepped.push({ key: g.key, encoded: g.encoded, finalIndex: this.finals.length > before ? before : -1 });
+  }
+
+  handleExact(x, wireBytes) {
+    if (!this.active || x.request_id !== this.request.request_id) return;
+    const at = this.stepped.findIndex((s) => sameKey(s.key, x.key));
+    if (at < 0) throw new WireError('exact message: key: no group of the request awaits exact values');
+    const s = this.stepped[at];
+    this.stepped.splice(at, 1);
+    const t0 = this.now();
+    const mesh = this.decode({ key: s.key, encoded: s.encoded }, x.bits);
+    const ms = this.now() - t0;
+    this.stats.decode_ms += ms;
+    // The second decoding of a cells group is the client's work too (its triangles were counted).
+    const d = this.decoded.get(GroupEncoding.cells) ?? { triangles: 0, ms: 0 };
+    d.ms += ms;
+    this.decoded.set(GroupEncoding.cells, d);
+    this.stats.bytes += wireBytes;
+    if (s.finalIndex < 0) return;
+    this.finals[s.finalIndex] = mesh;
+    // Over the stepped surface, which lies within a hair of it: the frame's end draws the
+    // full-resolution groups again alone.
+    const t1 = this.now();
+    this.renderer.draw(mesh, this.viewM, this.projM);
+    this.stats.draw_ms += this.now() - t1;
+    this.replaced = true;
   }
 
   handleVisible(v, wireBytes) {
@@ -179,6 +218,10 @@ export class ClientFrames {
       this.handleVisible(m, wireBytes);
       return false;
     }
+    if (name === 'exact') {
+      this.handleExact(m, wireBytes);
+      return false;
+    }
     if (name === 'end_of_frame') {
       if (!this.active || m.request_id !== this.request.request_id) return false;
       this.stats.bytes += wireBytes;
@@ -199,7 +242,9 @@ export class ClientFrames {
   }
 
   finishFrame(end) {
-    if (this.drewCoarse) {
+    if (this.stepped.length > 0)
+      throw new WireError(`end of frame message: ${this.stepped.length} groups of the request never got their exact values`);
+    if (this.drewCoarse || this.replaced) {
       // The full-resolution groups alone: no coarse surface outside the fine one stays.
       this.renderer.clear();
       for (const mesh of this.finals) this.renderer.draw(mesh, this.viewM, this.projM);

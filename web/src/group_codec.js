@@ -258,9 +258,12 @@ export function encodingOf(bytes) {
   return e;
 }
 
-export function decodeGroup(bytes) {
+// exact: a cells group's exact values (an exact message's bits), or null. A cells group's result
+// says whether its gradients' voxels came to a step (`stepped`: exact values are to follow).
+export function decodeGroup(bytes, exact = null) {
   const encoding = encodingOf(bytes);
   const r = new ByteReader(bytes.subarray(2), WHAT);
+  if (exact && encoding !== GroupEncoding.cells) r.fail('exact values: only a cells group takes them');
   if (encoding === GroupEncoding.compact_zstd) {
     const compact = getZstd(r, kMaxCompactBytes);
     const inner = encodingOf(compact);
@@ -269,7 +272,7 @@ export function decodeGroup(bytes) {
     return decodeGroup(compact);
   }
   const g = getHeader(r);
-  if (encoding === GroupEncoding.cells) return Object.assign(g, decodeCellBody(getZstd(r, kMaxCellBytes), g.iso));
+  if (encoding === GroupEncoding.cells) return Object.assign(g, decodeCellBody(getZstd(r, kMaxCellBytes), g.iso, exact));
   const mesh = encoding === GroupEncoding.vertices ? getVertices(r)
     : encoding === GroupEncoding.indexed ? getIndexed(r) : getCompact(r);
   r.finish();

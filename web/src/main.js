@@ -237,7 +237,9 @@ function connect(name) {
   let ended = false;  // an error or a bye came: the close that follows is expected
   socket.onopen = () => {
     if (mine !== session) return;
-    sendFrame(MsgType.hello, { protocol_version: 1, dataset: name, token: el.token.value, encoding: settings.encoding });
+    // takes_exact: a cells group the page does not cache may come with its gradients to a step first.
+    sendFrame(MsgType.hello, { protocol_version: 1, dataset: name, token: el.token.value, encoding: settings.encoding,
+      takes_exact: true });
   };
   socket.onmessage = (ev) => {
     if (mine !== session) return;

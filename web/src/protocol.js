@@ -9,9 +9,9 @@ import { cameraProblem } from './camera.js';
 
 export const MsgType = {
   hello: 1, ready: 2, request: 3, group: 4, visible: 5, end_of_frame: 6, error: 7, bye: 8, session: 9,
-  decode_rate: 10,
+  decode_rate: 10, exact: 11,
 };
-export const kLastMsgType = 10;
+export const kLastMsgType = 11;
 const typeNames = Object.fromEntries(Object.entries(MsgType).map(([k, v]) => [v, k]));
 export function typeName(type) {
   return typeNames[type] ?? 'unknown';
@@ -37,9 +37,11 @@ export const kMaxImageSide = 32768;
 export const kDecodeRateEncodings = 5;
 const MAGIC = [0x49, 0x57, 0x56, 0x50];
 
-// hello: 1 without a shared session, 2 with one (role and session); both decode.
+// hello: 1 with neither a shared session nor takes_exact, 2 with a session (role and session
+// name), 3 with takes_exact (role 0 without a session); all three decode.
 const VERSION = {
   hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1, decode_rate: 1,
+  exact: 1,
 };
 
 // ---- text ----------------------------------------------------------------------------------
@@ -148,15 +150,17 @@ function getGroupKey(r) {
 
 const encoders = {
   hello(m) {
-    const w = new Writer(m.role ? 2 : VERSION.hello);
+    const version = m.takes_exact ? 3 : m.role ? 2 : VERSION.hello;
+    const w = new Writer(version);
     w.u16(m.protocol_version ?? 1);
     putText(w, m.dataset);
     putText(w, m.token ?? '');
     w.u8(m.encoding ?? 0);
-    if (m.role) {
-      w.u8(m.role);
-      putText(w, m.session);
+    if (version >= 2) {
+      w.u8(m.role ?? 0);
+      putText(w, m.session ?? '');
     }
+    if (version >= 3) w.u8(1);
     return w.take();
   },
   session(m) {
@@ -190,6 +194,14 @@ const encoders = {
     w.u8(m.draw_from_next_frame ? 1 : 0);
     w.u64(m.cache_gen);
     w.bytes(m.encoded);
+    return w.take();
+  },
+  // A cells group's exact values (remote/cell_exact.h) after its group message stepped them.
+  exact(m) {
+    const w = new Writer(VERSION.exact);
+    w.u64(m.request_id);
+    putGroupKey(w, m.key);
+    w.bytes(m.bits);
     return w.take();
   },
   visible(m) {
@@ -233,11 +245,16 @@ const decoders = {
     m.dataset = getText(r, 'dataset', kMaxDatasetNameBytes, false);
     m.token = getText(r, 'token', kMaxTokenBytes, true);
     m.encoding = r.u8();
-    if (version === 2) {
+    if (version >= 2) {
+      // Version 2 has a role; version 3 may have none (0), and then no session name.
       m.role = r.u8();
-      if (m.role < 1 || m.role > 2) r.fail(`role: ${m.role}, expected 1 (presenter) or 2 (follower)`);
-      m.session = getText(r, 'session', kMaxSessionNameBytes, false);
+      const least = version === 2 ? 1 : 0;
+      if (m.role < least || m.role > 2)
+        r.fail(`role: ${m.role}, expected ${least === 0 ? '0 (none), ' : ''}1 (presenter) or 2 (follower)`);
+      m.session = getText(r, 'session', kMaxSessionNameBytes, m.role === 0);
+      if (m.role === 0 && m.session !== '') r.fail('session: a name without a role');
     }
+    if (version >= 3) m.takes_exact = getFlag(r, 'takes_exact');
     return m;
   },
   session(r) {
@@ -292,6 +309,15 @@ const decoders = {
     m.encoded = encoded;
     return m;
   },
+  exact(r) {
+    const m = {};
+    m.request_id = r.u64('request_id');
+    m.key = getGroupKey(r);
+    const bits = r.getBytes();
+    if (bits.length > kMaxGroupBytes) r.fail(`bits: ${bits.length} bytes, expected at most ${kMaxGroupBytes}`);
+    m.bits = bits;
+    return m;
+  },
   visible(r) {
     const m = {};
     m.request_id = r.u64('request_id');
@@ -343,7 +369,8 @@ export function encodePayload(type, m) {
 export function decodePayload(type, payload) {
   const name = typeNames[type];
   if (!name) throw new WireError(`view protocol: unknown message type ${type}`);
-  const version = name === 'hello' && payload.length > 0 && payload[0] === 2 ? 2 : VERSION[name];
+  // A hello is read in the layout its version byte names (1..3), as the C++ does; another fails on 3.
+  const version = name !== 'hello' ? VERSION[name] : payload.length > 0 && payload[0] >= 1 && payload[0] <= 3 ? payload[0] : 3;
   const r = new Reader(payload, `${name} message`, version);
   const m = decoders[name](r, version);
   r.finish();

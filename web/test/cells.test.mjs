@@ -81,10 +81,31 @@ test('the groups cover every voxel type, coarse passes and refinements', () => {
 
 test('cells groups decode to the C++ decoder\'s mesh, bit for bit', () => {
   for (const g of groups) {
-    const d = decodeGroup(g.cells);
+    const d = decodeGroup(g.cells, g.exact.length ? g.exact : null);
+    assert.equal(d.stepped ?? false, g.exact.length > 0, g.name);
     assert.ok(Number.isFinite(d.iso) && d.seed.length === 3, g.name);
     assertSameMesh(d, g.mesh, `${g.name} (${encodingName(encodingOf(g.cells))})`);
   }
+});
+
+test('a group whose gradients came to a step gives the server\'s vertices first, and its mesh with the exact values', () => {
+  const stepped = groups.filter((g) => g.exact.length > 0);
+  assert.ok(stepped.some((g) => g.name.startsWith('u16')) && stepped.some((g) => g.name.startsWith('cthead')),
+    stepped.map((g) => g.name).join(', '));
+  for (const g of stepped) {
+    const first = decodeGroup(g.cells);
+    assert.equal(first.stepped, true, g.name);
+    assert.deepEqual(first.positions, g.mesh.positions, `${g.name}: the vertices stay`);
+    assert.deepEqual(first.indices, g.mesh.indices, g.name);
+    assert.notDeepEqual(first.normals, g.mesh.normals, `${g.name}: the normals moved`);
+    // Every cut and a byte over, as the C++ (ExactBitsReader) names them.
+    for (const n of [0, 1, g.exact.length - 1])
+      assert.throws(() => decodeGroup(g.cells, g.exact.subarray(0, n)), /^WireError: group: exact values: \d+ bytes of exact values, expected/, `${g.name} cut to ${n}`);
+    assert.throws(() => decodeGroup(g.cells, new Uint8Array([...g.exact, 0])), /^WireError: group: exact values:/, g.name);
+    assert.throws(() => decodeGroup(g.compact, g.exact), /^WireError: group: exact values: only a cells group takes them/, g.name);
+  }
+  const exact = groups.find((g) => g.name === 'u8-cells');
+  assert.throws(() => decodeGroup(exact.cells, new Uint8Array(1)), /^WireError: group: exact values: the body has no values to make exact/);
 });
 
 test('compact+zstd of the same groups has as many triangles', () => {

@@ -129,3 +129,46 @@ test('decode reports: triangles and seconds per encoding, at most every 50 ms, c
   assert.deepEqual(f.decodeReport(1050), { entries: [{ encoding: 4, triangles: 1, seconds: 0.002 }] });
   assert.equal(f.decodeReport(2000), null, 'nothing decoded since');
 });
+
+// A stepped cells group (remote/cell_codec.h) as the fake decoder sees it: the first decode gives
+// the stepped mesh, the one with the exact message's bits its exact mesh.
+function steppedFrames() {
+  const r = new Recorder();
+  let t = 0;
+  const decode = (m, exact) => (exact ? { name: `${m.encoded.name}!`, indices: m.encoded.indices } : m.encoded);
+  return { r, f: new ClientFrames(r, () => (t += 1), decode) };
+}
+function stepped(id, name, seed, gen = 0) {
+  const g = group(id, name, 0, { gen });
+  g.key.seed = [seed, 0, 0];
+  g.encoded.stepped = true;
+  return g;
+}
+const exact = (id, seed) => ({ request_id: id, key: { seed: [seed, 0, 0], level: 0, iso: 1, refinement: false }, bits: new Uint8Array(1) });
+
+test('exact values: each replaces its stepped group, and the frame ends on the exact groups alone', () => {
+  const { r, f } = steppedFrames();
+  f.begin(request(1, false));
+  f.handle('group', stepped(1, 'a', 1), 100);
+  f.handle('group', group(1, 'b', 0), 100);
+  f.handle('group', stepped(1, 'c', 3), 100);
+  f.handle('exact', exact(1, 3), 10);
+  f.handle('exact', exact(1, 1), 10);
+  assert.equal(f.handle('end_of_frame', { request_id: 1 }, 50), true);
+  assert.deepEqual(r.ops, ['resize 4x4', 'clear', 'draw a', 'draw b', 'draw c', 'draw c!', 'draw a!',
+    'clear', 'draw a!', 'draw b', 'draw c!']);
+  assert.equal(f.stats.bytes, 370);
+  assert.equal(f.stats.triangles, 3, 'an exact mesh is not counted again');
+});
+
+test('exact values: for no awaiting group, missing at the end, or for a group to cache are errors', () => {
+  let { f } = steppedFrames();
+  f.begin(request(1, false));
+  assert.throws(() => f.handle('exact', exact(1, 1), 10), /exact message: key: no group of the request awaits exact values/);
+  f.handle('group', stepped(1, 'a', 1), 100);
+  f.handle('exact', exact(2, 1), 10);  // another request's: dropped
+  assert.throws(() => f.handle('end_of_frame', { request_id: 1 }, 10), /end of frame message: 1 groups of the request never got their exact values/);
+  ({ f } = steppedFrames());
+  f.begin(request(1));
+  assert.throws(() => f.handle('group', stepped(1, 'a', 1, 1), 100), /group message: a group to cache came with its values to a step/);
+});

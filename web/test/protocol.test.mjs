@@ -12,7 +12,7 @@ const read = (dir, name) => new Uint8Array(readFileSync(new URL(name, dir)));
 
 test('corpus payloads decode, and encode back to their bytes', () => {
   const names = readdirSync(corpus).filter((n) => n.startsWith('payload-'));
-  assert.equal(names.length, 10);
+  assert.equal(names.length, 11);
   for (const name of names) {
     const b = read(corpus, name);
     assert.equal(b[0] % 2, 0, name);
@@ -55,16 +55,19 @@ test('corpus values are the seeds\' (fuzz/view_protocol_seeds.cpp)', () => {
   assert.deepEqual(msg('session'), { session: 'class 3b', presenter: '10.0.0.7:51234', members: 12 });
   assert.deepEqual(msg('decode_rate'), { entries: [{ encoding: 3, triangles: 120000, seconds: 0.0125 },
     { encoding: 4, triangles: 30000, seconds: 0.01 }] });
+  const x = msg('exact');
+  assert.deepEqual([x.request_id, x.key, Array.from(x.bits)],
+    [3, { seed: [4, 5, 6], level: 2, iso: 105.5, refinement: true }, [0x5a, 0x81]]);
 });
 
-test('stream-all splits into its ten frames, whatever the chunks', () => {
+test('stream-all splits into its eleven frames, whatever the chunks', () => {
   const stream = read(corpus, 'stream-all').subarray(2);
   for (const chunk of [1, 5, 13, 1000]) {
     const s = new FrameSplitter();
     const frames = [];
     for (let i = 0; i < stream.length; i += chunk) frames.push(...s.push(stream.subarray(i, i + chunk)));
     assert.deepEqual(frames.map((f) => decodeFrame(f).name),
-      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye', 'session', 'decode_rate'],
+      ['hello', 'ready', 'request', 'group', 'visible', 'end_of_frame', 'error', 'bye', 'session', 'decode_rate', 'exact'],
       `chunks of ${chunk}`);
   }
 });
@@ -105,11 +108,25 @@ test('round trips of what the page sends: hello, request, decode_rate, bye', () 
   assert.equal(encodePayload(MsgType.request, sampleRequest()).length, 111);
 });
 
+test('a hello that takes exact values is version 3, with or without a role, as the C++ writes it', () => {
+  const mine = { protocol_version: 1, dataset: 'head', token: '', encoding: 255, takes_exact: true };
+  const p = encodePayload(MsgType.hello, mine);
+  assert.equal(p[0], 3);
+  assert.deepEqual(decodePayload(MsgType.hello, p), { ...mine, role: 0, session: '' });
+  const presenter = { ...mine, role: 1, session: 'class 3b' };
+  assert.deepEqual(decodePayload(MsgType.hello, encodePayload(MsgType.hello, presenter)), presenter);
+  const flag = encodePayload(MsgType.hello, mine);
+  flag[flag.length - 1] = 2;
+  assert.throws(() => decodePayload(MsgType.hello, flag), /^WireError: hello message: takes_exact: expected 0 or 1, got 2$/);
+  const named = encodePayload(MsgType.hello, { ...mine, session: 'x' });
+  assert.throws(() => decodePayload(MsgType.hello, named), /^WireError: hello message: session: a name without a role$/);
+});
+
 test('decoders name the message and the field', () => {
   const hello = encodePayload(MsgType.hello, { protocol_version: 1, dataset: 'phantom', token: '', encoding: 3 });
   assert.throws(() => decodePayload(MsgType.hello, hello.subarray(0, 5)), /^WireError: hello message: truncated$/);
   assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([...hello, 0])), /hello message: 1 trailing bytes/);
-  assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([3, ...hello.subarray(1)])), /hello message: version 3, expected 1/);
+  assert.throws(() => decodePayload(MsgType.hello, new Uint8Array([4, ...hello.subarray(1)])), /hello message: version 4, expected 3/);
   const empty = encodePayload(MsgType.hello, { protocol_version: 1, dataset: 'x', token: '', encoding: 3 });
   empty[11] = 0x07;  // the dataset's one byte
   assert.throws(() => decodePayload(MsgType.hello, empty), /hello message: dataset: byte 0 is 7, expected printable ASCII/);
@@ -135,7 +152,7 @@ test('decoders name the message and the field', () => {
   assert.throws(() => decodePayload(MsgType.decode_rate, rate([one, { ...one, encoding: 3 }])), /entries.encoding: 3 after 4, expected ascending/);
   assert.throws(() => decodePayload(MsgType.decode_rate, rate([{ ...one, seconds: -1 }])), /entries.seconds: -1, expected >= 0/);
   assert.throws(() => decodePayload(MsgType.decode_rate, rate([{ ...one, seconds: NaN }])), /entries.seconds: expected a finite number, got NaN/);
-  assert.throws(() => decodePayload(11, new Uint8Array([1])), /view protocol: unknown message type 11/);
+  assert.throws(() => decodePayload(12, new Uint8Array([1])), /view protocol: unknown message type 12/);
 });
 
 test('headers are checked before the payload', () => {
@@ -143,7 +160,7 @@ test('headers are checked before the payload', () => {
   const h = (patch) => { const b = f.slice(); patch(b); return b; };
   assert.throws(() => decodeHeader(h((b) => { b[0] = 0x58; })), /view protocol header: magic: expected 49 57 56 50 \("IWVP"\), got 58 57 56 50/);
   assert.throws(() => decodeHeader(h((b) => { b[4] = 2; })), /header: version: expected 1, got 2/);
-  assert.throws(() => decodeHeader(h((b) => { b[6] = 11; })), /header: type: expected 1..10, got 11/);
+  assert.throws(() => decodeHeader(h((b) => { b[6] = 12; })), /header: type: expected 1..11, got 12/);
   assert.throws(() => decodeHeader(h((b) => { b[11] = 0x10; })), /header: length: 268435457 bytes is over the limit of 67108864 \(bye message\)/);
   assert.throws(() => decodeFrame(new Uint8Array([...f, 0])), /header: length: the header says 1 payload bytes, the frame holds 2/);
 });

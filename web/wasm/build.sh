@@ -31,7 +31,8 @@ sources=("$here/cells_wasm.cpp" "$root/remote/cell_codec.cpp" "$root/remote/cell
 # ENVIRONMENT web: node (the tests, the bench) runs it too, as it has atob and WebAssembly; the
 # node environment would reach for require and __dirname, which an ES module lacks.
 exports='["_cells_decode","_cells_vertex_count","_cells_positions","_cells_normals",'
-exports+='"_cells_index_count","_cells_indices","_cells_error","_cells_alloc","_cells_free"]'
+exports+='"_cells_index_count","_cells_indices","_cells_stepped","_cells_error","_cells_alloc",'
+exports+='"_cells_free"]'
 tmp="$out.tmp.js"
 # emcc's JavaScript passes need acorn, which Debian installs for its own nodejs under
 # /usr/share/nodejs; another node (NodeSource's) looks there only through NODE_PATH.

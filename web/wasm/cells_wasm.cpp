@@ -27,19 +27,24 @@ constexpr int kCellsOk = 0, kCellsMalformed = 1, kCellsOutOfMemory = 2;
 // The last decode's mesh, or its error: what the accessors read.
 isowall::Mesh g_mesh;
 std::string g_error;
+bool g_stepped = false;
 
 }  // namespace
 
 extern "C" {
 
 // Decodes the `size` bytes at `body` (a cells body, past its zstd frame) at isovalue `iso`; the
-// body must be whole: trailing bytes are an error, as in decode_group.
-int cells_decode(const std::uint8_t* body, std::size_t size, double iso) {
+// body must be whole: trailing bytes are an error, as in decode_group. With has_exact, the
+// `exact_size` bytes at `exact` are its gradients' exact values (an ExactMsg's bits).
+int cells_decode(const std::uint8_t* body, std::size_t size, double iso, const std::uint8_t* exact,
+                 std::size_t exact_size, int has_exact) {
     g_mesh = {};
     g_error.clear();
+    g_stepped = false;
     try {
         isowall::remote::ByteReader r(std::span(body, size), "group");
-        g_mesh = isowall::remote::decode_cell_body(r, iso);
+        const std::span<const std::uint8_t> bits(exact, exact_size);
+        g_mesh = isowall::remote::decode_cell_body(r, iso, {has_exact ? &bits : nullptr, &g_stepped});
         r.finish();
         return kCellsOk;
     } catch (const isowall::WireError& e) {
@@ -69,6 +74,10 @@ std::uint32_t cells_index_count() {
 }
 const std::uint32_t* cells_indices() {
     return g_mesh.indices.data();
+}
+// Whether the last body decoded had its gradients' voxels to a step (exact values may follow).
+int cells_stepped() {
+    return g_stepped ? 1 : 0;
 }
 // The last failure's message, empty after a success.
 const char* cells_error() {

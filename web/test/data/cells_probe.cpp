@@ -15,7 +15,9 @@
 // OUT: u32 group count, then per group (little endian)
 //   name: u32 length, bytes; cells: u32 length, the encoded group (its encoding byte says whether
 //   it went as cells: a coarse pass may not, see group_codec.h); compact+zstd: u32 length, bytes;
-//   the decoded mesh: u32 vertex count V, u32 index count I, V x 3 f32 positions, V x 3 f32
+//   exact: u32 length, the bits of its ExactMsg (empty unless its gradients went to a step: the
+//   "-stepped" groups, as the server sends them to a client that takes exact values); the decoded
+//   mesh (with the exact bits): u32 vertex count V, u32 index count I, V x 3 f32 positions, V x 3 f32
 //   normals, I x u32 indices.
 #include <algorithm>
 #include <chrono>
@@ -43,7 +45,8 @@ using Clock = std::chrono::steady_clock;
 struct Entry {
     std::string name;
     std::vector<std::uint8_t> cells, compact;
-    Mesh mesh;  // decode_group(cells)
+    std::vector<std::uint8_t> exact;  // its gradients' exact values (ExactMsg), if stepped
+    Mesh mesh;                        // decode_group(cells), with `exact`
 };
 
 class Out {
@@ -79,6 +82,7 @@ void write(const std::filesystem::path& path, const std::vector<Entry>& entries)
         o.bytes(std::span(reinterpret_cast<const std::uint8_t*>(e.name.data()), e.name.size()));
         o.bytes(e.cells);
         o.bytes(e.compact);
+        o.bytes(e.exact);
         o.u32(e.mesh.vertex_count());
         o.u32(e.mesh.indices.size());
         o.raw(e.mesh.positions.data(), e.mesh.positions.size() * sizeof(glm::vec3));
@@ -98,12 +102,12 @@ float grid_step(const Volume& v) {
     return position_grid_step(2 * std::max({far.x, far.y, far.z}));
 }
 
-Entry entry(std::string name, const Group& g, const Volume& v) {
-    Entry e{std::move(name),
-            encode_group(g, GroupEncoding::cells, grid_step(v), &v),
-            encode_group(g, GroupEncoding::compact_zstd, grid_step(v)),
-            {}};
-    e.mesh = decode_group(e.cells).mesh;
+// With `stepped`, the group as the server sends it to a client that takes exact values.
+Entry entry(std::string name, const Group& g, const Volume& v, bool stepped = false) {
+    Entry e{std::move(name), {}, encode_group(g, GroupEncoding::compact_zstd, grid_step(v)), {}, {}};
+    e.cells = encode_group(g, GroupEncoding::cells, grid_step(v), &v, stepped ? &e.exact : nullptr);
+    const std::span<const std::uint8_t> bits(e.exact);
+    e.mesh = decode_group(e.cells, {e.exact.empty() ? nullptr : &bits, nullptr}).mesh;
     return e;
 }
 
@@ -124,6 +128,9 @@ void passes(std::vector<Entry>& out, const std::string& name, const Volume& v, d
             int max_count, bool coarse) {
     const auto fine = sample_groups(v, iso, 5, max_count);
     out.push_back(entry(name + "-cells", fine.at(0), v));
+    // Integer voxels whose crossed edges span values enough: the gradients go to a step.
+    if (Entry s = entry(name + "-stepped", fine.at(0), v, true); !s.exact.empty())
+        out.push_back(std::move(s));
     if (!coarse) return;
     const auto meta = sample_groups(v, iso, 5, max_count / 4, uniform_levels(2));
     out.push_back(entry(name + "-level2", meta.at(0), v));
@@ -138,7 +145,7 @@ int reference(const std::filesystem::path& out, const std::filesystem::path& cor
     // The seed corpus's cells groups, decoded as they are.
     for (const char* seed :
          {"cells-phantom-cells", "cells-phantom-level2", "cells-phantom-refinement"}) {
-        Entry e{std::string("corpus-") + seed, read_file(corpus / seed), {}, {}};
+        Entry e{std::string("corpus-") + seed, read_file(corpus / seed), {}, {}, {}};
         const Group g = decode_group(e.cells);
         e.compact = encode_group(g, GroupEncoding::compact_zstd);
         e.mesh = g.mesh;
