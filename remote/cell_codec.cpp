@@ -23,7 +23,9 @@ constexpr std::uint64_t kMaxPlacesPerByte = 384;
 enum class Normals : std::uint8_t { gradients = 0, faces = 1 };
 // A body of face normals steps every phase (a coarse pass); one of gradient normals only the
 // gradients' voxels, the last phase (a full-resolution group sent to a step first).
-int first_stepped_phase(Normals n) { return n == Normals::faces ? 0 : cells::kValuePhases - 1; }
+int first_stepped_phase(Normals n) {
+    return n == Normals::faces ? 0 : cells::kValuePhases - 1;
+}
 
 // The units' triangles, as both sides emit them: the same order, the same vertex per edge.
 template <class View>

@@ -67,8 +67,8 @@ inline constexpr int kMaxCellVolumeSide = 1 << 20;
 // its gradients' voxels to a step (the values that make only its normals: every vertex stays
 // where it is, the shading moves a little) and their exact offsets go to *exact (cell_exact.h),
 // for a later message; *exact is left empty when the body is exact as it is.
-std::optional<std::vector<std::uint8_t>> encode_cell_body(const Group& group, const Volume& volume,
-                                                          std::vector<std::uint8_t>* exact = nullptr);
+std::optional<std::vector<std::uint8_t>> encode_cell_body(
+    const Group& group, const Volume& volume, std::vector<std::uint8_t>* exact = nullptr);
 
 // What decoding a body may take and tell beside its mesh.
 struct CellExact {

@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-
 namespace isowall::remote::cells {
 
 class ExactBitsWriter {
@@ -19,8 +18,8 @@ class ExactBitsWriter {
     void put(std::uint64_t offset, int bits) {
         for (int b = 0; b < bits; ++b, ++used_) {
             if (used_ % 8 == 0) bytes_.push_back(0);
-            bytes_.back() = static_cast<std::uint8_t>(bytes_.back() | ((offset >> b) & 1u)
-                                                                          << (used_ % 8));
+            bytes_.back() =
+                static_cast<std::uint8_t>(bytes_.back() | ((offset >> b) & 1u) << (used_ % 8));
         }
     }
     std::vector<std::uint8_t> take() { return std::move(bytes_); }
@@ -40,7 +39,8 @@ inline std::string exact_bits_problem(std::span<const std::uint8_t> bytes, std::
                std::to_string(need) + " for " + std::to_string(count) + " values of " +
                std::to_string(bits) + " bits";
     const std::uint64_t tail = count * static_cast<std::uint64_t>(bits) % 8;
-    if (tail != 0 && (bytes.back() >> tail) != 0) return "the exact values' unused bits are not zero";
+    if (tail != 0 && (bytes.back() >> tail) != 0)
+        return "the exact values' unused bits are not zero";
     return {};
 }
 

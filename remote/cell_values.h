@@ -256,9 +256,9 @@ class ValueWriter {
                            static_cast<Residual<T>>(zigzag(k - bins_.of(guess.value))));
                 kept = bins_.middle(k);
                 if (exact_)
-                    exact_->put(static_cast<std::uint64_t>(static_cast<std::int64_t>(value) -
-                                                           bins_.low(k)),
-                                bins_.shift);
+                    exact_->put(
+                        static_cast<std::uint64_t>(static_cast<std::int64_t>(value) - bins_.low(k)),
+                        bins_.shift);
             }
             held.set(p, kept);
             previous = kept;
@@ -354,7 +354,8 @@ class ValueReader {
     // Whether values went to a step that exact bits could undo.
     bool stepped() const { return any_stepped_; }
     // Puts every stepped value back at its exact value: its bin's least integer plus its offset
-    // from `exact` (cell_exact.h; WireError for bits that do not fit the values, or a value past T).
+    // from `exact` (cell_exact.h; WireError for bits that do not fit the values, or a value past
+    // T).
     void apply_exact(BoxVoxels<T>& held, std::span<const std::uint8_t> exact) const {
         if constexpr (std::is_integral_v<T>) {
             if (!undoable_) r_.fail("exact values: the body's step is not one they undo");
@@ -364,7 +365,8 @@ class ValueReader {
             ExactBitsReader bits(exact);
             for (const glm::ivec3 p : stepped_) {
                 const std::int64_t k = bins_.of(held.at(p.x, p.y, p.z));
-                const std::int64_t v = bins_.low(k) + static_cast<std::int64_t>(bits.get(bins_.shift));
+                const std::int64_t v =
+                    bins_.low(k) + static_cast<std::int64_t>(bits.get(bins_.shift));
                 if (v < static_cast<std::int64_t>(std::numeric_limits<T>::lowest()) ||
                     v > static_cast<std::int64_t>(std::numeric_limits<T>::max()))
                     r_.fail("exact values: a value past the voxel type");

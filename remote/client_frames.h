@@ -111,9 +111,9 @@ class ClientFrames {
         std::size_t final_index = 0;
     };
     std::vector<Stepped> stepped_;
-    bool replaced_ = false;  // an exact mesh took a stepped one's place: redraw at the end
-    std::vector<Cached> cache_;                        // index = slot in generation cache_gen_
-    std::uint64_t cache_gen_ = 0;                      // 0: none yet
+    bool replaced_ = false;        // an exact mesh took a stepped one's place: redraw at the end
+    std::vector<Cached> cache_;    // index = slot in generation cache_gen_
+    std::uint64_t cache_gen_ = 0;  // 0: none yet
     ClientFrameResult result_;
     // Decoded since the last report, by encoding id (DecodeRateMsg).
     std::array<DecodeRateMsg::Entry, kDecodeRateEncodings> decoded_{};

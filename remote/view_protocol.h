@@ -194,9 +194,9 @@ struct ByeMsg {
     static constexpr std::uint8_t kVersion = 1;
 };
 
-using RemoteMessage = std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg,
-                                   EndOfFrameMsg, ErrorMsg, ByeMsg, SessionMsg, DecodeRateMsg,
-                                   ExactMsg>;
+using RemoteMessage =
+    std::variant<HelloMsg, ReadyMsg, RequestMsg, GroupMsg, VisibleMsg, EndOfFrameMsg, ErrorMsg,
+                 ByeMsg, SessionMsg, DecodeRateMsg, ExactMsg>;
 
 // The payload of a message (what follows the frame header).
 std::vector<std::byte> encode_payload(const RemoteMessage& m);

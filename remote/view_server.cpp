@@ -114,9 +114,10 @@ class ViewServer::Client {
         }
         for (const Dataset& d : server_.datasets_)
             if (d.name == h->dataset) {
-                hello_encoding_ = h->encoding;
-                // A shared session's groups go to every member alike: exact for all of them.
-                takes_exact_ = h->takes_exact && h->role == SessionRole::none;
+                options_ = server_.options_.session;
+                apply_hello_encoding(h->encoding, options_.encoding, options_.adaptive);
+                // A shared session's groups go to all its members alike: exact.
+                options_.exact_after = h->takes_exact && h->role == SessionRole::none;
                 if (h->role == SessionRole::none) return &d;
                 std::string why;
                 seat_ = server_.hub_.join(*h, conn_.peer(), why);
@@ -165,12 +166,9 @@ class ViewServer::Client {
         conn_.send(ready);
         if (server_.options_.rate_bits_per_s > 0) conn_.set_rate(server_.options_.rate_bits_per_s);
         say("serve: %s: dataset %s%s\n", d.name);
-        SessionOptions so = server_.options_.session;
-        apply_hello_encoding(hello_encoding_, so.encoding, so.adaptive);
-        so.exact_after = takes_exact_;
-        so.link_cap_bytes_per_s = server_.options_.rate_bits_per_s / 8;
+        options_.link_cap_bytes_per_s = server_.options_.rate_bits_per_s / 8;
         session_ =
-            std::make_unique<ServerSession>(*d.extractor, so, [this](const RemoteMessage& m) {
+            std::make_unique<ServerSession>(*d.extractor, options_, [this](const RemoteMessage& m) {
                 touch();             // the client's silence counts from the send's start
                 computing_ = false;  // a send the client does not read counts as idle
                 const std::size_t bytes = conn_.send(m);
@@ -323,8 +321,7 @@ class ViewServer::Client {
     std::unique_ptr<SessionSeat> seat_;  // in a shared session
     std::uint64_t status_seen_ = 0;
     std::atomic<bool> worker_done_{false};
-    std::uint8_t hello_encoding_ = 0;  // what the hello asked for (apply_hello_encoding)
-    bool takes_exact_ = false;         // the hello's takes_exact, for a client of its own
+    SessionOptions options_;  // the server's, with what the hello asked for
     std::unique_ptr<ServerSession> session_;
     std::thread thread_, worker_;
     NewestRequest<RequestMsg> requests_;      // the reader puts, the worker takes

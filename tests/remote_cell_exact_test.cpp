@@ -28,7 +28,8 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 Mesh decode_two(const Bytes& group, const Bytes* exact, bool* stepped = nullptr) {
-    const std::span<const std::uint8_t> bits = exact ? std::span(*exact) : std::span<const std::uint8_t>();
+    const std::span<const std::uint8_t> bits =
+        exact ? std::span(*exact) : std::span<const std::uint8_t>();
     return decode_group(group, {exact ? &bits : nullptr, stepped}).mesh;
 }
 
@@ -44,7 +45,8 @@ struct ExactTally {
 };
 
 // Every group of `groups` both ways; returns what it saw.
-ExactTally exact_check_groups(const std::vector<Group>& groups, const Volume& v, const std::string& what) {
+ExactTally exact_check_groups(const std::vector<Group>& groups, const Volume& v,
+                              const std::string& what) {
     ExactTally t;
     for (const Group& g : groups) {
         const Bytes whole = encode_group(g, GroupEncoding::cells, 0, &v);
@@ -79,17 +81,19 @@ ExactTally exact_check_groups(const std::vector<Group>& groups, const Volume& v,
         EXPECT_EQ(back.indices, want.indices) << what << " " << g.key();
         if (testing::Test::HasFailure()) break;
     }
-    std::printf("%s: %zu groups, %zu stepped; bytes %zu exact, %zu + %zu in two (%.3f first); "
-                "normals %.2f degrees apart on average, %.1f at most\n",
-                what.c_str(), t.groups, t.stepped, t.bytes_exact, t.bytes_first, t.bytes_after,
-                double(t.bytes_first) / double(t.bytes_exact),
-                t.vertices ? t.angle_sum / double(t.vertices) : 0.0, t.angle_max);
+    std::printf(
+        "%s: %zu groups, %zu stepped; bytes %zu exact, %zu + %zu in two (%.3f first); "
+        "normals %.2f degrees apart on average, %.1f at most\n",
+        what.c_str(), t.groups, t.stepped, t.bytes_exact, t.bytes_first, t.bytes_after,
+        double(t.bytes_first) / double(t.bytes_exact),
+        t.vertices ? t.angle_sum / double(t.vertices) : 0.0, t.angle_max);
     return t;
 }
 
 TEST(RemoteCellExact, ThePhantomsGroupsComeExactFromBothMessages) {
     const Volume v = make_phantom();
-    const ExactTally t = exact_check_groups(sample_groups(v, kPhantomSkinIso, 24, 2000), v, "phantom");
+    const ExactTally t =
+        exact_check_groups(sample_groups(v, kPhantomSkinIso, 24, 2000), v, "phantom");
     EXPECT_GT(t.groups, 0u);
 }
 
@@ -117,7 +121,7 @@ TEST(RemoteCellExact, EverySharedVolumeComesExactFromBothMessages) {
     for (const auto& [name, iso] : cases) {
         const Volume v = load_volume(*data / (name + ".nhdr"), std::nullopt);
         const ExactTally t = exact_check_groups(sample_groups(v, iso, 16, 2000), v,
-                                     name + " at " + std::to_string(int(iso)));
+                                                name + " at " + std::to_string(int(iso)));
         if (testing::Test::HasFailure()) return;
         if (v.type() == VoxelType::u16) {
             EXPECT_GT(t.stepped, t.groups / 2) << name << ": 16-bit gradients go to a step";
@@ -159,7 +163,7 @@ TEST(RemoteCellExactMalformed, OffsetsOfTheWrongLengthOrWithStrayBitsThrow) {
     ASSERT_NO_THROW(decode_two(s->group, &s->exact));
     for (std::size_t n = 0; n < s->exact.size(); ++n)
         exact_expect_wire_error(s->group, Bytes(s->exact.begin(), s->exact.begin() + long(n)),
-                          "cut to " + std::to_string(n) + " bytes");
+                                "cut to " + std::to_string(n) + " bytes");
     Bytes longer = s->exact;
     longer.push_back(0);
     exact_expect_wire_error(s->group, longer, "a byte over");

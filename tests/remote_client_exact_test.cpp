@@ -44,7 +44,8 @@ SkinMessages skin_messages(bool exact_only) {
     s.request.view = {cam, cam.frustum(float(w) / h), w, h, kPhantomSkinIso};
     for (const Group& g : sample_groups(v, kPhantomSkinIso, 24, 2000)) {
         std::vector<std::uint8_t> exact;
-        const auto bytes = encode_group(g, GroupEncoding::cells, 0, &v, exact_only ? nullptr : &exact);
+        const auto bytes =
+            encode_group(g, GroupEncoding::cells, 0, &v, exact_only ? nullptr : &exact);
         s.groups.push_back({4, g.key(), false, 0, as_wire(bytes)});
         if (!exact.empty()) s.exacts.push_back({4, g.key(), as_wire(exact)});
     }

@@ -101,18 +101,17 @@ TEST(RemoteProtocolMalformed, ExactHelloFields) {
         what = e.what();
     }
     EXPECT_NE(what.find("takes_exact: expected 0 or 1, got 2"), std::string::npos) << what;
-    expect_faults<HelloMsg>(exact, {{"session: a name without a role",
-                                     [](HelloMsg& m) { m.session.assign(1, 'x'); }},
-                                    {"role: 3, expected 0 (none), 1 (presenter) or 2 (follower)",
-                                     [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
+    expect_faults<HelloMsg>(
+        exact, {{"session: a name without a role", [](HelloMsg& m) { m.session.assign(1, 'x'); }},
+                {"role: 3, expected 0 (none), 1 (presenter) or 2 (follower)",
+                 [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
 }
 
 TEST(RemoteProtocolMalformed, ExactFields) {
-    expect_faults<ExactMsg>(sample_exact(),
-                            {{"key.level: expected 0..30, got 31",
-                              [](ExactMsg& m) { m.key.level = 31; }},
-                             {"key.iso: expected a finite number",
-                              [](ExactMsg& m) { m.key.iso = kNaN; }}});
+    expect_faults<ExactMsg>(
+        sample_exact(),
+        {{"key.level: expected 0..30, got 31", [](ExactMsg& m) { m.key.level = 31; }},
+         {"key.iso: expected a finite number", [](ExactMsg& m) { m.key.iso = kNaN; }}});
     EXPECT_NO_THROW(decode_payload(RemoteTag::exact, encode_payload(ExactMsg{})));
 }
 

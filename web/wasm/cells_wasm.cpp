@@ -44,7 +44,8 @@ int cells_decode(const std::uint8_t* body, std::size_t size, double iso, const s
     try {
         isowall::remote::ByteReader r(std::span(body, size), "group");
         const std::span<const std::uint8_t> bits(exact, exact_size);
-        g_mesh = isowall::remote::decode_cell_body(r, iso, {has_exact ? &bits : nullptr, &g_stepped});
+        g_mesh =
+            isowall::remote::decode_cell_body(r, iso, {has_exact ? &bits : nullptr, &g_stepped});
         r.finish();
         return kCellsOk;
     } catch (const isowall::WireError& e) {

@@ -17,8 +17,8 @@
 //   it went as cells: a coarse pass may not, see group_codec.h); compact+zstd: u32 length, bytes;
 //   exact: u32 length, the bits of its ExactMsg (empty unless its gradients went to a step: the
 //   "-stepped" groups, as the server sends them to a client that takes exact values); the decoded
-//   mesh (with the exact bits): u32 vertex count V, u32 index count I, V x 3 f32 positions, V x 3 f32
-//   normals, I x u32 indices.
+//   mesh (with the exact bits): u32 vertex count V, u32 index count I, V x 3 f32 positions, V x 3
+//   f32 normals, I x u32 indices.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -104,7 +104,8 @@ float grid_step(const Volume& v) {
 
 // With `stepped`, the group as the server sends it to a client that takes exact values.
 Entry entry(std::string name, const Group& g, const Volume& v, bool stepped = false) {
-    Entry e{std::move(name), {}, encode_group(g, GroupEncoding::compact_zstd, grid_step(v)), {}, {}};
+    Entry e{
+        std::move(name), {}, encode_group(g, GroupEncoding::compact_zstd, grid_step(v)), {}, {}};
     e.cells = encode_group(g, GroupEncoding::cells, grid_step(v), &v, stepped ? &e.exact : nullptr);
     const std::span<const std::uint8_t> bits(e.exact);
     e.mesh = decode_group(e.cells, {e.exact.empty() ? nullptr : &bits, nullptr}).mesh;
