@@ -5,6 +5,7 @@
 #include <string>
 
 #include "common/extract/edge_cache.h"
+#include "common/volume/load_checks.h"
 #include "remote/cell_values.h"
 #include "remote/cell_voxels.h"
 #include "remote/group_codec.h"
@@ -186,6 +187,7 @@ Mesh decode_typed(ByteReader& r, glm::ivec3 dims, glm::vec3 spacing, double iso,
     // A coarse pass's values went to a step of their own, which nothing undoes.
     const bool undoable = normals == Normals::gradients && values.stepped();
     if (x.stepped) *x.stepped = undoable;
+    if (x.exact_bytes) *x.exact_bytes = undoable ? values.exact_bytes() : 0;
     if (x.exact) {
         if (!undoable) r.fail("exact values: the body has no values to make exact");
         values.apply_exact(held, *x.exact);
@@ -228,6 +230,11 @@ Mesh decode_cell_body(ByteReader& r, double iso, const CellExact& x) {
         spacing[a] = r.get<float>();
         if (!(spacing[a] > 0) || !std::isfinite(spacing[a]))
             r.fail("spacing: expected a positive finite number, got " + std::to_string(spacing[a]));
+        // As a volume that loads (load_checks.h): a side past it puts positions past a float.
+        if (double(spacing[a]) * (dims[a] - 1) > kMaxVolumeSide)
+            r.fail("spacing: " + std::to_string(spacing[a]) + " makes the volume " +
+                   std::to_string(double(spacing[a]) * (dims[a] - 1)) +
+                   " units a side, over the limit " + std::to_string(kMaxVolumeSide));
     }
     const auto normals = r.get<std::uint8_t>();
     if (normals > static_cast<std::uint8_t>(Normals::faces))

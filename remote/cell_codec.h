@@ -76,6 +76,7 @@ struct CellExact {
     // WireError when they do not fit the body's stepped values, or the body has none.
     const std::span<const std::uint8_t>* exact = nullptr;
     bool* stepped = nullptr;  // set: whether the body went to a step that exact offsets undo
+    std::size_t* exact_bytes = nullptr;  // set: how many bytes of them it takes (0: exact)
 };
 // The mesh a cells body gives at `iso`; throws WireError on anything malformed or truncated.
 Mesh decode_cell_body(ByteReader& r, double iso, const CellExact& x = {});

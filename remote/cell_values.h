@@ -353,6 +353,10 @@ class ValueReader {
     }
     // Whether values went to a step that exact bits could undo.
     bool stepped() const { return any_stepped_; }
+    // How many bytes the exact offsets of the stepped values take (undoable bodies).
+    std::size_t exact_bytes() const {
+        return (stepped_.size() * static_cast<std::size_t>(bins_.shift) + 7) / 8;
+    }
     // Puts every stepped value back at its exact value: its bin's least integer plus its offset
     // from `exact` (cell_exact.h; WireError for bits that do not fit the values, or a value past
     // T).

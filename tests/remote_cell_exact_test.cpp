@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 #include <random>
 #include <span>
@@ -197,6 +198,27 @@ TEST(RemoteCellExactMalformed, SeededMutationsOfTheOffsetsDecodeOrThrow) {
             decode_two(s->group, &m);  // any offset in a bin is a value: a mesh, not a crash
         } catch (const WireError&) {
         }
+    }
+}
+
+// Found by the cell_body fuzzer (fuzz/regressions/cell_body/spacing-past-a-float-side): a
+// spacing of 8.5e37 passed as finite, and the positions it made were not.
+TEST(RemoteCellExactMalformed, ASpacingThatPutsPositionsPastAFloatThrows) {
+    const Volume v = make_phantom();
+    const Group g = sample_groups(v, kPhantomSkinIso, 4, 30).at(0);
+    Bytes body = encode_cell_body(g, v).value();
+    // Voxel type u8, dims 3 x i32, then the spacing's x: 1e7 units a side at most.
+    for (const float sx : {8.5e37f, 1e7f / 199 * 1.001f}) {
+        Bytes b = body;
+        std::memcpy(b.data() + 1 + 12, &sx, sizeof sx);
+        ByteReader r(b, "cells");
+        std::string what;
+        try {
+            decode_cell_body(r, g.iso);
+        } catch (const WireError& e) {
+            what = e.what();
+        }
+        EXPECT_NE(what.find("over the limit"), std::string::npos) << sx << ": " << what;
     }
 }
 
