@@ -28,12 +28,26 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
     return std::max({server, rate > 0 ? s.bytes / s.triangles / rate : 0.0, client});
 }
 
-GroupEncoding EncodingChooser::best() const {
+bool EncodingChooser::probing() const {
     // The link is unknown until two sends waited (the first one's rate says little), or until
-    // kProbeSends went with none waiting (buffers absorb them: a fast link): cells, fewer bytes.
-    const bool probing =
-        blocked_sends_ == 0 ? cells_.sends + compact_.sends < kProbeSends : blocked_sends_ < 2;
-    if (probing && link_cap_ <= 0) return GroupEncoding::cells;
+    // kProbeSends went with none waiting (buffers absorb them: a fast link).
+    return blocked_sends_ == 0 ? cells_.sends + compact_.sends < kProbeSends : blocked_sends_ < 2;
+}
+
+bool EncodingChooser::steps_pay() const {
+    const double rate = bytes_per_s();
+    if (rate <= 0) return probing();
+    if (cells_.groups == 0) return rate < kCellsPayBelow;
+    const Estimate& s = cells_;
+    const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
+    const double server = making + s.seconds / s.triangles;
+    const double client = s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0;
+    return s.bytes / s.triangles / rate > std::max(server, client);
+}
+
+GroupEncoding EncodingChooser::best() const {
+    // While the link is unknown: cells, fewer bytes.
+    if (probing() && link_cap_ <= 0) return GroupEncoding::cells;
     // Cells cannot pay on a link known to be fast: they are not even measured (wants_measure).
     if (cells_.groups == 0 && fast_link()) return GroupEncoding::compact_zstd;
     // Nothing to weigh yet (the session measures both with the first group, after sending it):

@@ -96,6 +96,14 @@ class EncodingChooser {
     double bytes_per_s() const;
     // Groups sent in `e`.
     std::uint64_t chosen(GroupEncoding e) const { return slot(e).sends; }
+    // Whether a cells group's gradients' voxels should go to a step first, their exact values
+    // after (cell_codec.h): where the link bounds cells (their bytes a triangle over the rate take
+    // longer than the server's work and the client's decoding), fewer bytes first bring the
+    // picture sooner; where the server or the client bounds them, a step brings nothing sooner
+    // and costs a second decoding and 2-3% more bytes. While the link is unknown, yes (cells go
+    // then for their fewer bytes); on one whose sends never waited, no (bytes cost no time);
+    // before cells are measured, below kCellsPayBelow.
+    bool steps_pay() const;
 
   private:
     struct Estimate {
@@ -109,6 +117,8 @@ class EncodingChooser {
         return e == GroupEncoding::cells ? cells_ : compact_;
     }
     GroupEncoding best() const;
+    // The link is unknown: fewer than two sends waited for it, and fewer than kProbeSends went.
+    bool probing() const;
 
     Estimate cells_, compact_;
     double made_triangles_ = 0, making_s_ = 0;  // extraction, the same in either encoding

@@ -56,8 +56,6 @@ class ServerSession::Sink final : public GroupSink {
         const double making_s = s_.since_sent_.seconds();  // the engine made the group meanwhile
         // Encodes in `e` and tells the chooser what asking for `e` cost: cells fall back to
         // compact+zstd where that is smaller (a coarse pass), and the chooser learns it so.
-        // A group the client does not cache may go with its gradients' voxels to a step first.
-        const bool stepped_first = s_.options_.exact_after && s_.cache_gen_ == 0;
         std::vector<std::uint8_t> exact;
         const auto encode = [&](GroupEncoding e, std::vector<std::uint8_t>* x) {
             const Stopwatch encoding;
@@ -77,6 +75,10 @@ class ServerSession::Sink final : public GroupSink {
             asked = s_.chooser_.next();
             measure_other = s_.chooser_.wants_measure(other_encoding(asked));
         }
+        // A group the client does not cache may go with its gradients' voxels to a step first:
+        // when the server chooses, only where the link bounds cells.
+        const bool stepped_first =
+            s_.options_.exact_after && s_.cache_gen_ == 0 && (!adaptive || s_.chooser_.steps_pay());
         const std::vector<std::uint8_t> bytes = encode(asked, stepped_first ? &exact : nullptr);
         m.encoded.resize(bytes.size());
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),

@@ -157,6 +157,29 @@ TEST(EncodingChoice, TheServerAndTheLinkOverlap) {
 
 // Passes of a few triangles (a header each, and a while to find them) weigh by their triangles:
 // they do not swamp what thousands of triangles showed.
+// Gradients' voxels to a step first (cell_codec.h) only where the link bounds cells.
+TEST(EncodingChoice, StepsPayWhereTheLinkBoundsCells) {
+    EncodingChooser unknown;
+    EXPECT_TRUE(unknown.steps_pay()) << "the link unknown: fewer bytes first";
+    EncodingChooser fast;
+    run(fast, 0, 400);
+    EXPECT_FALSE(fast.steps_pay()) << "sends that never wait: bytes cost no time";
+    // 1 Mbit/s: cells' 1.2 B a triangle take 9.6 us on the link, the client 2 us: the link.
+    EncodingChooser slow;
+    run(slow, 125e3, 400, 2e-6);
+    EXPECT_TRUE(slow.steps_pay());
+    // 30 Mbit/s: 0.32 us on the link, the server 0.65 us and the client 2: not the link.
+    EncodingChooser client_bound;
+    run(client_bound, 3.75e6, 400, 2e-6);
+    EXPECT_FALSE(client_bound.steps_pay());
+    // A link the server paces, before cells are measured: the prior (kCellsPayBelow).
+    EncodingChooser paced_slow, paced_fast;
+    paced_slow.set_link_cap(125e3);
+    paced_fast.set_link_cap(12.5e6);
+    EXPECT_TRUE(paced_slow.steps_pay());
+    EXPECT_FALSE(paced_fast.steps_pay());
+}
+
 TEST(EncodingChoice, TinyPassesWeighByTheirTriangles) {
     EncodingChooser c;
     run(c, 0, 100);
