@@ -115,11 +115,7 @@ TEST(RemoteCellExact, ACoarsePassIsNeverSteppedForOffsets) {
 TEST(RemoteCellExact, EverySharedVolumeComesExactFromBothMessages) {
     const auto data = test::shared_data_dir();
     if (!data) GTEST_SKIP() << "../shared/data is absent: the shared volumes are not checked";
-    const std::vector<std::pair<std::string, double>> cases{
-        {"tooth", 620},     {"tooth", 1000},    {"cthead", 600},     {"cthead", 1650},
-        {"engine", 75},     {"engine", 190},    {"heptane", 50},     {"heptane", 200},
-        {"mrhead_t1", 112}, {"mrhead_t1", 490}, {"vhp_ct_head", 40}, {"vhp_ct_head", 105}};
-    for (const auto& [name, iso] : cases) {
+    for (const auto& [name, iso] : test::shared_isovalues()) {
         const Volume v = load_volume(*data / (name + ".nhdr"), std::nullopt);
         const ExactTally t = exact_check_groups(sample_groups(v, iso, 16, 2000), v,
                                                 name + " at " + std::to_string(int(iso)));
