@@ -184,35 +184,6 @@ class ValueModel {
     std::vector<BitProbability> tree_, first_, second_;
 };
 
-// A coarse pass's values to a step of 2^shift (cell_codec.h): bins aligned on the isovalue, so
-// every value keeps its side of it, and every unit its case and crossed edges; only where the
-// surface cuts an edge moves, by at most half a step over the edge's difference. A value goes as
-// its bin's difference to the predicted value's bin; both sides then hold the bin's middle.
-template <class T>
-struct Bins {
-    double iso = 0;
-    int shift = 0;  // 0: the values exact; else at least 2 (a difference of bins then fits T)
-
-    std::int64_t of(T v) const {
-        const double k = std::floor((static_cast<double>(v) - iso) / step());
-        constexpr double kFar = 0x1p62;  // past any bin of a 32-bit voxel's values
-        return static_cast<std::int64_t>(k < -kFar ? -kFar : k > kFar ? kFar : k);
-    }
-    // The bin's middle, rounded half up: on the isovalue's side of the bin (the step is 2 or
-    // more), and clamped into T, which keeps it in any bin a value of T was in.
-    T middle(std::int64_t k) const {
-        const double x = std::floor(iso + (static_cast<double>(k) + 0.5) * step() + 0.5);
-        const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
-        const double hi = static_cast<double>(std::numeric_limits<T>::max());
-        return static_cast<T>(x < lo ? lo : x > hi ? hi : x);
-    }
-    double step() const { return std::ldexp(1.0, shift); }
-    // The least integer in bin k: a value's exact offset in its bin counts from it.
-    std::int64_t low(std::int64_t k) const {
-        return static_cast<std::int64_t>(std::ceil(iso + static_cast<double>(k) * step()));
-    }
-};
-
 inline std::uint64_t zigzag(std::int64_t d) {
     return static_cast<std::uint64_t>(d) << 1 ^ static_cast<std::uint64_t>(d >> 63);
 }
