@@ -70,11 +70,11 @@ struct Viewer {
         ++frames;
         const ClientSample& last = r.timeline.back();
         std::printf(
-            "view: frame %d done in %.3f s: %llu bytes, %llu groups (%llu as cells), %llu named, "
-            "%llu triangles drawn\n",
+            "view: frame %d done in %.3f s: %llu bytes, %llu groups (%llu as cells), %llu made "
+            "exact after a step, %llu named, %llu triangles drawn\n",
             frames, last.time_s, (unsigned long long)last.bytes, (unsigned long long)last.groups,
-            (unsigned long long)last.cells, (unsigned long long)last.named,
-            (unsigned long long)last.triangles);
+            (unsigned long long)last.cells, (unsigned long long)last.exact,
+            (unsigned long long)last.named, (unsigned long long)last.triangles);
         for (double th : {0.90, 0.99, 0.999, 1.0}) {
             const ClientSample* hit = nullptr;
             for (const ClientSample& s : r.timeline)

@@ -123,6 +123,7 @@ void ClientFrames::handle_exact(const ExactMsg& x, std::size_t wire_bytes, doubl
     // The second decoding of a cells group is the client's work too (its triangles were counted).
     decoded_[static_cast<std::size_t>(GroupEncoding::cells)].seconds += decoding.seconds();
     now_.bytes += wire_bytes;
+    ++now_.exact;
     if (it->final_index != SIZE_MAX) {
         finals_[it->final_index] = mesh;
         // Over the stepped surface, which lies within a hair of it: the frame's end draws the

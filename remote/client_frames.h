@@ -40,6 +40,7 @@ struct ClientSample {
     std::uint64_t bytes = 0;      // received for this request, headers included
     std::uint64_t groups = 0;     // received (new groups) for this request
     std::uint64_t cells = 0;      // of them, in the cells encoding (the adaptive server's choice)
+    std::uint64_t exact = 0;      // of them, made exact after a step by an ExactMsg
     std::uint64_t named = 0;      // cached groups named visible
     std::uint64_t triangles = 0;  // drawn
     std::size_t ops = 0;          // draw steps done by then (for the replay)

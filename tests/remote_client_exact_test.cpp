@@ -58,7 +58,7 @@ EndOfFrameMsg end_of(const SkinMessages& s) {
     return e;
 }
 
-Image final_image(const SkinMessages& s, double* c_before_exact) {
+Image final_image(const SkinMessages& s, double* c_before_exact, std::uint64_t* exact = nullptr) {
     auto renderer = make_renderer("osmesa");
     ClientFrames frames(*renderer);
     frames.begin(s.request, 0);
@@ -70,6 +70,7 @@ Image final_image(const SkinMessages& s, double* c_before_exact) {
     frames.measure();
     for (const ClientSample& sample : frames.result().timeline)
         if (sample.time_s <= before + 1e-9) *c_before_exact = sample.correctness.c;
+    if (exact) *exact = frames.result().timeline.back().exact;
     return frames.result().final_image;
 }
 
@@ -78,12 +79,14 @@ TEST(ClientExact, TheFrameEndsOnTheImageOfTheExactGroups) {
     ASSERT_FALSE(two.exacts.empty()) << "the phantom's gradients go to a step";
     ASSERT_TRUE(one.exacts.empty());
     double c_stepped = 0, c_one = 0;
-    const Image got = final_image(two, &c_stepped);
+    std::uint64_t exact_count = 0;
+    const Image got = final_image(two, &c_stepped, &exact_count);
     const Image want = final_image(one, &c_one);
     std::printf("%zu groups, %zu stepped; C before the exact values %.5f\n", two.groups.size(),
                 two.exacts.size(), c_stepped);
     EXPECT_EQ(got.rgba, want.rgba) << "the final image is the exact groups' to the bit";
     EXPECT_GT(c_stepped, 0.99) << "the stepped groups draw the picture almost right";
+    EXPECT_EQ(exact_count, two.exacts.size()) << "the frame counts its exact messages";
     EXPECT_LT(c_stepped, 1.0) << "and not exactly: their normals moved";
 }
 
