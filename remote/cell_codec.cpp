@@ -61,7 +61,7 @@ constexpr double kCoarseStepOfEdge = 1.0 / 8;
 // A full-resolution group's gradient voxels (phase 3: the values that only make its normals) may
 // go to a step of a quarter of that median first, their exact offsets after (cell_exact.h): the
 // vertices stay where they are, so every pixel the surface covers is covered, and the shading
-// moves a little. Over the shared 16-bit volumes this drew the image to C = 99.7-99.8% of the
+// moves a little. Over the shared 16-bit volumes this drew the image to C = 99.6-99.8% of the
 // exact one for 10-13% fewer bytes (8-bit ones step little: their edges span fewer values).
 constexpr double kGradientStepOfEdge = 1.0 / 4;
 

@@ -26,7 +26,7 @@
 // range_coder.h); floating-point values as they are, in byte planes.
 //
 // A full-resolution group may go in two messages on a slow link: first with its gradients'
-// voxels to a step (only the shading moves: C = 99.7-99.8% of the exact image on the shared 16-bit
+// voxels to a step (only the shading moves: C = 99.6-99.8% of the exact image on the shared 16-bit
 // volumes), then their exact offsets (remote/cell_exact.h; the view protocol's ExactMsg), after
 // which the client decodes the body again with them and has the server's triangles to the bit.
 //

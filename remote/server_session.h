@@ -59,7 +59,7 @@ struct SessionOptions {
     // The client takes ExactMsg (its hello's takes_exact): a full-resolution cells group it does
     // not cache then goes with its gradients' voxels to a step, and their exact values follow
     // once the request's last group is out (remote/cell_codec.h). On the shared 16-bit volumes
-    // the image before them is 99.7-99.8% correct, for 10-13% fewer bytes.
+    // the image before them is 99.6-99.8% correct, for 10-13% fewer bytes.
     bool exact_after = false;
 };
 
