@@ -307,7 +307,6 @@ class ValueReader {
                     value = from_residual(*got, guess.value);
                 } else {
                     value = bins_.middle(bins_.of(guess.value) + unzigzag(*got));
-                    any_stepped_ = true;
                     if (undoable_) stepped_.push_back(p);
                 }
             } else {
@@ -322,8 +321,8 @@ class ValueReader {
     void finish() const {
         if (!coder_.at_end()) r_.fail("voxel values: the coded stream does not end there");
     }
-    // Whether values went to a step that exact bits could undo.
-    bool stepped() const { return any_stepped_; }
+    // Whether values went to a step that exact offsets undo (an undoable body's).
+    bool stepped() const { return !stepped_.empty(); }
     // How many bytes the exact offsets of the stepped values take (undoable bodies).
     std::size_t exact_bytes() const {
         return (stepped_.size() * static_cast<std::size_t>(bins_.shift) + 7) / 8;
@@ -333,7 +332,6 @@ class ValueReader {
     // T).
     void apply_exact(BoxVoxels<T>& held, std::span<const std::uint8_t> exact) const {
         if constexpr (std::is_integral_v<T>) {
-            if (!undoable_) r_.fail("exact values: the body's step is not one they undo");
             if (const std::string p = exact_bits_problem(exact, stepped_.size(), bins_.shift);
                 !p.empty())
                 r_.fail("exact values: " + p);
@@ -365,7 +363,7 @@ class ValueReader {
     ValueModel<T> model_;
     Bins<T> bins_;
     int first_stepped_;
-    bool undoable_, any_stepped_ = false;
+    bool undoable_;
     std::vector<glm::ivec3> stepped_;  // undoable: where values went to the step, in their order
     RangeDecoder coder_;
     std::uint64_t max_named_ = 0, stream_bytes_ = 0;

@@ -18,14 +18,18 @@ double EncodingChooser::bytes_per_s() const {
     return seen > 0 ? std::min(seen, link_cap_) : link_cap_;
 }
 
-double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
+EncodingChooser::Stages EncodingChooser::stages(GroupEncoding e) const {
     const Estimate& s = slot(e);
-    if (s.groups == 0) return 0;
+    if (s.groups == 0) return {};
     const double rate = bytes_per_s();
     const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
-    const double server = making + s.seconds / s.triangles;
-    const double client = s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0;
-    return std::max({server, rate > 0 ? s.bytes / s.triangles / rate : 0.0, client});
+    return {making + s.seconds / s.triangles, rate > 0 ? s.bytes / s.triangles / rate : 0.0,
+            s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0};
+}
+
+double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
+    const Stages s = stages(e);
+    return std::max({s.server, s.link, s.client});
 }
 
 bool EncodingChooser::probing() const {
@@ -38,11 +42,8 @@ bool EncodingChooser::steps_pay() const {
     const double rate = bytes_per_s();
     if (rate <= 0) return probing();
     if (cells_.groups == 0) return rate < kCellsPayBelow;
-    const Estimate& s = cells_;
-    const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
-    const double server = making + s.seconds / s.triangles;
-    const double client = s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0;
-    return s.bytes / s.triangles / rate > std::max(server, client);
+    const Stages s = stages(GroupEncoding::cells);
+    return s.link > std::max(s.server, s.client);
 }
 
 GroupEncoding EncodingChooser::best() const {

@@ -117,6 +117,12 @@ class EncodingChooser {
         return e == GroupEncoding::cells ? cells_ : compact_;
     }
     GroupEncoding best() const;
+    // The three stages of a triangle in `e` that overlap, in seconds (0 where unknown): the
+    // server's (making and encoding), the link's (its bytes at the rate seen) and the client's.
+    struct Stages {
+        double server = 0, link = 0, client = 0;
+    };
+    Stages stages(GroupEncoding e) const;
     // The link is unknown: fewer than two sends waited for it, and fewer than kProbeSends went.
     bool probing() const;
 
