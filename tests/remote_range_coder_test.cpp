@@ -1,7 +1,10 @@
 // The range coder of the cells encoding (remote/range_coder.h): bits and direct bits round-trip
 // through adaptive probabilities, the decoder reads exactly the encoder's bytes (so a cut or a
 // trailing byte shows), and no bit costs less than the floor the decoders' limits rest on.
+#include <algorithm>
+#include <bit>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -93,6 +96,34 @@ TEST(RangeCoder, ACutStreamOverrunsAndALongerOneDoesNotEnd) {
     RangeDecoder d(std::span<const std::uint8_t>{});
     EXPECT_TRUE(decodes(longer, symbols, &d));
     EXPECT_FALSE(d.at_end()) << "a trailing byte";
+}
+
+// A young probability moves by 1/2, 1/2, 1/4 (x4), 1/8 (x8), 1/16 (x16) of its distance, then
+// by 1/32 from its 30th bit on, as range_coder.h says.
+TEST(RangeCoder, AYoungProbabilityLearnsFastThenSettles) {
+    BitProbability prob;
+    std::vector<int> shifts;
+    for (int i = 0; i < 40; ++i) {
+        const std::uint32_t before = prob.p;
+        range::update(prob, 1);
+        const std::uint32_t moved = before - prob.p;
+        int shift = 0;
+        while (shift < 16 && (before >> shift) != moved) ++shift;
+        shifts.push_back(prob.p == range::kLeast ? -1 : shift);
+    }
+    std::vector<int> expected;
+    for (int i = 0; i < 40; ++i)
+        expected.push_back(std::min(range::kMoveBits, static_cast<int>(std::bit_width(unsigned(i) + 2)) - 1));
+    // The floor stops it first: count only the moves above kLeast.
+    for (std::size_t i = 0; i < shifts.size() && shifts[i] >= 0; ++i)
+        EXPECT_EQ(shifts[i], expected[i]) << "bit " << i;
+    EXPECT_EQ(shifts[0], 1) << "the first bit moves it half way";
+    EXPECT_EQ(prob.p, range::kLeast) << "40 ones take it to its floor";
+    EXPECT_EQ(prob.seen, range::kSettled);
+    BitProbability settled;
+    settled.seen = range::kSettled;
+    range::update(settled, 0);
+    EXPECT_EQ(settled.p, (1u << 15) + (1u << 10)) << "a settled one moves 1/32 of the way";
 }
 
 // The floor the cells decoder's limits (kMaxValuesPerByte) rest on: a bit never costs less than
