@@ -113,7 +113,8 @@ TEST(RangeCoder, AYoungProbabilityLearnsFastThenSettles) {
     }
     std::vector<int> expected;
     for (int i = 0; i < 40; ++i)
-        expected.push_back(std::min(range::kMoveBits, static_cast<int>(std::bit_width(unsigned(i) + 2)) - 1));
+        expected.push_back(
+            std::min(range::kMoveBits, static_cast<int>(std::bit_width(unsigned(i) + 2)) - 1));
     // The floor stops it first: count only the moves above kLeast.
     for (std::size_t i = 0; i < shifts.size() && shifts[i] >= 0; ++i)
         EXPECT_EQ(shifts[i], expected[i]) << "bit " << i;
