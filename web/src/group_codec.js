@@ -6,7 +6,7 @@
 //   3 compact_zstd  the whole compact message in one zstd frame
 //   4 cells         the units and voxel values marching cubes triangulates, in one zstd frame
 //                   (cells.js: the server's C++ decoder in WebAssembly)
-// Bytes: [version u8 = 2][encoding u8][header: id u32, seed 3 x i32, level i32, iso f64,
+// Bytes: [version u8 = 3][encoding u8][header: id u32, seed 3 x i32, level i32, iso f64,
 // refinement u8][body]; compact_zstd has no header of its own: after the encoding byte come the
 // u64 size of the compact message, then the frame holding it; a cells body is the u64 size of the
 // cells body, then its frame. Decoding is for hostile input: every count is checked against the
@@ -26,7 +26,7 @@ export const GroupEncoding = { vertices: 0, indexed: 1, compact: 2, compact_zstd
 // The hello's encoding for "the server chooses per group" between cells and compact+zstd
 // (remote/encoding_choice.h); not a codec's id.
 export const kAdaptiveEncoding = 255;
-export const kGroupCodecVersion = 2;
+export const kGroupCodecVersion = 3;  // 3: remote/group_codec.h
 export const kMaxNarrowIndexedVertices = 65536;
 export const kMaxGroupTriangles = 1 << 22;
 export const kMaxGroupVertices = 3 * kMaxGroupTriangles;

@@ -3,6 +3,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { ClientFrames, RemoteError } from '../src/frames.js';
 import { frontFullView, fitDepthRange, frustum } from '../src/camera.js';
+import { kGroupCodecVersion } from '../src/group_codec.js';
 
 class Recorder {
   constructor() { this.ops = []; this.live = null; }
@@ -115,7 +116,7 @@ test('decode reports: triangles and seconds per encoding, at most every 50 ms, c
   // A clock that moves 2 ms for each reading: each decode takes 2 ms.
   const f = new ClientFrames(r, () => (t += 2), (m) => m.mesh);
   const g = (e, tris, gen = 0, id = 1) => ({ request_id: id, key: { seed: [0, 0, 0], level: 0, iso: 1, refinement: false },
-    draw_from_next_frame: false, cache_gen: gen, encoded: new Uint8Array([2, e]), mesh: { name: `e${e}`, indices: new Uint32Array(3 * tris) } });
+    draw_from_next_frame: false, cache_gen: gen, encoded: new Uint8Array([kGroupCodecVersion, e]), mesh: { name: `e${e}`, indices: new Uint32Array(3 * tris) } });
   assert.equal(f.decodeReport(0), null, 'nothing decoded');
   f.begin(request(1));
   f.handle('group', g(4, 10), 10);

@@ -123,7 +123,7 @@ test('every truncation and trailing byte is an error naming the group', () => {
 test('fields are checked and named', () => {
   const b = read(dir, 'indexed-tetrahedron');
   const patch = (at, v) => { const c = b.slice(); c[at] = v; return c; };
-  assert.throws(() => decodeGroup(patch(0, 1)), /group: version 1, expected 2/);
+  assert.throws(() => decodeGroup(patch(0, 2)), /group: version 2, expected 3/);
   assert.throws(() => decodeGroup(patch(1, 5)), /group: encoding: expected 0..4, got 5/);
   assert.throws(() => decodeGroup(patch(2 + 16, 31)), /group: level: expected 0..30, got 31/);
   assert.throws(() => decodeGroup(patch(2 + 28, 2)), /group: refinement: expected 0 or 1, got 2/);
