@@ -21,9 +21,10 @@
 //   3. the six neighbours of the two voxels that bracket each crossing: the gradients there give
 //      the vertex's normal (not for a coarse pass).
 // Each phase's voxels go in increasing linear index (z, then y, then x), without those of an
-// earlier phase. Integer values go as the difference to the mean of their known face neighbours
-// (at 1, else 2, else 4 voxels), coded in context through a binary range coder (cell_values.h,
-// range_coder.h); floating-point values as they are, in byte planes.
+// earlier phase. Integer values go as the difference to a prediction from their known neighbours
+// (at 1 voxel, axis by axis; else the mean of those at 2, else 4 voxels), coded in context through
+// a binary range coder (cell_values.h, range_coder.h); floating-point values as they are, in byte
+// planes.
 //
 // A full-resolution group may go in two messages on a slow link: first with its gradients'
 // voxels to a step (only the shading moves: C = 99.6-99.8% of the exact image on the shared 16-bit

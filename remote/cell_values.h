@@ -2,18 +2,19 @@
 // The voxel values of a `cells` group (remote/cell_codec.h) on either side: each predicted from
 // the voxels both sides already know, the residual coded by its context. Internal to the codec.
 //
-// Integer voxels go as the difference to a prediction (the mean of the known face neighbours at
-// the nearest of 1, 2 and 4 voxels that has any, else the value sent just before), taken modulo
-// 2^bits and zigzagged so small ones of either sign are small numbers. The residual's bit length
-// goes through a binary tree of adaptive probabilities (remote/range_coder.h), one tree for each
-// context: the phase that names the voxel, how far the known neighbours at 1 voxel disagree (or
-// how few there are), and how far the prediction lies from the isovalue (voxels near the surface
-// vary more). The two bits below the leading one are adaptive too, the rest go at one bit each.
-// On one frame's groups (isowall_bench_codec's), this took the values from zstd on byte planes
-// (what went before) to about 10% fewer bytes on cthead at 600 and the 256 head at 40; most of it
-// is the adaptive coding of the bit length, a fifth the contexts. The models start afresh in each
-// group, so a group decodes alone; a few contexts learn faster than many (3 x 10 x 4 here against
-// 3 x 32 x 16: 2% fewer bytes on cthead).
+// Integer voxels go as the difference to a prediction (at 1 voxel, the mean of each axis's
+// estimate, axis_estimate; else the mean of the known face neighbours at 2, else 4 voxels; else
+// the value sent just before), taken modulo 2^bits and zigzagged so small ones of either sign are
+// small numbers (the prediction: cell_predict.h). The residual's bit length goes through a binary
+// tree of adaptive probabilities (remote/range_coder.h), one tree for each context: the phase that
+// names the voxel, how far the known neighbours at 1 voxel disagree (or how few there are), and how
+// far the prediction lies from the isovalue (voxels near the surface vary more). The two bits below
+// the leading one are adaptive too, the rest go at one bit each. On one frame's groups
+// (isowall_bench_codec's), this took the values from zstd on byte planes (what went before) to
+// about 10% fewer bytes on cthead at 600 and the 256 head at 40; most of it is the adaptive coding
+// of the bit length, a fifth the contexts. The models start afresh in each group, so a group
+// decodes alone; a few contexts learn faster than many (3 x 10 x 4 here against 3 x 32 x 16: 2%
+// fewer bytes on cthead).
 //
 // Floating-point voxels go as they are, as byte planes (zstd compresses the body outside).
 //
@@ -21,6 +22,7 @@
 // pass of integer voxels), the stream's length u32 and the range coder's stream (the units' bits,
 // then integer values), then floating-point values as planes, phase by phase (every value's low
 // byte, then the next, ...).
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -33,14 +35,12 @@
 
 #include "remote/byte_io.h"
 #include "remote/cell_exact.h"
+#include "remote/cell_predict.h"
 #include "remote/cell_voxels.h"
 #include "remote/range_coder.h"
 
 namespace isowall::remote::cells {
 
-// Classes of how far the known face neighbours at 1 voxel disagree: the bit width of max - min
-// of two or more (capped at 7), one neighbour, none (a farther ring or the previous value).
-inline constexpr int kSpreadClasses = 10;
 // Classes of the prediction's distance to the isovalue: its bit width / 4, capped.
 inline constexpr int kDistanceClasses = 4;
 // Phases: the units' corners, the inner voxels of long edges, the gradients' neighbours.
@@ -49,74 +49,6 @@ inline constexpr int kValuePhases = 3;
 // each at least 0.022 bits (range_coder.h): at most 91 values a byte of stream. A stream that
 // names more than this many voxels a byte is forged.
 inline constexpr std::uint64_t kMaxValuesPerByte = 128;
-
-template <class T>
-struct Prediction {
-    T value{};
-    int spread = kSpreadClasses - 1;
-};
-
-template <class T>
-Prediction<T> predict(const BoxVoxels<T>& held, glm::ivec3 p, T previous) {
-    if constexpr (!std::is_integral_v<T>) {
-        return {};
-    } else {
-        // The nearest ring that holds a known voxel: 1 voxel away, else 2, else 4 (a coarse
-        // level's corners lie 2^level apart, and their neighbours there are its other corners).
-        for (int step = 1; step <= 4; step *= 2) {
-            std::int64_t sum = 0, n = 0, lo = 0, hi = 0;
-            for (int a = 0; a < 3; ++a)
-                for (int d : {-step, step}) {
-                    glm::ivec3 q = p;
-                    q[a] += d;
-                    T value;
-                    if (!held.known(q, value)) continue;
-                    const auto v = static_cast<std::int64_t>(value);
-                    lo = n == 0 ? v : std::min(lo, v);
-                    hi = n == 0 ? v : std::max(hi, v);
-                    sum += v;
-                    ++n;
-                }
-            if (n == 0) continue;
-            const T mean = static_cast<T>(sum >= 0 ? (sum + n / 2) / n : -((-sum + n / 2) / n));
-            const int width = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(hi - lo)));
-            const int spread = step > 1 ? kSpreadClasses - 1
-                               : n == 1 ? kSpreadClasses - 2
-                                        : std::min(width, kSpreadClasses - 3);
-            return {mean, spread};
-        }
-        return {previous, kSpreadClasses - 1};
-    }
-}
-
-template <class T>
-auto residual(T value, T predicted) {
-    if constexpr (!std::is_integral_v<T>) {
-        return value;
-    } else {
-        using U = std::make_unsigned_t<T>;
-        using S = std::make_signed_t<T>;
-        const auto d =
-            static_cast<S>(static_cast<U>(static_cast<U>(value) - static_cast<U>(predicted)));
-        return static_cast<U>(static_cast<U>(static_cast<U>(d) << 1) ^
-                              static_cast<U>(d >> (8 * sizeof(T) - 1)));
-    }
-}
-
-template <class T, class R>
-T from_residual(R r, T predicted) {
-    if constexpr (!std::is_integral_v<T>) {
-        return r;
-    } else {
-        using U = std::make_unsigned_t<T>;
-        const auto d =
-            static_cast<U>(static_cast<U>(r >> 1) ^ static_cast<U>(-static_cast<U>(r & 1)));
-        return static_cast<T>(static_cast<U>(static_cast<U>(predicted) + d));
-    }
-}
-
-template <class T>
-using Residual = decltype(residual(T{}, T{}));
 
 // The adaptive probabilities of one group's integer residuals.
 template <class T>

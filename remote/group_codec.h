@@ -56,8 +56,9 @@ inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
 }
 
 // 2: `indexed` sends uint16 indices for groups of at most kMaxNarrowIndexedVertices vertices.
-// 3: a cells body's range coder lets a young probability learn fast (remote/range_coder.h): the
-// same bytes mean other values, so a client of version 2 must refuse them.
+// 3: a cells body's range coder lets a young probability learn fast (remote/range_coder.h) and
+// its values are predicted axis by axis (cell_values.h): the same bytes mean other values, so a
+// client of version 2 must refuse them.
 inline constexpr std::uint8_t kGroupCodecVersion = 3;
 inline constexpr std::size_t kMaxNarrowIndexedVertices = 65536;
 // One propagation pass makes a few thousand triangles (max_count 1000 cells); the whole skin of

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # After a change to the cells codec (remote/cell_codec.cpp, cell_units.cpp, cell_voxels.h,
-# cell_values.h, range_coder.h) and the fuzz seeds made again from it (web/README.md): makes
-# everything of the page's that follows from it again, from the sources of one build folder:
+# cell_values.h, cell_predict.h, range_coder.h) and the fuzz seeds made again from it
+# (web/README.md): makes everything of the page's that follows from it again, from the sources of one build folder:
 #   1. test/data/cells_groups.bin: the test groups and the meshes the C++ decodes them to
 #      (test/data/cells_probe.cpp, linked against that build's libraries, which it brings up to
 #      date; the seed corpus's cells groups are read from fuzz/corpus/group_codec there);
