@@ -62,7 +62,13 @@ TEST(RemoteCellValues, APredictionTakesEachAxisAsItsKnownNeighboursSay) {
                                  {at(0, 0, -1), 7}});
     const auto guess = cells::predict(held, p, std::uint8_t{0});
     EXPECT_EQ(guess.value, 22) << "(15 + 45 + 7) / 3 = 22.3";
-    EXPECT_EQ(guess.spread, std::bit_width(40u - 7u)) << "four neighbours from 7 to 40";
+    // The axes' estimates 15, 45 and 7 are 38 apart: 9 units of kSpreadUnit (4), 4 bits.
+    EXPECT_EQ(guess.spread, 4);
+    // One axis alone: its two sides' spread, 10 apart (4 bits); one neighbour alone: its class.
+    const auto one_axis = held_with({{at(0, -1, 0), 10}, {at(0, 1, 0), 20}});
+    EXPECT_EQ(cells::predict(one_axis, p, std::uint8_t{0}).spread, 4);
+    const auto one = held_with({{at(0, 1, 0), 20}});
+    EXPECT_EQ(cells::predict(one, p, std::uint8_t{0}).spread, cells::kSpreadClasses - 2);
     // A ramp carried past the type's top stays at 255.
     const auto steep = held_with({{at(1, 0, 0), 250}, {at(2, 0, 0), 100}});
     EXPECT_EQ(cells::predict(steep, p, std::uint8_t{0}).value, 255);
