@@ -60,8 +60,8 @@ Ring ring_at(const BoxVoxels<T>& held, glm::ivec3 p, int step) {
 // one is, its value carried on by half the slope to the voxel beyond it (when that one is known
 // too), which a surface's ramp continues. The prediction is the estimates' mean, rounded. Against
 // the mean of the face neighbours alone, on one frame's groups of each shared volume at its
-// isovalues (isowall_bench_codec): 1-9% fewer cells bytes on 11 of the 12, 1% more on the MR head
-// at 112.
+// isovalues (isowall_bench_codec): 0.6-9.1% fewer cells bytes on 11 of the 12, 1.1% more on the MR
+// head at 112.
 //
 // How far the axes' estimates disagree is the prediction's context (its spread class) where two
 // or more axes give one: the bit width of max - min in units of kSpreadUnit values (capped), so

@@ -6,7 +6,7 @@
 // of the bits seen would (1/(n + 2)), and 1/32 from its 30th bit on. A cells group starts its
 // models afresh and codes a few thousand values over a few thousand probabilities, most of which
 // see few bits: on one frame's groups of each shared volume at its isovalues
-// (isowall_bench_codec), this took 3-6.5% off the cells bytes against LZMA's fixed 1/32. The
+// (isowall_bench_codec), this took 2.6-6.4% off the cells bytes against LZMA's fixed 1/32. The
 // `cells` encoding codes its voxel values through it (remote/cell_values.h): against zstd on byte
 // planes it lets each value's code depend on its context, which the planes cannot.
 //
