@@ -37,7 +37,7 @@
 // the value step's shift u8 (with face normals it steps every phase, with gradient normals only
 // phase 3); the range coder's stream, its length u32 first (the boxes'
 // occupancy, a bit a place, then the integer values); floating-point values' planes.
-// group_codec.cpp sends it through zstd.
+// group_codec.cpp sends it as it is, or through zstd where that is smaller.
 //
 // A group whose mesh is not the marching cubes of its units (a mesh from elsewhere, units past the
 // volume) or whose units spread over more than kMaxCellBoxVoxels has no cells body: the encoder

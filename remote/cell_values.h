@@ -16,7 +16,8 @@
 // decodes alone; a few contexts learn faster than many (3 x 10 x 4 here against 3 x 32 x 16: 2%
 // fewer bytes on cthead).
 //
-// Floating-point voxels go as they are, as byte planes (zstd compresses the body outside).
+// Floating-point voxels go as they are, as byte planes (zstd may pack the body outside,
+// group_codec.h).
 //
 // Byte layout after the units' boxes: the value step's shift u8 (Bins: 0, or 2 and up on a coarse
 // pass of integer voxels), the stream's length u32 and the range coder's stream (the units' bits,

@@ -145,6 +145,10 @@ Mesh get_indexed(ByteReader& r) {
     return m;
 }
 
+// How a cells body follows its header: as it is, or through zstd when that is smaller (a body of
+// floating-point voxels, whose byte planes the range coder does not code).
+enum class CellPacking : std::uint8_t { as_it_is = 0, zstd = 1 };
+
 // ---- compact + zstd ------------------------------------------------------------------------
 
 void put_zstd(ByteWriter& w, const std::vector<std::uint8_t>& compact) {
@@ -227,7 +231,13 @@ std::vector<std::uint8_t> encode_group(const Group& group, GroupEncoding encodin
         w.put(kGroupCodecVersion);
         w.put(static_cast<std::uint8_t>(encoding));
         put_header(w, group);
-        put_zstd(w, *body);
+        ByteWriter packed;
+        put_zstd(packed, *body);
+        const std::vector<std::uint8_t> zstd = packed.take();
+        const CellPacking packing =
+            zstd.size() < body->size() ? CellPacking::zstd : CellPacking::as_it_is;
+        w.put(static_cast<std::uint8_t>(packing));
+        w.put_raw(std::span<const std::uint8_t>(packing == CellPacking::zstd ? zstd : *body));
         std::vector<std::uint8_t> cells = w.take();
         // A coarse pass's corners lie 2^level apart, where neighbours predict them poorly: cells
         // may then be the larger, on a small pass (before coarse values went to a step, cthead's
@@ -291,7 +301,17 @@ Group decode_group(std::span<const std::uint8_t> bytes, const CellExact& x) {
     if (x.exact && encoding != GroupEncoding::cells)
         r.fail("exact values: only a cells group takes them");
     if (encoding == GroupEncoding::cells) {
-        const std::vector<std::uint8_t> body = get_zstd(r, kMaxCellBytes);
+        const auto packing = r.get<std::uint8_t>();
+        if (packing > static_cast<std::uint8_t>(CellPacking::zstd))
+            r.fail("cells packing: expected 0 (as it is) or 1 (zstd), got " +
+                   std::to_string(packing));
+        std::vector<std::uint8_t> unpacked;
+        if (packing == static_cast<std::uint8_t>(CellPacking::zstd))
+            unpacked = get_zstd(r, kMaxCellBytes);
+        const std::span<const std::uint8_t> body =
+            packing == static_cast<std::uint8_t>(CellPacking::zstd)
+                ? std::span<const std::uint8_t>(unpacked)
+                : r.get_span(r.remaining());
         ByteReader cells(body, kWhat);
         g.mesh = decode_cell_body(cells, g.iso, x);
         cells.finish();

@@ -10,14 +10,17 @@
 //                 index codec after its vertex cache and vertex fetch orders
 //   compact_zstd  the compact bytes through zstd (level kZstdLevel)
 //   cells         what marching cubes needs, not what it made: the group's units and the voxel
-//                 values that triangulate them (remote/cell_codec.h), through zstd; the client runs
-//                 marching cubes and gets the server's triangles and normals. Needs the volume.
+//                 values that triangulate them (remote/cell_codec.h); the client runs marching
+//                 cubes and gets the server's triangles and normals. Needs the volume.
 //
 // Bytes: [version u8][encoding u8][group header][body]; compact_zstd's body is the u64 size of
 // the compact message, then one zstd frame holding that whole message (its own version and
-// encoding bytes included). The group header is id u32, seed 3 x i32, level i32, iso f64,
-// refinement u8. Group::cells is not sent: it is the server's bookkeeping of which cells a pass
-// took, and the client draws only the mesh.
+// encoding bytes included). A cells body follows its header after a packing byte: 0, the body as
+// it is, to the end (range-coded, zstd made it larger: 47 bytes a group on cthead, frame and size
+// included); 1, the u64 size of the body and one zstd frame holding it, where that is smaller (a
+// body of floating-point voxels, sent as byte planes). The group header is id u32, seed 3 x i32,
+// level i32, iso f64, refinement u8. Group::cells is not sent: it is the server's bookkeeping of
+// which cells a pass took, and the client draws only the mesh.
 //
 // What decoding gives back: `vertices` gives an unindexed mesh (indices 0, 1, 2, ...); `indexed`
 // gives the mesh as it was; `compact` and `compact_zstd` give the same triangles with the same
@@ -56,9 +59,10 @@ inline std::ostream& operator<<(std::ostream& os, GroupEncoding e) {
 }
 
 // 2: `indexed` sends uint16 indices for groups of at most kMaxNarrowIndexedVertices vertices.
-// 3: a cells body's range coder lets a young probability learn fast (remote/range_coder.h) and
-// its values are predicted axis by axis (cell_values.h): the same bytes mean other values, so a
-// client of version 2 must refuse them.
+// 3: a cells body's range coder lets a young probability learn fast (remote/range_coder.h), its
+// values are predicted axis by axis (cell_predict.h): the same bytes mean other values, so a
+// client of version 2 must refuse them; and the body goes through zstd only where that is
+// smaller (the packing byte).
 inline constexpr std::uint8_t kGroupCodecVersion = 3;
 inline constexpr std::size_t kMaxNarrowIndexedVertices = 65536;
 // One propagation pass makes a few thousand triangles (max_count 1000 cells); the whole skin of

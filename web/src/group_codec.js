@@ -4,14 +4,15 @@
 //   2 compact       positions quantised to 16 bits in a box, octahedral snorm16 normals,
 //                   indices through meshoptimizer's index codec
 //   3 compact_zstd  the whole compact message in one zstd frame
-//   4 cells         the units and voxel values marching cubes triangulates, in one zstd frame
-//                   (cells.js: the server's C++ decoder in WebAssembly)
+//   4 cells         the units and voxel values marching cubes triangulates, as they are or in one
+//                   zstd frame (cells.js: the server's C++ decoder in WebAssembly)
 // Bytes: [version u8 = 3][encoding u8][header: id u32, seed 3 x i32, level i32, iso f64,
 // refinement u8][body]; compact_zstd has no header of its own: after the encoding byte come the
-// u64 size of the compact message, then the frame holding it; a cells body is the u64 size of the
-// cells body, then its frame. Decoding is for hostile input: every count is checked against the
-// limits and the bytes left before anything is allocated, indices against the vertex count,
-// floats must be finite; anything else throws an Error "group: <field>: <why>".
+// u64 size of the compact message, then the frame holding it; a cells body follows a packing
+// byte: 0, the body as it is, to the end; 1, its u64 size, then a frame holding it. Decoding is
+// for hostile input: every count is checked against the limits and the bytes left before anything
+// is allocated, indices against the vertex count, floats must be finite; anything else throws an
+// Error "group: <field>: <why>".
 //
 // A decoded group: { id, seed: [x, y, z], level, iso, refinement, positions: Float32Array(3V),
 // normals: Float32Array(3V), indices: Uint32Array(3T) }.
@@ -272,7 +273,12 @@ export function decodeGroup(bytes, exact = null) {
     return decodeGroup(compact);
   }
   const g = getHeader(r);
-  if (encoding === GroupEncoding.cells) return Object.assign(g, decodeCellBody(getZstd(r, kMaxCellBytes), g.iso, exact));
+  if (encoding === GroupEncoding.cells) {
+    const packing = r.u8();
+    if (packing > 1) r.fail(`cells packing: expected 0 (as it is) or 1 (zstd), got ${packing}`);
+    const body = packing === 1 ? getZstd(r, kMaxCellBytes) : r.span(r.remaining());
+    return Object.assign(g, decodeCellBody(body, g.iso, exact));
+  }
   const mesh = encoding === GroupEncoding.vertices ? getVertices(r)
     : encoding === GroupEncoding.indexed ? getIndexed(r) : getCompact(r);
   r.finish();
