@@ -16,9 +16,9 @@
 // Bytes: [version u8][encoding u8][group header][body]; compact_zstd's body is the u64 size of
 // the compact message, then one zstd frame holding that whole message (its own version and
 // encoding bytes included). A cells body follows its header after a packing byte: 0, the body as
-// it is, to the end (range-coded, zstd made it larger: 47 bytes a group on cthead, frame and size
-// included); 1, the u64 size of the body and one zstd frame holding it, where that is smaller (a
-// body of floating-point voxels, sent as byte planes). The group header is id u32, seed 3 x i32,
+// it is, to the end (range-coded, zstd made it about 15 bytes a group larger, frame and
+// size included); 1, the u64 size of the body and one zstd frame holding it, where that is smaller
+// (a body of floating-point voxels, sent as byte planes). The group header is id u32, seed 3 x i32,
 // level i32, iso f64, refinement u8. Group::cells is not sent: it is the server's bookkeeping of
 // which cells a pass took, and the client draws only the mesh.
 //
