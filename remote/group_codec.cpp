@@ -305,13 +305,11 @@ Group decode_group(std::span<const std::uint8_t> bytes, const CellExact& x) {
         if (packing > static_cast<std::uint8_t>(CellPacking::zstd))
             r.fail("cells packing: expected 0 (as it is) or 1 (zstd), got " +
                    std::to_string(packing));
-        std::vector<std::uint8_t> unpacked;
-        if (packing == static_cast<std::uint8_t>(CellPacking::zstd))
-            unpacked = get_zstd(r, kMaxCellBytes);
+        const bool zstd = packing == static_cast<std::uint8_t>(CellPacking::zstd);
+        const std::vector<std::uint8_t> unpacked =
+            zstd ? get_zstd(r, kMaxCellBytes) : std::vector<std::uint8_t>{};
         const std::span<const std::uint8_t> body =
-            packing == static_cast<std::uint8_t>(CellPacking::zstd)
-                ? std::span<const std::uint8_t>(unpacked)
-                : r.get_span(r.remaining());
+            zstd ? std::span<const std::uint8_t>(unpacked) : r.get_span(r.remaining());
         ByteReader cells(body, kWhat);
         g.mesh = decode_cell_body(cells, g.iso, x);
         cells.finish();
