@@ -76,15 +76,13 @@ Prediction<T> axis_estimate(const BoxVoxels<T>& held, glm::ivec3 p, const Ring& 
     for (int a = 0; a < 3; ++a) {
         const bool lo = r.known[a][0], hi = r.known[a][1];
         if (!lo && !hi) continue;
-        std::int64_t e = 2 * r.value[a][lo ? 0 : 1];
-        if (lo && hi) {
-            e = r.value[a][0] + r.value[a][1];
-        } else {
-            glm::ivec3 beyond = p;
-            beyond[a] += lo ? -2 : 2;
-            T far;
-            if (held.known(beyond, far)) e = 3 * r.value[a][lo ? 0 : 1] - far;
-        }
+        const std::int64_t near = r.value[a][lo ? 0 : 1];
+        glm::ivec3 beyond = p;
+        beyond[a] += lo ? -2 : 2;
+        T far;
+        const std::int64_t e = lo && hi                  ? r.value[a][0] + r.value[a][1]
+                               : held.known(beyond, far) ? 3 * near - far
+                                                         : 2 * near;
         lo_twice = axes == 0 ? e : std::min(lo_twice, e);
         hi_twice = axes == 0 ? e : std::max(hi_twice, e);
         twice += e;
