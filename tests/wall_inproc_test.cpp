@@ -156,8 +156,11 @@ TEST(WallInProcess, MeasuredWaitsEndOnFramesWithAndWithoutJobs) {
     o.timeout_s = 20;
     o.script = write_script(dir, "wait done\npan 10 0\nwait done\npan -10 0\nwait done\n").string();
     const WallRun r = run_wall_in_process(o);
+    // A wait that ran into the timeout throws ("no tile rank has answered for 20 s") and ends
+    // every rank with a non-zero code, so the codes tell it, not the wall clock (under ASan on a
+    // loaded machine this run alone took 16 s).
     for (int code : r.codes) EXPECT_EQ(code, 0) << r.err;
-    EXPECT_LT(r.seconds, 15.0) << "a wait ran into the timeout";
+    EXPECT_EQ(r.err.find("no tile rank has answered"), std::string::npos) << r.err;
     // Each tile kept the curve of every frame it finished before the last one.
     for (int rank = 1; rank <= 4; ++rank)
         EXPECT_EQ(r.results[static_cast<std::size_t>(rank)].earlier.size(), 2u) << "rank " << rank;
