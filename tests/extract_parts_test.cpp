@@ -1,4 +1,5 @@
-// The extractor's parts: the group key caches find groups by, and the thread budget.
+// The extractor's parts: the group key caches find groups by, uniform levels at the volume's
+// border, and the thread budget.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -71,6 +72,44 @@ TEST(GroupKey, PropagatedGroupRecordsItsIsovalue) {
     const Group g = ex->propagate(hit.cell, 7, PropagationParams{}, ray);
     EXPECT_EQ(g.iso, kPhantomSkinIso);
     EXPECT_EQ(g.key(), (GroupKey{g.seed, g.level, kPhantomSkinIso}));
+}
+
+// A coarse level of progressive LOD sends groups of its own level only: a group seeded at the
+// border's cells (past the last whole meta-cell) was a level-0 group, which the client took for
+// the start of the full resolution, dropping every coarse group after it (the shared CT head's
+// coarse picture reached C = 0.875 instead of 0.925).
+TEST(UniformLevels, ACoarseLevelLeavesTheBordersCellsToTheFullResolution) {
+    // A plane x = 9.5 through every cell row; 20x19x18 cells: whole meta-cells of 4 end at 16.
+    const glm::ivec3 dims(21, 20, 19);
+    std::vector<std::byte> bytes(std::size_t(dims.x) * dims.y * dims.z);
+    for (int z = 0; z < dims.z; ++z)
+        for (int y = 0; y < dims.y; ++y)
+            for (int x = 0; x < dims.x; ++x)
+                bytes[(std::size_t(z) * dims.y + y) * dims.x + x] = std::byte(x * 10);
+    const Volume v(dims, VoxelType::u8, glm::vec3(1), std::move(bytes), "ramp");
+    auto ex = make_surface_extractor(v);
+    const Ray ray{glm::vec3(-5, 18.5f, 17.5f), glm::vec3(1, 0, 0)};  // past y, z = 16
+    ex->begin_frame(95, uniform_levels(2));
+    const RayHit border = ex->cast(ray, IntersectMode::exact);
+    ASSERT_TRUE(border.found);
+    EXPECT_EQ(border.level, 0) << "the ray meets a border cell";
+    const Group none = ex->propagate(border.cell, 0, PropagationParams{}, ray);
+    EXPECT_TRUE(none.cells.empty());
+    EXPECT_TRUE(none.mesh.empty());
+    EXPECT_FALSE(ex->visited(border.cell)) << "left for the full resolution";
+    const Ray inner{glm::vec3(-5, 6.5f, 6.5f), glm::vec3(1, 0, 0)};
+    const RayHit hit = ex->cast(inner, IntersectMode::exact);
+    ASSERT_TRUE(hit.found);
+    const Group g = ex->propagate(hit.cell, 0, PropagationParams{}, inner);
+    EXPECT_EQ(g.level, 2);
+    EXPECT_FALSE(g.cells.empty());
+    EXPECT_TRUE(g.cell_levels.empty()) << "one level";
+    for (const glm::ivec3 c : g.cells) EXPECT_LE(c.y + 4, 19) << "a whole meta-cell";
+    // At full resolution the border's cells are cells, as ever.
+    ex->begin_frame(95);
+    const Group fine = ex->propagate(border.cell, 0, PropagationParams{}, ray);
+    EXPECT_EQ(fine.level, 0);
+    EXPECT_FALSE(fine.cells.empty());
 }
 
 TEST(ThreadBudget, ZeroIsReadAsOneAndSetsTheWorkers) {

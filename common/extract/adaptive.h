@@ -67,6 +67,12 @@ struct ResolutionLevels {
     // A propagation pass goes on into units of another level (the boundaries the error rule
     // draws anywhere); false: it stops there (uniform levels, whose groups name one level).
     bool cross_levels = true;
+    // Units finer than max_level (where a meta-cell of it would pass the volume's border) are
+    // extracted, as cells or smaller meta-cells; false: they are not (uniform levels: a coarse
+    // pass of progressive LOD leaves the border's cells to the full resolution, so every group it
+    // sends is of its own level and the client, which switches to a finer level at the first
+    // finer group, does not take a border sliver for the start of the next pass).
+    bool finer_units = true;
 
     // The largest i in [1, max_level] with distance > d[i], else 0.
     int level_at(float distance) const {
@@ -114,6 +120,7 @@ inline ResolutionLevels uniform_levels(int level) {
     levels.max_level = level;
     levels.refine = false;
     levels.cross_levels = false;
+    levels.finer_units = false;
     return levels;
 }
 
@@ -132,7 +139,8 @@ class ResolutionMap {
           eye_(levels.eye),
           max_level_(levels.max_level),
           refine_(levels.refine),
-          cross_levels_(levels.cross_levels) {
+          cross_levels_(levels.cross_levels),
+          finer_units_(levels.finer_units) {
         for (std::size_t i = 0; i < levels.d.size(); ++i) d2_[i] = levels.d[i] * levels.d[i];
         if (errors && !errors->empty() && std::isfinite(levels.error_px)) {
             // error (cells) * s_max <= error_px * (pixel_slope * distance + pixel_size), the
@@ -149,6 +157,7 @@ class ResolutionMap {
     int max_level() const { return max_level_; }
     bool refine() const { return refine_; }
     bool cross_levels() const { return cross_levels_; }
+    bool finer_units() const { return finer_units_; }
 
     // Whether the meta-cell of `level` >= 1 at `base` (a multiple of 2^level) may be a unit on its
     // own account: complete, and its centre beyond D[level]. A unit also needs no coarser unit
@@ -189,6 +198,7 @@ class ResolutionMap {
     int max_level_ = 0;
     bool refine_ = false;
     bool cross_levels_ = false;
+    bool finer_units_ = true;
     std::array<float, kMaxMetaLevel + 1> d2_{};  // D[i]^2
     const LodErrors* errors_ = nullptr;          // null: no error rule
     float err_k2_ = 0, err_c2_ = 0;              // the error rule's bound, squared (see above)

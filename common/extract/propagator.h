@@ -127,6 +127,8 @@ class Propagator {
         g.seed = seed;
         g.level = level;
         g.iso = iso;
+        // A border unit finer than a uniform level's is not this level's (adaptive.h).
+        if (!resolution_.finer_units() && level < resolution_.max_level()) return g;
         if (!visited.claim(seed, group_id, level)) return g;
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
