@@ -46,7 +46,7 @@ struct ViewCommand {
     std::string tls_ca;  // --tls-ca: TLS, trusting the authorities in this PEM file
     int test_case = 0;   // 1-7: the study's cases; 0: the options below
     std::string encoding = "auto";
-    bool lod = false, cache = false;
+    bool lod = false, no_lod = false, cache = false;
     bool exact_only = false;  // --exact-only: no cells group to a step first (ExactMsg)
     std::optional<double> iso;
     std::string size = "800x600";

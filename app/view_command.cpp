@@ -25,17 +25,19 @@ using namespace remote;
 // The study's cases (the dissertation's section 4.2, and ours as the fifth).
 struct CaseSetting {
     GroupEncoding encoding;
-    bool lod, cache;
+    LodSchedule lod;
+    bool cache;
     bool adaptive = false;  // the server chooses cells or compact+zstd per group
 };
+constexpr LodSchedule kOff = LodSchedule::off, kOn = LodSchedule::on;
 constexpr CaseSetting kCases[] = {
-    {GroupEncoding::vertices, false, false},    // 1 base
-    {GroupEncoding::indexed, false, false},     // 2 primitive compression
-    {GroupEncoding::indexed, true, false},      // 3 + progressive LOD
-    {GroupEncoding::indexed, true, true},       // 4 + cached primitives
-    {GroupEncoding::compact_zstd, true, true},  // 5 ours: compact + zstd
-    {GroupEncoding::cells, true, true},         // 6 issue 34: cells
-    {GroupEncoding::cells, true, true, true}};  // 7 issue 34: the server chooses (auto)
+    {GroupEncoding::vertices, kOff, false},    // 1 base
+    {GroupEncoding::indexed, kOff, false},     // 2 primitive compression
+    {GroupEncoding::indexed, kOn, false},      // 3 + progressive LOD
+    {GroupEncoding::indexed, kOn, true},       // 4 + cached primitives
+    {GroupEncoding::compact_zstd, kOn, true},  // 5 ours: compact + zstd
+    {GroupEncoding::cells, kOn, true},         // 6 issue 34: cells
+    {GroupEncoding::cells, kOn, true, true}};  // 7 issue 34: the server chooses (auto)
 
 GroupEncoding parse_encoding(const std::string& s) {
     if (s == "auto") return GroupEncoding::cells;  // and the hello asks the server to choose
@@ -86,6 +88,16 @@ struct Viewer {
                 std::printf("  C >= %5.1f%%: %8.3f s  %12llu bytes\n", 100 * th, hit->time_s,
                             (unsigned long long)hit->bytes);
         }
+        // The coarse passes' picture: the last sample before the full resolution drew.
+        const ClientSample* coarse = nullptr;
+        for (const ClientSample& s : r.timeline)
+            if (s.level > 0) coarse = &s;
+        if (coarse)
+            std::printf(
+                "  coarse passes: C = %.4f by %.3f s, %llu bytes, %llu groups, %llu "
+                "triangles\n",
+                coarse->correctness.c, coarse->time_s, (unsigned long long)coarse->bytes,
+                (unsigned long long)coarse->groups, (unsigned long long)coarse->triangles);
         for (const ClientSample& s : r.timeline) {
             char line[256];
             std::snprintf(line, sizeof(line), "%d,%.6f,%llu,%llu,%llu,%llu,%.6f,%.6f", frames,
@@ -169,7 +181,12 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
                   "cubes needs; the client triangulates)")
         ->check(CLI::IsMember({"auto", "vertices", "indexed", "compact", "compact-zstd", "cells"}))
         ->capture_default_str();
-    c->add_flag("--lod", o.lod, "Progressive LOD: two coarser LOD levels first");
+    auto* lod = c->add_flag("--lod", o.lod,
+                            "Progressive LOD on every frame: two coarser levels of detail first "
+                            "(by default the server sends them where it forecasts that they bring "
+                            "C = 90% sooner)");
+    c->add_flag("--no-lod", o.no_lod, "No progressive LOD: the full resolution only")
+        ->excludes(lod);
     c->add_flag("--cache", o.cache, "Cache groups per isovalue (the server names visible ones)");
     c->add_flag("--exact-only", o.exact_only,
                 "Every group exact in one message (otherwise a cells group the client does not "
@@ -271,7 +288,10 @@ int run_view(const ViewCommand& o) {
     std::vector<ScriptLine> script;
     if (!o.script.empty()) script = load_script(o.script);
     const Endpoint ep = parse_endpoint(o.connect, "--connect", "HOST:PORT");
-    CaseSetting setting{parse_encoding(o.encoding), o.lod, o.cache, o.encoding == "auto"};
+    const LodSchedule lod = o.lod      ? LodSchedule::on
+                            : o.no_lod ? LodSchedule::off
+                                       : LodSchedule::chosen;
+    CaseSetting setting{parse_encoding(o.encoding), lod, o.cache, o.encoding == "auto"};
     if (o.test_case > 0) setting = kCases[o.test_case - 1];
 
     auto renderer = make_renderer(o.gl);
@@ -292,10 +312,10 @@ int run_view(const ViewCommand& o) {
     hello.takes_exact = !o.exact_only;
     ViewClient client(*renderer, hello);
     std::printf(
-        "view: connected to %s, dataset %s, values [%g, %g], %s%s%s\n", o.connect.c_str(),
-        o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
+        "view: connected to %s, dataset %s, values [%g, %g], %s, progressive LOD %s%s\n",
+        o.connect.c_str(), o.dataset.c_str(), client.ready().value_min, client.ready().value_max,
         hello.adaptive ? "auto (cells or compact+zstd per group)" : to_string(setting.encoding),
-        setting.lod ? ", progressive LOD" : "", setting.cache ? ", cached groups" : "");
+        to_string(setting.lod).c_str(), setting.cache ? ", cached groups" : "");
     Viewer v{o, client, setting, *size, {}, 0, 0, {}};
     if (!o.follow.empty()) return follow_session(o, client, v);
     const float aspect = float(size->x) / float(size->y);

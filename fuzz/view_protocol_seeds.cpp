@@ -24,7 +24,7 @@ std::vector<RemoteMessage> samples() {
     request.view.width = 8;
     request.view.height = 6;
     request.view.iso = 105.5;
-    request.progressive_lod = true;
+    request.lod = LodSchedule::chosen;
     request.cached_groups = true;
     const GroupKey key{{4, 5, 6}, 2, 105.5, true};
     return {

@@ -57,6 +57,7 @@ void ClientFrames::draw(const std::shared_ptr<const Mesh>& mesh, int level) {
         ops_.push_back({nullptr});
     }
     draw_level_ = level;
+    now_.level = level;
     drew_coarse_ = drew_coarse_ || level > 0;
     renderer_.draw(*mesh, request_.view.camera.view(), request_.view.frustum.matrix());
     ops_.push_back({mesh});
@@ -95,6 +96,10 @@ void ClientFrames::handle_group(const GroupMsg& g, std::size_t wire_bytes, doubl
         cache_.push_back({mesh, g.key.level});
     }
     if (!current) return;
+    // The coarse passes' picture as it stands before the first full-resolution group covers it:
+    // a sample of its own, whatever the sampling's pace.
+    if (!g.draw_from_next_frame && g.key.level == 0 && drew_coarse_ && draw_level_ > 0)
+        sample(now_s, true);
     now_.bytes += wire_bytes;
     ++now_.groups;
     if (g.encoded.size() > 1 &&

@@ -44,6 +44,7 @@ struct ClientSample {
     std::uint64_t named = 0;      // cached groups named visible
     std::uint64_t triangles = 0;  // drawn
     std::size_t ops = 0;          // draw steps done by then (for the replay)
+    int level = -1;               // the finest level of detail drawn by then; -1: none
     Correctness correctness;      // against the final image; filled by measure()
 };
 

@@ -1,6 +1,7 @@
 #include "remote/server_session.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include <glm/mat4x4.hpp>
@@ -8,6 +9,7 @@
 
 #include "common/core/ray.h"
 #include "common/core/util.h"
+#include "remote/lod_choice.h"
 #include "remote/view_framing.h"
 
 namespace isowall::remote {
@@ -178,11 +180,10 @@ void ServerSession::begin_cached(LodLevel& lv, const RequestMsg& r, bool keep) {
 
 // Step 2 of a cached isovalue: one ray towards each cached group's seed, coarse levels first,
 // named in one message (the client orders its draws by level).
-void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
+void ServerSession::name_by_seed_rays(const RequestMsg& r, int top, RequestFigures& f) {
     const FrameView& v = r.view;
     const glm::mat4 view_inv = glm::inverse(v.camera.view());
     const glm::vec3 spacing = prototype_.volume().spacing();
-    const int top = r.progressive_lod ? options_.lod_levels : 0;
     VisibleMsg m;
     m.request_id = r.request_id;
     for (int l = top; l >= 0; --l) {
@@ -205,6 +206,24 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, RequestFigures& f) {
     std::sort(m.slots.begin(), m.slots.end());  // the wire wants them ascending
     f.named += m.slots.size();
     f.bytes += send_(m);
+}
+
+std::string lod_note(const RequestFigures& f) {
+    if (f.coarse_forecast < 0) return {};
+    char note[96];
+    std::snprintf(note, sizeof(note), "; coarse picture forecast C = %.3f: %d coarse levels",
+                  f.coarse_forecast, f.coarse_levels);
+    return note;
+}
+
+int ServerSession::coarse_levels(const RequestMsg& r, int most, RequestFigures& f) {
+    if (r.lod != LodSchedule::chosen || most == 0) return most;
+    std::vector<SurfaceExtractor*> levels;
+    for (int l = 0; l <= most; ++l) levels.push_back(lod_level(l).ex.get());
+    const CoarseForecast forecast = forecast_coarse_correctness(levels, r.view);
+    f.rays += forecast.rays * std::size_t(most + 1);
+    f.coarse_forecast = forecast.c;
+    return coarse_passes_pay(forecast) ? most : 0;
 }
 
 bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std::atomic<bool>& stop,
@@ -246,10 +265,13 @@ RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& 
         next_slot_ = 0;
         for (auto& lv : levels_) lv->sent.clear();
     }
-    const int top = r.progressive_lod ? options_.lod_levels : 0;
     exact_due_.clear();
-    for (int l = top; l >= 0; --l) begin_cached(lod_level(l), r, keep);
-    if (keep) name_by_seed_rays(r, f);
+    // Every level the request may cast begins (the forecast casts on them), with its cached cells.
+    const int most = r.lod == LodSchedule::off ? 0 : options_.lod_levels;
+    for (int l = most; l >= 0; --l) begin_cached(lod_level(l), r, keep);
+    const int top = coarse_levels(r, most, f);
+    f.coarse_levels = top;
+    if (keep) name_by_seed_rays(r, top, f);
     for (int l = top; l >= 0; --l)
         if (stop.load() || !cast_level(l, r, keep, stop, f)) return f;
     // The exact values, once every group is out: the picture is whole first, then exact.

@@ -32,6 +32,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "common/core/util.h"
@@ -73,7 +74,15 @@ struct RequestFigures {
     std::uint64_t named = 0;   // cached groups named visible
     std::uint64_t triangles = 0;
     std::uint64_t bytes = 0;  // of every message sent for the request
+    // The coarse picture's forecast C where the server chose the levels of detail
+    // (LodSchedule::chosen; remote/lod_choice.h), else -1; coarse passes went out where it paid.
+    double coarse_forecast = -1;
+    int coarse_levels = 0;  // the coarse levels cast
 };
+
+// "; coarse picture forecast C = 0.925: 2 coarse levels" where the server chose the levels of
+// detail, else empty: for the server's line per request.
+std::string lod_note(const RequestFigures& f);
 
 class ServerSession {
   public:
@@ -102,7 +111,10 @@ class ServerSession {
     // worker takes them); past this they are dropped, as the chooser weighs the recent most.
     static constexpr std::size_t kMaxPendingReports = 64;
     void begin_cached(LodLevel& lv, const RequestMsg& r, bool keep);
-    void name_by_seed_rays(const RequestMsg& r, RequestFigures& f);
+    void name_by_seed_rays(const RequestMsg& r, int top, RequestFigures& f);
+    // The coarse levels to cast before the full resolution, of the `most` the request allows:
+    // all, or with LodSchedule::chosen those the forecast says bring C = 90% sooner (all or none).
+    int coarse_levels(const RequestMsg& r, int most, RequestFigures& f);
     bool cast_level(int l, const RequestMsg& r, bool drawn, const std::atomic<bool>& stop,
                     RequestFigures& f);
 

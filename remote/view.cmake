@@ -3,7 +3,8 @@
 # tokens, loopback and what an address off loopback needs) and the client
 # (client_frames.cpp: drawing and the timeline; view_client.cpp: its connection).
 add_library(isowall_remote_view
-    ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/server_session.cpp ${CMAKE_CURRENT_LIST_DIR}/lod_choice.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/view_server.cpp
     ${CMAKE_CURRENT_LIST_DIR}/tcp_channel.cpp ${CMAKE_CURRENT_LIST_DIR}/server_access.cpp
     ${CMAKE_CURRENT_LIST_DIR}/shared_session.cpp ${CMAKE_CURRENT_LIST_DIR}/server_refusal.cpp
     ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)

@@ -37,11 +37,11 @@ double ViewClient::now_s() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
 }
 
-void ViewClient::request(const FrameView& view, bool progressive_lod, bool cached_groups) {
+void ViewClient::request(const FrameView& view, LodSchedule lod, bool cached_groups) {
     RequestMsg r;
     r.request_id = next_id_++;
     r.view = view;
-    r.progressive_lod = progressive_lod;
+    r.lod = lod;
     r.cached_groups = cached_groups;
     frames_.begin(r, now_s());
     conn_->send(r);

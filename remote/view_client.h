@@ -43,7 +43,7 @@ class ViewClient {
     const ReadyMsg& ready() const { return ready_; }
 
     // Sends a request for `view`; the frame it starts interrupts the one in progress.
-    void request(const FrameView& view, bool progressive_lod, bool cached_groups);
+    void request(const FrameView& view, LodSchedule lod, bool cached_groups);
     // Receives until the current request's end of frame: the frame, measured. Throws NetError
     // when nothing arrives for `timeout_s`.
     const ClientFrameResult& wait_done(double timeout_s);

@@ -169,11 +169,23 @@ static ReadyMsg decode_ready(std::span<const std::byte> bytes) {
     return m;
 }
 
+std::string to_string(LodSchedule s) {
+    switch (s) {
+        case LodSchedule::off:
+            return "off";
+        case LodSchedule::on:
+            return "on";
+        case LodSchedule::chosen:
+            return "chosen by the server";
+    }
+    return "lod " + std::to_string(static_cast<int>(s));
+}
+
 static std::vector<std::byte> encode(const RequestMsg& m) {
     MessageWriter w(RequestMsg::kVersion);
     w.put(m.request_id);
     wire_pieces::put_frame_view(w, m.view);
-    w.put(static_cast<std::uint8_t>(m.progressive_lod));
+    w.put(static_cast<std::uint8_t>(m.lod));
     w.put(static_cast<std::uint8_t>(m.cached_groups));
     return w.take();
 }
@@ -190,7 +202,11 @@ static RequestMsg decode_request(std::span<const std::byte> bytes) {
     // and said nothing (request_checks.h).
     if (const std::string problem = frustum_problem(m.view.frustum); !problem.empty())
         r.fail("view.frustum." + problem);
-    m.progressive_lod = get_flag(r, "progressive_lod");
+    const auto lod = r.get<std::uint8_t>();
+    if (lod > static_cast<std::uint8_t>(LodSchedule::chosen))
+        r.fail("lod: expected 0 (off), 1 (on) or 2 (the server chooses), got " +
+               std::to_string(lod));
+    m.lod = static_cast<LodSchedule>(lod);
     m.cached_groups = get_flag(r, "cached_groups");
     r.finish();
     return m;

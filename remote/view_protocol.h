@@ -96,16 +96,24 @@ struct ReadyMsg {
     glm::mat3 axes{1.0f};
 };
 
+// Progressive LOD for a request (the dissertation's section 4.1.3, case 3): coarse passes at
+// meta-cells of 4 and 2 cells a side before the full resolution, never, or where the server
+// forecasts that they bring C = 90% sooner (remote/lod_choice.h; `isowall view`'s and the page's
+// default).
+enum class LodSchedule : std::uint8_t { off = 0, on = 1, chosen = 2 };
+std::string to_string(LodSchedule s);
+
 struct RequestMsg {
     static constexpr RemoteTag kTag = RemoteTag::request;
-    static constexpr std::uint8_t kVersion = 1;
+    // 2: the lod byte may be 2 (chosen), which version 1 had as a flag.
+    static constexpr std::uint8_t kVersion = 2;
     std::uint64_t request_id = 0;  // grows with every request of a connection
     // Camera, frustum, image size (each side 1..kMaxImageSide) and isovalue; the camera and the
     // frustum must be ones that can be drawn (camera_problem and frustum_problem are empty). The
     // server checks the isovalue against the dataset's range (request_checks.h).
     FrameView view;
-    bool progressive_lod = false;  // case 3: start two levels coarser
-    bool cached_groups = false;    // case 4: the client caches groups per isovalue
+    LodSchedule lod = LodSchedule::off;
+    bool cached_groups = false;  // case 4: the client caches groups per isovalue
 };
 
 struct GroupMsg {

@@ -238,13 +238,13 @@ class ViewServer::Client {
                 if (server_.options_.verbose)
                     std::printf(
                         "serve: %s: request %llu %s: %llu groups, %llu named, %llu "
-                        "triangles, %llu bytes\n",
+                        "triangles, %llu bytes%s\n",
                         conn_.peer().c_str(), static_cast<unsigned long long>(r.request_id),
                         f.completed ? "done" : "interrupted",
                         static_cast<unsigned long long>(f.groups),
                         static_cast<unsigned long long>(f.named),
                         static_cast<unsigned long long>(f.triangles),
-                        static_cast<unsigned long long>(f.bytes));
+                        static_cast<unsigned long long>(f.bytes), lod_note(f).c_str());
             } catch (const NetError&) {
                 computing_ = false;
                 conn_.shutdown();  // the reader then ends the connection

@@ -49,7 +49,7 @@ struct Pair {
         RequestMsg r;
         r.request_id = id;
         r.view = view;
-        r.progressive_lod = true;
+        r.lod = LodSchedule::on;
         r.cached_groups = true;
         return r;
     }

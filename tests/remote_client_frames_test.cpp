@@ -67,7 +67,7 @@ TEST(ClientFrames, CoarsePixelsStayDrawnAfterTheDepthClearOfAFinerLevel) {
     RequestMsg req;
     req.request_id = 1;
     req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
-    req.progressive_lod = true;
+    req.lod = LodSchedule::on;
 
     auto renderer = make_renderer("osmesa");
     ClientFrames frames(*renderer);
@@ -105,7 +105,7 @@ TEST(ClientFrames, TheCacheFollowsTheServersGenerationsAndDrawsNamedSlotsCoarseF
     Camera cam = fit_depth_range(front_full_view(bounds, float(w) / h), bounds);
     RequestMsg req;
     req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
-    req.progressive_lod = true;
+    req.lod = LodSchedule::on;
     req.cached_groups = true;
     auto renderer = make_renderer("osmesa");
     ClientFrames frames(*renderer);

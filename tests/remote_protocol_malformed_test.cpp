@@ -181,8 +181,9 @@ TEST(RemoteProtocolMalformed, RequestFields) {
          {"view.frustum.far_z: expected more than near_z",
           [](RequestMsg& m) { m.view.frustum.far_z = 0.25f; }}});
     Bytes bytes = encode_payload(sample_request());
-    bytes[bytes.size() - 2] = std::byte{2};  // progressive_lod
-    expect_view_wire_error(RemoteTag::request, bytes, "progressive_lod: expected 0 or 1, got 2");
+    bytes[bytes.size() - 2] = std::byte{3};  // lod
+    expect_view_wire_error(RemoteTag::request, bytes,
+                           "lod: expected 0 (off), 1 (on) or 2 (the server chooses), got 3");
     bytes[bytes.size() - 2] = std::byte{1};
     bytes.back() = std::byte{255};  // cached_groups
     expect_view_wire_error(RemoteTag::request, bytes, "cached_groups: expected 0 or 1, got 255");

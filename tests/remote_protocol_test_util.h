@@ -31,8 +31,8 @@ inline bool operator==(const ReadyMsg& a, const ReadyMsg& b) {
            a.spacing == b.spacing && a.axes == b.axes;
 }
 inline bool operator==(const RequestMsg& a, const RequestMsg& b) {
-    return a.request_id == b.request_id && a.view == b.view &&
-           a.progressive_lod == b.progressive_lod && a.cached_groups == b.cached_groups;
+    return a.request_id == b.request_id && a.view == b.view && a.lod == b.lod &&
+           a.cached_groups == b.cached_groups;
 }
 inline bool operator==(const GroupMsg& a, const GroupMsg& b) {
     return a.request_id == b.request_id && a.key == b.key &&
@@ -100,7 +100,7 @@ inline RequestMsg sample_request() {
     m.view.width = 800;
     m.view.height = 600;
     m.view.iso = 105.5;
-    m.progressive_lod = true;
+    m.lod = LodSchedule::chosen;
     m.cached_groups = true;
     return m;
 }

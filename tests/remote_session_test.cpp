@@ -106,7 +106,7 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     std::vector<Image> shown;
     std::unique_ptr<Follower> late;
     for (const FrameView& v : views) {
-        presenter.request(v, /*progressive_lod=*/true, /*cached_groups=*/true);
+        presenter.request(v, LodSchedule::on, /*cached_groups=*/true);
         shown.push_back(presenter.wait_done(kTimeoutS).final_image);
         if (!late) {  // joins after the first view: catches up with it, then follows
             late = std::make_unique<Follower>(server.port(), views[2]);
@@ -139,7 +139,8 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     // sent whole (no cache), until it is (its connection closes within the error's 2 s).
     int more = 0;
     for (; more < 12 && server.server().sessions().dropped() == 0; ++more) {
-        presenter.request(test::phantom_view(640, 480, 10.0 * more, 60 + more), false, false);
+        presenter.request(test::phantom_view(640, 480, 10.0 * more, 60 + more), LodSchedule::off,
+                          false);
         presenter.wait_done(kTimeoutS);
         Stopwatch waited;
         while (server.server().sessions().dropped() == 0 && waited.seconds() < 3)

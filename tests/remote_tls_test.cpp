@@ -78,7 +78,7 @@ TEST(RemoteTls, TheViewOverTlsEndsWithTheLocalImage) {
     const FrameView view = phantom_view(kTlsW, kTlsH, 20);
     auto renderer = make_renderer("osmesa");
     ViewClient client(*renderer, tls_hello(server.port(), server_cert().cert));
-    client.request(view, true, true);
+    client.request(view, remote::LodSchedule::on, true);
     const ClientFrameResult& r = client.wait_done(60);
     ASSERT_TRUE(r.completed);
     expect_same_image(r.final_image, local_image(view), "over TLS");

@@ -20,20 +20,26 @@ using namespace remote;
 constexpr int kW = 240, kH = 180;
 constexpr double kTimeout = 60;
 
+constexpr LodSchedule kOff = LodSchedule::off, kOn = LodSchedule::on;
+
 struct Case {
     const char* name;
     GroupEncoding encoding;
-    bool lod, cache;
+    LodSchedule lod;
+    bool cache;
     bool adaptive = false;  // the server chooses (view's default), told the client's decoding
 };
-const Case kCases[] = {{"1 base", GroupEncoding::vertices, false, false},
-                       {"2 indexed", GroupEncoding::indexed, false, false},
-                       {"3 progressive LOD", GroupEncoding::indexed, true, false},
-                       {"4 cached groups", GroupEncoding::indexed, true, true},
-                       {"5 compact+zstd", GroupEncoding::compact_zstd, true, true},
-                       {"cells, new iso", GroupEncoding::cells, false, false},
-                       {"cells + LOD + cache", GroupEncoding::cells, true, true},
-                       {"auto + LOD + cache", GroupEncoding::cells, true, true, true}};
+const Case kCases[] = {
+    {"1 base", GroupEncoding::vertices, kOff, false},
+    {"2 indexed", GroupEncoding::indexed, kOff, false},
+    {"3 progressive LOD", GroupEncoding::indexed, kOn, false},
+    {"4 cached groups", GroupEncoding::indexed, kOn, true},
+    {"5 compact+zstd", GroupEncoding::compact_zstd, kOn, true},
+    {"cells, new iso", GroupEncoding::cells, kOff, false},
+    {"cells + LOD + cache", GroupEncoding::cells, kOn, true},
+    {"auto + LOD + cache", GroupEncoding::cells, kOn, true, true},
+    {"view's defaults", GroupEncoding::cells, LodSchedule::chosen, false, true},
+    {"auto + chosen LOD + cache", GroupEncoding::cells, LodSchedule::chosen, true, true}};
 
 ClientHello hello_for(int port, GroupEncoding e, bool adaptive = false) {
     ClientHello h;
@@ -82,7 +88,7 @@ struct RawClient {
         RequestMsg r;
         r.request_id = id;
         r.view = v;
-        r.progressive_lod = lod;
+        r.lod = lod ? LodSchedule::on : LodSchedule::off;
         r.cached_groups = cache;
         conn.send(r);
     }
@@ -162,9 +168,9 @@ TEST(RemoteView, ARequestInterruptsTheFrameAndTheNextFrameHoldsOnlyItsGroups) {
     // And the client's picture of request 2 is request 2's view alone.
     auto renderer = make_renderer("osmesa");
     ViewClient client(*renderer, hello_for(server.port(), GroupEncoding::compact_zstd));
-    client.request(phantom_view(kW, kH, 0), false, false);
+    client.request(phantom_view(kW, kH, 0), kOff, false);
     client.receive_for(0.05);
-    client.request(phantom_view(kW, kH, 90), false, false);
+    client.request(phantom_view(kW, kH, 90), kOff, false);
     expect_same_image(client.wait_done(kTimeout).final_image, local_image(phantom_view(kW, kH, 90)),
                       "after an interrupt");
 }

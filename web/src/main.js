@@ -2,7 +2,7 @@
 // of the TCP protocol per binary message), sends views and draws their groups as they arrive
 // (frames.js), and keeps window.isowall up to date for tests and the bench (the contract of
 // issue 13).
-import { MsgType, encodeFrame, decodeFrame, ErrorCode } from './protocol.js';
+import { MsgType, encodeFrame, decodeFrame, ErrorCode, LodSchedule } from './protocol.js';
 import { ready as codecReady, helloEncoding, kAdaptiveEncoding, GroupEncoding, cellsProblem } from './group_codec.js';
 import { viewCamera, cameraProblem } from './camera.js';
 import { Renderer } from './renderer.js';
@@ -59,7 +59,7 @@ function encodingParam() {
 
 const fixedSize = sizeParam();
 const settings = {
-  lod: intParam('lod', 0, 1, 1) === 1,
+  lod: intParam('lod', 0, 2, LodSchedule.chosen),  // 0 off, 1 on, 2 the server chooses
   cache: intParam('cache', 0, 1, 1) === 1,
   encoding: encodingParam(),
 };
@@ -164,7 +164,7 @@ function sendRequest() {
   const request = {
     request_id: id,
     view: { camera, frustum, width, height, iso: v.iso },
-    progressive_lod: settings.lod,
+    lod: settings.lod,
     cached_groups: settings.cache,
   };
   sendFrame(MsgType.request, request);
@@ -411,9 +411,9 @@ el.canvas.addEventListener('wheel', (e) => {
 
 // ---- the rest of the controls ------------------------------------------------------------------
 
-el.lod.checked = settings.lod;
+el.lod.value = String(settings.lod);
 el.cache.checked = settings.cache;
-el.lod.addEventListener('change', () => { settings.lod = el.lod.checked; scheduleRequest(); });
+el.lod.addEventListener('change', () => { settings.lod = Number(el.lod.value); scheduleRequest(); });
 el.cache.addEventListener('change', () => { settings.cache = el.cache.checked; scheduleRequest(); });
 
 el.snapshot.addEventListener('click', () => {

@@ -35,12 +35,15 @@ export const kMaxGroupLevel = 30;
 export const kMaxImageSide = 32768;
 // decode_rate: one entry at most per group codec (GroupEncoding's count).
 export const kDecodeRateEncodings = 5;
+// A request's progressive LOD (remote/view_protocol.h LodSchedule): never, always, or where the
+// server forecasts that the coarse passes bring C = 90% sooner (the page's default).
+export const LodSchedule = { off: 0, on: 1, chosen: 2 };
 const MAGIC = [0x49, 0x57, 0x56, 0x50];
 
 // hello: 1 with neither a shared session nor takes_exact, 2 with a session (role and session
 // name), 3 with takes_exact (role 0 without a session); all three decode.
 const VERSION = {
-  hello: 1, ready: 2, request: 1, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1, decode_rate: 1,
+  hello: 1, ready: 2, request: 2, group: 2, visible: 2, end_of_frame: 1, error: 1, bye: 1, session: 1, decode_rate: 1,
   exact: 1,
 };
 
@@ -183,7 +186,7 @@ const encoders = {
     const w = new Writer(VERSION.request);
     w.u64(m.request_id);
     putFrameView(w, m.view);
-    w.u8(m.progressive_lod ? 1 : 0);
+    w.u8(m.lod);
     w.u8(m.cached_groups ? 1 : 0);
     return w.take();
   },
@@ -294,7 +297,8 @@ const decoders = {
     m.view = getFrameView(r);
     const problem = cameraProblem(m.view.camera);
     if (problem) r.fail(`view.camera: ${problem}`);
-    m.progressive_lod = getFlag(r, 'progressive_lod');
+    m.lod = r.u8();
+    if (m.lod > LodSchedule.chosen) r.fail(`lod: expected 0 (off), 1 (on) or 2 (the server chooses), got ${m.lod}`);
     m.cached_groups = getFlag(r, 'cached_groups');
     return m;
   },

@@ -17,7 +17,7 @@ class Recorder {
 const bounds = { min: [0, 0, 0], max: [10, 10, 10] };
 function request(id, cache = true) {
   const c = fitDepthRange(frontFullView(bounds, 1), bounds);
-  return { request_id: id, view: { camera: c, frustum: frustum(c, 1), width: 4, height: 4, iso: 1 }, progressive_lod: true, cached_groups: cache };
+  return { request_id: id, view: { camera: c, frustum: frustum(c, 1), width: 4, height: 4, iso: 1 }, lod: 1, cached_groups: cache };
 }
 // A group message whose "encoded" bytes are the mesh itself (the decoder is replaced).
 function group(id, name, level, { gen = 0, late = false, tris = 1 } = {}) {

@@ -44,7 +44,7 @@ test('corpus values are the seeds\' (fuzz/view_protocol_seeds.cpp)', () => {
   assert.equal(q.request_id, 3);
   assert.deepEqual(q.view.camera.eye, [1, -40, 3]);
   assert.equal(q.view.frustum.left, -0.5);
-  assert.deepEqual([q.view.width, q.view.height, q.view.iso, q.progressive_lod, q.cached_groups], [8, 6, 105.5, true, true]);
+  assert.deepEqual([q.view.width, q.view.height, q.view.iso, q.lod, q.cached_groups], [8, 6, 105.5, 2, true]);
   const g = msg('group');
   assert.deepEqual([g.request_id, g.key, g.draw_from_next_frame, g.cache_gen, Array.from(g.encoded)],
     [3, { seed: [4, 5, 6], level: 2, iso: 105.5, refinement: true }, true, 3, [1, 2, 3]]);
@@ -87,7 +87,7 @@ function sampleRequest() {
   const bounds = { min: [0, 0, 0], max: [199, 183, 167] };
   const c = fitDepthRange(frontFullView(bounds, 4 / 3), bounds);
   return { request_id: 41, view: { camera: c, frustum: frustum(c, 4 / 3), width: 800, height: 600, iso: 50.25 },
-    progressive_lod: true, cached_groups: false };
+    lod: 2, cached_groups: false };
 }
 
 test('round trips of what the page sends: hello, request, decode_rate, bye', () => {
@@ -134,6 +134,12 @@ test('decoders name the message and the field', () => {
   const bad = req.slice();
   bad[bad.length - 1] = 2;
   assert.throws(() => decodePayload(MsgType.request, bad), /request message: cached_groups: expected 0 or 1, got 2/);
+  const lod = req.slice();
+  lod[lod.length - 2] = 3;
+  assert.throws(() => decodePayload(MsgType.request, lod), /request message: lod: expected 0 \(off\), 1 \(on\) or 2 \(the server chooses\), got 3/);
+  const v1 = req.slice();
+  v1[0] = 1;  // the version byte: a request of version 1 had the lod byte as a flag
+  assert.throws(() => decodePayload(MsgType.request, v1), /request message: version 1, expected 2/);
   const same = sampleRequest();
   same.view.camera.eye = [...same.view.camera.target];
   assert.throws(() => decodePayload(MsgType.request, encodePayload(MsgType.request, same)),

@@ -31,3 +31,19 @@ test('the fragment shader is gl_core.cpp\'s', () => {
   assert.deepEqual(page, statements(cppShader('kFragmentShader')));
   assert.ok(page.length > 15, `${page.length} statements`);
 });
+
+// The server forecasts the colours the client shows (remote/lod_choice.cpp) from
+// render/headlight.h: its constants are the fragment shader's.
+test('render/headlight.h holds the fragment shader\'s constants', () => {
+  const header = readFileSync(new URL('../../render/headlight.h', import.meta.url), 'utf8');
+  const shader = cppShader('kFragmentShader');
+  const numbers = (s) => s.split(',').map((x) => Number(x.trim().replace(/f$/, '')));
+  let checked = 0;
+  for (const m of shader.matchAll(/const (float|vec3) (k\w+) = (?:vec3\()?([^;)]+)\)?;/g)) {
+    const h = new RegExp(`${m[2]}(?:\\{([^}]*)\\}| = ([^;]+));`).exec(header);
+    assert.ok(h, `render/headlight.h: no ${m[2]}`);
+    assert.deepEqual(numbers(h[1] ?? h[2]), numbers(m[3]), m[2]);
+    ++checked;
+  }
+  assert.equal(checked, 6);
+});
