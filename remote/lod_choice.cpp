@@ -86,9 +86,19 @@ glm::vec3 shown_colour(const VolumeView<T>& v, const Ray& ray, float t, int leve
     return glm::clamp(headlight::colour(cosine), glm::vec3(0), glm::vec3(1));
 }
 
+// Whether C = 1 - sqrt(mean) of these `count` errors lies 3 standard errors from kCoarsePaysFrom.
+// The errors' variance is taken at its bound for values in [0, 1], mean (1 - mean): a few rays
+// that all agree say nothing of the misses a hundred more may meet. Through dC/dmean =
+// -1 / (2 sqrt(mean)), C's standard error is then sqrt((1 - mean) / count) / 2.
+bool clear(double sum, std::size_t count) {
+    const double mean = std::clamp(sum / double(count), 0.0, 1.0);
+    const double se = 0.5 * std::sqrt((1.0 - mean) / double(count));
+    return std::abs(1.0 - std::sqrt(mean) - kCoarsePaysFrom) >= 3.0 * se;
+}
+
 template <class T>
 CoarseForecast forecast(std::span<SurfaceExtractor* const> levels, const FrameView& view,
-                        std::size_t rays) {
+                        bool decide, std::size_t rays) {
     const VolumeView<T> v = levels[0]->volume().view<T>();
     const glm::mat4 view_inv = glm::inverse(view.camera.view());
     // A grid of about `rays` pixels with the aspect of the volume's box on the screen, over it:
@@ -100,42 +110,48 @@ CoarseForecast forecast(std::span<SurfaceExtractor* const> levels, const FrameVi
     const double aspect = double(box.width) / double(box.height);
     const int nx = std::clamp(int(std::lround(std::sqrt(double(rays) * aspect))), 1, box.width);
     const int ny = std::clamp(int(std::lround(double(rays) / nx)), 1, box.height);
-    double error_sum = 0;  // of e(P)^2 over the significant rays
-    for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-            const glm::ivec2 px(box.x + (2 * i + 1) * box.width / (2 * nx),
-                                box.y + (2 * j + 1) * box.height / (2 * ny));
-            const Ray ray = pixel_ray(view_inv, view.frustum, view.width, view.height, px);
-            ++f.rays;
-            const RayHit fine = levels[0]->cast(ray, IntersectMode::exact);
-            if (!fine.found) continue;
-            ++f.significant;
-            const glm::vec3 want = shown_colour(v, ray, fine.t, 0);
-            double e2 = 1;  // nothing drawn here by the coarse passes
-            for (std::size_t l = 1; l < levels.size(); ++l) {
-                const RayHit h = levels[l]->cast(ray, IntersectMode::exact);
-                // A refinement hit is the full resolution's (the level's own surface missed), and
-                // a border cell finer than the level is left to it (adaptive.h: finer_units).
-                if (!h.found || h.refine || h.level < int(l)) continue;
-                const glm::vec3 d = shown_colour(v, ray, h.t, int(l)) - want;
-                e2 = double(glm::dot(d, d)) / 3.0;
-                break;
-            }
-            error_sum += e2;
+    // The grid's cells in the order k * stride mod n, stride a prime that divides no n here:
+    // every prefix spreads over the grid.
+    const std::size_t n = std::size_t(nx) * std::size_t(ny);
+    constexpr std::size_t kStride = 7919;
+    const std::size_t stride = n % kStride == 0 ? 1 : kStride % n;
+    double sum = 0;  // of e(P)^2 over the significant rays
+    for (std::size_t k = 0, cell = 0; k < n; ++k, cell = (cell + stride) % n) {
+        const int i = int(cell % std::size_t(nx)), j = int(cell / std::size_t(nx));
+        const glm::ivec2 px(box.x + (2 * i + 1) * box.width / (2 * nx),
+                            box.y + (2 * j + 1) * box.height / (2 * ny));
+        const Ray ray = pixel_ray(view_inv, view.frustum, view.width, view.height, px);
+        ++f.rays;
+        const RayHit fine = levels[0]->cast(ray, IntersectMode::exact);
+        if (!fine.found) continue;
+        ++f.significant;
+        const glm::vec3 want = shown_colour(v, ray, fine.t, 0);
+        double e2 = 1;  // nothing drawn here by the coarse passes
+        for (std::size_t l = 1; l < levels.size(); ++l) {
+            const RayHit h = levels[l]->cast(ray, IntersectMode::exact);
+            // A refinement hit is the full resolution's (the level's own surface missed), and
+            // a border cell finer than the level is left to it (adaptive.h: finer_units).
+            if (!h.found || h.refine || h.level < int(l)) continue;
+            const glm::vec3 d = shown_colour(v, ray, h.t, int(l)) - want;
+            e2 = double(glm::dot(d, d)) / 3.0;
+            break;
         }
-    if (f.significant > 0) f.c = 1.0 - std::sqrt(error_sum / double(f.significant));
+        sum += e2;
+        if (decide && f.significant >= kDecideAfter && clear(sum, f.significant)) break;
+    }
+    if (f.significant > 0) f.c = 1.0 - std::sqrt(sum / double(f.significant));
     return f;
 }
 
 }  // namespace
 
 CoarseForecast forecast_coarse_correctness(std::span<SurfaceExtractor* const> levels,
-                                           const FrameView& view, std::size_t rays) {
+                                           const FrameView& view, bool decide, std::size_t rays) {
     if (levels.size() < 2)
         throw std::invalid_argument("forecast_coarse_correctness: no coarse level");
     if (view.width <= 0 || view.height <= 0 || rays == 0) return {};
     return dispatch_voxel_type(levels[0]->volume().type(), [&](auto tag) {
-        return forecast<decltype(tag)>(levels, view, rays);
+        return forecast<decltype(tag)>(levels, view, decide, rays);
     });
 }
 

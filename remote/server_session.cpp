@@ -210,9 +210,10 @@ void ServerSession::name_by_seed_rays(const RequestMsg& r, int top, RequestFigur
 
 std::string lod_note(const RequestFigures& f) {
     if (f.coarse_forecast < 0) return {};
-    char note[96];
-    std::snprintf(note, sizeof(note), "; coarse picture forecast C = %.3f: %d coarse levels",
-                  f.coarse_forecast, f.coarse_levels);
+    char note[128];
+    std::snprintf(note, sizeof(note),
+                  "; coarse picture forecast C = %.3f (%zu rays, %.1f ms): %d coarse levels",
+                  f.coarse_forecast, f.forecast_rays, 1e3 * f.forecast_s, f.coarse_levels);
     return note;
 }
 
@@ -220,7 +221,10 @@ int ServerSession::coarse_levels(const RequestMsg& r, int most, RequestFigures& 
     if (r.lod != LodSchedule::chosen || most == 0) return most;
     std::vector<SurfaceExtractor*> levels;
     for (int l = 0; l <= most; ++l) levels.push_back(lod_level(l).ex.get());
-    const CoarseForecast forecast = forecast_coarse_correctness(levels, r.view);
+    const Stopwatch took;
+    const CoarseForecast forecast = forecast_coarse_correctness(levels, r.view, /*decide=*/true);
+    f.forecast_s = took.seconds();
+    f.forecast_rays = forecast.rays;
     f.rays += forecast.rays * std::size_t(most + 1);
     f.coarse_forecast = forecast.c;
     return coarse_passes_pay(forecast) ? most : 0;

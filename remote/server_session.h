@@ -77,11 +77,13 @@ struct RequestFigures {
     // The coarse picture's forecast C where the server chose the levels of detail
     // (LodSchedule::chosen; remote/lod_choice.h), else -1; coarse passes went out where it paid.
     double coarse_forecast = -1;
-    int coarse_levels = 0;  // the coarse levels cast
+    std::size_t forecast_rays = 0;  // the forecast's rays at full resolution
+    double forecast_s = 0;          // and its seconds
+    int coarse_levels = 0;          // the coarse levels cast
 };
 
-// "; coarse picture forecast C = 0.925: 2 coarse levels" where the server chose the levels of
-// detail, else empty: for the server's line per request.
+// "; coarse picture forecast C = 0.925 (1329 rays, 4.1 ms): 2 coarse levels" where the server
+// chose the levels of detail, else empty: for the server's line per request.
 std::string lod_note(const RequestFigures& f);
 
 class ServerSession {

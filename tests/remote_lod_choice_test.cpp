@@ -66,7 +66,8 @@ LodFrame serve_and_draw_lod(const SurfaceExtractor& ex, const FrameView& view, L
     return out;
 }
 
-CoarseForecast lod_forecast_for(const SurfaceExtractor& prototype, const FrameView& view) {
+CoarseForecast lod_forecast_for(const SurfaceExtractor& prototype, const FrameView& view,
+                                bool decide = false) {
     std::vector<std::unique_ptr<SurfaceExtractor>> owned;
     std::vector<SurfaceExtractor*> levels;
     for (int l = 0; l <= 2; ++l) {
@@ -74,7 +75,7 @@ CoarseForecast lod_forecast_for(const SurfaceExtractor& prototype, const FrameVi
         owned.back()->begin_frame(view.iso, uniform_levels(l));
         levels.push_back(owned.back().get());
     }
-    return forecast_coarse_correctness(levels, view);
+    return forecast_coarse_correctness(levels, view, decide);
 }
 
 TEST(LodChoice, TheForecastIsTheCoarsePictureTheClientDraws) {
@@ -99,6 +100,14 @@ TEST(LodChoice, TheForecastIsTheCoarsePictureTheClientDraws) {
         EXPECT_NEAR(f.c, drawn.coarse_c, 0.05) << c.name;
         EXPECT_EQ(coarse_passes_pay(f), c.pays) << c.name << ": forecast " << f.c;
         EXPECT_EQ(drawn.coarse_c >= 0.9, c.pays) << c.name << ": drawn " << drawn.coarse_c;
+        // The server's way: it stops once the choice is clear, the same choice for fewer rays.
+        const CoarseForecast quick = lod_forecast_for(*ex, view, /*decide=*/true);
+        std::printf("  deciding: C %.4f after %zu of %zu rays\n", quick.c, quick.rays, f.rays);
+        EXPECT_EQ(coarse_passes_pay(quick), c.pays) << c.name << ": " << quick.c;
+        EXPECT_LE(quick.rays, f.rays) << c.name;
+        if (!c.pays) {
+            EXPECT_LT(quick.rays * 4, f.rays) << c.name << ": a clear case";
+        }
     }
 }
 
