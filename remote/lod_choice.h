@@ -15,7 +15,8 @@
 // picture shows the finest coarse level that the ray hits (the client clears depth for each finer
 // level; a coarser level's colour stays where a finer one draws nothing). A pixel the full
 // resolution covers and no coarse level does counts an error of 1, as in C = 1 - E
-// (common/progressive/correctness.h). A few thousand rays cost a few milliseconds.
+// (common/progressive/correctness.h). A few thousand rays cost a few milliseconds; the server
+// stops once its choice is clear (`decide`).
 #include <cstddef>
 #include <span>
 
