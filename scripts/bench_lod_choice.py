@@ -19,12 +19,11 @@ one line on stderr and exit status 1; the server is always stopped.
 import argparse
 import os
 import re
-import signal
 import subprocess
 import sys
 import time
 
-from bench_remote_bytes import CASES, ROOT
+from bench_remote_bytes import CASES, ROOT, stop_server
 
 PROG = "bench_lod_choice.py"
 PORT = 7983
@@ -144,11 +143,7 @@ def main():
                       f"{'holds' if ok else 'LATER'} ({got['chosen'][0] / best:.2f}) |",
                       flush=True)
         finally:
-            server.send_signal(signal.SIGINT)
-            try:
-                server.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                server.kill()
+            stop_server(server)
     print(f"\nthe default reached C = 90% within 10% of the sooner of --no-lod and --lod on "
           f"{held} of {total} rows")
 

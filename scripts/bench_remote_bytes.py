@@ -65,6 +65,15 @@ def start_server(isowall, data, names, rate, cpu):
     fail("isowall serve did not start listening")
 
 
+def stop_server(server):
+    """Stops `isowall serve` as a user would (SIGINT), killing it if it does not end in 20 s."""
+    server.send_signal(signal.SIGINT)
+    try:
+        server.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        server.kill()
+
+
 def view(isowall, name, iso, encoding, cpu):
     out = subprocess.run(
         pinned(cpu, [isowall, "view", "--connect", f"127.0.0.1:{PORT}", "--dataset", name,
@@ -115,11 +124,7 @@ def main():
             got = {e: sorted(r, key=lambda x: x[0][90.0][0])[len(r) // 2] for e, r in runs.items()}
             rows.append((name, iso, got))
     finally:
-        server.send_signal(signal.SIGINT)
-        try:
-            server.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            server.kill()
+        stop_server(server)
     rate = f"{a.rate_mbps:g} Mbit/s" if a.rate_mbps else "loopback, unpaced"
     rate += ", server on CPU 0 and client on CPU 1" if a.pin else ""
     runs = f", the median of {a.runs} runs" if a.runs > 1 else ""
