@@ -123,12 +123,14 @@ CoarseForecast forecast(std::span<SurfaceExtractor* const> levels, const FrameVi
         const Ray ray = pixel_ray(view_inv, view.frustum, view.width, view.height, px);
         ++f.rays;
         const RayHit fine = levels[0]->cast(ray, IntersectMode::exact);
+        ++f.casts;
         if (!fine.found) continue;
         ++f.significant;
         const glm::vec3 want = shown_colour(v, ray, fine.t, 0);
         double e2 = 1;  // nothing drawn here by the coarse passes
         for (std::size_t l = 1; l < levels.size(); ++l) {
             const RayHit h = levels[l]->cast(ray, IntersectMode::exact);
+            ++f.casts;
             // A refinement hit is the full resolution's (the level's own surface missed), and
             // a border cell finer than the level is left to it (adaptive.h: finer_units).
             if (!h.found || h.refine || h.level < int(l)) continue;

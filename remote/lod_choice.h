@@ -29,6 +29,7 @@ struct CoarseForecast {
     double c = 1;                 // the coarse picture's forecast C against the full one
     std::size_t rays = 0;         // cast at full resolution
     std::size_t significant = 0;  // of them, those that hit the surface
+    std::size_t casts = 0;        // rays cast at every level
 };
 
 // The coarse passes are worth their bytes when their picture reaches C = 90% on its own. Against

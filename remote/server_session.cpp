@@ -217,15 +217,16 @@ std::string lod_note(const RequestFigures& f) {
     return note;
 }
 
-int ServerSession::coarse_levels(const RequestMsg& r, int most, RequestFigures& f) {
+int ServerSession::coarse_levels(const RequestMsg& r, int most, bool keep, RequestFigures& f) {
     if (r.lod != LodSchedule::chosen || most == 0) return most;
+    if (keep) return std::min(last_top_, most);
     std::vector<SurfaceExtractor*> levels;
     for (int l = 0; l <= most; ++l) levels.push_back(lod_level(l).ex.get());
     const Stopwatch took;
     const CoarseForecast forecast = forecast_coarse_correctness(levels, r.view, /*decide=*/true);
     f.forecast_s = took.seconds();
     f.forecast_rays = forecast.rays;
-    f.rays += forecast.rays * std::size_t(most + 1);
+    f.rays += forecast.casts;
     f.coarse_forecast = forecast.c;
     return coarse_passes_pay(forecast) ? most : 0;
 }
@@ -273,8 +274,8 @@ RequestFigures ServerSession::run(const RequestMsg& r, const std::atomic<bool>& 
     // Every level the request may cast begins (the forecast casts on them), with its cached cells.
     const int most = r.lod == LodSchedule::off ? 0 : options_.lod_levels;
     for (int l = most; l >= 0; --l) begin_cached(lod_level(l), r, keep);
-    const int top = coarse_levels(r, most, f);
-    f.coarse_levels = top;
+    const int top = coarse_levels(r, most, keep, f);
+    f.coarse_levels = last_top_ = top;
     if (keep) name_by_seed_rays(r, top, f);
     for (int l = top; l >= 0; --l)
         if (stop.load() || !cast_level(l, r, keep, stop, f)) return f;

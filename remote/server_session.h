@@ -116,7 +116,10 @@ class ServerSession {
     void name_by_seed_rays(const RequestMsg& r, int top, RequestFigures& f);
     // The coarse levels to cast before the full resolution, of the `most` the request allows:
     // all, or with LodSchedule::chosen those the forecast says bring C = 90% sooner (all or none).
-    int coarse_levels(const RequestMsg& r, int most, RequestFigures& f);
+    // A request that keeps the cache generation keeps the levels of the one before it: the
+    // generation's coarse groups came with them, and a turned view at a cached isovalue reaches
+    // C = 90% in a few milliseconds, which a forecast each time would double.
+    int coarse_levels(const RequestMsg& r, int most, bool keep, RequestFigures& f);
     bool cast_level(int l, const RequestMsg& r, bool drawn, const std::atomic<bool>& stop,
                     RequestFigures& f);
 
@@ -134,6 +137,7 @@ class ServerSession {
     std::uint64_t cache_gen_ = 0;  // the generation groups are sent in; 0 while not caching
     std::uint32_t next_slot_ = 0;  // the slot of the generation's next group
     float grid_step_ = 0;  // compact encodings: one position grid for every group (no cracks)
+    int last_top_ = 0;     // the coarse levels the last request cast
 };
 
 }  // namespace isowall::remote

@@ -155,5 +155,37 @@ TEST(LodChoice, TheServerSendsCoarsePassesOnlyWhereTheForecastSaysTheyPay) {
     EXPECT_GT(on.coarse_groups, 0);
 }
 
+// A turned view at a cached isovalue keeps its generation's levels without a forecast: it
+// reaches C = 90% in milliseconds from the cache, which a forecast each time would double.
+TEST(LodChoice, AKeptCacheGenerationKeepsItsLevelsWithoutAForecast) {
+    const Volume phantom = make_phantom();
+    auto ex = make_surface_extractor(phantom);
+    std::size_t coarse = 0;
+    ServerSession session(*ex, SessionOptions{}, [&](const RemoteMessage& m) {
+        if (const auto* g = std::get_if<GroupMsg>(&m); g && g->key.level > 0) ++coarse;
+        return std::size_t{100};
+    });
+    const std::atomic<bool> stop{false};
+    RequestMsg r;
+    r.lod = LodSchedule::chosen;
+    r.cached_groups = true;
+    r.request_id = 1;
+    r.view = front_view(phantom.bounds(), kLodW, kLodH, 0, kPhantomSkinIso);
+    const RequestFigures first = session.run(r, stop);
+    EXPECT_GE(first.coarse_forecast, kCoarsePaysFrom);
+    EXPECT_EQ(first.coarse_levels, 2);
+    EXPECT_GT(coarse, 0u);
+    r.request_id = 2;
+    r.view = front_view(phantom.bounds(), kLodW, kLodH, 30, kPhantomSkinIso);
+    const RequestFigures turned = session.run(r, stop);
+    EXPECT_LT(turned.coarse_forecast, 0) << "no forecast for a kept generation";
+    EXPECT_EQ(turned.coarse_levels, 2);
+    EXPECT_GT(turned.named, 0u);
+    // A new isovalue begins a generation: the server forecasts again.
+    r.request_id = 3;
+    r.view.iso = kPhantomBoneIso;
+    EXPECT_GE(session.run(r, stop).coarse_forecast, 0);
+}
+
 }  // namespace
 }  // namespace isowall::test
