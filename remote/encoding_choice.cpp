@@ -13,7 +13,13 @@ constexpr double kKeep = 1.0 - 1.0 / EncodingChooser::kWindow;
 }  // namespace
 
 double EncodingChooser::bytes_per_s() const {
-    const double seen = blocked_s_ > 0 ? sent_bytes_ / blocked_s_ : 0;
+    // The link's own progress where the connection shows it. Else the sends that waited: a
+    // client that reads only as fast as it decodes makes them wait as a slow link would, so its
+    // decoding seconds are taken off the waiting, and what is left is the link's.
+    const double blocked_link_s = blocked_s_ - client_busy_s_;
+    const double seen = link_rates_ > 0 && link_s_ > 0 ? link_bytes_ / link_s_
+                        : blocked_link_s > 0           ? sent_bytes_ / blocked_link_s
+                                                       : 0;
     if (link_cap_ <= 0) return seen;
     return seen > 0 ? std::min(seen, link_cap_) : link_cap_;
 }
@@ -34,8 +40,44 @@ double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
 
 bool EncodingChooser::probing() const {
     // The link is unknown until two sends waited (the first one's rate says little), or until
-    // kProbeSends went with none waiting (buffers absorb them: a fast link).
-    return blocked_sends_ == 0 ? cells_.sends + compact_.sends < kProbeSends : blocked_sends_ < 2;
+    // kProbeSends went with none waiting (buffers absorb them: a fast link), or the link was
+    // found empty as kDrainedToKnow groups in a row were ready.
+    if (link_rates_ >= kRatesToKnow || drained_in_row_ >= kDrainedToKnow) return false;
+    if (blocked_sends_ > 0) return blocked_sends_ < 2;
+    return cells_.sends + compact_.sends < kProbeSends;
+}
+
+void EncodingChooser::ready_to_send(std::optional<LinkProgress> link, double now_s) {
+    if (!link) return;
+    // A peer on this host has no link between: its bytes on their way wait for the host's CPUs
+    // (on 2 loaded cores the page's were held for 60 ms at a time, and read as a 2-10 MB/s link
+    // they put the server into cells the page decodes slowly). Its sends' waits still count.
+    if (last_link_ && !link->same_host && link->unacked >= kBacklogBytes && now_s > last_link_s_ &&
+        link->acked >= last_link_->acked) {
+        // A backlog on its way now: the link was busy since the last look (the one send since
+        // then went right after it), and what it delivered meanwhile is its rate. A few bytes
+        // unacknowledged say nothing: a receiver delays its acknowledgement of the last segment
+        // up to 40 ms, and read as a backlog that made a 10 Gbit/s veth a 0.5 MB/s link (the
+        // groups' own pace, 3 KB every 5 ms). Less the time
+        // the client's receive window held the bytes back: a client that does not read as fast
+        // as the link brings them (a page busy decoding) is the client's stage, not the link's.
+        const double busy_s = (now_s - last_link_s_) -
+                              std::max(0.0, link->receiver_held_s - last_link_->receiver_held_s);
+        if (busy_s > 0.25 * (now_s - last_link_s_)) {
+            constexpr double keep = 1.0 - 1.0 / (4 * kWindow);
+            link_bytes_ = link_bytes_ * keep + static_cast<double>(link->acked - last_link_->acked);
+            link_s_ = link_s_ * keep + busy_s;
+            ++link_rates_;
+        }
+    }
+    // The link is empty and took bytes since the last look: it keeps up, whatever waits on this
+    // side for a thread to write it (a WebSocket's io thread on a loaded host).
+    const bool took = last_link_ && link->acked > last_link_->acked;
+    if (cells_.sends + compact_.sends > 0)
+        drained_in_row_ =
+            link->unacked == 0 && (link->queued == 0 || took) ? drained_in_row_ + 1 : 0;
+    last_link_ = link;
+    last_link_s_ = now_s;
 }
 
 bool EncodingChooser::steps_pay() const {
@@ -89,13 +131,14 @@ void EncodingChooser::encoded(GroupEncoding e, std::size_t triangles, std::size_
     making_s_ = making_s_ * kKeep + making_seconds;
 }
 
-void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {
+void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds, bool waited) {
     // Decayed sums: the recent sends weigh most, so a link that changes is followed.
     constexpr double keep = 1.0 - 1.0 / (4 * kWindow);
     ++slot(e).sends;
     sent_bytes_ *= keep;
     blocked_s_ *= keep;
-    if (seconds < kBlockedS) return;
+    client_busy_s_ *= keep;
+    if (!waited || seconds < kBlockedS) return;
     // The first send that waits finds the buffers (a socket's, a paced link's burst) part full
     // and waits for part of its bytes only: counted, it made a 1 Mbit/s link look 130 MB/s.
     if (++blocked_sends_ == 1) return;
@@ -104,8 +147,11 @@ void EncodingChooser::sent(GroupEncoding e, std::size_t bytes, double seconds) {
 }
 
 void EncodingChooser::decoded(GroupEncoding e, std::uint64_t triangles, double seconds) {
+    if (!(seconds >= 0)) return;
+    // Only once the sends waited: before, the client's decoding held nothing back.
+    if (blocked_sends_ > 1) client_busy_s_ += seconds;
     if (e != GroupEncoding::cells && e != GroupEncoding::compact_zstd) return;
-    if (triangles == 0 || !(seconds >= 0)) return;
+    if (triangles == 0) return;
     Estimate& s = slot(e);
     s.decoded_triangles = s.decoded_triangles * kKeep + static_cast<double>(triangles);
     s.decoded_s = s.decoded_s * kKeep + seconds;

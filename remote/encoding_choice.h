@@ -20,10 +20,22 @@
 // much for the exploring. Pure: no clock, no I/O; the session measures and reports.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "remote/group_codec.h"
 
 namespace isowall::remote {
+
+// How far a connection's link has taken what was sent: bytes still queued on this side (not yet
+// written to the socket), bytes the peer's host acknowledged in all, and bytes written but not
+// yet acknowledged (remote/net/tcp_progress.h).
+struct LinkProgress {
+    std::size_t queued = 0;
+    std::uint64_t acked = 0;
+    std::size_t unacked = 0;
+    double receiver_held_s = 0;  // in all, the seconds the peer's receive window held sends back
+    bool same_host = false;      // no network between the ends: no rate is read from progress
+};
 
 // The hello's encoding value for "the server chooses per group" (not a codec's id).
 inline constexpr std::uint8_t kAdaptiveEncoding = 255;
@@ -80,19 +92,45 @@ class EncodingChooser {
     // link's burst and a socket's buffer make the first sends look fast (the 256 head at
     // 1 Mbit/s sent its fifth group as compact+zstd in some runs, 23.7 KB against 5.8).
     static constexpr std::uint64_t kProbeSends = 8;
+    // ...or until this many groups in a row found every byte sent before them already at the
+    // client's host as they were ready to go (ready_to_send): the link keeps up with the server,
+    // whatever its rate, so bytes cost no time. A slow link still holds the group before (a
+    // 5 KB group takes 40 ms at 1 Mbit/s; the engine makes the next in a few), and a fresh
+    // page was sent 8 cells groups it decodes 10x slower than compact+zstd before WebAssembly
+    // warms up (100-200 ms of its first frame on the head).
+    static constexpr int kDrainedToKnow = 2;
+    // ...or once the link's progress gave this many rates (ready_to_send).
+    static constexpr int kRatesToKnow = 2;
+    // A backlog: more bytes unacknowledged than a receiver's delayed acknowledgement leaves (a
+    // segment or two), fewer than two groups hold on a slow link.
+    static constexpr std::size_t kBacklogBytes = 8192;
+    // As a group is ready to go (`now_s` on any steady clock): how far the link has taken what
+    // was sent, or nullopt where the connection cannot tell. Where bytes are still on their way
+    // (unacknowledged), the link was busy since the last look, and the bytes acknowledged
+    // meanwhile over the seconds are its rate: measured so, a slow link shows from its second
+    // group on, however many bytes the socket's buffers take before a send has to wait.
+    void ready_to_send(std::optional<LinkProgress> link, double now_s);
     // What a group cost: its triangles, the bytes it encoded to, the server's seconds to encode it
     // and to make it (from the end of the previous send to the start of encoding).
     void encoded(GroupEncoding e, std::size_t triangles, std::size_t bytes, double seconds,
                  double making_seconds = 0);
-    // One send of a group in `e`: its bytes on the wire and the seconds the call blocked.
-    void sent(GroupEncoding e, std::size_t bytes, double seconds);
+    // One send of a group in `e`: its bytes on the wire, the seconds the call took, and whether
+    // it waited (the thread blocked in it: voluntary_switches() moved). A send that took long
+    // without waiting was the scheduler's doing, not the link's: on a loaded machine (the page,
+    // its GPU process and the server on 2 cores) such sends made loopback look like 2 MB/s and
+    // the server sent a fresh page 145 of the head's 180 groups as cells.
+    void sent(GroupEncoding e, std::size_t bytes, double seconds, bool waited = true);
     // The client's report: it decoded `triangles` of groups in `e` in `seconds`. Encodings the
     // chooser does not pick between are ignored.
     void decoded(GroupEncoding e, std::uint64_t triangles, double seconds);
 
     // Seconds a triangle costs in `e` at the rate seen; 0 until `e` was measured.
     double cost_per_triangle(GroupEncoding e) const;
-    // Bytes a second the sends went at while they blocked; 0 while none has blocked.
+    // Bytes a second the sends went at while they blocked for the link (the seconds they waited
+    // less those the client reported decoding: a client that reads no faster than it decodes
+    // makes sends wait too, and counted as the link's that waiting locked a busy page into
+    // cells, which it decodes ten times slower, the waiting taken for a 0.2 MB/s link); 0 while
+    // none has blocked, or the client's decoding accounts for all the waiting.
     double bytes_per_s() const;
     // Groups sent in `e`.
     std::uint64_t chosen(GroupEncoding e) const { return slot(e).sends; }
@@ -123,14 +161,22 @@ class EncodingChooser {
         double server = 0, link = 0, client = 0;
     };
     Stages stages(GroupEncoding e) const;
-    // The link is unknown: fewer than two sends waited for it, and fewer than kProbeSends went.
+    // The link is unknown: fewer than two sends waited for it, fewer than kProbeSends went,
+    // fewer than kDrainedToKnow groups in a row found it empty, and fewer than kRatesToKnow
+    // rates came from its progress.
     bool probing() const;
 
     Estimate cells_, compact_;
     double made_triangles_ = 0, making_s_ = 0;  // extraction, the same in either encoding
     double sent_bytes_ = 0, blocked_s_ = 0;     // decayed sums over the recent sends
+    double client_busy_s_ = 0;                  // the client's decoding meanwhile (its reports)
     std::uint64_t blocked_sends_ = 0;           // sends that waited for the link
-    double link_cap_ = 0;                       // bytes a second; 0: none known
+    int drained_in_row_ = 0;                    // groups that found the link empty (ready_to_send)
+    std::optional<LinkProgress> last_link_;     // the last look at the link, and when
+    double last_link_s_ = 0;
+    double link_bytes_ = 0, link_s_ = 0;  // decayed sums of the link's busy progress
+    int link_rates_ = 0;                  // rates read from the link's progress
+    double link_cap_ = 0;                 // bytes a second; 0: none known
     std::uint64_t since_explored_ = 0;
 };
 

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "remote/encoding_choice.h"
 #include "remote/net/connection.h"
 #include "remote/view_protocol.h"
 
@@ -31,6 +32,9 @@ class MessageChannel {
     // The next whole message within `timeout_s`, or nullopt. Throws WireError when what arrived
     // does not decode, PeerClosed when the peer has gone or after shutdown().
     virtual std::optional<RemoteMessage> receive(double timeout_s) = 0;
+    // How far the link has taken what was sent (EncodingChooser::LinkProgress); nullopt where
+    // the channel cannot tell. Any thread.
+    virtual std::optional<LinkProgress> link_progress() const { return std::nullopt; }
     // The emulated link (token bucket on every send); 0: none.
     virtual void set_rate(double bits_per_second) = 0;
     // Wakes a blocked receive and a blocked or paced send; later calls throw PeerClosed.
@@ -53,6 +57,7 @@ class TcpChannel final : public MessageChannel {
     std::optional<RemoteMessage> receive(double timeout_s) override {
         return conn_.receive(timeout_s);
     }
+    std::optional<LinkProgress> link_progress() const override;
     void set_rate(double bits_per_second) override { conn_.set_rate(bits_per_second); }
     void shutdown() override { conn_.shutdown(); }
     void close_gracefully() override;

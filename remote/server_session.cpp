@@ -74,6 +74,8 @@ class ServerSession::Sink final : public GroupSink {
         bool measure_other = false;
         if (adaptive) {
             s_.take_reports();
+            if (s_.read_link_)
+                s_.chooser_.ready_to_send(s_.read_link_(), s_.since_start_.seconds());
             asked = s_.chooser_.next();
             measure_other = s_.chooser_.wants_measure(other_encoding(asked));
         }
@@ -86,8 +88,10 @@ class ServerSession::Sink final : public GroupSink {
         std::transform(bytes.begin(), bytes.end(), m.encoded.begin(),
                        [](std::uint8_t b) { return std::byte{b}; });
         const Stopwatch sending;
+        const long switches = voluntary_switches();
         const std::size_t sent = s_.send_(m);
-        if (adaptive) s_.chooser_.sent(asked, sent, sending.seconds());
+        if (adaptive)
+            s_.chooser_.sent(asked, sent, sending.seconds(), voluntary_switches() != switches);
         if (measure_other) encode(other_encoding(asked), nullptr);
         if (!exact.empty()) {
             ExactMsg x{r_.request_id, m.key, {}};

@@ -32,6 +32,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,9 @@ struct SessionOptions {
 
 // Sends one message; returns its bytes on the wire. Throws when the connection is gone.
 using SendMessage = std::function<std::size_t(const RemoteMessage&)>;
+// How far the link has taken what was sent (MessageChannel::link_progress); nullopt where the
+// connection cannot tell.
+using ReadLink = std::function<std::optional<LinkProgress>()>;
 
 struct RequestFigures {
     bool completed = false;    // false: stopped by a newer request or a closed connection
@@ -103,6 +107,9 @@ class ServerSession {
     // The client's decoding report (adaptive sessions); any thread: the chooser takes it before
     // its next group.
     void client_decoded(const DecodeRateMsg& report);
+    // How the chooser may see what the link takes (adaptive sessions): read as each group is
+    // ready to go (EncodingChooser::ready_to_send).
+    void set_link_reader(ReadLink read) { read_link_ = std::move(read); }
 
   private:
     struct LodLevel;
@@ -126,6 +133,8 @@ class ServerSession {
     const SurfaceExtractor& prototype_;
     SessionOptions options_;
     SendMessage send_;
+    ReadLink read_link_;
+    Stopwatch since_start_;    // the clock of the link's progress
     EncodingChooser chooser_;  // options_.adaptive: which encoding each group goes in
     std::mutex reports_mutex_;
     std::vector<DecodeRateMsg> reports_;  // the client's, not yet taken by the chooser

@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "remote/message_channel.h"
+#include "remote/net/tcp_progress.h"
 #include "remote/view_framing.h"
 
 namespace isowall::remote {
@@ -27,6 +28,13 @@ void TcpChannel::open(double timeout_s) {
 
 // Ends the sending side, then reads what the client still sends for a moment: closing with
 // unread bytes would reset the connection, and the reset can discard the error just sent.
+std::optional<LinkProgress> TcpChannel::link_progress() const {
+    // Sends write whole messages into the socket before they return: nothing waits on this side.
+    const std::optional<TcpProgress> tcp = tcp_progress(conn_.socket().fd());
+    if (!tcp) return std::nullopt;
+    return LinkProgress{0, tcp->acked, tcp->unacked, tcp->receiver_held_s, tcp->same_host};
+}
+
 void TcpChannel::close_gracefully() {
     if (TlsSession* t = conn_.tls()) t->close_notify();
     ::shutdown(conn_.socket().fd(), SHUT_WR);

@@ -177,6 +177,7 @@ class ViewServer::Client {
                 if (seat_ && !seat_->queue()) seat_->session().fan_out(m);
                 return bytes;
             });
+        session_->set_link_reader([this] { return conn_.link_progress(); });
         if (seat_ && seat_->queue()) return follow();
         if (seat_) say("serve: %s: presents session %s\n", seat_->session().name());
         worker_ = std::thread([this] { work(); });

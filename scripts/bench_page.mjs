@@ -4,13 +4,16 @@
 // loopback. One `isowall serve --http 0` serves both clients; each run is a fresh connection (a
 // fresh page, a fresh `isowall view` process) asking for the front view with progressive LOD and
 // the cache (the study's case 5, compact + zstd), so neither client starts with cached groups.
-// The page runs twice: asking for compact+zstd as case 5 does (the page's default until issue 34),
-// and at its default since (auto: the server chooses cells or compact+zstd per group, the page
-// decodes cells in WebAssembly). Runs alternate page / page auto / view, so load on this 2-core
-// machine falls on all alike.
+// The page runs twice: asking for compact+zstd with LOD on as case 5 does (the page's default
+// until issue 34), and at its defaults since (no parameter: the server chooses cells or
+// compact+zstd per group and whether coarse passes go out; the page decodes cells in
+// WebAssembly). Runs alternate page / page default / view, so load on this 2-core machine falls
+// on all alike. Besides end-to-end times it prints the page's own work in the frame (main-thread
+// decoding, GL calls and GL waits, by the page's clock), which the server and link do not move.
 //
 //   node scripts/bench_page.mjs [--isowall build/bin/isowall] [--runs 5] [--size 800x600]
 //                               [--head ../shared/data/vhp_ct_head.nhdr] [--out out/bench-page]
+//                               [--no-view]   (the two page runs alone: less load, less spread)
 //
 // Prints a table of medians (and the fastest run) and writes bench.json and bench.md to --out.
 import { spawnSync } from 'node:child_process';
@@ -38,14 +41,19 @@ function parseArgs(argv) {
         headIso: 40,
         out: path.join(root, 'out/bench-page'),
         timeoutS: 120,
+        view: true,
     };
     const numeric = { '--runs': 'runs', '--head-iso': 'headIso', '--timeout': 'timeoutS' };
     const text = { '--isowall': 'isowall', '--size': 'size', '--head': 'head', '--out': 'out' };
     for (let i = 0; i < argv.length; ++i) {
         const a = argv[i];
+        if (a === '--no-view') {
+            o.view = false;
+            continue;
+        }
         if (a === '--help' || a === '-h') {
             console.log(readFileSync(fileURLToPath(import.meta.url), 'utf8').split('\n')
-                .slice(1, 12).map((l) => l.replace(/^\/\/ ?/, '')).join('\n'));
+                .slice(1, 16).map((l) => l.replace(/^\/\/ ?/, '')).join('\n'));
             process.exit(0);
         }
         const key = numeric[a] ?? text[a];
@@ -71,6 +79,35 @@ function startServer(o, datasets) {
     return startServe(o.isowall, extra, { timeoutS: 120 });
 }
 
+// The renderer's main-thread CPU seconds so far (DevTools' Performance.getMetrics ThreadTime):
+// what the page's frames cost its main thread, whatever else runs on the machine's 2 cores.
+async function mainThreadS(cdp) {
+    const { metrics } = await cdp.send('Performance.getMetrics');
+    const m = metrics.find((x) => x.name === 'ThreadTime');
+    if (!m) throw new Error('page: DevTools gave no ThreadTime metric');
+    return m.value;
+}
+
+async function waitFrame(page, o, afterRequest) {
+    await page.waitForFunction(
+        (b) => window.isowall && (window.isowall.state === 'error' ||
+                                  (window.isowall.state === 'done' && window.isowall.done_request_id > b)),
+        afterRequest, { timeout: o.timeoutS * 1000 });
+    const s = await page.evaluate(() => ({ ...window.isowall.stats, state: window.isowall.state,
+                                           error: window.isowall.error, request_id: window.isowall.request_id }));
+    if (s.state === 'error') throw new Error(`page: ${s.error}`);
+    // The page's own work in the frame, on its main thread: decoding, issuing GL calls and
+    // waiting for the GL (by the page's clock, so preemption on a loaded machine counts in it).
+    return { work_ms: s.decode_ms + s.draw_ms + s.gl_wait_ms, first_ms: s.first_group_ms,
+             frame_ms: s.frame_ms, bytes: s.bytes, cells: s.cells, triangles: s.triangles,
+             groups: s.groups, decode_ms: s.decode_ms, cells_decode_ms: s.cells_decode_ms,
+             cells_triangles: s.cells_triangles, draw_ms: s.draw_ms, gl_wait_ms: s.gl_wait_ms,
+             request_id: s.request_id };
+}
+
+// One fresh page: its first frame (d.iso), then a frame at each of d.more (new isovalues set
+// through the slider, as a user would, in the same connection: the server's encoding choice
+// and the page's decoders are warm). Returns the first frame's figures and the later ones'.
 async function pageRun(browser, server, d, o, encoding) {
     const url = server.url;
     const [w, h] = o.size.split('x').map(Number);
@@ -79,18 +116,29 @@ async function pageRun(browser, server, d, o, encoding) {
     const cpu0 = { client: browserCpu(), server: cpuOfTree(server.proc.pid) };
     const page = await browser.newPage({ viewport: { width: w + 400, height: h + 200 } });
     try {
-        const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}&lod=1&cache=1` +
-                  (encoding === undefined ? '' : `&encoding=${encoding}`);
+        const cdp = await page.context().newCDPSession(page);
+        await cdp.send('Performance.enable');
+        // Today's (before issue 34): compact+zstd with LOD on. The page's default: no parameter
+        // but the view's (auto encoding, LOD chosen by the server, the cache).
+        const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}` +
+                  (encoding === undefined ? '' : `&lod=1&cache=1&encoding=${encoding}`);
+        let t0 = await mainThreadS(cdp);
         await page.goto(new URL(q, url).href);
-        await page.waitForFunction(
-            () => window.isowall && (window.isowall.state === 'done' || window.isowall.state === 'error'),
-            null, { timeout: o.timeoutS * 1000 });
-        const s = await page.evaluate(() => ({ ...window.isowall.stats, state: window.isowall.state,
-                                               error: window.isowall.error }));
-        if (s.state === 'error') throw new Error(`page: ${s.error}`);
-        const cpu = { client_s: browserCpu() - cpu0.client, server_s: cpuOfTree(server.proc.pid) - cpu0.server };
-        return { ...cpu, first_ms: s.first_group_ms, frame_ms: s.frame_ms, bytes: s.bytes, cells: s.cells,
-                 triangles: s.triangles, groups: s.groups, decode_ms: s.decode_ms, draw_ms: s.draw_ms, gl_wait_ms: s.gl_wait_ms };
+        const first = await waitFrame(page, o, 0);
+        // The first frame's main-thread CPU includes loading the page (the same for both).
+        first.main_ms = 1000 * (await mainThreadS(cdp) - t0);
+        first.client_s = browserCpu() - cpu0.client;
+        first.server_s = cpuOfTree(server.proc.pid) - cpu0.server;
+        const later = [];
+        for (const iso of d.more) {
+            const before = await page.evaluate(() => window.isowall.request_id);
+            t0 = await mainThreadS(cdp);
+            await page.locator('#iso-slider').fill(String(iso));
+            const f = await waitFrame(page, o, before);
+            f.main_ms = 1000 * (await mainThreadS(cdp) - t0);
+            later.push(f);
+        }
+        return { ...first, later };
     } finally {
         await page.close();
     }
@@ -163,23 +211,26 @@ const median = (xs) => {
 };
 
 function summarise(runs) {
+    const med = (key) => (runs[0][key] === undefined ? null : median(runs.map((r) => r[key])));
     return {
-        first_ms: median(runs.map((r) => r.first_ms)),
+        first_ms: med('first_ms'),
         first_min_ms: Math.min(...runs.map((r) => r.first_ms)),
-        frame_ms: median(runs.map((r) => r.frame_ms)),
+        frame_ms: med('frame_ms'),
         frame_min_ms: Math.min(...runs.map((r) => r.frame_ms)),
-        bytes: median(runs.map((r) => r.bytes)),
-        triangles: median(runs.map((r) => r.triangles)),
-        client_cpu_s: median(runs.map((r) => r.client_s)),
-        server_cpu_s: median(runs.map((r) => r.server_s)),
+        work_ms: med('work_ms'),
+        main_ms: med('main_ms'),
+        bytes: med('bytes'),
+        triangles: med('triangles'),
+        client_cpu_s: med('client_s'),
+        server_cpu_s: med('server_s'),
         runs,
     };
 }
 
 async function main() {
     const o = parseArgs(process.argv.slice(2));
-    const datasets = [{ name: 'phantom', path: null, iso: 50 }];
-    if (existsSync(o.head)) datasets.push({ name: 'head', path: o.head, iso: o.headIso });
+    const datasets = [{ name: 'phantom', path: null, iso: 50, more: [60, 70] }];
+    if (existsSync(o.head)) datasets.push({ name: 'head', path: o.head, iso: o.headIso, more: [o.headIso + 10, o.headIso + 20] });
     else console.log(`bench_page: ${o.head} is absent; the head is skipped`);
     mkdirSync(o.out, { recursive: true });
     const { chromium } = requireWeb('playwright-core');
@@ -195,39 +246,62 @@ async function main() {
             // One warm-up of each: the server's first request on a dataset pages in its octree.
             await pageRun(browser, server, d, o, 3);
             await pageRun(browser, server, d, o);
-            viewRun(server, d, o, o.out);
+            if (o.view) viewRun(server, d, o, o.out);
             for (let i = 0; i < o.runs; ++i) {
                 page.push(await pageRun(browser, server, d, o, 3));
                 auto.push(await pageRun(browser, server, d, o));
-                view.push(viewRun(server, d, o, o.out));
+                if (o.view) view.push(viewRun(server, d, o, o.out));
+                const v = o.view ? `, view ${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms` : '';
                 process.stdout.write(`bench_page: ${d.name} run ${i + 1}/${o.runs}: page ` +
-                    `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms, page auto ` +
-                    `${auto[i].first_ms.toFixed(1)} / ${auto[i].frame_ms.toFixed(1)} ms (${auto[i].cells} ` +
-                    `groups as cells), view ${view[i].first_ms.toFixed(1)} / ${view[i].frame_ms.toFixed(1)} ms\n`);
+                    `${page[i].first_ms.toFixed(1)} / ${page[i].frame_ms.toFixed(1)} ms ` +
+                    `(work ${page[i].work_ms.toFixed(1)}), page default ` +
+                    `${auto[i].first_ms.toFixed(1)} / ${auto[i].frame_ms.toFixed(1)} ms (work ` +
+                    `${auto[i].work_ms.toFixed(1)}, ${auto[i].cells} groups as cells)${v}\n`);
             }
-            results[d.name] = { iso: d.iso, page: summarise(page), page_auto: summarise(auto), view: summarise(view) };
+            results[d.name] = {
+                iso: d.iso, more: d.more, page: summarise(page), page_auto: summarise(auto),
+                page_later: summarise(page.flatMap((r) => r.later)),
+                page_auto_later: summarise(auto.flatMap((r) => r.later)),
+                ...(o.view ? { view: summarise(view) } : {}),
+            };
         }
     } finally {
         await browser.close();
         server.proc.kill('SIGINT');
     }
-    const rows = [`| dataset | client | first group ms (median, fastest) | end of frame ms (median, fastest) | client CPU s | server CPU s | bytes | triangles | page / view, end of frame |`,
-                  '|---|---|---|---|---|---|---|---|---|'];
-    const names = { page: 'browser page, compact+zstd', page_auto: 'browser page, auto (its default)', view: 'isowall view' };
+    const rows = [`| dataset | client | frames | first group ms (median, fastest) | ` +
+                  `end of frame ms (median, fastest) | page's work ms | main thread CPU ms | ` +
+                  `client CPU s | server CPU s | bytes | triangles | page / view, end of frame |`,
+                  '|---|---|---|---|---|---|---|---|---|---|---|---|'];
+    const names = { page: 'browser page, compact+zstd, LOD on', page_auto: 'browser page, its defaults',
+                    view: 'isowall view' };
     const verdicts = [];
+    const ratioText = (x) => `${x.toFixed(2)}x (${x <= 1 ? 'no worse' : 'WORSE'})`;
+    const f1 = (x) => (x === null ? '' : x.toFixed(1));
+    const f2 = (x) => (x === null ? '' : x.toFixed(2));
     for (const [name, r] of Object.entries(results)) {
-        const ratio = r.page_auto.frame_ms / r.page.frame_ms;
-        verdicts.push(`${name}: the page's end of frame at its default (auto) is ${ratio.toFixed(2)}x ` +
-                      `its compact+zstd one (${ratio <= 1 ? 'no worse' : 'WORSE'})`);
-        for (const who of ['page', 'page_auto', 'view']) {
+        const verdict = (what, a, b) => `${name}, ${what}: the page at its defaults against ` +
+            `compact+zstd with LOD on (today's): end of frame ${ratioText(a.frame_ms / b.frame_ms)}, ` +
+            `the page's work ${ratioText(a.work_ms / b.work_ms)}, main-thread CPU ` +
+            `${ratioText(a.main_ms / b.main_ms)}`;
+        verdicts.push(verdict('first frame of a fresh page', r.page_auto, r.page));
+        verdicts.push(verdict(`later frames (new isovalues ${r.more.join(', ')})`, r.page_auto_later, r.page_later));
+        const shown = [['page', 'first'], ['page_later', 'later'], ['page_auto', 'first'],
+                       ['page_auto_later', 'later'], ['view', 'first']];
+        for (const [who, frames] of shown) {
             const s = r[who];
-            rows.push(`| ${name} (iso ${r.iso}) | ${names[who]} | ` +
-                `${s.first_ms.toFixed(1)}, ${s.first_min_ms.toFixed(1)} | ${s.frame_ms.toFixed(1)}, ` +
-                `${s.frame_min_ms.toFixed(1)} | ${s.client_cpu_s.toFixed(2)} | ${s.server_cpu_s.toFixed(2)} | ${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
-                `${who !== 'view' ? (s.frame_ms / r.view.frame_ms).toFixed(2) : ''} |`);
+            if (!s) continue;
+            const client = names[who.replace('_later', '')];
+            const vsView = who === 'page' || who === 'page_auto' ? r.view : null;
+            rows.push(`| ${name} (iso ${r.iso}) | ${client} | ${frames} | ` +
+                `${f1(s.first_ms)}, ${f1(s.first_min_ms)} | ${f1(s.frame_ms)}, ${f1(s.frame_min_ms)} | ` +
+                `${f1(s.work_ms)} | ${f1(s.main_ms)} | ${f2(s.client_cpu_s)} | ${f2(s.server_cpu_s)} | ` +
+                `${Math.round(s.bytes)} | ${Math.round(s.triangles)} | ` +
+                `${vsView ? (s.frame_ms / vsView.frame_ms).toFixed(2) : ''} |`);
         }
     }
-    const header = `Front view ${o.size}, case 5 (LOD, cache; view in compact + zstd), fresh connection each run, ` +
+    const header = `Front view ${o.size}; today's page and view: case 5 (LOD on, cache, compact + zstd); ` +
+                   `fresh connection each run, ` +
                    `${o.runs} runs after one warm-up, loopback, ${new Date().toISOString()}`;
     console.log(`\n${header}\n\n${rows.join('\n')}\n\n${verdicts.join('\n')}`);
     writeFileSync(path.join(o.out, 'bench.json'), JSON.stringify({ size: o.size, runs: o.runs, results }, null, 1));

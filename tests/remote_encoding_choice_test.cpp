@@ -3,6 +3,7 @@
 // rarely it explores the dearer one. Pure: the costs are fed in, as a session measures them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "remote/encoding_choice.h"
@@ -178,6 +179,125 @@ TEST(EncodingChoice, StepsPayWhereTheLinkBoundsCells) {
     paced_fast.set_link_cap(12.5e6);
     EXPECT_TRUE(paced_slow.steps_pay());
     EXPECT_FALSE(paced_fast.steps_pay());
+}
+
+TEST(EncodingChoice, SendsTheSchedulerDelayedAreNotTheLinks) {
+    // Every send takes 2 ms (a loaded machine's time slice); on a link that made them wait that
+    // is a slow link, on one where the thread never blocked it says nothing of the link.
+    const auto feed = [](EncodingChooser& c, bool waited) {
+        std::uint64_t cells = 0;
+        for (int i = 0; i < 200; ++i) {
+            const GroupEncoding e = c.next();
+            const bool is_cells = e == GroupEncoding::cells;
+            cells += is_cells ? 1 : 0;
+            const std::size_t bytes = is_cells ? 2400 : 13000;
+            c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
+            c.sent(e, bytes, 2e-3, waited);
+            c.decoded(e, 2000, 2000 * (is_cells ? 0.3e-6 : 0.026e-6));
+        }
+        return cells;
+    };
+    EncodingChooser waited, preempted;
+    const auto slow_cells = feed(waited, true), fast_cells = feed(preempted, false);
+    EXPECT_GT(waited.bytes_per_s(), 0.0);
+    EXPECT_LT(waited.bytes_per_s(), 7e6);
+    EXPECT_GT(slow_cells, 200u - 200u / 8);
+    EXPECT_EQ(preempted.bytes_per_s(), 0.0);
+    EXPECT_FALSE(preempted.steps_pay());
+    EXPECT_LT(fast_cells, 200u / 8);
+}
+
+TEST(EncodingChoice, AClientThatReadsAsItDecodesIsNotASlowLink) {
+    // A fast link to a busy page: it reads a group only once it decoded the one before, so each
+    // send waits as long as the client's decoding of the group ahead (cells 5 us a triangle,
+    // compact+zstd 0.4). Taken for the link's, those waits made the cells' 0.2 MB/s the rate, and
+    // compact+zstd's bytes looked 5x dearer on that "link" than cells' decoding.
+    EncodingChooser c;
+    std::uint64_t cells = 0;
+    double ahead_s = 0;  // the client's decoding of the group sent before
+    for (int i = 0; i < 400; ++i) {
+        const GroupEncoding e = c.next();
+        const bool is_cells = e == GroupEncoding::cells;
+        cells += is_cells ? 1 : 0;
+        const std::size_t bytes = is_cells ? 2400 : 13000;
+        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
+        c.sent(e, bytes, std::max(ahead_s, 10e-6), ahead_s > 50e-6);
+        ahead_s = 2000 * (is_cells ? 5e-6 : 0.4e-6);
+        c.decoded(e, 2000, ahead_s);
+    }
+    std::printf("a client reading as it decodes: %llu of 400 groups as cells, rate seen %.3g B/s\n",
+                (unsigned long long)cells, c.bytes_per_s());
+    EXPECT_LT(cells, 400u / 8);
+    // The same client behind a 1 Mbit/s link: the link's waits are far longer than its decoding.
+    EncodingChooser slow;
+    EXPECT_GT(run(slow, 125e3, 400, 5e-6), 400u - 400u / 8);
+}
+
+// Groups ready every 5 ms whose sends never wait (buffers absorb them) over a link that carries
+// `link_rate` bytes a second (0: at once), and that a client holds back for `held` of the time
+// (its receive window full); returns how many of `groups` went as cells.
+std::uint64_t through_link(EncodingChooser& c, int groups, double link_rate, double held = 0,
+                           bool tells = true) {
+    std::uint64_t cells = 0, sent = 0;
+    for (int i = 0; i < groups; ++i) {
+        const double now = 0.005 * i;
+        const double carried = link_rate > 0 ? link_rate * (1 - held) * now : 1e18;
+        const auto acked = static_cast<std::uint64_t>(std::min(double(sent), carried));
+        if (tells)
+            c.ready_to_send(LinkProgress{0, acked, sent - acked, held * now}, now);
+        else
+            c.ready_to_send(std::nullopt, now);
+        const GroupEncoding e = c.next();
+        const bool is_cells = e == GroupEncoding::cells;
+        cells += is_cells ? 1 : 0;
+        const std::size_t bytes = is_cells ? 2400 : 13000;
+        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
+        c.sent(e, bytes, 0);
+        sent += bytes;
+    }
+    return cells;
+}
+
+TEST(EncodingChoice, TheLinksProgressTellsItsRate) {
+    // A link that delivered every byte before the next group was ready keeps up: the probe ends
+    // after 2 groups found it empty.
+    EncodingChooser fast;
+    EXPECT_LE(through_link(fast, 8, 0), 2u);
+    // 1 Mbit/s behind buffers that never make a send wait: its rate from the bytes acknowledged
+    // while others were on their way, and cells throughout.
+    EncodingChooser slow;
+    EXPECT_GT(through_link(slow, 100, 125e3), 100u - 100u / 8);
+    EXPECT_NEAR(slow.bytes_per_s(), 125e3, 125e3 * 0.05);
+    // 100 Mbit/s behind the same buffers: known after two rates, then compact+zstd.
+    EncodingChooser quick;
+    EXPECT_LT(through_link(quick, 100, 12.5e6), 100u / 8);
+    // A client that holds the bytes back (its window full) 90% of the time is not a slow link:
+    // no rate is read from it.
+    EncodingChooser held;
+    through_link(held, 100, 12.5e6, 0.9);
+    EXPECT_EQ(held.bytes_per_s(), 0.0);
+    // A fast link whose receiver delays its last acknowledgement: a segment's bytes are always on
+    // their way, which is no backlog.
+    EncodingChooser delayed;
+    for (int i = 0; i < 40; ++i) {
+        delayed.ready_to_send(LinkProgress{0, 3000u * i, 1448, 0, false}, 0.005 * i);
+        const GroupEncoding e = delayed.next();
+        delayed.encoded(e, 2000, 3000, 1e-3, 1e-3);
+        delayed.sent(e, 3000, 0);
+    }
+    EXPECT_EQ(delayed.bytes_per_s(), 0.0);
+    // A peer on this host: no link between, and bytes on their way wait for the CPUs.
+    EncodingChooser local;
+    for (int i = 0; i < 20; ++i) {
+        local.ready_to_send(LinkProgress{0, 1000u * i, 50000, 0, true}, 0.005 * i);
+        const GroupEncoding e = local.next();
+        local.encoded(e, 2000, 2400, 1e-3, 1e-3);
+        local.sent(e, 2400, 0);
+    }
+    EXPECT_EQ(local.bytes_per_s(), 0.0);
+    // A connection that cannot tell: the sends' rules alone (8 groups as cells).
+    EncodingChooser blind;
+    EXPECT_EQ(through_link(blind, 8, 125e3, 0, false), 8u);
 }
 
 TEST(EncodingChoice, TinyPassesWeighByTheirTriangles) {

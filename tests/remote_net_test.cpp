@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "remote/net/connection.h"
+#include "remote/net/tcp_progress.h"
 #include "tests/remote_protocol_test_util.h"
 
 namespace isowall::remote {
@@ -52,6 +53,25 @@ TEST(RemoteNet, ListenerTakesAnEphemeralPortAndNamesThePeer) {
     EXPECT_GT(link.listener.port(), 0);
     EXPECT_EQ(link.listener.address(), "127.0.0.1");
     EXPECT_EQ(link.server_peer.rfind("127.0.0.1:", 0), 0u) << link.server_peer;
+}
+
+TEST(RemoteNet, TcpProgressCountsWhatThePeerTook) {
+    Loopback lo;
+    const std::optional<TcpProgress> before = tcp_progress(lo.server.fd());
+    ASSERT_TRUE(before.has_value());
+    EXPECT_TRUE(before->same_host);  // 127.0.0.1: no link between
+    const Bytes bytes(100000, std::byte{7});
+    send_all(lo.server, bytes, "client");
+    // The peer's host acknowledges what its socket took, read or not (its buffer holds 100 KB).
+    std::optional<TcpProgress> after;
+    const auto start = std::chrono::steady_clock::now();
+    do {
+        after = tcp_progress(lo.server.fd());
+        ASSERT_TRUE(after.has_value());
+    } while (after->acked < before->acked + bytes.size() && seconds_since(start) < kTimeout_s);
+    EXPECT_EQ(after->acked, before->acked + bytes.size());
+    EXPECT_EQ(after->unacked, 0u);
+    EXPECT_FALSE(tcp_progress(-1).has_value());
 }
 
 TEST(RemoteNet, ConnectsByName) {

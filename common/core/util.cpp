@@ -26,6 +26,12 @@ int cores_allowed() {
     return std::max(1, CPU_COUNT(&set));
 }
 
+long voluntary_switches() {
+    rusage ru{};
+    getrusage(RUSAGE_THREAD, &ru);
+    return ru.ru_nvcsw;
+}
+
 double peak_rss_mib() {
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);

@@ -34,6 +34,12 @@ void keep_freed_memory();
 // The cores this process may run on (its CPU affinity mask; mpirun's binding may narrow it).
 int cores_allowed();
 
+// How many times the calling thread gave up its core of its own accord (blocked in a call: a
+// socket write that waits for room, a sleep, a lock), as getrusage(RUSAGE_THREAD) counts them.
+// A call during which this did not change never waited, however long it took: on a loaded
+// machine a thread is also taken off its core by the scheduler, which this does not count.
+long voluntary_switches();
+
 // Peak resident set size of this process, in MiB (getrusage).
 double peak_rss_mib();
 // Current resident set size of this process, in MiB (/proc/self/statm).

@@ -67,6 +67,7 @@ class Connection {
     void shutdown();
     bool is_shut_down() const { return shut_down_.load(); }
     Socket& socket() { return socket_; }
+    const Socket& socket() const { return socket_; }
 
     // From now on every byte goes through `session` (a handshake done on socket()). Before any
     // message, from the thread that owns the connection.

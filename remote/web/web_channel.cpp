@@ -1,5 +1,7 @@
 #include "remote/web/web_channel.h"
 
+#include "remote/net/tcp_progress.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -78,6 +80,15 @@ void WebChannel::pace(std::size_t bytes) {
                                  [this] { return shut_down_.load() || inbox_->closed; });
         if (shut_down_ || inbox_->closed) throw_closed();
     }
+}
+
+std::optional<LinkProgress> WebChannel::link_progress() const {
+    const std::optional<web::WebServer::Outgoing> out = server_->outgoing(id_);
+    if (!out) return std::nullopt;
+    const std::optional<TcpProgress> tcp = tcp_progress(out->fd);
+    if (!tcp) return std::nullopt;
+    return LinkProgress{out->queued, tcp->acked, tcp->unacked, tcp->receiver_held_s,
+                        tcp->same_host};
 }
 
 std::size_t WebChannel::send(const RemoteMessage& m) {

@@ -55,6 +55,7 @@ class WebChannel final : public MessageChannel {
     // emulated link's tokens; both waits end at shutdown() or when the peer goes.
     std::size_t send(const RemoteMessage& m) override;
     std::optional<RemoteMessage> receive(double timeout_s) override;
+    std::optional<LinkProgress> link_progress() const override;
     void set_rate(double bits_per_second) override;
     void shutdown() override;
     // The closing handshake goes after every message already queued (the error just sent).

@@ -78,6 +78,7 @@ struct Server final : WebServer::Impl {
     void stop() override;
     bool send(ConnectionId id, const void* bytes, std::size_t size,
               const std::atomic<bool>* cancel) override;
+    std::optional<WebServer::Outgoing> outgoing(ConnectionId id) override;
     void close(ConnectionId id, const std::string& reason) override;
 
     WebOptions options;
@@ -359,6 +360,19 @@ bool Server<Config>::send(ConnectionId id, const void* bytes, std::size_t size,
     }
     if (over_cap(con, size)) return false;
     return !con->send(bytes, size, websocketpp::frame::opcode::binary);
+}
+
+template <class Config>
+std::optional<WebServer::Outgoing> Server<Config>::outgoing(ConnectionId id) {
+    Handle h;
+    if (!find(id, h)) return std::nullopt;
+    websocketpp::lib::error_code ec;
+    const ConnectionPtr con = endpoint.get_con_from_hdl(h, ec);
+    if (ec) return std::nullopt;
+    // The descriptor is only read: the io thread owns the socket. get_buffered_amount() as in
+    // send() above.
+    return WebServer::Outgoing{con->get_buffered_amount(),
+                               static_cast<int>(con->get_raw_socket().native_handle())};
 }
 
 template <class Config>

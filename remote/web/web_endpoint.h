@@ -18,6 +18,7 @@ struct WebServer::Impl {
     virtual void stop() = 0;
     virtual bool send(ConnectionId id, const void* bytes, std::size_t size,
                       const std::atomic<bool>* cancel) = 0;
+    virtual std::optional<WebServer::Outgoing> outgoing(ConnectionId id) = 0;
     virtual void close(ConnectionId id, const std::string& reason) = 0;
 };
 

@@ -36,6 +36,10 @@ bool WebServer::send(ConnectionId id, const void* bytes, std::size_t size,
     return impl_->send(id, bytes, size, cancel);
 }
 
+std::optional<WebServer::Outgoing> WebServer::outgoing(ConnectionId id) const {
+    return impl_->outgoing(id);
+}
+
 void WebServer::close(ConnectionId id, const std::string& reason) {
     impl_->close(id, reason);
 }

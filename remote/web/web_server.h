@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 struct ssl_ctx_st;  // OpenSSL's SSL_CTX
@@ -93,6 +94,14 @@ class WebServer {
     // over max_queued_bytes, which closes the connection).
     bool send(ConnectionId id, const void* bytes, std::size_t size,
               const std::atomic<bool>* cancel = nullptr);
+    // What a connection has not yet sent: the bytes queued here and the socket's descriptor (whose
+    // unacknowledged bytes the caller may ask the kernel for); nullopt when the connection is
+    // gone. Any thread.
+    struct Outgoing {
+        std::size_t queued = 0;
+        int fd = -1;
+    };
+    std::optional<Outgoing> outgoing(ConnectionId id) const;
     // Starts the closing handshake (after every message already queued); any thread.
     void close(ConnectionId id, const std::string& reason);
 
