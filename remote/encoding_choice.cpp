@@ -112,7 +112,8 @@ GroupEncoding EncodingChooser::next() {
         b == GroupEncoding::cells ? GroupEncoding::compact_zstd : GroupEncoding::cells;
     if (slot(other).groups == 0) return b;  // still measuring the first of each
     const double mine = cost_per_triangle(b), theirs = cost_per_triangle(other);
-    const double dearer = mine > 0 ? std::clamp(theirs / mine, 1.0, 8.0) : 8.0;
+    const double dearer =
+        mine > 0 ? std::clamp(theirs / mine, 1.0, kExploreDearest) : kExploreDearest;
     if (++since_explored_ < static_cast<std::uint64_t>(static_cast<double>(kExploreEvery) * dearer))
         return b;
     since_explored_ = 0;

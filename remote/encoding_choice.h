@@ -16,7 +16,7 @@
 // once the socket buffers between the two were full (megabytes on a fast link), so the server
 // kept sending cells to a client that decoded them ten times slower than compact+zstd. A group in
 // the encoding not chosen goes out every kExploreEvery groups times how many times dearer it was
-// (at most 8x), so both estimates follow the surface and the machine without a slow link paying
+// (at most kExploreDearest), so both estimates follow the surface and the machine without a slow link paying
 // much for the exploring. Pure: no clock, no I/O; the session measures and reports.
 #include <cstddef>
 #include <cstdint>
@@ -57,6 +57,11 @@ inline GroupEncoding other_encoding(GroupEncoding e) {
 class EncodingChooser {
   public:
     static constexpr std::uint64_t kExploreEvery = 16;
+    // Exploring costs a sixteenth of the chosen encoding's time up to this ratio, more beyond.
+    // A page decodes cells 10-30x slower than compact+zstd; with 8 here the groups explored in
+    // cells cost it about a tenth of its frame's main-thread time on a fast link. The link is
+    // measured on whichever encoding goes, so a link that slows is followed without exploring.
+    static constexpr double kExploreDearest = 32;
     // The estimates are ratios of decayed sums (seconds or bytes over triangles), which weigh
     // the last this many groups most and each group by its triangles: a pass of a few triangles
     // (its header, the time to find it) says little of the next thousand.
