@@ -30,7 +30,11 @@ EncodingChooser::Stages EncodingChooser::stages(GroupEncoding e) const {
     const double rate = bytes_per_s();
     const double making = made_triangles_ > 0 ? making_s_ / made_triangles_ : 0;
     return {making + s.seconds / s.triangles, rate > 0 ? s.bytes / s.triangles / rate : 0.0,
-            s.decoded_triangles > 0 ? s.decoded_s / s.decoded_triangles : 0};
+            s.reports == 0
+                ? 0
+                : *std::min_element(s.decoded.begin(),
+                                    s.decoded.begin() + static_cast<std::ptrdiff_t>(
+                                                            std::min(s.reports, kReportsKept)))};
 }
 
 double EncodingChooser::cost_per_triangle(GroupEncoding e) const {
@@ -43,12 +47,14 @@ bool EncodingChooser::probing() const {
     // kProbeSends went with none waiting (buffers absorb them: a fast link), or the link was
     // found empty as kDrainedToKnow groups in a row were ready.
     if (link_rates_ >= kRatesToKnow || drained_in_row_ >= kDrainedToKnow) return false;
+    if (same_host_ && blocked_sends_ == 0) return false;
     if (blocked_sends_ > 0) return blocked_sends_ < 2;
     return cells_.sends + compact_.sends < kProbeSends;
 }
 
 void EncodingChooser::ready_to_send(std::optional<LinkProgress> link, double now_s) {
     if (!link) return;
+    same_host_ = link->same_host;
     // A peer on this host has no link between: its bytes on their way wait for the host's CPUs
     // (on 2 loaded cores the page's were held for 60 ms at a time, and read as a 2-10 MB/s link
     // they put the server into cells the page decodes slowly). Its sends' waits still count.
@@ -106,7 +112,7 @@ GroupEncoding EncodingChooser::best() const {
                : GroupEncoding::compact_zstd;
 }
 
-GroupEncoding EncodingChooser::next() {
+GroupEncoding EncodingChooser::next(double now_s) {
     const GroupEncoding b = best();
     const GroupEncoding other =
         b == GroupEncoding::cells ? GroupEncoding::compact_zstd : GroupEncoding::cells;
@@ -116,7 +122,9 @@ GroupEncoding EncodingChooser::next() {
         mine > 0 ? std::clamp(theirs / mine, 1.0, kExploreDearest) : kExploreDearest;
     if (++since_explored_ < static_cast<std::uint64_t>(static_cast<double>(kExploreEvery) * dearer))
         return b;
+    if (now_s >= 0 && explored_s_ >= 0 && now_s - explored_s_ < kExploreGapS) return b;
     since_explored_ = 0;
+    if (now_s >= 0) explored_s_ = now_s;
     return other;
 }
 
@@ -154,8 +162,9 @@ void EncodingChooser::decoded(GroupEncoding e, std::uint64_t triangles, double s
     if (e != GroupEncoding::cells && e != GroupEncoding::compact_zstd) return;
     if (triangles == 0) return;
     Estimate& s = slot(e);
-    s.decoded_triangles = s.decoded_triangles * kKeep + static_cast<double>(triangles);
-    s.decoded_s = s.decoded_s * kKeep + seconds;
+    // A report of a few triangles is all overhead and clock grain (0 ms for 84 triangles).
+    if (triangles < kReportTriangles || seconds <= 0) return;
+    s.decoded[s.reports++ % kReportsKept] = seconds / static_cast<double>(triangles);
 }
 
 }  // namespace isowall::remote

@@ -16,8 +16,9 @@
 // once the socket buffers between the two were full (megabytes on a fast link), so the server
 // kept sending cells to a client that decoded them ten times slower than compact+zstd. A group in
 // the encoding not chosen goes out every kExploreEvery groups times how many times dearer it was
-// (at most kExploreDearest), so both estimates follow the surface and the machine without a slow link paying
-// much for the exploring. Pure: no clock, no I/O; the session measures and reports.
+// (at most kExploreDearest), so both estimates follow the surface and the machine without a slow
+// link paying much for the exploring. Pure: no clock, no I/O; the session measures and reports.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -62,6 +63,18 @@ class EncodingChooser {
     // cells cost it about a tenth of its frame's main-thread time on a fast link. The link is
     // measured on whichever encoding goes, so a link that slows is followed without exploring.
     static constexpr double kExploreDearest = 32;
+    // ...and at most once in this many seconds. Where both encodings' stages are the server's
+    // (a fast link), cells look only 1.5x dearer and went out every 24 groups: 3-9 of each of
+    // the head's frames, which a page decodes at 3-10 ms each against 1 for compact+zstd. What
+    // exploring refreshes (the other encoding's costs, the client's decoding of it) changes over
+    // seconds, not groups; the link is measured on whichever encoding goes.
+    static constexpr double kExploreGapS = 1.0;
+    // The client's decoding of an encoding is the fastest of its last this many reports: what it
+    // can do. A report that covers a stall says little of the encoding: the page's first
+    // compact+zstd report, its decoders cold and the machine loaded, read 6 us a triangle (0.3 once
+    // warm), and set against cells' 3.5 it sent 171 of 180 groups as cells.
+    static constexpr std::size_t kReportsKept = 4;
+    static constexpr std::uint64_t kReportTriangles = 500;  // fewer: the report is left out
     // The estimates are ratios of decayed sums (seconds or bytes over triangles), which weigh
     // the last this many groups most and each group by its triangles: a pass of a few triangles
     // (its header, the time to find it) says little of the next thousand.
@@ -71,7 +84,8 @@ class EncodingChooser {
     // until one is seen, and the most one may be. Without it the link is probed (kProbeSends).
     void set_link_cap(double bytes_per_s) { link_cap_ = bytes_per_s; }
     // The encoding for the next group.
-    GroupEncoding next();
+    // `now_s` (any steady clock; negative: none) spaces the exploring by kExploreGapS.
+    GroupEncoding next(double now_s = -1);
     // Whether the session should encode a group it sent in the other encoding `e` too, after the
     // send, for the chooser alone: while `e` is unmeasured, so neither has to be sent to be known
     // and the measuring costs the group no time. Exploring by sending compact+zstd's first group
@@ -83,8 +97,14 @@ class EncodingChooser {
     bool wants_measure(GroupEncoding e) const {
         return slot(e).groups == 0 && !(e == GroupEncoding::cells && fast_link());
     }
-    // The link is the server's own pacing at kCellsPayBelow or more, and no slower rate was seen.
-    bool fast_link() const { return link_cap_ > 0 && bytes_per_s() >= kCellsPayBelow; }
+    // The link is the server's own pacing at kCellsPayBelow or more, and no slower rate was seen;
+    // or the peer is on this host, unpaced, and no send has waited (a tunnel to a far client
+    // shows once its buffers fill and sends wait; until then bytes cost nothing, and cells cost
+    // a page on this host 10-40 ms a group while its WebAssembly is cold).
+    bool fast_link() const {
+        return (same_host_ && link_cap_ <= 0 && blocked_sends_ == 0) ||
+               (link_cap_ > 0 && bytes_per_s() >= kCellsPayBelow);
+    }
     // The first group's encoding on a link the server paces (set_link_cap), before either is
     // measured: cells below this rate. A triangle costs about 6.5 bytes as compact+zstd and 1 as
     // cells; the stages overlap, and cells' slowest is about 1.1 us a triangle (the page's decoding
@@ -153,7 +173,9 @@ class EncodingChooser {
         double triangles = 0, seconds = 0, bytes = 0;  // decayed sums over its groups
         std::uint64_t groups = 0, sends = 0;           // measured, sent
         double sent_bytes = 0, blocked_s = 0;          // decayed sums over the recent sends
-        double decoded_triangles = 0, decoded_s = 0;   // decayed sums over the client's reports
+        // The client's seconds a triangle in its last kReportsKept reports of this encoding.
+        std::array<double, kReportsKept> decoded{};
+        std::size_t reports = 0;
     };
     Estimate& slot(GroupEncoding e) { return e == GroupEncoding::cells ? cells_ : compact_; }
     const Estimate& slot(GroupEncoding e) const {
@@ -168,7 +190,11 @@ class EncodingChooser {
     Stages stages(GroupEncoding e) const;
     // The link is unknown: fewer than two sends waited for it, fewer than kProbeSends went,
     // fewer than kDrainedToKnow groups in a row found it empty, and fewer than kRatesToKnow
-    // rates came from its progress.
+    // rates came from its progress. Not probed at all to a peer on this host while no send
+    // waited: its bytes go through the kernel's buffers, and 8 groups never fill them, so the
+    // probe would end as one on a fast link does; only a send that waits shows a slow one (a
+    // tunnel to a far client), then as on any link. On 2 loaded cores the page's first frame
+    // decoded the probe's 8 cells groups in cold WebAssembly, 10 ms each.
     bool probing() const;
 
     Estimate cells_, compact_;
@@ -181,6 +207,8 @@ class EncodingChooser {
     double last_link_s_ = 0;
     double link_bytes_ = 0, link_s_ = 0;  // decayed sums of the link's busy progress
     int link_rates_ = 0;                  // rates read from the link's progress
+    bool same_host_ = false;              // the peer is on this host (LinkProgress)
+    double explored_s_ = -1;              // when the other encoding last went (next's clock)
     double link_cap_ = 0;                 // bytes a second; 0: none known
     std::uint64_t since_explored_ = 0;
 };

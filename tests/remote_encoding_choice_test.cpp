@@ -278,26 +278,98 @@ TEST(EncodingChoice, TheLinksProgressTellsItsRate) {
     EXPECT_EQ(held.bytes_per_s(), 0.0);
     // A fast link whose receiver delays its last acknowledgement: a segment's bytes are always on
     // their way, which is no backlog.
-    EncodingChooser delayed;
-    for (int i = 0; i < 40; ++i) {
-        delayed.ready_to_send(LinkProgress{0, 3000u * i, 1448, 0, false}, 0.005 * i);
-        const GroupEncoding e = delayed.next();
-        delayed.encoded(e, 2000, 3000, 1e-3, 1e-3);
-        delayed.sent(e, 3000, 0);
-    }
-    EXPECT_EQ(delayed.bytes_per_s(), 0.0);
+    // Every look finds `unacked` bytes on their way, `acked` more acknowledged than the last.
+    const auto looks = [](std::size_t unacked, std::uint64_t acked, bool same_host) {
+        EncodingChooser c;
+        for (int i = 0; i < 40; ++i) {
+            c.ready_to_send(LinkProgress{0, acked * i, unacked, 0, same_host}, 0.005 * i);
+            const GroupEncoding e = c.next();
+            c.encoded(e, 2000, 3000, 1e-3, 1e-3);
+            c.sent(e, 3000, 0);
+        }
+        return c.bytes_per_s();
+    };
+    EXPECT_EQ(looks(1448, 3000, false), 0.0);
     // A peer on this host: no link between, and bytes on their way wait for the CPUs.
-    EncodingChooser local;
-    for (int i = 0; i < 20; ++i) {
-        local.ready_to_send(LinkProgress{0, 1000u * i, 50000, 0, true}, 0.005 * i);
-        const GroupEncoding e = local.next();
-        local.encoded(e, 2000, 2400, 1e-3, 1e-3);
-        local.sent(e, 2400, 0);
-    }
-    EXPECT_EQ(local.bytes_per_s(), 0.0);
+    EXPECT_EQ(looks(50000, 1000, true), 0.0);
+    EXPECT_NEAR(looks(50000, 1000, false), 1000 / 0.005, 1.0);  // the same, over a network
     // A connection that cannot tell: the sends' rules alone (8 groups as cells).
     EncodingChooser blind;
     EXPECT_EQ(through_link(blind, 8, 125e3, 0, false), 8u);
+}
+
+TEST(EncodingChoice, AClientsStallIsNotItsDecoding) {
+    // The client's first compact+zstd report covers a stall (cold decoders, a loaded machine):
+    // 6 us a triangle against cells' 3.5. Its next reports, 0.3 us, are what it can do.
+    EncodingChooser c;
+    c.ready_to_send(LinkProgress{0, 0, 0, 0, false}, 0);
+    c.ready_to_send(LinkProgress{0, 0, 0, 0, false}, 0.001);
+    for (int i = 0; i < 200; ++i) {
+        const GroupEncoding e = c.next();
+        const bool is_cells = e == GroupEncoding::cells;
+        c.encoded(e, 2000, is_cells ? 2400 : 13000, 2000 * (is_cells ? 0.35e-6 : 0.13e-6),
+                  2000 * 0.3e-6);
+        c.sent(e, is_cells ? 2400 : 13000, 0);
+        if (i == 0) {
+            c.decoded(GroupEncoding::cells, 2000, 2000 * 3.5e-6);
+            c.decoded(GroupEncoding::compact_zstd, 2000, 2000 * 6e-6);
+        } else if (!is_cells) {
+            c.decoded(GroupEncoding::compact_zstd, 2000, 2000 * 0.3e-6);
+        }
+        c.decoded(GroupEncoding::cells, 84, 0);  // a report of a tiny group: clock grain
+    }
+    EXPECT_EQ(c.next(), GroupEncoding::compact_zstd);
+    EXPECT_NEAR(c.cost_per_triangle(GroupEncoding::cells), 3.5e-6, 1e-9);
+    EXPECT_LT(c.chosen(GroupEncoding::cells), 200u / 8);
+}
+
+TEST(EncodingChoice, APeerOnThisHostGetsNoCellsUntilASendWaits) {
+    EncodingChooser c;
+    std::uint64_t cells = 0;
+    for (int i = 0; i < 100; ++i) {
+        c.ready_to_send(LinkProgress{0, 0, 0, 0, true}, 0.001 * i);
+        const GroupEncoding e = c.next(0.001 * i);
+        cells += e == GroupEncoding::cells ? 1 : 0;
+        c.encoded(e, 2000, 13000, 2000 * 0.13e-6, 2000 * 0.3e-6);
+        c.sent(e, 13000, 0);
+    }
+    EXPECT_EQ(cells, 0u);
+    EXPECT_FALSE(c.wants_measure(GroupEncoding::cells));
+    // A tunnel to a far client at 1 Mbit/s: once its buffers are full the sends wait.
+    for (int i = 0; i < 300; ++i) {
+        const GroupEncoding e = c.next();
+        const bool is_cells = e == GroupEncoding::cells;
+        const std::size_t bytes = is_cells ? 2400 : 13000;
+        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
+        if (c.wants_measure(GroupEncoding::cells))
+            c.encoded(GroupEncoding::cells, 2000, 2400, 7e-4);
+        c.sent(e, bytes, double(bytes) / 125e3);
+        cells += is_cells ? 1 : 0;
+    }
+    EXPECT_GT(cells, 300u - 300u / 8);
+}
+
+TEST(EncodingChoice, ExploringIsSpacedInTime) {
+    // A fast link, 400 groups in 0.4 s: cells are about 1.5x dearer (both bound by the server),
+    // so without a clock they went every 24 groups; with one, at most once a second.
+    const auto explored = [](bool clock) {
+        EncodingChooser c;
+        std::uint64_t cells = 0;
+        for (int i = 0; i < 400; ++i) {
+            const GroupEncoding e = clock ? c.next(0.001 * i) : c.next();
+            const bool is_cells = e == GroupEncoding::cells;
+            cells += is_cells ? 1 : 0;
+            c.encoded(e, 2000, is_cells ? 2400 : 13000, 2000 * (is_cells ? 0.35e-6 : 0.13e-6),
+                      2000 * 0.5e-6);
+            c.sent(e, is_cells ? 2400 : 13000, 0);
+        }
+        return cells;
+    };
+    const auto by_groups = explored(false), by_time = explored(true);
+    std::printf("cells explored in 400 groups: %llu by groups, %llu with a clock\n",
+                (unsigned long long)by_groups, (unsigned long long)by_time);
+    EXPECT_GE(by_groups, 10u);
+    EXPECT_LE(by_time, 10u);  // the probe's 8 and the first exploration
 }
 
 TEST(EncodingChoice, TinyPassesWeighByTheirTriangles) {

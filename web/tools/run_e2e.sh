@@ -11,7 +11,9 @@ ISOWALL=${1:?usage: run_e2e.sh ISOWALL OUT_DIR}
 OUT=${2:?usage: run_e2e.sh ISOWALL OUT_DIR}
 WEB=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUT"
-"$ISOWALL" serve --port 0 --http 0 > "$OUT/serve.log" 2>&1 &
+# A 20 Mbit/s link (the server's own pacing): there cells pay, so the page decodes and draws
+# them; to a page on loopback unpaced the server sends compact+zstd alone (encoding_choice.h).
+"$ISOWALL" serve --port 0 --http 0 --rate-mbps 20 > "$OUT/serve.log" 2>&1 &
 SERVE=$!
 trap 'kill -INT $SERVE 2>/dev/null || true' EXIT
 URL=
