@@ -64,9 +64,9 @@ void EncodingChooser::ready_to_send(std::optional<LinkProgress> link, double now
         // then went right after it), and what it delivered meanwhile is its rate. A few bytes
         // unacknowledged say nothing: a receiver delays its acknowledgement of the last segment
         // up to 40 ms, and read as a backlog that made a 10 Gbit/s veth a 0.5 MB/s link (the
-        // groups' own pace, 3 KB every 5 ms). Less the time
-        // the client's receive window held the bytes back: a client that does not read as fast
-        // as the link brings them (a page busy decoding) is the client's stage, not the link's.
+        // groups' own pace, 3 KB every 5 ms). The time the client's receive window held the
+        // bytes back is left out: a client that does not read as fast as the link brings them
+        // (a page busy decoding) is the client's stage, not the link's.
         const double busy_s = (now_s - last_link_s_) -
                               std::max(0.0, link->receiver_held_s - last_link_->receiver_held_s);
         if (busy_s > 0.25 * (now_s - last_link_s_)) {

@@ -119,10 +119,9 @@ class EncodingChooser {
     static constexpr std::uint64_t kProbeSends = 8;
     // ...or until this many groups in a row found every byte sent before them already at the
     // client's host as they were ready to go (ready_to_send): the link keeps up with the server,
-    // whatever its rate, so bytes cost no time. A slow link still holds the group before (a
-    // 5 KB group takes 40 ms at 1 Mbit/s; the engine makes the next in a few), and a fresh
-    // page was sent 8 cells groups it decodes 10x slower than compact+zstd before WebAssembly
-    // warms up (100-200 ms of its first frame on the head).
+    // whatever its rate, so bytes cost no time, and a far client on a fast link is spared the
+    // rest of the probe's cells groups. A slow link still holds the group before (a 5 KB group
+    // takes 40 ms at 1 Mbit/s; the engine makes the next in a few).
     static constexpr int kDrainedToKnow = 2;
     // ...or once the link's progress gave this many rates (ready_to_send).
     static constexpr int kRatesToKnow = 2;
@@ -151,11 +150,12 @@ class EncodingChooser {
 
     // Seconds a triangle costs in `e` at the rate seen; 0 until `e` was measured.
     double cost_per_triangle(GroupEncoding e) const;
-    // Bytes a second the sends went at while they blocked for the link (the seconds they waited
-    // less those the client reported decoding: a client that reads no faster than it decodes
-    // makes sends wait too, and counted as the link's that waiting locked a busy page into
-    // cells, which it decodes ten times slower, the waiting taken for a 0.2 MB/s link); 0 while
-    // none has blocked, or the client's decoding accounts for all the waiting.
+    // The link's bytes a second: from its progress (ready_to_send) where that gave a rate; else
+    // from the sends that blocked for it, over the seconds they waited less those the client
+    // reported decoding (a client that reads no faster than it decodes makes sends wait too,
+    // and counted as the link's that waiting locked a busy page into cells, which it decodes ten
+    // times slower); 0 while neither says anything, or the client's decoding accounts for all the
+    // waiting. Never more than the server's own pacing (set_link_cap).
     double bytes_per_s() const;
     // Groups sent in `e`.
     std::uint64_t chosen(GroupEncoding e) const { return slot(e).sends; }

@@ -15,16 +15,28 @@ namespace {
 // and 0.13 us (the codec benchmark's figures on the shared head), made by the engine in 0.3 us a
 // triangle. A send of n bytes blocks for n / rate seconds (rate 0: never blocks).
 
+// One group of the costs above: the chooser's pick (`now_s`: its clock, negative for none),
+// encoded; the engine made it in `making_s` a triangle.
+struct Pick {
+    GroupEncoding e;
+    bool cells;
+    std::size_t bytes;
+};
+Pick pick(EncodingChooser& c, double now_s = -1, double making_s = 0.3e-6) {
+    const GroupEncoding e = c.next(now_s);
+    const bool cells = e == GroupEncoding::cells;
+    const std::size_t bytes = cells ? 2400 : 13000;
+    c.encoded(e, 2000, bytes, 2000 * (cells ? 0.35e-6 : 0.13e-6), 2000 * making_s);
+    return {e, cells, bytes};
+}
+
 // With `cells_decode_s` > 0 the client reports its decoding too: that many seconds a triangle for
 // cells, 0.026 us for compact+zstd (39 M triangles/s, the codec benchmark on the head).
 std::uint64_t run(EncodingChooser& c, double rate, int groups, double cells_decode_s = 0) {
     std::uint64_t cells = 0;
     for (int i = 0; i < groups; ++i) {
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
+        const auto [e, is_cells, bytes] = pick(c);
         cells += is_cells ? 1 : 0;
-        const std::size_t bytes = is_cells ? 2400 : 13000;
-        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
         c.sent(e, bytes, rate > 0 ? double(bytes) / rate : 0);
         if (cells_decode_s > 0) c.decoded(e, 2000, 2000 * (is_cells ? cells_decode_s : 0.026e-6));
     }
@@ -187,11 +199,8 @@ TEST(EncodingChoice, SendsTheSchedulerDelayedAreNotTheLinks) {
     const auto feed = [](EncodingChooser& c, bool waited) {
         std::uint64_t cells = 0;
         for (int i = 0; i < 200; ++i) {
-            const GroupEncoding e = c.next();
-            const bool is_cells = e == GroupEncoding::cells;
+            const auto [e, is_cells, bytes] = pick(c);
             cells += is_cells ? 1 : 0;
-            const std::size_t bytes = is_cells ? 2400 : 13000;
-            c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
             c.sent(e, bytes, 2e-3, waited);
             c.decoded(e, 2000, 2000 * (is_cells ? 0.3e-6 : 0.026e-6));
         }
@@ -216,11 +225,8 @@ TEST(EncodingChoice, AClientThatReadsAsItDecodesIsNotASlowLink) {
     std::uint64_t cells = 0;
     double ahead_s = 0;  // the client's decoding of the group sent before
     for (int i = 0; i < 400; ++i) {
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
+        const auto [e, is_cells, bytes] = pick(c);
         cells += is_cells ? 1 : 0;
-        const std::size_t bytes = is_cells ? 2400 : 13000;
-        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
         c.sent(e, bytes, std::max(ahead_s, 10e-6), ahead_s > 50e-6);
         ahead_s = 2000 * (is_cells ? 5e-6 : 0.4e-6);
         c.decoded(e, 2000, ahead_s);
@@ -247,11 +253,8 @@ std::uint64_t through_link(EncodingChooser& c, int groups, double link_rate, dou
             c.ready_to_send(LinkProgress{0, acked, sent - acked, held * now}, now);
         else
             c.ready_to_send(std::nullopt, now);
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
+        const auto [e, is_cells, bytes] = pick(c);
         cells += is_cells ? 1 : 0;
-        const std::size_t bytes = is_cells ? 2400 : 13000;
-        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
         c.sent(e, bytes, 0);
         sent += bytes;
     }
@@ -305,11 +308,8 @@ TEST(EncodingChoice, AClientsStallIsNotItsDecoding) {
     c.ready_to_send(LinkProgress{0, 0, 0, 0, false}, 0);
     c.ready_to_send(LinkProgress{0, 0, 0, 0, false}, 0.001);
     for (int i = 0; i < 200; ++i) {
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
-        c.encoded(e, 2000, is_cells ? 2400 : 13000, 2000 * (is_cells ? 0.35e-6 : 0.13e-6),
-                  2000 * 0.3e-6);
-        c.sent(e, is_cells ? 2400 : 13000, 0);
+        const auto [e, is_cells, bytes] = pick(c);
+        c.sent(e, bytes, 0);
         if (i == 0) {
             c.decoded(GroupEncoding::cells, 2000, 2000 * 3.5e-6);
             c.decoded(GroupEncoding::compact_zstd, 2000, 2000 * 6e-6);
@@ -328,19 +328,15 @@ TEST(EncodingChoice, APeerOnThisHostGetsNoCellsUntilASendWaits) {
     std::uint64_t cells = 0;
     for (int i = 0; i < 100; ++i) {
         c.ready_to_send(LinkProgress{0, 0, 0, 0, true}, 0.001 * i);
-        const GroupEncoding e = c.next(0.001 * i);
-        cells += e == GroupEncoding::cells ? 1 : 0;
-        c.encoded(e, 2000, 13000, 2000 * 0.13e-6, 2000 * 0.3e-6);
-        c.sent(e, 13000, 0);
+        const auto [e, is_cells, bytes] = pick(c, 0.001 * i);
+        cells += is_cells ? 1 : 0;
+        c.sent(e, bytes, 0);
     }
     EXPECT_EQ(cells, 0u);
     EXPECT_FALSE(c.wants_measure(GroupEncoding::cells));
     // A tunnel to a far client at 1 Mbit/s: once its buffers are full the sends wait.
     for (int i = 0; i < 300; ++i) {
-        const GroupEncoding e = c.next();
-        const bool is_cells = e == GroupEncoding::cells;
-        const std::size_t bytes = is_cells ? 2400 : 13000;
-        c.encoded(e, 2000, bytes, 2000 * (is_cells ? 0.35e-6 : 0.13e-6), 2000 * 0.3e-6);
+        const auto [e, is_cells, bytes] = pick(c);
         if (c.wants_measure(GroupEncoding::cells))
             c.encoded(GroupEncoding::cells, 2000, 2400, 7e-4);
         c.sent(e, bytes, double(bytes) / 125e3);
@@ -356,12 +352,9 @@ TEST(EncodingChoice, ExploringIsSpacedInTime) {
         EncodingChooser c;
         std::uint64_t cells = 0;
         for (int i = 0; i < 400; ++i) {
-            const GroupEncoding e = clock ? c.next(0.001 * i) : c.next();
-            const bool is_cells = e == GroupEncoding::cells;
+            const auto [e, is_cells, bytes] = pick(c, clock ? 0.001 * i : -1, 0.5e-6);
             cells += is_cells ? 1 : 0;
-            c.encoded(e, 2000, is_cells ? 2400 : 13000, 2000 * (is_cells ? 0.35e-6 : 0.13e-6),
-                      2000 * 0.5e-6);
-            c.sent(e, is_cells ? 2400 : 13000, 0);
+            c.sent(e, bytes, 0);
         }
         return cells;
     };
