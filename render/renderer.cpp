@@ -27,6 +27,16 @@ void warm_up(Renderer& renderer) {
     renderer.clear();
     renderer.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
     renderer.finish();
+    // Each way a frame is read back, and a draw over a cleared depth: first calls of these set up
+    // Mesa's paths too.
+    Image image;
+    renderer.read_back(image);
+    renderer.read_back(image, PixelRect{0, 0, 8, 8});
+    std::vector<std::uint8_t> covered;
+    renderer.read_coverage(covered, PixelRect{0, 0, 8, 8});
+    renderer.clear_depth();
+    renderer.draw(tiny, glm::mat4(1.0f), glm::mat4(1.0f));
+    renderer.finish();
 }
 
 Image draw_alone(Renderer& renderer, const Mesh& mesh, const FrameView& view) {
