@@ -66,9 +66,9 @@ std::unique_ptr<Renderer> make_renderer(std::string_view backend);
 // read-back paths on their first use. An interactive viewer pays that once at start-up, not in
 // every frame: this draws one triangle, reads it back in every way a frame is read (whole, a
 // rectangle, coverage) and draws again over a cleared depth, before any frame is timed (the owner
-// of a renderer that times frames calls it; scripts/vtk_reference.py warms VTK alike). On the
-// one-tile head over 24 balanced ranks, the read-backs took the first frame's render stage from
-// 0.350 to 0.305 s in all (medians of 5 runs).
+// of a renderer that times frames calls it; scripts/vtk_reference.py warms VTK alike). A wall
+// rank's first help job costs about 0.7 ms after it against 2-2.5 ms after one draw alone
+// (isowall-bench-frames).
 void warm_up(Renderer& renderer);
 
 // `mesh` drawn alone into `renderer` at `view`'s size and read back: the full surface's image,
