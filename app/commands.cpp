@@ -6,17 +6,19 @@
 #include <filesystem>
 
 #include "app/render_report.h"
+#include "app/whole_frame.h"
 #include "cli/cli_checks.h"
-#include "common/core/camera.h"
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/extract/surface_extractor.h"
-#include "common/formats/voxel_ops.h"
-#include "common/io/image_io.h"
-#include "common/io/ply.h"
-#include "common/volume/phantom.h"
+#include "cli/iso_option.h"
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/util.h"
 #include "engine/progressive_engine.h"
+#include "extract/surface_extractor.h"
+#include "files/image_io.h"
+#include "files/ply.h"
+#include "readers/voxel_ops.h"
 #include "render/renderer.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -62,20 +64,11 @@ void prepare_error_rule(const EngineOptions& e, const SurfaceExtractor& ex, cons
     if (!lod.cache_note.empty()) std::printf("octree: note: %s\n", lod.cache_note.c_str());
 }
 
-double checked_iso(const std::optional<double>& iso, const OpenedVolume& ov,
-                   const SurfaceExtractor& ex) {
-    const std::string where = ov.file ? ov.file->string() : std::string("phantom");
-    if (!iso) {
-        if (!ov.file) return kPhantomSkinIso;
-        throw InputError(where, "--iso", "an isovalue is required (see `isowall info`)");
-    }
-    if (!std::isfinite(*iso) || *iso < ex.value_min() || *iso > ex.value_max()) {
-        char msg[160];
-        std::snprintf(msg, sizeof(msg), "isovalue %g is outside the volume's value range [%g, %g]",
-                      *iso, ex.value_min(), ex.value_max());
-        throw InputError(where, "--iso", msg);
-    }
-    return *iso;
+// --iso for the volume `ov` that `ex` extracts from.
+double volume_iso(const std::optional<double>& iso, const OpenedVolume& ov,
+                  const SurfaceExtractor& ex) {
+    return checked_iso(iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
+                             ex.value_min(), ex.value_max()});
 }
 
 Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
@@ -122,7 +115,7 @@ void check_render_outputs(const RenderOptions& o) {
 }
 
 // The view of `render`: the front full view, turned and zoomed; InputError naming the option
-// when the result is degenerate (common/core/camera.h: camera_problem).
+// when the result is degenerate (core/camera.h: camera_problem).
 Camera render_camera(const RenderOptions& o, const Volume& volume, float aspect) {
     const Projection proj =
         o.projection == "orthographic" ? Projection::orthographic : Projection::perspective;
@@ -181,9 +174,8 @@ void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Imag
 // draw-only floor and the timeline. With --against-full (`full` drawn), every replayed image is
 // also measured against the full surface: the time to C = 99% of the true picture, not only of
 // the engine's own final one.
-void replay_and_report(const RenderOptions& o, ProgressiveEngine& engine, FrameResult& fr,
-                       const FrameView& fv, Renderer& renderer, const Image& full,
-                       OutputFiles& batch) {
+void replay_and_report(const RenderOptions& o, FrameResult& fr, const FrameView& fv,
+                       Renderer& renderer, const Image& full, OutputFiles& batch) {
     Stopwatch sw;
     std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
     std::vector<TimelineSample> vs_full;
@@ -196,7 +188,7 @@ void replay_and_report(const RenderOptions& o, ProgressiveEngine& engine, FrameR
         vs_full.push_back(s);
         vs_full.back().correctness = measure_correctness(img, full);
     };
-    engine.measure(
+    measure_frame(
         fr, fv, renderer,
         images ? std::function<void(const TimelineSample&, const Image&)>(on_image) : nullptr);
     print_thresholds(fr, fr.timeline);
@@ -226,7 +218,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         std::fflush(stdout);
     };
     if (o.warm_up) {
-        const FrameResult w = engine.run(warm_up_view(fv, ex.volume().bounds()), renderer);
+        const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer);
         std::printf(
             "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
             "%.3f s\n",
@@ -234,7 +226,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     }
     const double frame_at = t.command.seconds();
     const double cpu0 = thread_cpu_seconds();
-    FrameResult fr = engine.run(fv, renderer, nullptr, progress);
+    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
     preload_image_io();  // OpenImageIO loads beside the report, not after it
     const TimelineSample& last = fr.timeline.back();
@@ -270,7 +262,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
     const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
                               !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (want_measure) replay_and_report(o, engine, fr, fv, renderer, full, batch);
+    if (want_measure) replay_and_report(o, fr, fv, renderer, full, batch);
 
     // After the replay, by when OpenImageIO has loaded beside it (preload_image_io above).
     Stopwatch sw;
@@ -318,7 +310,7 @@ int run_extract(const ExtractOptions& o) {
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
     auto ex = prepare(ov, t);
-    const double iso = checked_iso(o.iso, ov, *ex);
+    const double iso = volume_iso(o.iso, ov, *ex);
     Mesh mesh = extract_timed(*ex, iso, t);
     print_paging(ov);
     Stopwatch sw;
@@ -350,7 +342,7 @@ int run_render(const RenderOptions& o) {
     t.load = ov.load_s;
     auto ex = prepare(ov, t, render_threads(o));
     if (!o.full) prepare_error_rule(engine_options(o), *ex, ov.volume);
-    const double iso = checked_iso(o.iso, ov, *ex);
+    const double iso = volume_iso(o.iso, ov, *ex);
 
     const float aspect = float(size->x) / float(size->y);
     const Camera cam = render_camera(o, ov.volume, aspect);

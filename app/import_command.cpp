@@ -7,11 +7,11 @@
 #include <thread>
 
 #include "cli/cli_checks.h"
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/store/store_writer.h"
-#include "common/volume/load_checks.h"
-#include "common/volume/octree.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "store/store_writer.h"
+#include "volume/load_checks.h"
+#include "volume/octree.h"
 
 namespace isowall {
 namespace {

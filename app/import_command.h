@@ -1,5 +1,5 @@
 #pragma once
-// `isowall import SOURCE --out STORE` (issue 32): any volume isowall reads, as a chunked,
+// `isowall import SOURCE --out STORE`: any volume isowall reads, as a chunked,
 // compressed store that `--volume STORE` then reads on first touch under a memory limit.
 #include <string>
 

@@ -10,15 +10,15 @@
 #include "app/commands.h"
 #include "app/program_cli.h"
 #include "app/wall_run.h"
-#include "common/core/error.h"
-#include "common/core/output_files.h"
-#include "common/core/util.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "files/output_files.h"
 
 namespace {
 
 using namespace isowall;
 
-// Every error line goes out once, bounded and with control bytes escaped (common/core/error.h):
+// Every error line goes out once, bounded and with control bytes escaped (core/error.h):
 // CLI11 quotes the offending argument whole.
 void print_error(std::string_view message, const char* tail = "") {
     std::fflush(stdout);

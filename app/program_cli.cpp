@@ -1,8 +1,9 @@
 #include "app/program_cli.h"
 
 #include "cli/cli_checks.h"
-#include "common/core/error.h"
-#include "common/core/util.h"
+#include "cli/iso_option.h"
+#include "core/error.h"
+#include "core/util.h"
 
 namespace isowall {
 namespace {
@@ -21,8 +22,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
         "render", "Render one view progressively (or the full surface with --full) to an image");
     add_volume_options(*re_cmd, re.volume);
-    re_cmd->add_option("--iso", re.iso, "Isovalue (default for the phantom: skin, 50)")
-        ->transform(number_in(limits::kAnyFinite));
+    add_iso_option(*re_cmd, re.iso);
     re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     re_cmd->add_option("--out,-o", re.out, "Output image (PNG, or any format OpenImageIO writes)")
         ->capture_default_str();
@@ -160,8 +160,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         "Display-wall run under mpirun: rank 0 is the master, ranks 1..T drive one tile each");
     add_volume_options(*wall_cmd, wall.volume);
     wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
-    wall_cmd->add_option("--iso", wall.iso, "Isovalue (default for the phantom: skin, 50)")
-        ->transform(number_in(limits::kAnyFinite));
+    add_iso_option(*wall_cmd, wall.iso);
     wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")
         ->capture_default_str();
     wall_cmd->add_option("--tiles-out", wall.tiles_out,
@@ -232,8 +231,7 @@ ProgramCli::ProgramCli() {
 
     ex_cmd = app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
     add_volume_options(*ex_cmd, ex.volume);
-    ex_cmd->add_option("--iso", ex.iso, "Isovalue (default for the phantom: skin, 50)")
-        ->transform(number_in(limits::kAnyFinite));
+    add_iso_option(*ex_cmd, ex.iso);
     ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
 
     re_cmd = add_render_command(app, re);

@@ -1,5 +1,5 @@
 #pragma once
-// `isowall serve` and `isowall view` (issue 12): their options, command lines and runs.
+// `isowall serve` and `isowall view`: their options, command lines and runs.
 #include <memory>
 #include <optional>
 #include <string>

@@ -4,9 +4,9 @@
 #include <cstdio>
 #include <optional>
 
-#include "common/core/util.h"
-#include "common/progressive/correctness.h"
-#include "common/progressive/timeline.h"
+#include "core/util.h"
+#include "progressive/correctness.h"
+#include "progressive/timeline.h"
 
 namespace isowall {
 

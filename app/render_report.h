@@ -5,11 +5,11 @@
 #include <string>
 
 #include "cli/volume_options.h"
-#include "common/core/image.h"
-#include "common/core/util.h"
-#include "common/core/view.h"
-#include "common/extract/surface_extractor.h"
+#include "core/image.h"
+#include "core/util.h"
+#include "core/view.h"
 #include "engine/progressive_engine.h"
+#include "extract/surface_extractor.h"
 #include "render/renderer.h"
 
 namespace isowall {
@@ -47,7 +47,7 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
 // what a user waits before a picture, a cold volume's read included.
 void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s);
 
-// A store's reads (common/store/paged_voxels.h), when the volume is one; nothing otherwise.
+// A store's reads (store/paged_voxels.h), when the volume is one; nothing otherwise.
 void print_paging(const OpenedVolume& ov);
 
 }  // namespace isowall

@@ -6,12 +6,12 @@
 #include "app/remote_commands.h"
 #include "cli/cli_checks.h"
 #include "cli/volume_options.h"
-#include "common/core/error.h"
-#include "common/core/number.h"
-#include "common/volume/octree.h"
+#include "core/error.h"
+#include "core/number.h"
 #include "remote/net/endpoint.h"
 #include "remote/view_server.h"
 #include "remote/web/http_front.h"
+#include "volume/octree.h"
 
 namespace isowall {
 namespace {

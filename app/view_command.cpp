@@ -6,16 +6,17 @@
 
 #include "app/remote_commands.h"
 #include "cli/cli_checks.h"
-#include "common/core/camera.h"
-#include "common/core/error.h"
-#include "common/core/number.h"
-#include "common/core/output_files.h"
-#include "common/core/util.h"
-#include "common/io/image_io.h"
-#include "common/wall/script.h"
+#include "cli/iso_option.h"
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/number.h"
+#include "core/util.h"
+#include "files/image_io.h"
+#include "files/output_files.h"
 #include "remote/net/endpoint.h"
 #include "remote/view_client.h"
 #include "render/renderer.h"
+#include "wall_spec/script.h"
 
 namespace isowall {
 namespace {
@@ -36,8 +37,8 @@ constexpr CaseSetting kCases[] = {
     {GroupEncoding::indexed, kOn, false},      // 3 + progressive LOD
     {GroupEncoding::indexed, kOn, true},       // 4 + cached primitives
     {GroupEncoding::compact_zstd, kOn, true},  // 5 ours: compact + zstd
-    {GroupEncoding::cells, kOn, true},         // 6 issue 34: cells
-    {GroupEncoding::cells, kOn, true, true}};  // 7 issue 34: the server chooses (auto)
+    {GroupEncoding::cells, kOn, true},         // 6 cells
+    {GroupEncoding::cells, kOn, true, true}};  // 7 the server chooses (auto)
 
 GroupEncoding parse_encoding(const std::string& s) {
     if (s == "auto") return GroupEncoding::cells;  // and the hello asks the server to choose
@@ -192,8 +193,7 @@ CLI::App* add_view_command(CLI::App& app, ViewCommand& o) {
                 "Every group exact in one message (otherwise a cells group the client does not "
                 "cache may come with the voxels that make only its normals to a step, and their "
                 "exact values once the frame's last group is out)");
-    c->add_option("--iso", o.iso, "Isovalue (default for the phantom: skin, 50)")
-        ->transform(number_in(limits::kAnyFinite));
+    add_iso_option(*c, o.iso);
     c->add_option("--size", o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     c->add_option("--orbit", o.orbit, "Rotate the front view: YAW PITCH in degrees")
         ->expected(2)
@@ -324,11 +324,8 @@ int run_view(const ViewCommand& o) {
     v.camera = zoom(v.camera, float(o.zoom));
     if (std::string p = camera_problem(v.camera); !p.empty())
         throw InputError("--zoom", "value", p);
-    if (!o.iso && o.dataset != "phantom")
-        throw InputError("--iso", "value",
-                         "an isovalue is required for dataset " + quote(o.dataset));
-    v.iso = o.iso.value_or(50.0);
-    v.check_iso(v.iso, "--iso", "value");
+    v.iso = checked_iso(o.iso, {"dataset " + quote(o.dataset), o.dataset == "phantom",
+                                client.ready().value_min, client.ready().value_max});
     v.send();
     for (const ScriptLine& l : script)
         if (!v.execute(l.command, o.script + ":" + std::to_string(l.line))) break;

@@ -23,13 +23,13 @@
 #include <thread>
 #include <vector>
 
-#include "common/core/pacer.h"
-#include "common/core/util.h"
-#include "common/wall/control_layout.h"
+#include "core/pacer.h"
+#include "core/util.h"
 #include "master/steering.h"
 #include "master/wall_page.h"
 #include "remote/net/tls.h"
 #include "remote/web/web_server.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 

@@ -4,7 +4,7 @@
 #include <set>
 #include <string>
 
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall {
 

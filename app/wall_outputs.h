@@ -6,8 +6,8 @@
 
 #include "app/wall_run.h"
 #include "cli/cli_checks.h"
-#include "common/wall/script.h"
-#include "common/wall/wall.h"
+#include "wall_spec/script.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 

@@ -14,22 +14,23 @@
 #include "app/remote_commands.h"
 #include "app/wall_http.h"
 #include "app/wall_outputs.h"
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/extract/surface_extractor.h"
-#include "common/store/open_store.h"
-#include "common/volume/phantom.h"
-#include "common/wall/control_layout.h"
-#include "common/wall/script.h"
-#include "common/wall/wall.h"
+#include "cli/iso_option.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "extract/surface_extractor.h"
 #include "master/console.h"
 #include "master/control_window.h"
 #include "master/wall_master.h"
 #include "render/renderer.h"
+#include "store/open_store.h"
 #include "tile/preview_show.h"
 #include "tile/remote_store.h"
 #include "tile/tile_loop.h"
 #include "tile/tile_window.h"
+#include "volume/phantom.h"
+#include "wall_spec/control_layout.h"
+#include "wall_spec/script.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 namespace {
@@ -41,7 +42,7 @@ std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadB
     return make_surface_extractor(ov.volume, src, nullptr, budget);
 }
 
-// The rank's thread budget: --threads, or its share of the node's cores (common/core/
+// The rank's thread budget: --threads, or its share of the node's cores (core/
 // thread_budget.h), so that ranks emulating a wall on one machine do not oversubscribe it.
 ThreadBudget rank_budget(const WallOptions& o, const Comm& comm) {
     if (o.threads > 0) return ThreadBudget{o.threads};
@@ -63,14 +64,8 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
-    in.iso = o.iso.value_or(kPhantomSkinIso);
-    if (!o.iso && ov.file)
-        throw InputError(ov.file->string(), "--iso",
-                         "an isovalue is required (see `isowall info`)");
-    if (!(in.iso >= in.extractor->value_min() && in.iso <= in.extractor->value_max()))
-        throw InputError(
-            ov.file ? ov.file->string() : "phantom", "--iso",
-            "isovalue " + std::to_string(in.iso) + " is outside the volume's value range");
+    in.iso = checked_iso(o.iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
+                                 in.extractor->value_min(), in.extractor->value_max()});
     to_engine_options(o.engine);
     // The console and the window or page would both take the operator's commands; one at a
     // time (the window and the page share one loop and take turns).

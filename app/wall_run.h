@@ -10,7 +10,7 @@
 #include "cli/engine_cli.h"
 #include "cli/volume_options.h"
 #include "comm/comm.h"
-#include "common/core/test_fault.h"
+#include "core/test_fault.h"
 #include "protocol/protocol.h"
 
 namespace isowall {
@@ -58,7 +58,7 @@ struct WallOptions {
     // propagating side by side): ranks share nodes, so this is the rank's budget, not the
     // machine's core count. 0: the rank's share of its node (rank_budget in wall_run.cpp).
     int threads = 0;
-    // Test hook (ISOWALL_TEST_FAULT=KIND:RANK, common/core/test_fault.h): the rank named fails in
+    // Test hook (ISOWALL_TEST_FAULT=KIND:RANK, core/test_fault.h): the rank named fails in
     // the way named (tile: hang, exit, throw; master: throw; either: stop or kill at a moment).
     TestFault fault;
     // When set, the master also leaves every tile's figures here (by rank; for tests).

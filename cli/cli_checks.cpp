@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <system_error>
 
-#include "common/core/error.h"
-#include "common/core/output_files.h"
+#include "core/error.h"
+#include "files/output_files.h"
 
 namespace isowall {
 

@@ -1,5 +1,5 @@
 #pragma once
-// The checks every command-line number goes through (the rule of common/core/number.h), and the
+// The checks every command-line number goes through (the rule of core/number.h), and the
 // check of a command's output files before any work.
 #include <filesystem>
 #include <string>
@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "common/core/number.h"
+#include "core/number.h"
 
 namespace isowall {
 
@@ -24,7 +24,7 @@ struct OutputPath {
     std::filesystem::path path;
 };
 
-// InputError(path, option, ...) for the first output that cannot be written (common/core/
+// InputError(path, option, ...) for the first output that cannot be written (core/
 // output_files.h: output_problem) or that another output of the same command names too.
 void check_outputs(const std::vector<OutputPath>& outputs);
 

@@ -5,7 +5,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "cli/cli_checks.h"
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall {
 

@@ -3,13 +3,13 @@
 #include <cstdio>
 
 #include "cli/cli_checks.h"
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/formats/read_volume.h"
-#include "common/store/open_store.h"
-#include "common/store/store_format.h"
-#include "common/volume/octree.h"
-#include "common/volume/phantom.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "readers/read_volume.h"
+#include "store/open_store.h"
+#include "store/store_format.h"
+#include "volume/octree.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 

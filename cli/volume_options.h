@@ -8,9 +8,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "common/store/paged_voxels.h"
-#include "common/volume/plane_source.h"
-#include "common/volume/volume.h"
+#include "store/paged_voxels.h"
+#include "volume/plane_source.h"
+#include "volume/volume.h"
 
 namespace isowall {
 
@@ -23,7 +23,7 @@ struct VolumeOptions {
     std::size_t header_bytes = 0;
     std::string cache_dir;
     bool no_cache = false;
-    std::string huge_pages = "auto";  // auto, on, off (common/volume/huge_pages.h)
+    std::string huge_pages = "auto";  // auto, on, off (volume/huge_pages.h)
     std::string memory_limit;         // a store's cap ("512M", "8G"); empty: the default share
 };
 
@@ -34,7 +34,7 @@ struct OpenedVolume {
     std::optional<std::filesystem::path> file;  // nullopt for the phantom
     std::filesystem::path cache_dir;            // empty: no octree cache
     double load_s = 0;
-    // A store's pager (common/store/paged_voxels.h), for what it read; null for other volumes.
+    // A store's pager (store/paged_voxels.h), for what it read; null for other volumes.
     std::shared_ptr<const store::PagedVoxels> pager;
     // A store's reader, for a wall master that sends chunks to ranks that cannot see the store.
     std::shared_ptr<const store::StoreReader> store;
@@ -61,7 +61,7 @@ std::filesystem::path cache_dir(const VolumeOptions& opts);
 // and prints one line about it.
 OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false, VolumeUse use = {});
 
-// The volume's planes for `isowall import` to stream (common/formats/read_volume.h: open_planes),
+// The volume's planes for `isowall import` to stream (readers/read_volume.h: open_planes),
 // or null where open_volume serves (the phantom, a store, raw data and raw NRRD it maps).
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& opts);
 

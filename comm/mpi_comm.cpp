@@ -34,7 +34,7 @@ namespace {
 constexpr auto kPollSleep = std::chrono::microseconds(200);
 // A receive sleeps longer the longer nothing has come (an eighth of the quiet time, up to this):
 // each poll costs a lock, an MPI_Iprobe and a wake-up, and a rank that waits a whole frame for
-// its next job polled 5,000 times a second at kPollSleep (issue 33: the communication thread took
+// its next job polled 5,000 times a second at kPollSleep (the communication thread took
 // a third of a tile rank's CPU). While messages flow, the sleep stays at kPollSleep.
 constexpr auto kPollSleepMax = std::chrono::microseconds(2000);
 // How long a rank that ends waits for its last sends to be taken.

@@ -6,8 +6,8 @@
 
 #include <X11/Xlib.h>
 
-#include "common/io/image_io.h"
 #include "display/x_window.h"
+#include "files/image_io.h"
 
 int main(int argc, char** argv) {
     if (argc != 4) {

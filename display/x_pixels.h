@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "common/core/image.h"
+#include "core/image.h"
 
 namespace isowall {
 

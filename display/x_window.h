@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "common/core/image.h"
-#include "common/core/pacer.h"  // PresentPacer, for callers that present
+#include "core/image.h"
+#include "core/pacer.h"  // PresentPacer, for callers that present
 
 namespace isowall {
 

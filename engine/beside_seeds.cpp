@@ -3,7 +3,7 @@
 #include <glm/common.hpp>
 #include <glm/ext/matrix_transform.hpp>
 
-#include "common/core/pixel_rect_ops.h"
+#include "core/pixel_rect_ops.h"
 
 namespace isowall {
 
@@ -31,23 +31,20 @@ std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, const
     return out;
 }
 
-std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, GroupSink& sink,
+std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, ShownPixels* shown,
                                          const PixelRect& rect,
                                          std::vector<std::uint8_t>& scratch) {
-    if (pending.empty() || !sink.coverage(scratch, rect)) {
+    if (pending.empty() || !shown) {
         pending.clear();
         return {};
     }
+    shown->coverage(scratch, rect);
     return take_still_empty(pending, rect, scratch);
 }
 
 std::optional<glm::ivec2> cell_pixel(const glm::mat4& clip_from_voxel, glm::ivec3 cell, int width,
                                      int height) {
-    const glm::vec4 c = clip_from_voxel * glm::vec4(glm::vec3(cell) + 0.5f, 1.0f);
-    if (!(c.w > 1e-6f)) return std::nullopt;
-    const glm::vec2 w = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
-    if (!(w.x >= 0 && w.y >= 0 && w.x < float(width) && w.y < float(height))) return std::nullopt;
-    return glm::ivec2(int(w.x), int(w.y));
+    return clip_to_pixel(clip_from_voxel * glm::vec4(glm::vec3(cell) + 0.5f, 1.0f), width, height);
 }
 
 std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pending,

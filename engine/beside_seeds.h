@@ -1,18 +1,18 @@
 #pragma once
 // Seeds taken where the picture still shows nothing: the engine's side of
-// common/extract/hit_neighbours.h (a region's rays note the unvisited cells beside their hits on
+// extract/hit_neighbours.h (a region's rays note the unvisited cells beside their hits on
 // visited ones) and the frontier units of full passes (Group::frontier). The engine seeds them
 // before the ray order's fill level and, the cells beside hits, again at the region's end.
 #include <cstdint>
 #include <optional>
 #include <vector>
 
-#include "common/core/camera.h"
-#include "common/core/ray.h"
-#include "common/core/view.h"
-#include "common/extract/hit_neighbours.h"
-#include "common/extract/surface_extractor.h"
-#include "engine/group_sink.h"
+#include "core/camera.h"
+#include "core/ray.h"
+#include "core/view.h"
+#include "extract/group_sink.h"
+#include "extract/hit_neighbours.h"
+#include "extract/surface_extractor.h"
 
 namespace isowall {
 
@@ -44,8 +44,8 @@ std::vector<BesideSeed> take_frontier_still_empty(std::vector<glm::ivec3>& pendi
 // another's cell.
 std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, const PixelRect& rect,
                                          const std::vector<std::uint8_t>& covered);
-// The same with the coverage read from `sink` into `scratch`; none when `sink` cannot tell.
-std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, GroupSink& sink,
+// The same with the coverage read from `shown` into `scratch`; none without `shown`.
+std::vector<BesideSeed> take_still_empty(std::vector<BesideSeed>& pending, ShownPixels* shown,
                                          const PixelRect& rect, std::vector<std::uint8_t>& scratch);
 
 }  // namespace isowall

@@ -14,7 +14,7 @@ bool FrameRun::cast_level_parallel(int n, IntersectMode mode, bool second_pass, 
     LevelJob job{ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
                  mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_,
                  seeds};
-    job.want_seen = sink_->wants_seen();
+    job.want_seen = seen_ != nullptr;
     const double own0 = thread_cpu_seconds();
     const LevelTally t = isowall::cast_level_parallel(
         job, n, [this](FoundGroup& f) { add_found(f); },
@@ -31,7 +31,8 @@ bool FrameRun::cast_level_parallel(int n, IntersectMode mode, bool second_pass, 
     ids_used_ = t.next_id - opt_.first_group_id;
     cursor_->beside.insert(cursor_->beside.end(), t.beside.begin(), t.beside.end());
     // After the level's rays and before its coverage is read (cast_level), as the sink allows.
-    for (const std::uint32_t id : t.seen) sink_->seen(id);
+    if (seen_)
+        for (const std::uint32_t id : t.seen) seen_->seen(id);
     now_.t_intersect_s += t.intersect_s;
     cursor_->hits += t.hits;
     if (second_pass) frame_.rays_second_pass += t.rays;

@@ -12,7 +12,7 @@
 
 #include <glm/matrix.hpp>
 
-#include "common/core/ray.h"
+#include "core/ray.h"
 #include "engine/beside_seeds.h"
 #include "engine/parallel_level.h"
 #include "engine/progressive_engine.h"
@@ -54,19 +54,22 @@ class FrameRun {
                              masked() ? &active_.boxes : nullptr);
     }
 
-    bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink, std::size_t ray_limit) {
+    bool cast(const FrameView& view, RegionCursor& c, const FrameOutput& out,
+              std::size_t ray_limit) {
         settle(true);  // a present in flight belongs to the sink of the last cast
         // The region's rays are intersection until a group, a coverage read or a present says
         // otherwise (the caller may have been in any stage: a wall job starts in render).
         stage(Stage::intersection);
         view_ = &view;
-        sink_ = &sink;
+        sink_ = &out.groups;
+        shown_ = out.shown;
+        seen_ = out.seen;
         view_m_ = view.camera.view();
         view_inv_ = glm::inverse(view_m_);
         rect_ = c.rect;
         cursor_ = &c;
         params_ = opt_.propagation;
-        params_.keep_frontier = opt_.frontier_seeds && sink.tells_coverage();
+        params_.keep_frontier = opt_.frontier_seeds && shown_ != nullptr;
         if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
         // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
         // c.rays, so a region's second band would cast nothing.
@@ -136,8 +139,7 @@ class FrameRun {
 
     int workers() const {
         const int have = ex_.threads();
-        const int want = opt_.threads <= 0 ? have : std::min(opt_.threads, have);
-        return sink_->wants_seen() && !sink_->seen_after_level() ? 1 : std::max(1, want);
+        return std::max(1, opt_.threads <= 0 ? have : std::min(opt_.threads, have));
     }
 
     bool cast_level(RayOrder& order, bool second_pass) {
@@ -175,7 +177,7 @@ class FrameRun {
         if (hit.found) ++cursor_->hits;
         if (!hit.found) return true;
         if (!hit.refine && ex_.visited(hit.cell)) {
-            if (sink_->wants_seen()) sink_->seen(ex_.group_of(hit.cell));
+            if (seen_) seen_->seen(ex_.group_of(hit.cell));
             note_beside(ex_, hit, ray, px, mode == IntersectMode::exact, cursor_->beside);
             return true;
         }
@@ -187,7 +189,7 @@ class FrameRun {
     bool seed_beside() {
         stage(Stage::render);
         const std::vector<BesideSeed> todo =
-            take_still_empty(cursor_->beside, *sink_, rect_, covered_);
+            take_still_empty(cursor_->beside, shown_, rect_, covered_);
         stage(Stage::intersection);
         return seed_all(todo);
     }
@@ -278,7 +280,7 @@ class FrameRun {
         if (cursor_->hits == 0) return false;
         stage(Stage::render);
         const auto t0 = Clock::now();
-        const bool read = give_order_coverage(order, *cursor_, *sink_, covered_);
+        const bool read = give_order_coverage(order, *cursor_, shown_, covered_);
         now_.t_render_s += since(t0);
         stage(Stage::intersection);
         return read;
@@ -294,7 +296,9 @@ class FrameRun {
     SurfaceExtractor& ex_;
     const EngineOptions& opt_;
     const FrameView* view_ = nullptr;
-    GroupSink* sink_ = nullptr;
+    GroupSink* sink_ = nullptr;  // the output of the region being cast
+    ShownPixels* shown_ = nullptr;
+    SeenGroups* seen_ = nullptr;
     const std::atomic<bool>& stop_;
     const ProgressiveEngine::Progress progress_;  // a copy: callers pass temporaries
     // What propagation polls; made once per frame, not once per pass.

@@ -10,9 +10,9 @@
 #include <mutex>
 #include <thread>
 
-#include "common/core/ray.h"
-#include "common/progressive/trace.h"
+#include "core/ray.h"
 #include "engine/beside_seeds.h"
+#include "progressive/trace.h"
 
 namespace isowall {
 namespace {

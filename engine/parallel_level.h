@@ -1,7 +1,7 @@
 #pragma once
 // One ray-order level cast over several threads (EngineOptions::threads): each thread takes the
 // next pixel, casts its ray on its own extractor worker and propagates from an unvisited hit (the
-// units' claims keep passes apart, common/extract/visited.h); the calling thread is worker 0 and,
+// units' claims keep passes apart, extract/visited.h); the calling thread is worker 0 and,
 // between its own rays, hands the groups found so far to `draw` in the order of their ids, so the
 // drawing (the renderer's context is the caller's) never leaves it.
 #include <cstddef>
@@ -12,9 +12,9 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 
-#include "common/core/view.h"
-#include "common/extract/hit_neighbours.h"
-#include "common/extract/surface_extractor.h"
+#include "core/view.h"
+#include "extract/hit_neighbours.h"
+#include "extract/surface_extractor.h"
 
 namespace isowall {
 

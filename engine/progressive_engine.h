@@ -2,9 +2,10 @@
 // The progressive view-dependent engine (chapters 2-3): fills a region of one view's pixels (a
 // whole tile, or later a screen-region job) ray by ray in a progressive order until every pixel of
 // the region that the volume covers has had its ray, or until it is stopped. Each ray that finds an
-// unvisited seed starts a propagation pass; the pass's group goes at once to a group sink (drawn
-// into the frame being built: no clear, no redraw of older groups, so drawing cost follows new
-// triangles only; recorded for the replay; later streamed).
+// unvisited seed starts a propagation pass; the pass's group goes at once to a group sink
+// (extract/group_sink.h: drawn into the frame being built, with no clear and no redraw of older
+// groups, so drawing cost follows new triangles only; recorded for the replay; streamed to a
+// client). The engine draws nothing and sees no renderer.
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -14,21 +15,19 @@
 #include <optional>
 #include <vector>
 
-#include "common/core/camera.h"
-#include "common/core/image.h"
-#include "common/core/view.h"
-#include "common/extract/adaptive.h"
-#include "common/extract/surface_extractor.h"
-#include "common/progressive/correctness.h"
-#include "common/progressive/ray_order.h"
-#include "common/progressive/timeline.h"
-#include "common/progressive/trace.h"
-#include "engine/group_sink.h"
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/view.h"
 #include "engine/region_cursor.h"
+#include "extract/adaptive.h"
+#include "extract/group_sink.h"
+#include "extract/surface_extractor.h"
+#include "progressive/correctness.h"
+#include "progressive/ray_order.h"
+#include "progressive/timeline.h"
+#include "progressive/trace.h"
 
 namespace isowall {
-
-class Renderer;
 
 struct EngineOptions {
     RayOrderKind order = RayOrderKind::dynamic_grid;
@@ -36,7 +35,7 @@ struct EngineOptions {
     PropagationParams propagation;
     bool screen_box = true;  // cast no ray outside the volume's projected bounding box
     // Within the box, cast no ray whose pixel no active node of a coarse octree level covers
-    // (common/progressive/screen_mask.h): such a ray cannot meet the surface. Needs screen_box.
+    // (progressive/screen_mask.h): such a ray cannot meet the surface. Needs screen_box.
     bool screen_mask = true;
     // Propagation enters only cells that may project into the region being cast (ScreenClip):
     // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
@@ -53,14 +52,14 @@ struct EngineOptions {
     // less than a pixel, extract it as one cell, up to 2^adaptive_max_level cells per side. Off:
     // every cell at full resolution, exactly as without the option. adaptive_refine: draw a
     // meta-cell again at full resolution where a pixel's ray sees the full-resolution surface that
-    // its triangles miss (common/extract/adaptive.h); false: the text's distance rule alone.
+    // its triangles miss (extract/adaptive.h); false: the text's distance rule alone.
     bool adaptive = false;
     int adaptive_max_level = kMaxMetaLevel;
     bool adaptive_refine = true;
     // The projected size, in pixels, below which a meta-cell is taken (resolution_levels): 1 is
     // the text's rule; 2 keeps triangles about a pixel on volumes finer than the screen.
     float adaptive_pixels = 1.0f;
-    // The error rule (common/volume/lod_error.h): a meta-cell is also taken only where its
+    // The error rule (volume/lod_error.h): a meta-cell is also taken only where its
     // surface lies within this many pixels of the full-resolution surface, projected. Infinite:
     // the distance rule alone.
     float adaptive_error_px = std::numeric_limits<float>::infinity();
@@ -106,10 +105,10 @@ struct FrameResult {
     std::size_t rays_second_pass = 0;  // approximate mode: rays cast again exactly
     double elapsed_s = 0;
     std::size_t group_count = 0;
-    std::vector<Group> groups;  // every group in order (the convenience run() only)
+    std::vector<Group> groups;  // every group in order (app/whole_frame.h's run only)
     std::vector<TimelineSample> timeline;
-    Image final_image;  // colour and depth after the last ray (the convenience run() only; empty
-                        // when interrupted)
+    Image final_image;      // colour and depth after the last ray (app/whole_frame.h's run only;
+                            // empty when interrupted)
     PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
     std::size_t screen_pixels = 0;  // of them, the pixels to cast (the screen mask's, if on)
     // The screen mask's octree level and active nodes (-1 and 0 without the mask).
@@ -122,32 +121,18 @@ class FrameRun;
 
 class ProgressiveEngine {
   public:
-    // The engine draws nothing: each group goes to the sink a run is given. Only the whole-screen
-    // run() and measure() below take a renderer, to draw into.
+    // The engine draws nothing: each group goes to the output a run is given. The whole screen
+    // drawn into a renderer, and the correctness replay, are app/whole_frame.h's.
     explicit ProgressiveEngine(SurfaceExtractor& extractor, EngineOptions options = {});
 
     using Progress = std::function<void(const TimelineSample&)>;
 
-    // Fills `region` of `view`'s screen, handing each group to `sink`. `stop` is read between rays
+    // Fills `region` of `view`'s screen, handing each group to `out`. `stop` is read between rays
     // and inside long propagation passes (a communication thread sets it when a new view
     // arrives); once it reads true the frame ends at once with completed = false. `progress`
     // (optional) sees the latest sample about every options().progress_interval_s.
-    FrameResult run(const FrameView& view, const PixelRect& region, GroupSink& sink,
+    FrameResult run(const FrameView& view, const PixelRect& region, const FrameOutput& out,
                     const std::atomic<bool>& stop, const Progress& progress = {});
-
-    // The whole screen drawn into `renderer` (warmed up beforehand: render/renderer.h warm_up),
-    // keeping every group and the final image in the result (what `isowall render` and the tests
-    // use).
-    FrameResult run(const FrameView& view, Renderer& renderer,
-                    const std::atomic<bool>* stop = nullptr, const Progress& progress = {});
-
-    // Replays the frame's groups in order and measures both correctness measures of the image at
-    // every timeline sample against the final image (not part of the timed run). `on_image` sees
-    // each replayed image (the whole screen), e.g. to write snapshots; without it the replay
-    // reads back only the box of the pixels the final image covers (the only ones that count),
-    // and never twice for samples that show the same groups. The replay draws into `renderer`.
-    void measure(FrameResult& frame, const FrameView& view, Renderer& renderer,
-                 const std::function<void(const TimelineSample&, const Image&)>& on_image = {});
 
     const EngineOptions& options() const { return options_; }
 
@@ -174,9 +159,10 @@ class EngineFrame {
     // The cursor of `region` of `view`: clipped to the screen and to the volume's screen box, and
     // masked by the frame's screen mask (EngineOptions::screen_mask).
     RegionCursor cursor(const FrameView& view, const PixelRect& region) const;
-    // Casts whole levels of `c` into `sink` until it has cast `ray_limit` more rays or is done;
-    // `view` must be the one the cursor was made for. False when stopped (c stays where it was).
-    bool cast(const FrameView& view, RegionCursor& c, GroupSink& sink,
+    // Casts whole ray-order levels of `c` into `out` until it has cast `ray_limit` more rays or is
+    // done; `view` must be the one the cursor was made for. False when stopped (c stays where it
+    // was).
+    bool cast(const FrameView& view, RegionCursor& c, const FrameOutput& out,
               std::size_t ray_limit = SIZE_MAX);
     // The frame's figures and timeline (groups and the final image are not kept here).
     FrameResult finish(bool completed);

@@ -6,11 +6,11 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "common/core/pixel_rect_ops.h"
-#include "common/core/ray.h"
-#include "common/progressive/mesh_coverage.h"
-#include "common/progressive/screen_mask.h"
+#include "core/pixel_rect_ops.h"
+#include "core/ray.h"
 #include "engine/progressive_engine.h"
+#include "progressive/mesh_coverage.h"
+#include "progressive/screen_mask.h"
 
 namespace isowall {
 
@@ -58,7 +58,7 @@ void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const
     add_mesh_coverage(mesh, view_m, view.frustum, view.width, view.height, c.rect, c.drawn);
 }
 
-bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+bool give_order_coverage(RayOrder& order, RegionCursor& c, ShownPixels* shown,
                          std::vector<std::uint8_t>& scratch) {
     if (c.sizing) {
         order.set_coverage(c.drawn);
@@ -66,10 +66,12 @@ bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
         if (!c.sizing) c.drawn = {};
         return false;
     }
-    const bool read = sink.coverage(scratch, c.rect);
-    if (!read) scratch.assign(pixel_count(c.rect), 0);
+    if (shown)
+        shown->coverage(scratch, c.rect);
+    else
+        scratch.assign(pixel_count(c.rect), 0);
     order.set_coverage(scratch);
-    return read;
+    return shown != nullptr;
 }
 
 void keep_frontier(RegionCursor& c, std::vector<glm::ivec3>& units, const SurfaceExtractor& ex) {

@@ -12,14 +12,14 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "common/core/box.h"
-#include "common/core/mesh.h"
-#include "common/core/view.h"
-#include "common/extract/adaptive.h"
-#include "common/extract/hit_neighbours.h"
-#include "common/extract/surface_extractor.h"
-#include "common/progressive/ray_order.h"
-#include "engine/group_sink.h"
+#include "core/box.h"
+#include "core/mesh.h"
+#include "core/view.h"
+#include "extract/adaptive.h"
+#include "extract/group_sink.h"
+#include "extract/hit_neighbours.h"
+#include "extract/surface_extractor.h"
+#include "progressive/ray_order.h"
 
 namespace isowall {
 
@@ -44,7 +44,7 @@ struct RegionCursor {
     bool done = false;                // every pixel to cast has had its ray
     // The dynamic grid before it has sized its grid: the groups this region finds add the pixels
     // they cover to `drawn` (rect-local), which the order gets as the region's coverage, with no
-    // read-back from the renderer (common/progressive/mesh_coverage.h).
+    // read-back from the renderer (progressive/mesh_coverage.h).
     bool sizing = false;
     std::vector<std::uint8_t> drawn;
     // Unvisited cells beside hits on visited ones, seeded at the region's end if their pixels
@@ -83,9 +83,9 @@ void add_drawn(RegionCursor& c, const Mesh& mesh, const glm::mat4& view_m, const
 void keep_frontier(RegionCursor& c, std::vector<glm::ivec3>& units, const SurfaceExtractor& ex);
 
 // Gives `order` the region's coverage after a level that wants it: while sizing, c.drawn (and
-// sizing ends once the order has its size); else what `sink` shows (`scratch` holds it), or
-// nothing covered when the sink cannot tell. True when `scratch` holds what the sink shows now.
-bool give_order_coverage(RayOrder& order, RegionCursor& c, GroupSink& sink,
+// sizing ends once the order has its size); else what `shown` shows (`scratch` holds it), or
+// nothing covered without it. True when `scratch` holds what the frame shows now.
+bool give_order_coverage(RayOrder& order, RegionCursor& c, ShownPixels* shown,
                          std::vector<std::uint8_t>& scratch);
 
 }  // namespace isowall

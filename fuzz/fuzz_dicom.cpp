@@ -1,10 +1,10 @@
-// Harness: the DICOM series reader (common/formats/dicom_reader.cpp through GDCM). The bytes are
+// Harness: the DICOM series reader (readers/dicom_reader.cpp through GDCM). The bytes are
 // the files of a series, split at each line "@next.dcm" (a series needs two slices or more).
 #include <string>
 
-#include "common/core/error.h"
-#include "common/formats/read_volume.h"
+#include "core/error.h"
 #include "fuzz/fuzz_files.h"
+#include "readers/read_volume.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace isowall;

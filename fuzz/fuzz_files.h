@@ -10,9 +10,9 @@
 #include <string>
 #include <string_view>
 
-#include "common/core/error.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
+#include "volume/volume.h"
 
 namespace isowall::fuzz {
 

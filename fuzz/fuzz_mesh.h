@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "common/core/mesh.h"
+#include "core/mesh.h"
 #include "fuzz/fuzz_check.h"
 #include "remote/group_codec.h"
 

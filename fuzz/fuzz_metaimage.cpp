@@ -1,11 +1,11 @@
-// Harness: the MetaImage reader (common/formats/metaimage_reader.cpp), header parser and data
+// Harness: the MetaImage reader (readers/metaimage_reader.cpp), header parser and data
 // together. Without a line "@data.raw" the bytes are in.mha (a LOCAL header with its data after
 // it); with one, everything before it is in.mhd and everything after it data.raw beside it (for
 // "ElementDataFile = data.raw" headers). A volume that loads passes fuzz_files.h's check_volume
 // and names its header first among its files.
-#include "common/core/error.h"
-#include "common/formats/readers.h"
+#include "core/error.h"
 #include "fuzz/fuzz_files.h"
+#include "readers/readers.h"
 
 namespace {
 constexpr std::string_view kDataMark = "\n@data.raw\n";

@@ -1,7 +1,7 @@
-// Harness: the NIfTI reader (common/formats/nifti_reader.cpp through niftilib). The bytes are a
+// Harness: the NIfTI reader (readers/nifti_reader.cpp through niftilib). The bytes are a
 // .nii file.
-#include "common/formats/read_volume.h"
 #include "fuzz/fuzz_files.h"
+#include "readers/read_volume.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     isowall::fuzz::read_as_file("nifti", "in.nii", data, size, [](const std::string& path) {

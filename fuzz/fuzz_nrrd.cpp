@@ -1,4 +1,4 @@
-// Harness: the NRRD loader (common/volume/volume.cpp through Teem). The loader takes a path, so
+// Harness: the NRRD loader (volume/volume.cpp through Teem). The loader takes a path, so
 // the bytes go to files in a per-process folder: everything before a line "@data.raw" is in.nrrd,
 // everything after it data.raw beside it (for "data file: data.raw" headers). A volume that loads
 // must hold exactly dims x voxel size bytes, every one readable; so must its planes streamed as
@@ -20,10 +20,10 @@
 #include <string>
 #include <string_view>
 
-#include "common/core/error.h"
-#include "common/volume/plane_source.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
+#include "volume/plane_source.h"
+#include "volume/volume.h"
 
 namespace {
 

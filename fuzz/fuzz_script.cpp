@@ -1,4 +1,4 @@
-// Harness: wall script lines (common/wall/script.cpp), both entry points: parse_script for a
+// Harness: wall script lines (wall_spec/script.cpp), both entry points: parse_script for a
 // script file and parse_command for one console line. A command that parses must be one the
 // master can apply as is: finite numbers (a float cast of 1e300 is infinity, of 1e-50 zero), a
 // positive zoom, a non-negative wait and a plain snapshot name.
@@ -7,9 +7,9 @@
 #include <type_traits>
 #include <variant>
 
-#include "common/core/error.h"
-#include "common/wall/script.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
+#include "wall_spec/script.h"
 
 namespace {
 

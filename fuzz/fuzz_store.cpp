@@ -1,4 +1,4 @@
-// Harness: a store's metadata (common/store/store_format.cpp: 0/.zarray and .zattrs, JSON through
+// Harness: a store's metadata (store/store_format.cpp: 0/.zarray and .zattrs, JSON through
 // nlohmann's parser). The input is the two texts separated by the first NUL byte. A layout that
 // parses must be one the pager can map: its bricks' bytes fit in 64 TiB, the brick is a power of
 // two from 8 to 128, every side has at least 2 voxels, the chunk count is the grid's, and the
@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <string_view>
 
-#include "common/core/error.h"
-#include "common/store/store_format.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
+#include "store/store_format.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using isowall::fuzz::check;

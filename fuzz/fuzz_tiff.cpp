@@ -1,7 +1,7 @@
-// Harness: the TIFF stack reader (common/formats/tiff_reader.cpp through OpenImageIO). The
+// Harness: the TIFF stack reader (readers/tiff_reader.cpp through OpenImageIO). The
 // bytes are a multi-page TIFF file.
-#include "common/formats/read_volume.h"
 #include "fuzz/fuzz_files.h"
+#include "readers/read_volume.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     isowall::fuzz::read_as_file("tiff", "in.tif", data, size, [](const std::string& path) {

@@ -1,4 +1,4 @@
-// Harness: wall files (common/wall/wall_file.cpp, TOML through toml++). A wall that parses must
+// Harness: wall files (wall_spec/wall_file.cpp, TOML through toml++). A wall that parses must
 // be one the rest of the program can use as is: its virtual screen and every tile rectangle fit
 // in an int (they are computed in int by wall_geometry.cpp; here first in 64 bits, so an overflow
 // is caught as a broken property even without UBSan), at least one tile is enabled, and for a
@@ -8,15 +8,16 @@
 #include <cstdint>
 #include <string>
 
-#include "common/core/error.h"
-#include "common/wall/wall.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
+#include "wall_spec/wall.h"
 
 namespace {
 
 using isowall::fuzz::check;
 
-constexpr int kMaxTileSide = 32768;  // protocol/protocol.h's kMaxImageSide; common/ cannot see it
+constexpr int kMaxTileSide =
+    32768;  // protocol/protocol.h's kMaxImageSide; wall_spec/ cannot see it
 
 bool fits_int(std::int64_t v) {
     return v >= INT_MIN && v <= INT_MAX;

@@ -5,10 +5,10 @@
 #include <string>
 #include <variant>
 
-#include "common/core/error.h"
-#include "common/wall/script.h"
+#include "core/error.h"
 #include "fuzz/fuzz_check.h"
 #include "master/wall_page.h"
+#include "wall_spec/script.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using isowall::PageMessage;

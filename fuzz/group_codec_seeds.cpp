@@ -15,10 +15,10 @@
 #include <utility>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "remote/cell_codec.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
+#include "volume/phantom.h"
 
 namespace {
 

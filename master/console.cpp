@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall {
 namespace {

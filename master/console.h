@@ -4,7 +4,7 @@
 #include <functional>
 #include <string>
 
-#include "common/wall/script.h"
+#include "wall_spec/script.h"
 
 namespace isowall {
 

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "common/core/camera.h"  // PixelRect
-#include "common/core/image.h"
+#include "core/camera.h"  // PixelRect
+#include "core/image.h"
 
 namespace isowall {
 

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "common/core/image_ops.h"
+#include "core/image_ops.h"
 
 namespace isowall {
 namespace {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "common/core/image.h"
-#include "common/wall/control_layout.h"
+#include "core/image.h"
 #include "master/control_text.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 

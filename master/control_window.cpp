@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "master/control_view.h"
 
 namespace isowall {

@@ -6,13 +6,13 @@
 #include <memory>
 #include <string>
 
-#include "common/core/pacer.h"
-#include "common/core/util.h"
-#include "common/wall/control_layout.h"
+#include "core/pacer.h"
+#include "core/util.h"
 #include "display/x_window.h"
 #include "master/control_input.h"
 #include "master/steering.h"
 #include "master/wall_master.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 

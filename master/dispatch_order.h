@@ -1,5 +1,5 @@
 #pragma once
-// In which order the master hands out jobs to ranks that ask for one (issue 33: an emulation that
+// In which order the master hands out jobs to ranks that ask for one (an emulation that
 // predicts a cluster). By default a rank is served when its request arrives: on a cluster, where
 // each rank has a core of its own, that is also the order of the ranks' clocks. On one machine
 // with more ranks than cores, arrival follows the operating system's choice of who ran, not who

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "common/core/ray.h"
+#include "core/ray.h"
 
 namespace isowall {
 

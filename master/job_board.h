@@ -18,9 +18,9 @@
 #include <optional>
 #include <vector>
 
-#include "common/core/box.h"
-#include "common/core/camera.h"
-#include "common/core/view.h"
+#include "core/box.h"
+#include "core/camera.h"
+#include "core/view.h"
 #include "protocol/protocol.h"
 
 namespace isowall {

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/core/camera.h"
-#include "common/core/image.h"
-#include "common/core/image_ops.h"  // composite_by_depth, for callers of the mosaic
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/image_ops.h"  // composite_by_depth, for callers of the mosaic
 
 namespace isowall {
 

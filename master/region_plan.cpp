@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "common/core/ray.h"
+#include "core/ray.h"
 
 namespace isowall {
 

@@ -1,5 +1,5 @@
 #pragma once
-// Regions from the work (issue 33): at its defaults the screen-region scheduler cuts each tile
+// Regions from the work: at its defaults the screen-region scheduler cuts each tile
 // where the work is, not on a grid of one size. A tile's work is estimated on a grid of cells:
 //   - every frame: the active octree nodes at the isovalue (what the engine's screen mask casts
 //     into) projected through the tile's view, each adding the pixels it covers to the cells it
@@ -17,9 +17,9 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/core/box.h"
-#include "common/core/camera.h"
-#include "common/core/view.h"
+#include "core/box.h"
+#include "core/camera.h"
+#include "core/view.h"
 #include "master/job_board.h"
 
 namespace isowall {

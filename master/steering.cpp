@@ -4,9 +4,9 @@
 #include <cstdio>
 #include <thread>
 
-#include "common/core/error.h"
-#include "common/core/preview.h"
-#include "common/core/util.h"
+#include "core/error.h"
+#include "core/preview.h"
+#include "core/util.h"
 
 namespace isowall {
 namespace {

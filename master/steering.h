@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "common/core/image.h"
+#include "core/image.h"
 #include "master/wall_master.h"
 
 namespace isowall {

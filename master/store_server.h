@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "comm/comm.h"
-#include "common/store/store_reader.h"
 #include "protocol/protocol.h"
+#include "store/store_reader.h"
 
 namespace isowall {
 

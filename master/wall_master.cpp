@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "common/core/error.h"
-#include "common/io/image_io.h"
+#include "core/error.h"
+#include "files/image_io.h"
 #include "master/wall_report.h"
 
 namespace isowall {

@@ -8,19 +8,19 @@
 #include <vector>
 
 #include "comm/comm.h"
-#include "common/core/output_files.h"
-#include "common/core/test_fault.h"
-#include "common/core/util.h"
-#include "common/core/view.h"
-#include "common/progressive/trace.h"
-#include "common/wall/script.h"
-#include "common/wall/wall.h"
+#include "core/test_fault.h"
+#include "core/util.h"
+#include "core/view.h"
+#include "files/output_files.h"
 #include "master/dispatch_order.h"
 #include "master/job_board.h"
 #include "master/mosaic.h"
 #include "master/region_plan.h"
 #include "master/store_server.h"
 #include "master/wall_report.h"
+#include "progressive/trace.h"
+#include "wall_spec/script.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 
@@ -31,13 +31,13 @@ struct MasterOptions {
     std::string trace;               // PREFIX for PREFIX.json and PREFIX.csv, or empty
     double timeout_s = 120;          // the wall silent this long ends the job
     double startup_timeout_s = 600;  // the same, while the tiles start (load, say hello)
-    TestFault fault;  // the fault tests' hook (common/core/test_fault.h); none by default
+    TestFault fault;                 // the fault tests' hook (core/test_fault.h); none by default
     // The screen-region scheduler: off, every tile casts its own screen (one job per band);
     // on, tiles are cut into regions of region_w x region_h and idle ranks take others' regions.
     // The first view: the front full view turned, zoomed and panned by these.
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
-    // The volume's axes in patient space (common/volume/volume.h: Orientation), so that the
+    // The volume's axes in patient space (volume/volume.h: Orientation), so that the
     // front view is the patient's front whatever the acquisition.
     glm::mat3 front_axes{1.0f};
     bool balance = true;

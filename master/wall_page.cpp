@@ -5,9 +5,9 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-#include "common/core/error.h"
-#include "common/core/wire.h"
-#include "common/wall/script.h"
+#include "core/error.h"
+#include "wall_spec/script.h"
+#include "wire/wire.h"
 
 namespace isowall {
 namespace {

@@ -20,9 +20,9 @@
 #include <string_view>
 #include <vector>
 
-#include "common/core/image.h"
-#include "common/wall/control_layout.h"
+#include "core/image.h"
 #include "master/wall_master.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 

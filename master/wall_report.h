@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "common/core/output_files.h"
-#include "common/progressive/trace.h"
-#include "common/wall/wall.h"
+#include "files/output_files.h"
 #include "master/dispatch_order.h"
 #include "master/job_board.h"
+#include "progressive/trace.h"
 #include "protocol/protocol.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 

@@ -4,9 +4,9 @@
 // caller repeats the checks and none forgets them.
 #include "protocol/protocol.h"
 
-#include "common/core/wire_pieces.h"
 #include "protocol/protocol_jobs.h"
 #include "protocol/protocol_store.h"
+#include "wire/wire_pieces.h"
 
 #include <cmath>
 #include <iterator>

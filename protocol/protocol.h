@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "comm/comm.h"
-#include "common/core/preview.h"
-#include "common/core/view.h"
-#include "common/core/wire.h"
-#include "common/progressive/trace.h"
-#include "common/wall/wall.h"  // kMasterRank: the rank the messages go to and come from
+#include "core/preview.h"
+#include "core/view.h"
+#include "progressive/trace.h"
+#include "wall_spec/wall.h"  // kMasterRank: the rank the messages go to and come from
+#include "wire/wire.h"
 
 namespace isowall {
 
@@ -140,7 +140,7 @@ struct AliveMsg {
 };
 
 // With --control, each tile sends the master a scaled-down copy of what it shows
-// (common/core/preview.h: make_preview) while a frame builds and when it ends; the master's control
+// (core/preview.h: make_preview) while a frame builds and when it ends; the master's control
 // window shows them as a live mosaic of the wall.
 struct PreviewMsg : Preview {
     static constexpr Tag kTag = Tag::preview;

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "common/core/wire_pieces.h"
+#include "wire/wire_pieces.h"
 
 namespace isowall {
 

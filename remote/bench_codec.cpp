@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
+#include "volume/phantom.h"
 
 namespace {
 

@@ -1,6 +1,6 @@
 #pragma once
 // Raw little-endian bytes for the group codecs. Unlike MessageWriter/MessageReader
-// (common/core/wire.h), arrays carry no count of their own and go in one copy: a group's counts
+// (wire/wire.h), arrays carry no count of their own and go in one copy: a group's counts
 // sit once in its header, and a per-array u64 count would cost as much as the whole index stream
 // of a small compact group. Reading keeps wire.h's rule: every length is checked against the
 // bytes left before anything is sized from it, and every failure is a WireError.
@@ -12,7 +12,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "common/core/wire.h"
+#include "wire/wire.h"
 
 namespace isowall::remote {
 

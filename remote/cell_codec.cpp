@@ -4,11 +4,11 @@
 #include <cmath>
 #include <string>
 
-#include "common/extract/edge_cache.h"
-#include "common/volume/load_checks.h"
+#include "extract/edge_cache.h"
 #include "remote/cell_values.h"
 #include "remote/cell_voxels.h"
 #include "remote/group_codec.h"
+#include "volume/load_checks.h"
 
 namespace isowall::remote {
 namespace {

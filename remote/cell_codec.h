@@ -1,7 +1,7 @@
 #pragma once
-// The body of the `cells` group encoding (remote/group_codec.h; issue 34, the dissertation's
+// The body of the `cells` group encoding (remote/group_codec.h; the dissertation's
 // open problem 5.2.3): a group sent as what marching cubes needs, not what it made. The client
-// runs the project's own marching cubes (common/extract/marching_cubes.h) on what it receives and
+// runs the project's own marching cubes (extract/marching_cubes.h) on what it receives and
 // gets the server's triangles: the same positions and the same normals, the interpolated
 // central-difference gradients, to the bit, with nothing quantised at full resolution. A coarse
 // pass (level >= 1: drawn only until the full resolution replaces it) is sent cheaper: no normals
@@ -10,7 +10,7 @@
 // gradients' by 28 degrees on average on the head), and its values to a step (cell_values.h:
 // bins aligned on the isovalue keep every unit's case; only where the surface cuts an edge moves,
 // by 0.03 of an edge on average). On the 256-wide head at 1 Mbit/s, C = 90% came in 0.112 s
-// (stop 53, exact values through zstd: 0.283; with 8-bit normals sent too: 0.342).
+// (with exact values through zstd: 0.283; with 8-bit normals sent too: 0.342).
 //
 // What travels: the group's units (the cells, or meta-cells of a level, whose triangles the mesh
 // is) and the values of the voxels marching cubes reads to triangulate them, in three phases, each
@@ -49,10 +49,10 @@
 #include <span>
 #include <vector>
 
-#include "common/core/mesh.h"
-#include "common/extract/group.h"
-#include "common/volume/volume.h"
+#include "core/mesh.h"
+#include "extract/group.h"
 #include "remote/byte_io.h"
+#include "volume/volume.h"
 
 namespace isowall::remote {
 

@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
-#include "common/extract/marching_cubes.h"
-#include "common/extract/mc_tables.h"
+#include "extract/marching_cubes.h"
+#include "extract/mc_tables.h"
 #include "remote/byte_io.h"
 #include "remote/cell_units.h"
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <type_traits>
 
-#include "common/core/util.h"
-#include "common/core/wire.h"
+#include "core/util.h"
 #include "remote/group_codec.h"
+#include "wire/wire.h"
 
 namespace isowall::remote {
 namespace {

@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "common/core/image.h"
-#include "common/progressive/correctness.h"
+#include "core/image.h"
+#include "progressive/correctness.h"
 #include "remote/view_protocol.h"
 #include "render/renderer.h"
 

@@ -1,6 +1,6 @@
 # The group codecs: how a group travels from the extraction server to the client.
 find_package(meshoptimizer REQUIRED)
-# PkgConfig::ZSTD: found in common/CMakeLists.txt (the stores use it too).
+# PkgConfig::ZSTD: found in store/CMakeLists.txt (the stores use it too).
 
 add_library(isowall_remote_codec group_codec.cpp compact_mesh.cpp cell_codec.cpp cell_units.cpp
     encoding_choice.cpp)

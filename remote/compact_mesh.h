@@ -10,7 +10,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "common/core/mesh.h"
+#include "core/mesh.h"
 #include "remote/byte_io.h"
 
 namespace isowall::remote {

@@ -1,5 +1,5 @@
 #pragma once
-// Which encoding a server sends the next group in, when the client lets it choose (issue 34; the
+// Which encoding a server sends the next group in, when the client lets it choose (the
 // dissertation's 5.2.3: tune compression to whichever of server and network is the bottleneck).
 // `cells` sends about a quarter of compact+zstd's bytes and costs several times its CPU a
 // triangle; which brings the picture sooner depends on the link. The chooser keeps, for each of

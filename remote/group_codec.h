@@ -1,5 +1,5 @@
 #pragma once
-// How a group travels from the extraction server to the client (issue 12; the dissertation's
+// How a group travels from the extraction server to the client (the dissertation's
 // section 4.2 and its open problem 5.2.3). Four encodings, from the base case to ours:
 //   vertices      every triangle as three separate vertices, float32 position + normal each,
 //                 no index (section 4.2's case 1): 72 bytes a triangle
@@ -36,10 +36,10 @@
 #include <span>
 #include <vector>
 
-#include "common/core/wire.h"
-#include "common/extract/group.h"
-#include "common/volume/volume.h"
+#include "extract/group.h"
 #include "remote/cell_codec.h"
+#include "volume/volume.h"
+#include "wire/wire.h"
 
 namespace isowall::remote {
 

@@ -8,8 +8,8 @@
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 
-#include "common/core/ray.h"
-#include "common/extract/marching_cubes.h"
+#include "core/ray.h"
+#include "extract/marching_cubes.h"
 #include "render/headlight.h"
 
 namespace isowall::remote {

@@ -1,6 +1,6 @@
 #pragma once
 // Whether a frame's coarse passes of progressive LOD (the dissertation's section 4.1.3, case 3)
-// bring C = 90% sooner, for the server that chooses the schedule (issue 34; RequestMsg's
+// bring C = 90% sooner, for the server that chooses the schedule (RequestMsg's
 // progressive_lod `chosen`). Measured on the shared volumes at their README isovalues
 // (docs/benchmarks.md): where the coarse picture alone reaches C = 0.9, the coarse passes bring
 // C = 90% 9-20x sooner at 1 Mbit/s (the engine at 75, the tooth at 620), as they take a fraction
@@ -15,13 +15,13 @@
 // picture shows the finest coarse level that the ray hits (the client clears depth for each finer
 // level; a coarser level's colour stays where a finer one draws nothing). A pixel the full
 // resolution covers and no coarse level does counts an error of 1, as in C = 1 - E
-// (common/progressive/correctness.h). A few thousand rays cost a few milliseconds; the server
+// (progressive/correctness.h). A few thousand rays cost a few milliseconds; the server
 // stops once its choice is clear (`decide`).
 #include <cstddef>
 #include <span>
 
-#include "common/core/view.h"
-#include "common/extract/surface_extractor.h"
+#include "core/view.h"
+#include "extract/surface_extractor.h"
 
 namespace isowall::remote {
 

@@ -8,7 +8,7 @@
 // against the volume's value range when the request arrives.
 #include <string>
 
-#include "common/core/camera.h"
+#include "core/camera.h"
 
 namespace isowall::remote {
 

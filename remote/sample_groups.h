@@ -7,7 +7,7 @@
 // benchmark; header-only so the codec library does not depend on the extractor.
 #include <vector>
 
-#include "common/extract/surface_extractor.h"
+#include "extract/surface_extractor.h"
 
 namespace isowall::remote {
 

@@ -7,9 +7,9 @@
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 
-#include "common/core/ray.h"
-#include "common/core/util.h"
-#include "common/progressive/trace.h"
+#include "core/ray.h"
+#include "core/util.h"
+#include "progressive/trace.h"
 #include "remote/lod_choice.h"
 #include "remote/view_framing.h"
 
@@ -18,12 +18,8 @@ namespace {
 
 // The pixel whose centre sees `p` (object space), if it is on the screen.
 std::optional<glm::ivec2> pixel_of(const FrameView& v, glm::vec3 p) {
-    const glm::vec4 clip = v.frustum.matrix() * v.camera.view() * glm::vec4(p, 1.0f);
-    if (!(clip.w > 0)) return std::nullopt;
-    const glm::vec2 w = ndc_to_window(clip.x / clip.w, clip.y / clip.w, v.width, v.height);
-    const float x = w.x, y = w.y;
-    if (!(x >= 0 && y >= 0 && x < float(v.width) && y < float(v.height))) return std::nullopt;
-    return glm::ivec2(int(x), int(y));
+    return clip_to_pixel(v.frustum.matrix() * v.camera.view() * glm::vec4(p, 1.0f), v.width,
+                         v.height);
 }
 
 }  // namespace
@@ -42,7 +38,7 @@ struct ServerSession::LodLevel {
 };
 
 // Sends each group as it is made, and names cached groups that rays meet.
-class ServerSession::Sink final : public GroupSink {
+class ServerSession::Sink final : public GroupSink, public SeenGroups {
   public:
     Sink(ServerSession& s, LodLevel& lv, const RequestMsg& r, bool keep, RequestFigures& f)
         : s_(s), lv_(lv), r_(r), keep_(keep), f_(f) {
@@ -116,7 +112,10 @@ class ServerSession::Sink final : public GroupSink {
         lv_.named.push_back(1);
     }
 
-    bool wants_seen() const override { return s_.cache_gen_ != 0; }
+    // Cached groups are named only in a request that caches.
+    FrameOutput output() {
+        return FrameOutput(*this, nullptr, s_.cache_gen_ != 0 ? this : nullptr);
+    }
 
     void seen(std::uint32_t id) override {
         if (id >= lv_.named.size() || lv_.named[id]) return;
@@ -249,6 +248,9 @@ bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std:
     eo.first_group_id = static_cast<std::uint32_t>(lv.sent.size());
     eo.trace = nullptr;
     eo.sample_at_rays.clear();
+    // A cached group is named to the client as soon as a ray meets it, not at the end of the
+    // ray-order level, which one thread gives (EngineOptions::threads, SeenGroups).
+    if (cache_gen_ != 0) eo.threads = 1;
     ProgressiveEngine engine(*lv.ex, eo);
     Sink sink(*this, lv, r, keep, f);
     EngineFrame frame(engine, r.view, stop);
@@ -258,7 +260,7 @@ bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std:
         const double pixels = double(r.view.width) * double(r.view.height);
         limit = std::max<std::size_t>(1, static_cast<std::size_t>(options_.lod_ray_share * pixels));
     }
-    const bool ok = frame.cast(r.view, c, sink, limit);
+    const bool ok = frame.cast(r.view, c, sink.output(), limit);
     f.rays += frame.finish(ok).rays_cast;
     return ok && !stop.load();
 }

@@ -36,9 +36,9 @@
 #include <string>
 #include <vector>
 
-#include "common/core/util.h"
-#include "common/extract/surface_extractor.h"
+#include "core/util.h"
 #include "engine/progressive_engine.h"
+#include "extract/surface_extractor.h"
 #include "remote/encoding_choice.h"
 #include "remote/group_codec.h"
 #include "remote/view_protocol.h"

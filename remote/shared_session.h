@@ -1,5 +1,5 @@
 #pragma once
-// Shared sessions of `isowall serve` (issue 35): a presenter names a session (view --present
+// Shared sessions of `isowall serve`: a presenter names a session (view --present
 // NAME), followers join it (view --follow NAME) and see every view the presenter asks for. The
 // server extracts each view once, on the presenter's connection, and its messages go out to every
 // follower through a queue of the follower's own, drained by the follower's own thread at its own

@@ -1,5 +1,5 @@
 #pragma once
-// The cached-group slots a VisibleMsg names (issue 12, case 4), on the wire. A slot is a group's
+// The cached-group slots a VisibleMsg names (case 4), on the wire. A slot is a group's
 // index in the client's cache of the current generation (GroupMsg::cache_gen), so a list of slots
 // costs bits, not the 25 bytes of a GroupKey. Two forms, the encoder picks the smaller (a tie goes
 // to the bitmap):
@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "common/core/wire.h"
 #include "remote/view_protocol.h"  // kMaxVisibleKeys: every slot is below it
+#include "wire/wire.h"
 
 namespace isowall::remote {
 

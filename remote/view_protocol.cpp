@@ -9,10 +9,10 @@
 #include <string>
 #include <type_traits>
 
-#include "common/core/wire_pieces.h"
 #include "remote/request_checks.h"
 #include "remote/slot_list.h"
 #include "remote/view_protocol_parts.h"
+#include "wire/wire_pieces.h"
 
 namespace isowall::remote {
 
@@ -142,7 +142,7 @@ static ReadyMsg decode_ready(std::span<const std::byte> bytes) {
     m.bounds.min = get_finite_vec3(r, "bounds.min");
     m.bounds.max = get_finite_vec3(r, "bounds.max");
     if (m.bounds.empty()) r.fail("bounds: expected min <= max on every axis");
-    // A volume loads only up to 1e7 object units a side (common/volume/load_checks.h), which
+    // A volume loads only up to 1e7 object units a side (volume/load_checks.h), which
     // any view can frame; a server saying more would end in a view option's error instead.
     for (int a = 0; a < 3; ++a)
         if (!(std::abs(m.bounds.min[a]) <= 1e9 && std::abs(m.bounds.max[a]) <= 1e9 &&

@@ -1,5 +1,5 @@
 #pragma once
-// The messages between `isowall serve` and `isowall view` (issue 12): one typed struct per
+// The messages between `isowall serve` and `isowall view`: one typed struct per
 // message, encode and decode side by side in view_protocol.cpp. A payload starts with its layout
 // version byte (MessageWriter), then the fields, little-endian. Decoding checks every value, not
 // only lengths (finite numbers, enum ranges, bounded printable text, counts against the bytes
@@ -13,10 +13,10 @@
 #include <variant>
 #include <vector>
 
-#include "common/core/box.h"
-#include "common/core/view.h"
-#include "common/core/wire.h"
-#include "common/extract/group.h"
+#include "core/box.h"
+#include "core/view.h"
+#include "extract/group.h"
+#include "wire/wire.h"
 
 namespace isowall::remote {
 
@@ -91,7 +91,7 @@ struct ReadyMsg {
     double value_min = 0, value_max = 0;      // finite, min <= max
     glm::ivec3 dims{1};                       // samples per axis, each >= 1
     glm::vec3 spacing{1};                     // finite, each > 0
-    // The volume's axes in patient space (common/volume/volume.h: Orientation): finite unit
+    // The volume's axes in patient space (volume/volume.h: Orientation): finite unit
     // columns making a rotation, identity when the file gave none.
     glm::mat3 axes{1.0f};
 };
@@ -169,7 +169,7 @@ struct ErrorMsg {
 // every byte outside printable ASCII (a newline, UTF-8) replaced by '?'.
 ErrorMsg make_error(ErrorCode code, std::string_view text);
 
-// What decoding the groups cost the client since its last report, per encoding (issue 34: the
+// What decoding the groups cost the client since its last report, per encoding (the
 // adaptive server weighs the client's decoding beside its own work and the link). Sent by a
 // client that asked for the server's choice (hello encoding kAdaptiveEncoding), every few groups.
 struct DecodeRateMsg {

@@ -6,9 +6,9 @@
 #include <span>
 #include <vector>
 
-#include "common/core/wire.h"
-#include "common/extract/group.h"
+#include "extract/group.h"
 #include "remote/view_protocol.h"
+#include "wire/wire.h"
 
 namespace isowall::remote {
 

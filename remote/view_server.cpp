@@ -9,9 +9,9 @@
 #include <list>
 #include <optional>
 
-#include "common/core/camera.h"
-#include "common/core/error.h"
-#include "common/core/newest_request.h"
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/newest_request.h"
 #include "remote/net/socket.h"
 #include "remote/request_checks.h"
 #include "remote/server_refusal.h"
@@ -356,7 +356,7 @@ void ViewServer::reap(bool all) {
             [all](const std::unique_ptr<Refusal>& r) { return all || r->done.load(); });
     }
     // What a client that left had the server hold goes back to the system: `isowall` keeps
-    // freed memory for the next frame (keep_freed_memory, common/core/util.h), which would keep
+    // freed memory for the next frame (keep_freed_memory, core/util.h), which would keep
     // it for as long as the server runs.
     if (gone > 0 && !all) ::malloc_trim(0);
 }

@@ -34,7 +34,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/extract/surface_extractor.h"
+#include "extract/surface_extractor.h"
 #include "remote/message_channel.h"
 #include "remote/server_session.h"
 #include "remote/shared_session.h"

@@ -11,8 +11,8 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/core/image.h"
-#include "common/core/mesh.h"
+#include "core/image.h"
+#include "core/mesh.h"
 #include "render/renderer.h"
 
 namespace isowall {

@@ -9,10 +9,10 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/core/camera.h"
-#include "common/core/image.h"
-#include "common/core/mesh.h"
-#include "common/core/view.h"
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/mesh.h"
+#include "core/view.h"
 
 namespace isowall {
 

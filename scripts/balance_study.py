@@ -14,12 +14,12 @@ LP_NUM_THREADS=0). The makespan is the largest busy CPU of any rank; efficiency 
 makespan (the master's "balance"); emulated times to wall-wide C are from each rank's own CPU
 clock, as if every rank had a core of its own (isowall wall --measure). Writes study.csv,
 study.md (the table the README quotes), per-rank busy bars and a summary plot, and each run's
-mosaic, into --out; prints which of the issue's targets hold.
+mosaic, into --out; prints which of the targets hold.
 
 With --repeat N each configuration keeps the one run whose makespan is the median (for an even
 N the lower of the two middle runs), with all its fields: a row never mixes runs. The targets are
 judged at the default regions ("auto": planned from the work, what `isowall wall` gives without
---region; issue 33's targets); the best
+--region); the best
 region of each case, chosen after the fact, is printed for information with no verdict.
 "auto:emulated" is the default regions with jobs handed out in emulated-time order (--dispatch
 emulated); the script prints how far the two orders differ.
@@ -171,7 +171,7 @@ def target_figures(case, static, bal):
                    f"{bal['comm_pct']}%", "<= 10%", bal["comm_pct"] <= 10)
     if case == "1 tile":
         ms = static["makespan"] / bal["makespan"]
-        # Issue 33's efficiency: the static wall's work over the balanced wall's ranks x makespan.
+        # The efficiency: the static wall's work over the balanced wall's ranks x makespan.
         eff = static["total"] / (TILE_RANKS * bal["makespan"])
         return [("makespan static/balanced", f"{ms:.1f}x", ">= 12x", ms >= 12),
                 ("efficiency static total/(ranks x makespan)", f"{eff:.2f}", ">= 0.75",
@@ -216,7 +216,7 @@ def check_targets(rows, volume):
 
 
 def compare_dispatch(rows, volume):
-    """How far the two dispatch orders differ at the default regions (issue 33)."""
+    """How far the two dispatch orders differ at the default regions."""
     mine = {(r["case"], r["region"]): r for r in rows if r["volume"] == volume}
     if not any(region == "auto:emulated" for _, region in mine):
         return

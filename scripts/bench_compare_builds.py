@@ -5,8 +5,8 @@ speed. Prints the median and minimum of each build and the ratio of medians.
 
 Usage: scripts/bench_compare_builds.py BEFORE_BUILD AFTER_BUILD [--volume PATH] [--isos 40,105]
                                        [--size 1600x1200] [--runs 7]
-A build is a folder holding bin/isowall (e.g. build/), or master/isowall (a build from before the
-folders of issue 28).
+A build is a folder holding bin/isowall (e.g. build/), or master/isowall (a build in the older
+folder layout).
 """
 import argparse
 import csv
@@ -36,7 +36,7 @@ def times_to_thresholds(isowall, volume, iso, size, tmp):
 
 
 def program_in(build):
-    """bin/isowall of a build, or master/isowall of one from before issue 28."""
+    """bin/isowall of a build, or master/isowall of one in the older folder layout."""
     for sub in ("bin", "master"):
         path = os.path.join(build, sub, "isowall")
         if os.access(path, os.X_OK):

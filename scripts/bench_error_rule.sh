@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The error rule of adaptive resolution (issue 29) against full resolution and the size rule alone,
+# The error rule of adaptive resolution against full resolution and the size rule alone,
 # on shared volumes and their trilinear copies, 1600x1200, front view, warm (--warm-up), 2 threads:
 # the defaults first, then the gaps order (--order gaps) alone and with each rule.
 # For each run: time to C = 99% (against the engine's own final image), time to 99% of final

@@ -1,11 +1,11 @@
 #!/usr/bin/env node
-// The browser page against `isowall view`, in one run (issue 13): time from sending a request to
+// The browser page against `isowall view`, in one run: time from sending a request to
 // the first group drawn and to the end of the frame, on the phantom and the shared CT head, over
 // loopback. One `isowall serve --http 0` serves both clients; each run is a fresh connection (a
 // fresh page, a fresh `isowall view` process) asking for the front view with progressive LOD and
 // the cache (the study's case 5, compact + zstd), so neither client starts with cached groups.
 // The page runs twice: asking for compact+zstd with LOD on as case 5 does (the page's default
-// until issue 34), and at its defaults since (no parameter: the server chooses cells or
+// before the cells encoding), and at its defaults since (no parameter: the server chooses cells or
 // compact+zstd per group and whether coarse passes go out; the page decodes cells in
 // WebAssembly). Runs alternate page / page default / view, so load on this 2-core machine falls
 // on all alike. Besides end-to-end times it prints the page's own work in the frame (main-thread
@@ -118,7 +118,7 @@ async function pageRun(browser, server, d, o, encoding) {
     try {
         const cdp = await page.context().newCDPSession(page);
         await cdp.send('Performance.enable');
-        // Today's (before issue 34): compact+zstd with LOD on. The page's default: no parameter
+        // The old default: compact+zstd with LOD on. The page's default: no parameter
         // but the view's (auto encoding, LOD chosen by the server, the cache).
         const q = `?dataset=${encodeURIComponent(d.name)}&size=${o.size}&iso=${d.iso}` +
                   (encoding === undefined ? '' : `&lod=1&cache=1&encoding=${encoding}`);

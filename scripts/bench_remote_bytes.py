@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Bytes to C = 99% and seconds to C = 90% for a new isovalue with `isowall view` (front view,
-800x600, no cache) in three settings: `compact-zstd` without LOD (the default before issue 34),
+800x600, no cache) in three settings: `compact-zstd` without LOD (the default before cells),
 `cells` and `auto` (the default since: the server picks cells or compact-zstd per group for the
 link it sees), both with the default progressive LOD (the server sends coarse passes where it
 forecasts that they bring C = 90% sooner, remote/lod_choice.h), on every shared volume at its
@@ -14,7 +14,7 @@ One `isowall serve` on loopback holds every volume; each (volume, isovalue, enco
 cores, or with --pin the server on CPU 0 and the client on CPU 1, as on two machines with a core
 each), bytes are what the protocol counted; with --runs N each is the median of N runs, taken in
 turn (every encoding once, then again), so a disturbance of the machine falls on all three.
-Prints a Markdown table with a verdict per row against issue 34's targets: bytes to C = 99% of
+Prints a Markdown table with a verdict per row against the targets: bytes to C = 99% of
 cells at most 1/4 of compact-zstd's, and auto's seconds to C = 90% against compact-zstd's.
 Errors are one line on stderr and exit status 1; the server is always stopped.
 """
@@ -33,7 +33,7 @@ CASES = [("vhp_ct_head", 40), ("vhp_ct_head", 105), ("cthead", 600), ("cthead", 
          ("mrhead_t1", 112), ("mrhead_t1", 490), ("engine", 75), ("engine", 190),
          ("heptane", 50), ("heptane", 200), ("tooth", 620), ("tooth", 1000)]
 ENCODINGS = ["compact-zstd", "cells", "auto"]
-# The options besides --encoding: compact-zstd stands for the default before issue 34.
+# The options besides --encoding: compact-zstd stands for the default before cells.
 EXTRA = {"compact-zstd": ["--no-lod"], "cells": [], "auto": []}
 PORT = 7981
 
@@ -130,7 +130,7 @@ def main():
     runs = f", the median of {a.runs} runs" if a.runs > 1 else ""
     print(f"`isowall view` (front view, 800x600, new isovalue), {rate}{runs}; bytes to C = 99% "
           f"and seconds to C = 90% for each --encoding (auto is the default); compact-zstd "
-          f"without LOD (the default before issue 34), cells and auto with the default LOD "
+          f"without LOD (the default before cells), cells and auto with the default LOD "
           f"(coarse passes where the server forecasts that they pay)\n")
     print("| volume | iso | triangles | " +
           " | ".join(f"{e} bytes | {e} s" for e in ENCODINGS) +

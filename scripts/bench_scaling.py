@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Scaling benchmark of issue 10: time to C = 90/99/99.9/100% of final pixels of the progressive
+"""Scaling benchmark: time to C = 90/99/99.9/100% of final pixels of the progressive
 engine (`isowall render --timeline`), our full surface (`isowall render --full`: extraction plus
 drawing) and the FE + Embree peer (VTK flying edges on 2 threads, then an Embree 3 BVH and 8-wide
 primary rays: scripts/fe_mesh.py and bench/peer's isowall-peer), for one volume at several
@@ -24,7 +24,7 @@ once first), and the peer runs flying edges, the BVH build and the rays twice in
 times the second run. A wall's ranks draw frame after frame, so this is what a viewer waits for
 after moving the camera. --cold times every program's first run in a fresh process instead (the
 memory it touches then is new to it: page faults, the renderer's first buffers and bins). isowall
-keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the peer's processes
+keeps freed memory for the next frame (core/util.h: keep_freed_memory); the peer's processes
 run with the same C library settings (MALLOC_TRIM_THRESHOLD_, MALLOC_MMAP_THRESHOLD_).
 
 Two threads against one: the targets compare the defaults on one thread (full-res) and on every
@@ -250,7 +250,7 @@ def peer_missing(a):
     return None
 
 
-# isowall keeps freed memory for the next frame (common/core/util.h: keep_freed_memory); the
+# isowall keeps freed memory for the next frame (core/util.h: keep_freed_memory); the
 # peer's processes get the same C library settings through its environment.
 PEER_ENV = dict(os.environ, MALLOC_TRIM_THRESHOLD_=str(1 << 30), MALLOC_MMAP_THRESHOLD_=str(32 << 20))
 

@@ -1,4 +1,4 @@
-"""The targets, tables and plot of scripts/bench_scaling.py (issue 10), from its measured results:
+"""The targets, tables and plot of scripts/bench_scaling.py, from its measured results:
 one dict per scale with "progressive", "full" and "peer" (see bench_scaling.py)."""
 import statistics
 
@@ -234,7 +234,7 @@ def statistic_words(meta):
 def report(meta, results, checks):
     load = ", ".join(f"{x:g}" for x in meta["load_average"])
     pair = meta.get("pair", PAIR)
-    lines = [f"# Scaling (issue 10): {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
+    lines = [f"# Scaling: {meta['volume']}, iso {meta['iso']:g}, {meta['size']}", "",
              f"Measured {meta['date']} on {meta['cores']} cores (load average {load} over 1, 5, 15 min "
              f"at the end); {statistic_words(meta)}; seconds; {frame_words(meta)}. C is the share of "
              f"final pixels; the peer uses {meta['threads']} threads. The progressive columns and the "

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Volumes past memory (issue 32): the same volume read from its file and from a store made by
+"""Volumes past memory: the same volume read from its file and from a store made by
 `isowall import`, with the default `isowall render` (1600x1200, front view), on a cold page
 cache (as root: `sync; echo 3 > /proc/sys/vm/drop_caches` before each run) and warm: time to the
 first picture, to C = 99% and to 99% of the final pixels, the peak resident memory, and what the

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Resolution insensitivity on every shared volume (issue 29): for each volume in the data folder
+"""Resolution insensitivity on every shared volume: for each volume in the data folder
 at each isovalue its README suggests, at 1x, 2x and 4x a side where that fits in memory, the
 default `isowall render` (no engine option, warm, 1600x1200, front view) timed to C = 90/99/99.9%
 against the full surface at full resolution (`--against-full`: the truth, not the engine's own

@@ -1,4 +1,4 @@
-"""Tables, targets and plots of scripts/bench_volumes.py (issue 29) from its cases: one dict per
+"""Tables, targets and plots of scripts/bench_volumes.py from its cases: one dict per
 volume, isovalue and scale, with "engine" (the default render's median run) and "peer"."""
 # The issue's acceptance, per volume and isovalue.
 PICTURE_C, PICTURE_IOU = 0.99, 0.999  # the final image against the full surface, every scale

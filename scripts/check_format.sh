@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Checks that every C++ source is formatted by .clang-format (Debian 12's clang-format 14), and the
-# house rules (scripts/check_house.py: no file over 400 lines, no function over about 80).
+# house rules (scripts/check_house.py: no function over about 80 lines; a file past 800 is a prompt).
 # With --fix, formats the files in place instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(git ls-files '*.h' '*.cpp' | grep -v '^common/extract/mc_tables.h$')
+mapfile -t files < <(git ls-files '*.h' '*.cpp' | grep -v '^extract/mc_tables.h$')
 if [ "${1:-}" = "--fix" ]; then
     clang-format -i "${files[@]}"
     exit 0

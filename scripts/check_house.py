@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""House rules for the C++ sources (issue "One house"): no file over 400 lines and no function
-over about 80, generated tables aside. Prints every offender and exits 1 when there is one.
+"""House rules for the C++ sources: no function over about 80 lines, generated tables aside.
+Prints every offender and exits 1 when there is one. Files are cut where their concepts part,
+never to meet a count (STYLE.md), so a long file fails nothing: a file past PROMPT_FILE_LINES is
+listed as a prompt to look for a seam, with its length, and the check still passes.
 
 A function is found by brace depth: a `{` that opens at namespace or class scope after a line
 holding `)` (a signature) starts one, the matching `}` ends it. Lambdas and local classes count
@@ -9,10 +11,11 @@ import re
 import sys
 from pathlib import Path
 
-MAX_FILE_LINES = 400
+PROMPT_FILE_LINES = 800
 MAX_FUNCTION_LINES = 80
-GENERATED = {"common/extract/mc_tables.h"}
-FOLDERS = ["common", "comm", "render", "display", "engine", "protocol", "cli", "tile", "master",
+GENERATED = {"extract/mc_tables.h"}
+FOLDERS = ["core", "files", "wire", "volume", "progressive", "wall_spec", "extract", "readers",
+           "store", "comm", "render", "display", "engine", "protocol", "cli", "tile", "master",
            "remote", "app", "fuzz", "tests", "bench"]
 
 
@@ -58,7 +61,7 @@ def functions(text):
 
 def main(root):
     root = Path(root)
-    bad = []
+    bad, prompts = [], []
     for folder in FOLDERS:
         for path in sorted((root / folder).rglob("*")):
             if path.suffix not in (".h", ".cpp"):
@@ -68,13 +71,13 @@ def main(root):
                 continue
             text = path.read_text()
             n = text.count("\n")
-            if n > MAX_FILE_LINES:
-                bad.append(f"{rel}: {n} lines (at most {MAX_FILE_LINES})")
+            if n > PROMPT_FILE_LINES:
+                prompts.append(f"{rel}: {n} lines: is there a seam? (a prompt, not a failure)")
             for name, a, b in functions(text):
                 if b - a + 1 > MAX_FUNCTION_LINES:
                     bad.append(f"{rel}:{a}: function of {b - a + 1} lines (at most about "
                                f"{MAX_FUNCTION_LINES}): {name}")
-    for line in bad:
+    for line in prompts + bad:
         print(line)
     print(f"house rules: {len(bad)} offender(s)")
     return 1 if bad else 0

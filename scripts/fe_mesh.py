@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The flying-edges side of the FE + Embree peer (issue 10): VTK's vtkFlyingEdges3D over a whole
+"""The flying-edges side of the FE + Embree peer: VTK's vtkFlyingEdges3D over a whole
 volume on N threads (vtkSMPTools), timed alone, then the mesh written for bench/peer's
 isowall-peer (the file layout is in bench/peer/peer_mesh.h). Needs Debian's python3-vtk9.
 

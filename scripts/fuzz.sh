@@ -14,7 +14,7 @@ shift || true
 HARNESSES=("$@")
 # hdf5 and dicom: libhdf5 1.10 (Debian 12's) reads some damaged files unsafely, and Debian's GDCM
 # asserts on some structurally damaged ones. isowall reads both in a child process
-# (common/formats/isolated_read.h), and so do these harnesses, through read_volume: a crash of the
+# (readers/isolated_read.h), and so do these harnesses, through read_volume: a crash of the
 # library is one InputError, not a finding. A finding is then anything that escapes the child:
 # a crash, hang or leak of the reading process itself. Coverage guidance stops at the fork, so
 # these two check the boundary on mutations of their corpus rather than explore the libraries.

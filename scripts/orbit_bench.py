@@ -14,7 +14,7 @@ measured against its complete picture: a step that interrupted the last would le
 picture of the interrupted view to measure against. The balanced wall's regions of each step are
 planned from the last step's measured costs (master/region_plan.h), as while an operator turns
 the view. Prints every step, the medians and whether the balanced median time to C = 99% is at
-most 1/4 of the static one (issue 33); writes orbit.csv and orbit_<volume>.png into --out.
+most 1/4 of the static one; writes orbit.csv and orbit_<volume>.png into --out.
 """
 import argparse
 import csv

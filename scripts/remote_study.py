@@ -13,15 +13,15 @@ one `isowall view --case K` against it:
   1 base (separate vertices), 2 indexed face sets, 3 + progressive LOD: a new isovalue, the
   front view; 4 + cached groups: the front view, then the view turned by --turn degrees, which
   is measured; 5 ours (quantised, index-coded, zstd + LOD + cache), measured as 4 (its first
-  frame is also reported, as "5 new"); 6 as 5 in the cells encoding of issue 34, and 7 as 5 with
+  frame is also reported, as "5 new"); 6 as 5 in the cells encoding, and 7 as 5 with
   the server choosing cells or compact+zstd per group (view --encoding auto), both measured as 5.
 Times are the client's wall clock from sending the request (server and client share this
 machine's two cores). Each case runs once at each rate: every figure is from 1 run, no median.
-Writes study.json, study.md (the tables, beside the text's, with the targets of issue 12),
+Writes study.json, study.md (the tables, beside the text's, with the targets below),
 correctness-vs-time plots like Figures 4.4-4.6 (c_vs_time.png, one panel per rate) and C against
 bytes (c_vs_bytes.png), each run's timeline CSV and final image.
 
-The targets of issue 12, one verdict line (holds / MISSED) for every case in the tables:
+The targets, one verdict line (holds / MISSED) for every case in the tables:
   bytes to each C at most half the text's Table 4.1, scaled for the size of the volume;
   time to C = 90% at 1 Mbit/s at most 1/5 of the text's Table 4.4, not scaled.
 Case 5 with cache is judged against the text's case 4 (the same turned view), "5 ours, new iso"
@@ -237,7 +237,7 @@ def point(res, rate, case, i, key):
 
 
 def report(res, rates, cols, dims):
-    """The tables (ours, with the text's in brackets) and the targets of issue 12."""
+    """The tables (ours, with the text's in brackets) and the targets."""
     base = str(max(rates))
     lines = table(f"Bytes to reach C (at {base} Mbit/s; the text's Table 4.1 in brackets)", cols,
                   lambda c, i: fmt_bytes(point(res, base, c, i, "bytes")),
@@ -248,7 +248,7 @@ def report(res, rates, cols, dims):
         title = f"Seconds to reach C at {rate} Mbit/s" + (f" (Table {n} in brackets)" if n else "")
         lines += [""] + table(title, cols, lambda c, i, r=rate: fmt_s(point(res, r, c, i, "time_s")),
                               {c: [f"{v:g}" for v in text[c]] for c in text})
-    return lines + ["", "**Targets** (issue 12)", ""] + target_rules(dims) + \
+    return lines + ["", "**Targets**", ""] + target_rules(dims) + \
         byte_targets(res, base, cols, size_scale(dims)) + time_targets(res, rates, cols)
 
 

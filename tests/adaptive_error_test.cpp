@@ -1,4 +1,4 @@
-// The error rule of adaptive resolution (issue 29): a meta-cell is drawn coarse only where its
+// The error rule of adaptive resolution: a meta-cell is drawn coarse only where its
 // surface lies within a fraction of a pixel of the full-resolution surface. On a volume of tubes
 // and a sheet thinner than a cell (thin_structures.h), the size rule alone loses them; with the
 // error rule the final image is the full-resolution surface's, and the smooth ball is still
@@ -8,8 +8,9 @@
 #include <iostream>
 #include <limits>
 
-#include "common/progressive/correctness.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "progressive/correctness.h"
 #include "tests/engine_util.h"
 #include "tests/thin_structures.h"
 
@@ -31,7 +32,7 @@ ErrorFigures run_at_error(const Volume& volume, const FrameView& fv, float error
     opt.adaptive_refine = false;  // the rules alone
     opt.adaptive_error_px = error_px;
     opt.threads = threads;
-    const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
+    const FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
     EXPECT_TRUE(fr.completed);
     ErrorFigures f;
     for (const Group& g : fr.groups) {
@@ -64,10 +65,10 @@ TEST(AdaptiveError, ThreadedRunsEndOnTheSameImage) {
     opt.adaptive = true;
     opt.adaptive_pixels = 4.0f;
     opt.adaptive_error_px = 0.5f;
-    const Image one = ProgressiveEngine(*ex, opt).run(fv, *renderer).final_image;
+    const Image one = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer).final_image;
     opt.threads = 2;
     for (int i = 0; i < 3; ++i) {
-        const Image two = ProgressiveEngine(*ex, opt).run(fv, *renderer).final_image;
+        const Image two = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer).final_image;
         EXPECT_EQ(measure_correctness(two, one).c, 1.0) << "run " << i;
     }
 }

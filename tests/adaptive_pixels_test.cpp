@@ -1,4 +1,4 @@
-// Adaptive resolution with a pixel target (--adaptive-pixels, issue 10): D scales with the target,
+// Adaptive resolution with a pixel target (--adaptive-pixels): D scales with the target,
 // and a target above a pixel takes coarser units, fewer triangles and keeps the image within the
 // far view's bound (adaptive_test.cpp) of the full surface at full resolution.
 #include <gtest/gtest.h>
@@ -6,12 +6,13 @@
 #include <iostream>
 #include <limits>
 
-#include "common/extract/adaptive.h"
-#include "common/progressive/correctness.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "extract/adaptive.h"
+#include "progressive/correctness.h"
 #include "tests/engine_util.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -53,7 +54,7 @@ FrameFigures run_frame(const Volume& volume, const FrameView& fv, float pixels, 
     opt.adaptive = true;
     opt.adaptive_pixels = pixels;
     opt.adaptive_refine = refine;
-    const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
+    const FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
     EXPECT_TRUE(fr.completed);
     FrameFigures r;
     for (const Group& g : fr.groups) {

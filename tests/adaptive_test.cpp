@@ -13,11 +13,12 @@
 #include <limits>
 #include <vector>
 
-#include "common/extract/adaptive.h"
-#include "common/progressive/correctness.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "extract/adaptive.h"
+#include "progressive/correctness.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -248,7 +249,7 @@ void expect_groups_partition_the_visited_cells(SurfaceExtractor& ex, const Volum
 Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions& opt) {
     auto ex = make_surface_extractor(volume);
     auto renderer = make_renderer("osmesa");
-    const FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
+    const FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
     EXPECT_TRUE(fr.completed);
     Figures f;
     for (const Group& g : fr.groups) {
@@ -378,8 +379,8 @@ TEST(Adaptive, MaxLevelZeroIsFullResolution) {
     auto renderer = make_renderer("osmesa");
     EngineOptions opt = adaptive_options();
     opt.adaptive_max_level = 0;
-    const FrameResult a = ProgressiveEngine(*ex, opt).run(fv, *renderer);
-    const FrameResult b = ProgressiveEngine(*ex, EngineOptions{}).run(fv, *renderer);
+    const FrameResult a = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
+    const FrameResult b = draw_frame(ProgressiveEngine(*ex, EngineOptions{}), fv, *renderer);
     ASSERT_EQ(a.groups.size(), b.groups.size());
     for (std::size_t i = 0; i < a.groups.size(); ++i) {
         EXPECT_EQ(a.groups[i].level, 0);

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "common/core/camera.h"
-#include "common/core/util.h"
-#include "common/extract/extract.h"
-#include "common/volume/phantom.h"
+#include "core/camera.h"
+#include "core/util.h"
+#include "extract/extract.h"
 #include "render/renderer.h"
+#include "volume/phantom.h"
 
 namespace {
 

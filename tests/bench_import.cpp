@@ -13,11 +13,11 @@
 #include <thread>
 #include <vector>
 
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/store/store_writer.h"
-#include "common/volume/load_checks.h"
-#include "common/volume/plane_source.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "store/store_writer.h"
+#include "volume/load_checks.h"
+#include "volume/plane_source.h"
 
 namespace fs = std::filesystem;
 using namespace isowall;

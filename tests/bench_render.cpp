@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "common/core/camera.h"
+#include "core/camera.h"
 #include "render/backends.h"
 #include "render/renderer.h"
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Tests of scripts/bench_store.py (issue 32): a quick warm run on the shared tooth imports it,
+"""Tests of scripts/bench_store.py: a quick warm run on the shared tooth imports it,
 reads it from the file, from the store and from the store under a small limit, and prints every
 figure of each warm row, with the store's reads and a peak within the limit; bad options give one
 line and status 1. Skips (status 77) without ../shared/data.

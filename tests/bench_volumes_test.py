@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Tests of scripts/bench_volumes.py (issue 29): the README's isovalues are read; a quick run on
+"""Tests of scripts/bench_volumes.py: the README's isovalues are read; a quick run on
 the shared tooth at half and full size on a small screen writes a table per isovalue, the
 targets, the worst case, the JSON and a plot, with times against the full surface in order and
 the final image matching it; a memory share too small for any case skips every case and says

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "common/core/camera.h"
+#include "core/camera.h"
 
 namespace isowall {
 namespace {

@@ -1,10 +1,12 @@
 // Camera and frustum math: full views fit, sub-frusta tile the screen exactly.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <random>
 
-#include "common/core/camera.h"
-#include "common/core/util.h"
+#include "core/camera.h"
+#include "core/util.h"
 
 namespace isowall {
 namespace {
@@ -79,6 +81,17 @@ TEST(Camera, OrbitKeepsDistanceAndZoomMovesCloser) {
     EXPECT_NEAR(p.distance(), 10.0f, 1e-4f);
     EXPECT_NEAR(glm::dot(glm::normalize(p.up), glm::normalize(p.target - p.eye)), 0.0f, 1e-5f);
     EXPECT_NEAR(zoom(c, 2).distance(), 5.0f, 1e-5f);
+}
+
+TEST(Camera, ClipToPixelIsTheCentresPixelAndNoneBehindTheEyeOrOffTheScreen) {
+    // The screen's centre, a corner pixel, the edges (half-open), behind the eye, NaN.
+    EXPECT_EQ(clip_to_pixel({0, 0, 0.5f, 1}, 100, 50), glm::ivec2(50, 25));
+    EXPECT_EQ(clip_to_pixel({-0.99f, 0.99f, 0, 1}, 100, 50), glm::ivec2(0, 0));
+    EXPECT_EQ(clip_to_pixel({-2, 2, 0, 2}, 100, 50), glm::ivec2(0, 0));  // divided by w first
+    EXPECT_FALSE(clip_to_pixel({1, 0, 0, 1}, 100, 50).has_value());      // x = width
+    EXPECT_FALSE(clip_to_pixel({0, 0, 0, 0}, 100, 50).has_value());
+    EXPECT_FALSE(clip_to_pixel({0, 0, 0, -1}, 100, 50).has_value());
+    EXPECT_FALSE(clip_to_pixel({NAN, 0, 0, 1}, 100, 50).has_value());
 }
 
 TEST(Util, ParseSize) {

@@ -1,5 +1,5 @@
 // The command line's engine options default to the engine's own: a default chosen over every
-// shared volume (common/extract/propagator.h) is what `render`, `wall` and `serve` use. Before
+// shared volume (extract/propagator.h) is what `render`, `wall` and `serve` use. Before
 // this test, EngineCli kept a max count of its own (2000, chosen on one volume) while the engine's
 // was 1000.
 #include <gtest/gtest.h>

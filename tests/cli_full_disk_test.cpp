@@ -72,7 +72,7 @@ TEST_F(FullDisk, RenderAndExtractFailNamingTheFileAndLeaveNothing) {
     EXPECT_TRUE(fs::exists(disk_ / "small.png"));
 }
 
-// A store that does not fit (issue 32): noise does not compress, so 4 MiB of it fills the disk.
+// A store that does not fit: noise does not compress, so 4 MiB of it fills the disk.
 TEST_F(FullDisk, AnImportFailsNamingTheStoreAndLeavesNothing) {
     {
         std::ofstream raw(dir_ / "noise.raw", std::ios::binary);

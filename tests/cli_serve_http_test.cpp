@@ -1,4 +1,4 @@
-// `isowall serve --http` on the command line (issue 13): a port out of range, a port in use and
+// `isowall serve --http` on the command line: a port out of range, a port in use and
 // a non-loopback address without a token each end the program with one line.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Shared sessions on the command line (issue 35), as users run them: `view --present s` and a
+"""Shared sessions on the command line, as users run them: `view --present s` and a
 `view --follow s --frames 2` that joins after the first view (it catches up with it, then gets the
 second); the follower's last image equals the presenter's, and it names the presenter. A follower
 of no session, a client that both presents and follows, and a follower that asks for a view each

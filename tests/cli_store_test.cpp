@@ -10,9 +10,9 @@
 #include <fstream>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "tests/cli_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/io/image_io.h"
-#include "common/io/ply.h"
+#include "files/image_io.h"
+#include "files/ply.h"
 #include "tests/cli_util.h"
 #include "tests/test_util.h"
 

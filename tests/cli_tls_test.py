@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""`isowall serve` and `isowall view` over TLS on the command line (issue 35), as a user runs them:
+"""`isowall serve` and `isowall view` over TLS on the command line, as a user runs them:
 a certificate made with `openssl`, `serve --tls-cert --tls-key`, `view --tls-ca` gets the same
 image as a plain view of a plain server; a plain view against the TLS port, a TLS view against the
 plain port, a certificate the view does not trust, bad certificate files and a non-loopback

@@ -7,7 +7,7 @@
 #include <string>
 #include <thread>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "tests/cli_util.h"
 #include "tests/test_util.h"
 

@@ -2,9 +2,9 @@
 // hold, every line parses with parse_command, and bursts merge into one command.
 #include <gtest/gtest.h>
 
-#include "common/core/error.h"
-#include "common/wall/script.h"
+#include "core/error.h"
 #include "master/control_input.h"
+#include "wall_spec/script.h"
 
 namespace isowall {
 namespace {

@@ -2,8 +2,8 @@
 // tiles' previews, and the status bar.
 #include <gtest/gtest.h>
 
-#include "common/wall/control_layout.h"
 #include "master/control_view.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 namespace {

@@ -2,8 +2,8 @@
 // message made from it, and nearest-neighbour scaling back into the window.
 #include <gtest/gtest.h>
 
-#include "common/core/image_ops.h"
-#include "common/core/preview.h"
+#include "core/image_ops.h"
+#include "core/preview.h"
 #include "protocol/protocol.h"
 
 namespace isowall {

@@ -21,12 +21,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common/core/image_ops.h"
-#include "common/core/preview.h"
-#include "common/core/util.h"
-#include "common/io/image_io.h"
-#include "common/wall/control_layout.h"
+#include "core/image_ops.h"
+#include "core/preview.h"
+#include "core/util.h"
 #include "display/x_window.h"
+#include "files/image_io.h"
 #include "master/control_input.h"
 #include "master/control_view.h"
 #include "tests/image_compare.h"
@@ -34,6 +33,7 @@
 #include "tests/test_util.h"
 #include "tests/ws_test_client.h"
 #include "tests/xvfb_util.h"
+#include "wall_spec/control_layout.h"
 
 namespace isowall {
 namespace {

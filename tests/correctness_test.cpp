@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "common/progressive/correctness.h"
+#include "progressive/correctness.h"
 
 namespace isowall {
 namespace {

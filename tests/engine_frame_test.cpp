@@ -9,11 +9,13 @@
 #include <set>
 #include <vector>
 
-#include "common/progressive/trace.h"
-#include "common/volume/phantom.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "progressive/trace.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -29,7 +31,7 @@ TEST(EngineFrame, ACoarseBandThenTheRestCastEveryPixelOnceWithLimitedPropagation
     opt.propagation.max_count = 4;
     const FrameView fv = test::make_view(p, 200, 150, kPhantomSkinIso);
     ProgressiveEngine engine(*ex, opt);
-    const FrameResult whole = engine.run(fv, *renderer);
+    const FrameResult whole = draw_frame(engine, fv, *renderer);
     ASSERT_TRUE(whole.completed);
 
     std::atomic<bool> stop{false};
@@ -55,20 +57,12 @@ TEST(EngineFrame, ACoarseBandThenTheRestCastEveryPixelOnceWithLimitedPropagation
 }
 
 // Records what the engine tells a sink: the groups added and the groups seen.
-class SeenSink final : public GroupSink {
+class SeenSink final : public GroupSink, public SeenGroups {
   public:
-    explicit SeenSink(bool after_level) : after_level_(after_level) {}
-    void begin(const FrameView&) override {}
     void add(const Group& g) override { added.insert(g.id); }
-    double present() override { return 0; }
-    bool wants_seen() const override { return true; }
     void seen(std::uint32_t id) override { seen_ids.push_back(id); }
-    bool seen_after_level() const override { return after_level_; }
     std::set<std::uint32_t> added;
     std::vector<std::uint32_t> seen_ids;
-
-  private:
-    bool after_level_;
 };
 
 TEST(EngineFrame, ARegionHearsOfTheEarlierGroupsItsRaysMeetAtEachRayOrAfterEachLevel) {
@@ -76,19 +70,19 @@ TEST(EngineFrame, ARegionHearsOfTheEarlierGroupsItsRaysMeetAtEachRayOrAfterEachL
     const FrameView fv = test::make_view(p, 160, 120, kPhantomSkinIso);
     const PixelRect left{0, 0, 80, 120}, right{80, 0, 80, 120};
     for (const bool after_level : {false, true}) {
-        SCOPED_TRACE(after_level ? "after each level" : "at each ray");
+        SCOPED_TRACE(after_level ? "after each level, on two threads" : "at each ray, on one");
         auto ex = make_surface_extractor(p, {}, nullptr, ThreadBudget{2});
         EngineOptions opt;
-        opt.threads = 2;
+        opt.threads = after_level ? 2 : 1;
         ProgressiveEngine engine(*ex, opt);
         std::atomic<bool> stop{false};
         EngineFrame frame(engine, fv, stop);
         // The left half first: its groups (passes of up to 1000 cells) reach across.
-        SeenSink left_sink(after_level);
+        SeenSink left_sink;
         RegionCursor a = frame.cursor(fv, left);
         ASSERT_TRUE(frame.cast(fv, a, left_sink));
         ASSERT_FALSE(left_sink.added.empty());
-        SeenSink sink(after_level);
+        SeenSink sink;
         RegionCursor b = frame.cursor(fv, right);
         const double workers0 = frame.workers().sum_s;
         ASSERT_TRUE(frame.cast(fv, b, sink));
@@ -101,7 +95,7 @@ TEST(EngineFrame, ARegionHearsOfTheEarlierGroupsItsRaysMeetAtEachRayOrAfterEachL
             earlier += of_left;
         }
         EXPECT_GT(earlier, 0u) << "the right half's rays met none of the left half's groups";
-        // Seen at each ray needs one thread; after each level, the level runs on both.
+        // One thread hears at each ray; on two, the level runs on both and hears after it.
         if (after_level)
             EXPECT_GT(frame.workers().sum_s, workers0);
         else

@@ -6,10 +6,10 @@
 #include <atomic>
 #include <cstddef>
 
-#include "common/extract/surface_extractor.h"
-#include "common/volume/phantom.h"
-#include "engine/group_sink.h"
 #include "engine/progressive_engine.h"
+#include "extract/group_sink.h"
+#include "extract/surface_extractor.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {

@@ -10,12 +10,13 @@
 #include <string>
 #include <tuple>
 
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -43,7 +44,7 @@ FrameResult run(const Volume& volume, const FrameView& fv, EngineOptions opt, in
     auto ex = make_surface_extractor(volume, {}, nullptr, ThreadBudget{threads});
     auto renderer = make_renderer("osmesa");
     opt.threads = threads;
-    FrameResult fr = ProgressiveEngine(*ex, opt).run(fv, *renderer);
+    FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
     EXPECT_TRUE(fr.completed);
     // Every group's units are distinct from every other group's.
     std::set<std::tuple<int, int, int, int>> units;
@@ -162,8 +163,9 @@ TEST(Threads, AStopEndsEveryThread) {
     EngineOptions opt;
     opt.threads = 3;
     const std::atomic<bool> stop{true};
-    const FrameResult fr = ProgressiveEngine(*ex, opt).run(
-        test::make_view(p, 160, 120, kPhantomSkinIso), *renderer, &stop);
+    const FrameResult fr =
+        draw_frame(ProgressiveEngine(*ex, opt), test::make_view(p, 160, 120, kPhantomSkinIso),
+                   *renderer, &stop);
     EXPECT_FALSE(fr.completed);
     EXPECT_EQ(fr.group_count, 0u);
 }

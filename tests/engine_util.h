@@ -1,9 +1,9 @@
 #pragma once
 // Helpers shared by the engine tests: views of a volume and the full-surface reference image.
-#include "common/extract/surface_extractor.h"
-#include "common/volume/volume.h"
 #include "engine/progressive_engine.h"
+#include "extract/surface_extractor.h"
 #include "render/renderer.h"
+#include "volume/volume.h"
 
 namespace isowall::test {
 

@@ -7,9 +7,9 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "common/extract/group.h"
-#include "common/extract/surface_extractor.h"
-#include "common/volume/phantom.h"
+#include "extract/group.h"
+#include "extract/surface_extractor.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {

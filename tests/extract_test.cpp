@@ -5,10 +5,10 @@
 #include <map>
 #include <numbers>
 
-#include "common/extract/extract.h"
-#include "common/io/ply.h"
-#include "common/volume/phantom.h"
+#include "extract/extract.h"
+#include "files/ply.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {

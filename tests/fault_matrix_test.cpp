@@ -14,7 +14,7 @@
 #include <ostream>
 #include <string>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
 

@@ -1,4 +1,4 @@
-// The HDF5 reader (common/formats/hdf5_reader.cpp): files written here through libhdf5's C API,
+// The HDF5 reader (readers/hdf5_reader.cpp): files written here through libhdf5's C API,
 // chunked with deflate and contiguous, in both byte orders, load voxel for voxel; every bad file
 // is one line naming the file and the field.
 #include <hdf5.h>
@@ -7,8 +7,8 @@
 #include <fstream>
 #include <functional>
 
-#include "common/formats/read_volume.h"
-#include "common/formats/readers.h"
+#include "readers/read_volume.h"
+#include "readers/readers.h"
 #include "tests/formats_more_util.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"

@@ -1,4 +1,4 @@
-// Readers in a child process (common/formats/isolated_read.h): the volume comes back whole, an
+// Readers in a child process (readers/isolated_read.h): the volume comes back whole, an
 // error as its line, and a child that crashes or hangs as one InputError naming the file.
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <thread>
 #include <vector>
 
-#include "common/core/error.h"
-#include "common/core/wire.h"
-#include "common/formats/isolated_read.h"
-#include "common/formats/read_volume.h"
+#include "core/error.h"
+#include "readers/isolated_read.h"
+#include "readers/read_volume.h"
 #include "tests/test_util.h"
+#include "wire/wire.h"
 
 namespace isowall {
 namespace {

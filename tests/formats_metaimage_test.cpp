@@ -1,4 +1,4 @@
-// The MetaImage reader (common/formats/metaimage_reader.cpp): headers written here by hand, as
+// The MetaImage reader (readers/metaimage_reader.cpp): headers written here by hand, as
 // ITK writes them (.mhd beside its .raw, .mha with the data inside, zlib-compressed, either byte
 // order) load voxel for voxel with their spacing and orientation; every bad header is one line
 // naming the file and the key.
@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "common/formats/readers.h"
+#include "readers/readers.h"
 #include "tests/formats_more_util.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"

@@ -12,8 +12,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "common/core/error.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
+#include "volume/volume.h"
 
 namespace isowall::test {
 

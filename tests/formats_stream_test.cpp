@@ -1,5 +1,5 @@
-// Streamed import's pieces (common/volume/plane_source.h, inflate_stream.h, nrrd_planes;
-// common/formats/plane_stack.h, isolated_stream.h): planes decoded once each, in order, a slab
+// Streamed import's pieces (volume/plane_source.h, inflate_stream.h, nrrd_planes;
+// readers/plane_stack.h, isolated_stream.h): planes decoded once each, in order, a slab
 // held at a time; gzip inflated a piece at a time with decode_gzip's checks; a scaled stream's
 // type chosen before its first voxel, and a value past the declared range refused; a child that
 // fails mid-stream is one line; a store written from a stream equals one written from the volume.
@@ -11,17 +11,17 @@
 #include <fstream>
 #include <thread>
 
-#include "common/core/error.h"
-#include "common/formats/isolated_stream.h"
-#include "common/formats/plane_stack.h"
-#include "common/formats/read_volume.h"
-#include "common/store/source_pages.h"
-#include "common/store/store_format.h"
-#include "common/store/store_writer.h"
-#include "common/volume/inflate_stream.h"
+#include "core/error.h"
+#include "readers/isolated_stream.h"
+#include "readers/plane_stack.h"
+#include "readers/read_volume.h"
+#include "store/source_pages.h"
+#include "store/store_format.h"
+#include "store/store_writer.h"
 #include "tests/formats_more_util.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
+#include "volume/inflate_stream.h"
 
 namespace isowall {
 namespace {

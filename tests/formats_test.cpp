@@ -1,4 +1,4 @@
-// The readers of other formats against the shared files' twins (common/formats): a scanner's
+// The readers of other formats against the shared files' twins (readers/): a scanner's
 // DICOM series (and the same re-encoded to JPEG-LS and JPEG 2000 with GDCM here), NIfTI twins,
 // the value scaling, the orientation, and the bad files of the issue "Bring your own data".
 #include <algorithm>
@@ -19,11 +19,11 @@
 #include <gtest/gtest.h>
 #include <nifti2_io.h>
 
-#include "common/core/error.h"
-#include "common/extract/surface_extractor.h"
-#include "common/formats/dicom_lengths.h"
-#include "common/formats/read_volume.h"
-#include "common/formats/voxel_ops.h"
+#include "core/error.h"
+#include "extract/surface_extractor.h"
+#include "readers/dicom_lengths.h"
+#include "readers/read_volume.h"
+#include "readers/voxel_ops.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
 
@@ -214,7 +214,7 @@ TEST(FormatsDicom, BadSeriesGetOneLineNamingTheFileAndTheField) {
     }
 }
 
-// The check before GDCM reads a file (common/formats/dicom_lengths.h): a scanner's file passes;
+// The check before GDCM reads a file (readers/dicom_lengths.h): a scanner's file passes;
 // the same with one element's length raised past the end of the file, or an item tag put where
 // a data element belongs, is named.
 TEST(FormatsDicom, DeclaredLengthsAreCheckedBeforeGdcmReads) {

@@ -1,12 +1,12 @@
-// The TIFF stack reader (common/formats/tiff_reader.cpp): multi-page files and folders of slices
+// The TIFF stack reader (readers/tiff_reader.cpp): multi-page files and folders of slices
 // written here through OpenImageIO load voxel for voxel, the folder in natural name order (s2
 // before s10); every bad stack is one line naming the file and the field.
 #include <OpenImageIO/imageio.h>
 
 #include <fstream>
 
-#include "common/formats/read_volume.h"
-#include "common/formats/readers.h"
+#include "readers/read_volume.h"
+#include "readers/readers.h"
 #include "tests/formats_more_util.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"

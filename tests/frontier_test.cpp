@@ -13,11 +13,13 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 
-#include "common/progressive/correctness.h"
-#include "common/volume/phantom.h"
+#include "app/whole_frame.h"
 #include "engine/beside_seeds.h"
 #include "engine/progressive_engine.h"
+#include "progressive/correctness.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -100,17 +102,19 @@ TEST(FrontierSeeds, KeptOnlyForASinkThatCanTellWhatShows) {
     ProgressiveEngine engine(*ex, opt);
     RecordingSink recording;
     RendererSink drawing(*renderer);
-    EXPECT_FALSE(recording.tells_coverage());
-    EXPECT_TRUE(drawing.tells_coverage());
-    EXPECT_TRUE(TeeSink({&recording, &drawing}).tells_coverage());
+    // A sink that is its own ShownPixels tells coverage; a recording, or a tee named alone,
+    // does not.
+    EXPECT_EQ(FrameOutput(recording).shown, nullptr);
+    EXPECT_EQ(FrameOutput(drawing).shown, &drawing);
+    TeeSink both({&recording, &drawing});
+    EXPECT_EQ(FrameOutput(both).shown, nullptr);
     const std::atomic<bool> stop{false};
-    for (GroupSink* sink :
-         {static_cast<GroupSink*>(&recording), static_cast<GroupSink*>(&drawing)}) {
+    for (const FrameOutput& out : {FrameOutput(recording), FrameOutput(drawing)}) {
         EngineFrame frame(engine, fv, stop);
-        sink->begin(fv);
+        out.groups.begin(fv);
         RegionCursor c = frame.cursor(fv, fv.screen());
-        ASSERT_TRUE(frame.cast(fv, c, *sink, 200));  // the first levels only: no fill level yet
-        EXPECT_EQ(c.frontier.empty(), sink == &recording) << c.frontier.size();
+        ASSERT_TRUE(frame.cast(fv, c, out, 200));  // the first levels only: no fill level yet
+        EXPECT_EQ(c.frontier.empty(), out.shown == nullptr) << c.frontier.size();
     }
 }
 
@@ -132,9 +136,9 @@ FrameRunOutcome run_frame(SurfaceExtractor& ex, Renderer& r, const FrameView& fv
     // how fast the rasteriser runs beside the test.
     for (std::size_t r = 16; r < 20000; r += 16) opt.sample_at_rays.push_back(r);
     ProgressiveEngine engine(ex, opt);
-    FrameResult fr = engine.run(fv, r);
+    FrameResult fr = draw_frame(engine, fv, r);
     EXPECT_TRUE(fr.completed);
-    engine.measure(fr, fv, r, nullptr);
+    measure_frame(fr, fv, r, nullptr);
     FrameRunOutcome out;
     out.rays = fr.rays_cast;
     for (const TimelineSample& s : fr.timeline)

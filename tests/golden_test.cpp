@@ -22,14 +22,15 @@
 #include <string_view>
 #include <utility>
 
-#include "common/formats/read_volume.h"
-#include "common/io/image_io.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "files/image_io.h"
+#include "readers/read_volume.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -67,7 +68,7 @@ const GoldenView kViews[] = {
     {"bone_orbit_30_20_progressive", kPhantomBoneIso, 30, 20, Projection::perspective,
      Source::progressive},
     // A head CT acquired turned about x (its sform): the front view shows the face upright, as
-    // the unrotated heads' front views do (common/formats, Orientation).
+    // the unrotated heads' front views do (readers/, Orientation).
     {"ct_pitch_front", 60, 0, 0, Projection::perspective, Source::progressive, 160, 160,
      "formats/ct_pitch.nii.gz"},
 };
@@ -101,7 +102,7 @@ Image render(const GoldenView& g, const Volume& volume) {
     if (g.source == Source::full_surface)
         return test::full_surface_image(*extractor, *renderer, fv);
     ProgressiveEngine engine(*extractor);
-    FrameResult frame = engine.run(fv, *renderer);
+    FrameResult frame = draw_frame(engine, fv, *renderer);
     if (!frame.completed)
         throw std::runtime_error(std::string(g.name) + ": frame did not complete");
     return std::move(frame.final_image);

@@ -1,4 +1,4 @@
-// Volumes in huge pages (common/volume/huge_pages.h): the choice as a pure function, the kernel's
+// Volumes in huge pages (volume/huge_pages.h): the choice as a pure function, the kernel's
 // texts parsed, the buffer's alignment and advice, and a copied volume that reads as before.
 #include <gtest/gtest.h>
 
@@ -6,12 +6,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/core/error.h"
-#include "common/volume/huge_pages.h"
-#include "common/volume/octree.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
 #include "tests/test_util.h"
+#include "volume/huge_pages.h"
+#include "volume/octree.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {

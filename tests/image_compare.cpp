@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "common/io/image_io.h"
+#include "files/image_io.h"
 
 namespace isowall::test {
 namespace {

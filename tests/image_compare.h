@@ -8,7 +8,7 @@
 #include <ostream>
 #include <string>
 
-#include "common/core/image.h"
+#include "core/image.h"
 
 namespace isowall::test {
 

@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/image.h"
-#include "common/io/image_io.h"
-#include "common/io/ply.h"
+#include "core/image.h"
+#include "files/image_io.h"
+#include "files/ply.h"
 #include "tests/test_util.h"
 
 namespace isowall {

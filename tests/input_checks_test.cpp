@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "common/core/error.h"
-#include "common/core/input_file.h"
-#include "common/core/number.h"
+#include "core/error.h"
+#include "core/number.h"
+#include "files/input_file.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -1,4 +1,4 @@
-// keep_freed_memory (common/core/util.h): memory a frame frees stays in the process for the next
+// keep_freed_memory (core/util.h): memory a frame frees stays in the process for the next
 // frame instead of going back to the kernel.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <cstring>
 #include <vector>
 
-#include "common/core/util.h"
+#include "core/util.h"
 
 namespace isowall {
 namespace {

@@ -1,4 +1,4 @@
-// The meta-cell errors of adaptive resolution (common/volume/lod_error.h): the byte code, the
+// The meta-cell errors of adaptive resolution (volume/lod_error.h): the byte code, the
 // row-by-row table against the plain voxel-by-voxel statement, and what the bound says about
 // smooth fields, spikes and NaN.
 #include <gtest/gtest.h>
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "common/extract/adaptive.h"
-#include "common/volume/lod_error.h"
-#include "common/volume/volume.h"
+#include "extract/adaptive.h"
+#include "volume/lod_error.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {

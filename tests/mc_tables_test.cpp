@@ -1,4 +1,4 @@
-#include "common/extract/mc_tables.h"
+#include "extract/mc_tables.h"
 #include <gtest/gtest.h>
 
 #include <algorithm>

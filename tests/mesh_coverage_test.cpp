@@ -1,4 +1,4 @@
-// add_mesh_coverage (common/progressive/mesh_coverage.h): the pixels a mesh covers, found on the
+// add_mesh_coverage (progressive/mesh_coverage.h): the pixels a mesh covers, found on the
 // CPU, are the renderer's covered pixels but for a few along the silhouette, in both projections
 // and in a region of the screen; the dynamic grid sizes its grid from them.
 #include <gtest/gtest.h>
@@ -9,11 +9,12 @@
 #include <stdexcept>
 #include <vector>
 
-#include "common/progressive/mesh_coverage.h"
-#include "common/volume/phantom.h"
-#include "engine/group_sink.h"
 #include "engine/progressive_engine.h"
+#include "extract/group_sink.h"
+#include "progressive/mesh_coverage.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -50,7 +51,8 @@ TEST(MeshCoverage, IsTheRenderersCoverageButForTheSilhouette) {
         sink.add(g);
         for (const PixelRect rect : {PixelRect{0, 0, 320, 240}, PixelRect{70, 40, 150, 110}}) {
             std::vector<std::uint8_t> gl;
-            ASSERT_TRUE(sink.coverage(gl, rect));
+            sink.coverage(gl, rect);
+            ASSERT_EQ(gl.size(), std::size_t(rect.width) * std::size_t(rect.height));
             std::vector<std::uint8_t> cpu(gl.size(), 0);
             add_mesh_coverage(g.mesh, fv.camera.view(), fv.frustum, fv.width, fv.height, rect, cpu);
             const Agreement a = agree(gl, cpu);

@@ -1,4 +1,4 @@
-// `isowall wall` across hosts for real (issue 11): the 2x2 wall run over three emulated hosts
+// `isowall wall` across hosts for real: the 2x2 wall run over three emulated hosts
 // gives the mosaic of the same wall on one host. The hosts are network namespaces joined by veth
 // links to a bridge (scripts/netns_hosts.sh), each with a name of its own; mpirun runs on the
 // first, reads a plain hostfile and starts its daemons on the others through Open MPI's rsh
@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "common/core/util.h"
-#include "common/io/image_io.h"
-#include "common/volume/phantom.h"
+#include "core/util.h"
+#include "files/image_io.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -149,7 +149,7 @@ TEST(NetnsWall, TheTwoByTwoWallAcrossThreeNamespaceHostsGivesTheMosaicOfOneHost)
     expect_same_mosaic(dir, "netns_mosaic");
 }
 
-// Issue 32, bricks over MPI: the store lies on h1's disk only (the display nodes h2 and h3 see an
+// Bricks over MPI: the store lies on h1's disk only (the display nodes h2 and h3 see an
 // empty folder there). The ranks on h2 and h3 get its metadata, octree and every chunk they touch
 // from the master; the mosaic is the one the same store gives on one host.
 TEST(NetnsWall, AStoreOnTheFirstHostOnlyGivesTheMosaicOfOneHost) {

@@ -1,4 +1,4 @@
-// The newest-request mailbox (common/core/newest_request.h): the newest of several waiting requests
+// The newest-request mailbox (core/newest_request.h): the newest of several waiting requests
 // wins, a put raises the stop flag a worker reads, take lowers it, and close ends a waiting take.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <future>
 #include <thread>
 
-#include "common/core/newest_request.h"
+#include "core/newest_request.h"
 
 namespace isowall {
 namespace {

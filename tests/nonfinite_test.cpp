@@ -6,12 +6,13 @@
 #include <cmath>
 #include <cstring>
 
-#include "common/core/error.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
+#include "core/error.h"
 #include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -104,7 +105,7 @@ TEST(NonFinite, ProgressiveFrameMatchesTheFullSurfaceWithFiniteGroups) {
         auto renderer = make_renderer("osmesa");
         const FrameView fv = test::make_view(volume, 160, 120, 0.0, 30, 20);
         ProgressiveEngine engine(*ex);
-        const FrameResult fr = engine.run(fv, *renderer);
+        const FrameResult fr = draw_frame(engine, fv, *renderer);
         ASSERT_TRUE(fr.completed);
         std::size_t triangles = 0;
         for (const Group& g : fr.groups) {

@@ -8,10 +8,10 @@
 #include <limits>
 #include <random>
 
-#include "common/volume/mapped_file.h"
-#include "common/volume/octree.h"
-#include "common/volume/volume.h"
 #include "tests/test_util.h"
+#include "volume/mapped_file.h"
+#include "volume/octree.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -93,7 +93,7 @@ void flip_node_byte(const CacheScene&, const fs::path& cache_file) {
     f.put(c);
 }
 
-// A bit of the header's value range (issue 30: the range lay outside the checksum, so a flipped
+// A bit of the header's value range (the range lay outside the checksum, so a flipped
 // bit was served as the volume's range). `offset`: a byte of finite_min (56..63) or finite_max
 // (64..71) in the header.
 void flip_header_byte(const fs::path& cache_file, std::streamoff offset) {

@@ -4,9 +4,9 @@
 #include <fstream>
 #include <random>
 
-#include "common/volume/octree.h"
-#include "common/volume/phantom.h"
 #include "tests/test_util.h"
+#include "volume/octree.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {

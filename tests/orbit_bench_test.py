@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Tests of scripts/orbit_bench.py (issue 33: interaction timed): a quick orbit of two steps on a
+"""Tests of scripts/orbit_bench.py (interaction timed): a quick orbit of two steps on a
 2x2 wall with the shared tooth prints a row of figures for each step, static and balanced, the
 medians and the target's verdict, and writes orbit.csv and the plot; bad options give one line
 and status 1. Skips (status 77) without ../shared/data.

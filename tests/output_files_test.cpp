@@ -9,8 +9,8 @@
 
 #include <fstream>
 
-#include "common/core/error.h"
-#include "common/core/output_files.h"
+#include "core/error.h"
+#include "files/output_files.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -6,12 +6,12 @@
 #include <cstdio>
 #include <exception>
 
-#include "common/core/image_ops.h"
-#include "common/core/preview.h"
-#include "common/io/image_io.h"
-#include "common/wall/control_layout.h"
-#include "common/wall/wall.h"
+#include "core/image_ops.h"
+#include "core/preview.h"
+#include "files/image_io.h"
 #include "master/control_view.h"
+#include "wall_spec/control_layout.h"
+#include "wall_spec/wall.h"
 
 int main(int argc, char** argv) {
     using namespace isowall;

@@ -1,4 +1,4 @@
-// Pinholes (common/extract/hit_neighbours.h): a pixel whose ray meets a visited cell's triangle on
+// Pinholes (extract/hit_neighbours.h): a pixel whose ray meets a visited cell's triangle on
 // the edge it shares with the triangle of a cell never extracted, which the rasteriser gives the
 // pixel to. Before the engine seeded the cells beside such hits, 4 of the 216 final pictures below
 // had one such pixel empty (with the margin set to 0, the test fails so again).
@@ -8,11 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "common/extract/hit_neighbours.h"
-#include "common/volume/phantom.h"
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
+#include "extract/hit_neighbours.h"
 #include "tests/engine_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -117,7 +118,7 @@ TEST(Pinholes, NoneInThePhantomsFinalPictures) {
                         opt.propagation.max_count = max_count;
                         opt.threads = mask ? 2 : 1;  // the threaded level's path too
                         ProgressiveEngine engine(*ex, opt);
-                        const FrameResult fr = engine.run(fv, *renderer);
+                        const FrameResult fr = draw_frame(engine, fv, *renderer);
                         ASSERT_TRUE(fr.completed);
                         EXPECT_EQ(pinholes(fr.final_image, full), 0u)
                             << fv << " max count " << max_count << " " << to_string(order)

@@ -1,5 +1,5 @@
 #pragma once
-// What every reader's test asks of its plane stream (common/formats/read_volume.h: open_planes):
+// What every reader's test asks of its plane stream (readers/read_volume.h: open_planes):
 // the planes `import` streams are the volume read_volume reads, read as the store writer reads
 // them (a slab and one plane more, each call starting on the last call's last plane), with no
 // more than two calls' planes held at once (one read ahead).
@@ -8,8 +8,8 @@
 #include <cstring>
 #include <string>
 
-#include "common/formats/read_volume.h"
-#include "common/volume/plane_source.h"
+#include "readers/read_volume.h"
+#include "volume/plane_source.h"
 
 namespace isowall::test {
 

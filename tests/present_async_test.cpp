@@ -10,11 +10,12 @@
 #include <set>
 #include <vector>
 
-#include "common/volume/phantom.h"
-#include "engine/group_sink.h"
 #include "engine/progressive_engine.h"
+#include "extract/group_sink.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -83,7 +84,7 @@ TEST(PresentAsync, TeePresentsTheSinksThatCannotWaitAtOnce) {
 
 // Draws into a renderer and presents without waiting, but says a present is done only after
 // `lag` questions, so every present stays in flight while the engine casts on.
-class LaggingSink final : public GroupSink {
+class LaggingSink final : public GroupSink, public ShownPixels {
   public:
     explicit LaggingSink(Renderer& r, int lag) : inner_(r), lag_(lag) {}
     void begin(const FrameView& view) override { inner_.begin(view); }
@@ -107,10 +108,9 @@ class LaggingSink final : public GroupSink {
         left_ = 0;
         return inner_.presented(true);
     }
-    bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
-        return inner_.coverage(covered, rect);
+    void coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
+        inner_.coverage(covered, rect);
     }
-    bool tells_coverage() const override { return inner_.tells_coverage(); }
     void read_back(Image& out) { inner_.read_back(out); }
 
     std::size_t added = 0, added_in_flight = 0;

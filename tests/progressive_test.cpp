@@ -6,15 +6,16 @@
 #include <set>
 #include <tuple>
 
-#include "common/core/image_ops.h"
-#include "common/core/pixel_rect_ops.h"
-#include "common/core/ray.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
+#include "core/image_ops.h"
+#include "core/pixel_rect_ops.h"
+#include "core/ray.h"
 #include "engine/progressive_engine.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -42,7 +43,7 @@ void expect_final_matches_full(const Volume& volume, double iso, const Combo& co
     opt.propagation.facing_only = facing_only;
     const FrameView fv = make_view(volume, w, h, iso, yaw, 10);
     ProgressiveEngine engine(*ex, opt);
-    FrameResult fr = engine.run(fv, *renderer);
+    FrameResult fr = draw_frame(engine, fv, *renderer);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
     const test::ImageComparison m = test::compare_images(fr.final_image, full);
@@ -140,7 +141,7 @@ TEST(Engine, FarViewMatchesTheFullSurface) {
     fv.camera = fit_depth_range(zoom(fv.camera, 0.02f), p.bounds());
     fv.frustum = fv.camera.frustum(320.0f / 240.0f);
     ASSERT_GT(fv.camera.distance(), 5000.0f);
-    FrameResult fr = engine.run(fv, *renderer);
+    FrameResult fr = draw_frame(engine, fv, *renderer);
     ASSERT_TRUE(fr.completed);
     const Image full = full_surface_image(*ex, *renderer, fv);
     const test::ImageComparison m = test::compare_images(fr.final_image, full);
@@ -158,7 +159,7 @@ TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
         opt.propagation.max_count = 500;  // many small groups
         ProgressiveEngine engine(*ex, opt);
         const FrameView fv = make_view(p, 160, 120, kPhantomBoneIso, 30, 20);
-        FrameResult fr = engine.run(fv, *renderer);
+        FrameResult fr = draw_frame(engine, fv, *renderer);
         ASSERT_TRUE(fr.completed);
         const auto view = p.view<std::uint8_t>();
         std::set<std::tuple<int, int, int>> seen;
@@ -230,7 +231,7 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     // hold the cores (713 seen under ctest -j2), so the bound is a fifteenth of the screen's
     // 30,000 pixels: the frame stops long before its end, whatever the load.
     std::atomic<bool> stop{false};
-    FrameResult a = engine.run(first, *renderer, &stop, [&](const TimelineSample& s) {
+    FrameResult a = draw_frame(engine, first, *renderer, &stop, [&](const TimelineSample& s) {
         if (s.rays >= 300) stop = true;
     });
     EXPECT_FALSE(a.completed);
@@ -239,7 +240,7 @@ TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
 
     // New view and new isovalue: nothing of the first frame may remain.
     const FrameView second = make_view(p, 200, 150, kPhantomBoneIso, 60, -20);
-    FrameResult b = engine.run(second, *renderer);
+    FrameResult b = draw_frame(engine, second, *renderer);
     ASSERT_TRUE(b.completed);
     const Image full = full_surface_image(*ex, *renderer, second);
     const test::ImageComparison m = test::compare_images(b.final_image, full);
@@ -253,9 +254,9 @@ TEST(Engine, TimelineIsMonotoneAndReachesFullCorrectness) {
     auto renderer = make_renderer("osmesa");
     ProgressiveEngine engine(*ex);
     const FrameView fv = make_view(p, 240, 180, kPhantomSkinIso);
-    FrameResult fr = engine.run(fv, *renderer);
+    FrameResult fr = draw_frame(engine, fv, *renderer);
     ASSERT_TRUE(fr.completed);
-    engine.measure(fr, fv, *renderer);
+    measure_frame(fr, fv, *renderer);
     ASSERT_GT(fr.timeline.size(), 5u);
     for (std::size_t i = 1; i < fr.timeline.size(); ++i) {
         EXPECT_GE(fr.timeline[i].time_s, fr.timeline[i - 1].time_s);
@@ -285,12 +286,12 @@ TEST(Engine, TheBoxReplayMeasuresWhatTheWholeScreenReplayDoes) {
     opt.sample_ray_factor = 1.05;  // many samples, some with no new group
     ProgressiveEngine engine(*ex, opt);
     const FrameView fv = make_view(p, 240, 180, kPhantomBoneIso, 30, 20);
-    FrameResult box = engine.run(fv, *renderer);
+    FrameResult box = draw_frame(engine, fv, *renderer);
     ASSERT_TRUE(box.completed);
     FrameResult whole = box;
-    engine.measure(box, fv, *renderer);
+    measure_frame(box, fv, *renderer);
     std::size_t images = 0;
-    engine.measure(whole, fv, *renderer, [&](const TimelineSample&, const Image& img) {
+    measure_frame(whole, fv, *renderer, [&](const TimelineSample&, const Image& img) {
         EXPECT_EQ(img.width, fv.width);
         ++images;
     });
@@ -341,7 +342,8 @@ TEST(Engine, EveryStepOfAFrameIsChargedToItsOwnStage) {
         ProgressiveEngine engine(*ex, opt);
         trace.switch_to(Stage::idle);  // what a tile was doing before the view arrived
         const std::size_t first = trace.spans().size();  // the idle span, once closed
-        const FrameResult fr = engine.run(test::make_view(p, 160, 120, kPhantomSkinIso), *renderer);
+        const FrameResult fr =
+            draw_frame(engine, test::make_view(p, 160, 120, kPhantomSkinIso), *renderer);
         ASSERT_TRUE(fr.completed);
         trace.close();
         const auto& spans = trace.spans();

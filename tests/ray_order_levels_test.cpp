@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "common/progressive/ray_order.h"
+#include "progressive/ray_order.h"
 #include "tests/ray_order_test_util.h"
 
 namespace isowall {

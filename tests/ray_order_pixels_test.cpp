@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "common/progressive/ray_order.h"
+#include "progressive/ray_order.h"
 #include "tests/ray_order_test_util.h"
 
 namespace isowall {

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "common/progressive/ray_order.h"
+#include "progressive/ray_order.h"
 
 namespace isowall::ray_order_testing {
 

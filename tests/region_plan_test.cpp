@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "common/core/ray.h"
+#include "core/ray.h"
 #include "master/region_plan.h"
 
 namespace isowall {

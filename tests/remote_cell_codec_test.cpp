@@ -1,4 +1,4 @@
-// Issue 34's `cells` encoding (remote/cell_codec.h): a group sent as its units and the voxel values
+// The `cells` encoding (remote/cell_codec.h): a group sent as its units and the voxel values
 // marching cubes reads, triangulated again by the client. Round trips give the server's triangles
 // (same corners, same winding, positions to float rounding) and the very same normals at full
 // resolution and for refinements; a coarse pass's come with its vertices near the server's (its
@@ -20,12 +20,12 @@
 #include <tuple>
 #include <unordered_map>
 
-#include "common/volume/phantom.h"
 #include "remote/cell_codec.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
 #include "tests/largest_allocation.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall::remote {
 namespace {

@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "remote/cell_codec.h"
 #include "remote/cell_exact.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall::remote {
 namespace {

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "remote/cell_codec.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
+#include "volume/phantom.h"
 
 namespace isowall::remote {
 namespace {

@@ -8,12 +8,12 @@
 #include <cstring>
 #include <vector>
 
-#include "common/core/camera.h"
-#include "common/volume/phantom.h"
+#include "core/camera.h"
 #include "remote/client_frames.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
 #include "render/renderer.h"
+#include "volume/phantom.h"
 
 namespace isowall::test {
 namespace {

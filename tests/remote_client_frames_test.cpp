@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "common/core/camera.h"
+#include "core/camera.h"
 #include "remote/client_frames.h"
 #include "remote/group_codec.h"
 #include "render/renderer.h"

@@ -13,10 +13,10 @@
 #include <new>
 #include <random>
 
-#include "common/volume/phantom.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
 #include "tests/largest_allocation.h"
+#include "volume/phantom.h"
 
 namespace isowall::remote {
 namespace {

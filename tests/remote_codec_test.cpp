@@ -12,10 +12,10 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "common/volume/phantom.h"
 #include "remote/compact_mesh.h"
 #include "remote/group_codec.h"
 #include "remote/sample_groups.h"
+#include "volume/phantom.h"
 
 namespace isowall::remote {
 namespace {
@@ -234,7 +234,7 @@ TEST(RemoteCodec, EachStepIsSmallerOnAFrame) {
     EXPECT_LT(total[GroupEncoding::indexed], total[GroupEncoding::vertices]);
     EXPECT_LT(total[GroupEncoding::compact], total[GroupEncoding::indexed] / 2);
     EXPECT_LT(total[GroupEncoding::compact_zstd], total[GroupEncoding::compact]);
-    // cells (issue 34): at most a quarter of compact+zstd on the phantom's frame.
+    // cells: at most a quarter of compact+zstd on the phantom's frame.
     EXPECT_LT(total[GroupEncoding::cells], total[GroupEncoding::compact_zstd] / 4);
 }
 

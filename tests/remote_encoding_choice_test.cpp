@@ -1,4 +1,4 @@
-// Issue 34's adaptive server (remote/encoding_choice.h): which encoding the chooser picks for a
+// The adaptive server (remote/encoding_choice.h): which encoding the chooser picks for a
 // fast link, a slow one, and a client that takes cells more slowly than the link could, and how
 // rarely it explores the dearer one. Pure: the costs are fed in, as a session measures them.
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/net/endpoint.h"
 
 namespace isowall::remote {

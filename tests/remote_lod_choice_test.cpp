@@ -6,13 +6,13 @@
 #include <cstdio>
 #include <vector>
 
-#include "common/volume/phantom.h"
 #include "remote/client_frames.h"
 #include "remote/lod_choice.h"
 #include "remote/server_session.h"
 #include "render/renderer.h"
 #include "tests/remote_view_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall::test {
 namespace {

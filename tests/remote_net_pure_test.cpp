@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/net/endpoint.h"
 #include "remote/net/token_bucket.h"
 

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/ray.h"
+#include "core/ray.h"
 #include "remote/request_checks.h"
 
 namespace isowall::remote {

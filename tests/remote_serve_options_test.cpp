@@ -1,5 +1,5 @@
 // `isowall serve --idle-timeout` ("Nothing lies, nothing hangs, round two", class 4) goes through
-// the number rules of every other option (common/core/number.h): CLI11 refuses a non-finite or
+// the number rules of every other option (core/number.h): CLI11 refuses a non-finite or
 // out-of-range value naming the option and the value, and a good one reaches the ServeCommand.
 #include <sstream>
 

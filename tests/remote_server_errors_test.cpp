@@ -1,5 +1,5 @@
 // A server that is sent nonsense answers with an error naming it, closes that connection, never
-// allocates what a header claims, and serves the next client (issue 12).
+// allocates what a header claims, and serves the next client.
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/net/connection.h"
 #include "remote/net/socket.h"
 #include "remote/view_framing.h"

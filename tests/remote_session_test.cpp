@@ -13,7 +13,7 @@
 #include <cstdio>
 #include <thread>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "remote/net/socket.h"
 #include "remote/view_client.h"
 #include "tests/remote_rss_util.h"

@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "remote/net/connection.h"
 #include "tests/remote_raw_ws.h"
 #include "tests/remote_rss_util.h"

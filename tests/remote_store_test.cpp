@@ -1,4 +1,4 @@
-// A store read by a rank that cannot see it (issue 32, bricks over MPI): the tile's RemoteStore
+// A store read by a rank that cannot see it (bricks over MPI): the tile's RemoteStore
 // asks, the master's answer_store_ask answers, over the in-process transport. Every voxel comes
 // back as imported, the octree is copied, and each failure is one line: a master whose volume is
 // not a store, a damaged chunk on the master, a master that does not answer, an answer nobody
@@ -10,14 +10,14 @@
 #include <thread>
 
 #include "comm/inproc_comm.h"
-#include "common/core/error.h"
-#include "common/core/wire.h"
-#include "common/store/open_store.h"
-#include "common/store/store_writer.h"
+#include "core/error.h"
 #include "master/store_server.h"
+#include "store/open_store.h"
+#include "store/store_writer.h"
 #include "tests/store_test_util.h"
 #include "tests/test_util.h"
 #include "tile/remote_store.h"
+#include "wire/wire.h"
 
 namespace isowall {
 namespace {

@@ -1,4 +1,4 @@
-// Remote viewing over TLS (issue 35), in process on loopback: the image over TLS equals the local
+// Remote viewing over TLS, in process on loopback: the image over TLS equals the local
 // one; a plain client on a TLS port, a TLS client on a plain port, an untrusted certificate and
 // one for another host each fail with one line that says so; bad certificate files name the file
 // and the option; framed connections over TLS carry large messages and wake on shutdown.
@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/net/connection.h"
 #include "remote/net/tls.h"
 #include "remote/view_client.h"

@@ -1,4 +1,4 @@
-// `isowall serve` and `isowall view` over loopback (issue 12): the client's final image of a view
+// `isowall serve` and `isowall view` over loopback: the client's final image of a view
 // equals the local one in every case, cached groups after a rotation, interrupts, and every bad
 // message a server must survive.
 #include <set>

@@ -6,12 +6,13 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/camera.h"
-#include "common/volume/phantom.h"
+#include "app/whole_frame.h"
+#include "core/camera.h"
 #include "engine/progressive_engine.h"
 #include "remote/view_server.h"
 #include "render/renderer.h"
 #include "tests/image_compare.h"
+#include "volume/phantom.h"
 
 namespace isowall::test {
 
@@ -79,7 +80,7 @@ inline Image local_image(const FrameView& view) {
     auto ex = make_surface_extractor(v);
     auto r = make_renderer("osmesa");
     ProgressiveEngine engine(*ex);
-    return engine.run(view, *r).final_image;
+    return draw_frame(engine, view, *r).final_image;
 }
 
 // The thresholds every final-image test of the engine uses.

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "tests/remote_raw_ws.h"
 #include "tests/remote_rss_util.h"
 #include "tests/remote_web_util.h"

@@ -1,4 +1,4 @@
-// `isowall serve --http`: the HTTP side (issue 13). The routes as pure functions, then over
+// `isowall serve --http`: the HTTP side. The routes as pure functions, then over
 // loopback: the page, its content type, /datasets with and without a token, 404 and 405, and
 // the WebSocket upgrade's Origin and path rules.
 #include <cctype>
@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/net/socket.h"
 #include "remote/web/web_routes.h"
 #include "remote/web/web_server.h"
@@ -161,7 +161,7 @@ TEST(RemoteWebHttp, UpgradesOnlyAtWsFromTheSameOrigin) {
     EXPECT_EQ(upgrade_status(port, "/", ""), 404);
 }
 
-// Over TLS the page's origin is https://<Host>, and only that one (issue 35).
+// Over TLS the page's origin is https://<Host>, and only that one.
 TEST(RemoteWebHttp, OverTlsTheSameOriginIsHttps) {
     EXPECT_TRUE(web::origin_allowed("https://127.0.0.1:8443", "127.0.0.1:8443", true));
     EXPECT_FALSE(web::origin_allowed("http://127.0.0.1:8443", "127.0.0.1:8443", true));

@@ -1,4 +1,4 @@
-// `isowall serve --http`: the protocol over WebSocket (issue 13). A session gives the same frame
+// `isowall serve --http`: the protocol over WebSocket. A session gives the same frame
 // as over TCP; a wrong token, a text message, a frame whose header disagrees with its message
 // and one that does not decode each get an ErrorMsg and a close; max_clients counts both kinds.
 #include <chrono>

@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the tests of `isowall serve --http` (issue 13): a ViewServer with its HTTP front end
+// Shared by the tests of `isowall serve --http`: a ViewServer with its HTTP front end
 // on loopback ports of their own, and a plain HTTP client (one request, read to EOF, under a
 // timeout).
 #include <map>

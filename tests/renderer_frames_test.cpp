@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <string>
 
-#include "common/core/camera.h"
-#include "common/core/image.h"
-#include "common/core/mesh.h"
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/mesh.h"
 #include "render/renderer.h"
 
 namespace isowall {

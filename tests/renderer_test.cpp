@@ -13,10 +13,10 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "common/core/camera.h"
-#include "common/core/image.h"
-#include "common/core/mesh.h"
-#include "common/io/image_io.h"
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/mesh.h"
+#include "files/image_io.h"
 #include "render/renderer.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"

@@ -1,4 +1,4 @@
-// The screen mask in the engine (issue 10, "empty space costs nothing"): the final image is the
+// The screen mask in the engine ("empty space costs nothing"): the final image is the
 // one without the mask, pixel for pixel, in every view, intersection mode, ray order and
 // resolution; it never casts more rays; a region whose frustum holds no active node casts none;
 // and the active nodes it projects hold every triangle of the surface.
@@ -10,12 +10,14 @@
 #include <string>
 #include <vector>
 
-#include "common/core/ray.h"
-#include "common/volume/phantom.h"
-#include "common/volume/volume.h"
+#include "app/whole_frame.h"
+#include "core/ray.h"
 #include "engine/progressive_engine.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {
@@ -43,7 +45,7 @@ FrameResult run_engine(SurfaceExtractor& ex, Renderer& r, EngineOptions opt, con
                        bool mask) {
     opt.screen_mask = mask;
     ProgressiveEngine engine(ex, opt);
-    return engine.run(fv, r);
+    return draw_frame(engine, fv, r);
 }
 
 // With and without the mask: the same final colour and depth, and no more rays with it.
@@ -150,7 +152,8 @@ TEST(ScreenMaskEngine, AnIsovalueAboveEveryVoxelCastsNoRay) {
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
     ProgressiveEngine engine(*ex);
-    const FrameResult fr = engine.run(test::make_view(p, 160, 120, ex->value_max() + 1), *renderer);
+    const FrameResult fr =
+        draw_frame(engine, test::make_view(p, 160, 120, ex->value_max() + 1), *renderer);
     EXPECT_TRUE(fr.completed);
     EXPECT_EQ(fr.rays_cast, 0u);
     EXPECT_EQ(fr.mask_nodes, 0u);

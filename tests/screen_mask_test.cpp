@@ -13,9 +13,9 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/core/ray.h"
-#include "common/progressive/ray_order.h"
-#include "common/progressive/screen_mask.h"
+#include "core/ray.h"
+#include "progressive/ray_order.h"
+#include "progressive/screen_mask.h"
 #include "tests/ray_order_test_util.h"
 
 namespace isowall {

@@ -4,9 +4,9 @@
 
 #include <fstream>
 
-#include "common/core/error.h"
-#include "common/wall/script.h"
+#include "core/error.h"
 #include "tests/test_util.h"
+#include "wall_spec/script.h"
 
 namespace isowall {
 namespace {

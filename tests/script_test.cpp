@@ -1,8 +1,8 @@
 // Wall scripts: every command parses, every mistake names the file, line and command.
 #include <gtest/gtest.h>
 
-#include "common/core/error.h"
-#include "common/wall/script.h"
+#include "core/error.h"
+#include "wall_spec/script.h"
 
 namespace isowall {
 namespace {

@@ -1,13 +1,13 @@
-// The multiscale pyramid of a store (common/store/store_format.h): what each level holds, and
+// The multiscale pyramid of a store (store/store_format.h): what each level holds, and
 // levels that are damaged.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iterator>
 
-#include "common/core/error.h"
-#include "common/store/store_reader.h"
-#include "common/store/store_writer.h"
+#include "core/error.h"
+#include "store/store_reader.h"
+#include "store/store_writer.h"
 #include "tests/store_test_util.h"
 #include "tests/test_util.h"
 

@@ -1,18 +1,18 @@
-// Read-ahead of a paged store (common/store/paged_voxels.h) and the bricks it may read
-// (common/volume/surface_bricks.h).
+// Read-ahead of a paged store (store/paged_voxels.h) and the bricks it may read
+// (volume/surface_bricks.h).
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
-#include "common/extract/marching_cubes.h"
-#include "common/extract/surface_extractor.h"
-#include "common/store/open_store.h"
-#include "common/store/store_writer.h"
-#include "common/volume/phantom.h"
-#include "common/volume/surface_bricks.h"
+#include "extract/marching_cubes.h"
+#include "extract/surface_extractor.h"
+#include "store/open_store.h"
+#include "store/store_writer.h"
 #include "tests/store_test_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
+#include "volume/surface_bricks.h"
 
 namespace isowall::store {
 namespace {

@@ -1,4 +1,4 @@
-// Volume stores (common/store): the metadata, import, paging under a cap, and damaged stores.
+// Volume stores (store/): the metadata, import, paging under a cap, and damaged stores.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,13 +7,13 @@
 #include <random>
 #include <thread>
 
-#include "common/core/error.h"
-#include "common/extract/surface_extractor.h"
-#include "common/store/open_store.h"
-#include "common/store/store_writer.h"
-#include "common/volume/phantom.h"
+#include "core/error.h"
+#include "extract/surface_extractor.h"
+#include "store/open_store.h"
+#include "store/store_writer.h"
 #include "tests/store_test_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall::store {
 namespace {

@@ -3,9 +3,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/store/store_writer.h"
-#include "common/volume/volume.h"
+#include "store/store_writer.h"
 #include "tests/test_util.h"
+#include "volume/volume.h"
 
 namespace isowall::test {
 

@@ -1,7 +1,7 @@
-// The fault tests' hook is parsed once into a typed value (common/core/test_fault.h).
+// The fault tests' hook is parsed once into a typed value (core/test_fault.h).
 #include <gtest/gtest.h>
 
-#include "common/core/test_fault.h"
+#include "core/test_fault.h"
 
 namespace isowall {
 namespace {

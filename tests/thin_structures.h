@@ -1,5 +1,5 @@
 #pragma once
-// A test volume of structures thinner than a cell (issue 29): tubes of radius ~0.5 voxel along
+// A test volume of structures thinner than a cell: tubes of radius ~0.5 voxel along
 // oblique lines and a sheet ~1 voxel thick, beside a ball many cells across, in n^3 uint8 voxels.
 // At the isovalue kThinIso the tubes and the sheet are surfaces a meta-cell's eight corners miss,
 // where the ball is a smooth surface any level draws.
@@ -12,7 +12,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "common/volume/volume.h"
+#include "volume/volume.h"
 
 namespace isowall::test {
 

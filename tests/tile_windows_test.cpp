@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "common/io/image_io.h"
 #include "display/x_window.h"
+#include "files/image_io.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"

@@ -1,5 +1,5 @@
 #pragma once
-// Test certificates for the TLS tests (issue 35), made with the `openssl` program as a user
+// Test certificates for the TLS tests, made with the `openssl` program as a user
 // would make one: a self-signed P-256 certificate valid for a day, with the subject alternative
 // names given. `openssl` comes from scripts/setup.sh.
 #include <cstdlib>

@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/extract/visited.h"
+#include "extract/visited.h"
 
 namespace isowall {
 namespace {
@@ -114,7 +114,7 @@ std::size_t resident_bytes() {
 }
 
 // The 8x CT head's cells: the level-0 table is 245 MB of page numbers. It is not written when
-// made (stop 45: filling it held the first picture back by about a second), only the pages of
+// made (filling it held the first picture back by about a second), only the pages of
 // the bricks a frame takes become resident, and a new frame still forgets every unit.
 TEST(Visited, AHugeTableCostsOnlyThePagesItsFrameWrites) {
 #ifdef __SANITIZE_ADDRESS__

@@ -8,9 +8,9 @@
 #include <cstring>
 #include <fstream>
 
-#include "common/core/error.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
 #include "tests/test_util.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {

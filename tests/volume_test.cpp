@@ -5,9 +5,9 @@
 #include <fstream>
 #include <random>
 
-#include "common/core/error.h"
-#include "common/volume/volume.h"
+#include "core/error.h"
 #include "tests/test_util.h"
+#include "volume/volume.h"
 
 namespace isowall {
 namespace {

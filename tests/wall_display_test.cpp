@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "common/core/error.h"
-#include "common/wall/wall.h"
+#include "core/error.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 namespace {

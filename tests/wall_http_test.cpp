@@ -11,10 +11,10 @@
 
 #include "app/wall_http.h"
 #include "comm/inproc_comm.h"
-#include "common/core/error.h"
-#include "common/wall/wall.h"
+#include "core/error.h"
 #include "tests/test_util.h"
 #include "tests/ws_test_client.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 namespace {

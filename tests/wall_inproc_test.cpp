@@ -11,11 +11,11 @@
 
 #include "app/wall_run.h"
 #include "comm/inproc_comm.h"
-#include "common/core/wire.h"
-#include "common/io/image_io.h"
+#include "files/image_io.h"
 #include "master/wall_report.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
+#include "wire/wire.h"
 
 namespace isowall {
 namespace {

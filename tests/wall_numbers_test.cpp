@@ -4,9 +4,9 @@
 
 #include <fstream>
 
-#include "common/core/error.h"
-#include "common/wall/wall.h"
+#include "core/error.h"
 #include "tests/test_util.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 namespace {

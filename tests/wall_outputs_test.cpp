@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "app/wall_outputs.h"
-#include "common/core/error.h"
+#include "core/error.h"
 #include "tests/test_util.h"
 
 namespace isowall {

@@ -7,10 +7,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "common/core/error.h"
-#include "common/core/wire.h"
+#include "core/error.h"
 #include "master/control_view.h"
 #include "master/wall_page.h"
+#include "wire/wire.h"
 
 namespace isowall {
 namespace {

@@ -7,13 +7,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "common/core/thread_budget.h"
-#include "common/core/util.h"
-#include "common/io/image_io.h"
-#include "common/volume/phantom.h"
+#include "core/thread_budget.h"
+#include "core/util.h"
+#include "files/image_io.h"
 #include "tests/image_compare.h"
 #include "tests/run_util.h"
 #include "tests/test_util.h"
+#include "volume/phantom.h"
 
 namespace isowall {
 namespace {
@@ -67,7 +67,7 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
     }
 }
 
-// A store under a memory limit (issue 32): every rank pages its own bricks in; the mosaic is the
+// A store under a memory limit: every rank pages its own bricks in; the mosaic is the
 // picture of the file the store was imported from.
 TEST(WallRun, AStoreUnderAMemoryLimitGivesTheMosaicOfItsFile) {
     const auto dir = test::scratch_dir("wall_store");
@@ -297,7 +297,7 @@ TEST(WallRun, WaitTimeHoldsTheFinishedFrameLongerThanTheTimeout) {
     const auto dir = test::scratch_dir("wall_wait_time");
     std::ofstream(dir / "1x1.toml") << "tiles = [1, 1]\ntile_size_px = [96, 72]\n";
     // A timeout of 2 s, not 1: under the suite's load the tile once heard nothing from the master
-    // for more than 1 s while the frame ran (2.1 s for this 96x72 tile; stop 45). The pause is
+    // for more than 1 s while the frame ran (2.1 s for this 96x72 tile). The pause is
     // still more than twice the timeout.
     std::ofstream(dir / "hold.txt") << "wait done\nsnapshot done\nwait time 4.5\nquit\n";
     const auto t0 = std::chrono::steady_clock::now();

@@ -10,8 +10,8 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "common/core/error.h"
-#include "common/wall/wall.h"
+#include "core/error.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 namespace {

@@ -6,7 +6,7 @@
 // final frame is always shown. Implementations need no GL and take no locks of the tile loop.
 #include <cstdint>
 
-#include "common/core/image.h"
+#include "core/image.h"
 
 namespace isowall {
 

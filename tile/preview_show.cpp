@@ -1,6 +1,6 @@
 #include "tile/preview_show.h"
 
-#include "common/core/preview.h"
+#include "core/preview.h"
 #include "protocol/protocol.h"
 
 namespace isowall {

@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "common/core/error.h"
-#include "common/core/util.h"
-#include "common/store/store_format.h"
+#include "core/error.h"
+#include "core/util.h"
+#include "store/store_format.h"
 
 namespace isowall {
 namespace {

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "comm/comm.h"
-#include "common/store/store_reader.h"
 #include "protocol/protocol.h"
+#include "store/store_reader.h"
 
 namespace isowall {
 

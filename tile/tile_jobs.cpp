@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "common/core/image_ops.h"
-#include "common/core/pixel_rect_ops.h"
-#include "common/core/ray.h"
-#include "common/core/wire.h"
-#include "common/progressive/correctness.h"
-#include "common/progressive/trace.h"
+#include "core/image_ops.h"
+#include "core/pixel_rect_ops.h"
+#include "core/ray.h"
+#include "progressive/correctness.h"
+#include "progressive/trace.h"
+#include "wire/wire.h"
 
 namespace isowall {
 
@@ -25,9 +25,12 @@ FrameView region_view(const FrameView& owner, const PixelRect& rect) {
 // there (a group whose bounds project outside the tile cannot be what a later ray of the tile
 // hits, so leaving it out loses nothing). In a help job, the earlier groups whose cells its rays
 // meet are drawn before the engine reads the help image's coverage or the job's result is read.
-class TileJobs::JobSink final : public GroupSink {
+class TileJobs::JobSink final : public GroupSink, public ShownPixels, public SeenGroups {
   public:
-    JobSink(TileJobs& jobs, GroupSink* help) : jobs_(jobs), help_(help) {}
+    JobSink(TileJobs& jobs, RendererSink* help) : jobs_(jobs), help_(help) {}
+    // A help job is told of the earlier groups its rays meet; a job of the rank's own tile draws
+    // every group there already.
+    FrameOutput output() { return FrameOutput(*this, this, help_ ? this : nullptr); }
     void add(const Group& group) override {
         Box3 b;
         for (const glm::vec3& p : group.mesh.positions) b.merge(p);
@@ -40,21 +43,17 @@ class TileJobs::JobSink final : public GroupSink {
         if (help_) jobs_.draw_seen_groups();
         return (help_ ? help_->present() : 0.0) + jobs_.tile_sink_.present();
     }
-    bool coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
-        if (!help_) return jobs_.tile_sink_.coverage(covered, rect);
-        jobs_.help_coverage(covered, rect);
-        return true;
+    void coverage(std::vector<std::uint8_t>& covered, const PixelRect& rect) override {
+        if (help_)
+            jobs_.help_coverage(covered, rect);
+        else
+            jobs_.tile_sink_.coverage(covered, rect);
     }
-    bool wants_seen() const override { return help_ != nullptr; }
     void seen(std::uint32_t group_id) override { jobs_.seen_.push_back(group_id); }
-    bool seen_after_level() const override { return true; }
-    bool tells_coverage() const override {
-        return help_ ? help_->tells_coverage() : jobs_.tile_sink_.tells_coverage();
-    }
 
   private:
     TileJobs& jobs_;
-    GroupSink* help_;
+    RendererSink* help_;
 };
 
 bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
@@ -176,7 +175,7 @@ TileJobs::Outcome TileJobs::run(const JobMsg& job, int rank) {
     const std::size_t limit =
         job.band == Band::coarse ? std::max<std::size_t>(1, cursor.pixels / 16) : SIZE_MAX;
     const TimelineSample before = frame_->now();
-    out.completed = frame_->cast(view, cursor, sink, limit);
+    out.completed = frame_->cast(view, cursor, sink.output(), limit);
     in_own_job_ = false;
     const TimelineSample& after = frame_->now();
     out.done.rays = after.rays - before.rays;

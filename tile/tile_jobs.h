@@ -20,10 +20,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "common/core/box.h"
-#include "engine/group_sink.h"
+#include "core/box.h"
 #include "engine/progressive_engine.h"
 #include "protocol/protocol.h"
+#include "render/renderer_sink.h"
 
 namespace isowall {
 

@@ -10,9 +10,9 @@
 #include <thread>
 #include <vector>
 
-#include "common/core/pacer.h"
-#include "common/core/util.h"
-#include "common/progressive/trace.h"
+#include "core/pacer.h"
+#include "core/util.h"
+#include "progressive/trace.h"
 #include "tile/remote_store.h"
 #include "tile/tile_inbox.h"
 #include "tile/tile_jobs.h"

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "comm/comm.h"
-#include "common/core/test_fault.h"
-#include "common/extract/surface_extractor.h"
+#include "core/test_fault.h"
 #include "engine/progressive_engine.h"
+#include "extract/surface_extractor.h"
 #include "render/renderer.h"
 #include "tile/frame_show.h"
 
@@ -26,7 +26,7 @@ struct TileSetup {
     Renderer& renderer;       // the tile's own frame
     Renderer& help_renderer;  // the regions it fills for other tiles
     EngineOptions engine;
-    TestFault fault;         // the fault tests' hook (common/core/test_fault.h); none by default
+    TestFault fault;         // the fault tests' hook (core/test_fault.h); none by default
     bool measure = false;    // keep each job's result for the emulated correctness curve
     double timeout_s = 120;  // the master silent this long (not even alive messages) ends the job
     int tile_width = 0, tile_height = 0;  // when known: the frame is sized at start-up

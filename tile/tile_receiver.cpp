@@ -7,7 +7,7 @@
 #include <ctime>
 #include <string>
 
-#include "common/core/util.h"
+#include "core/util.h"
 #include "protocol/protocol.h"
 #include "tile/remote_store.h"
 #include "tile/tile_loop.h"

@@ -4,7 +4,7 @@
 // 10x a small frame's own (render/gl_core.cpp shrinks them now). Prints microseconds of thread
 // CPU per job, the small frames beside those of a renderer that never had a large one.
 // Then a rank's first help job after start-up, on a renderer warmed by warm_up() against one
-// warmed by a single draw (warm_up() before stop 60), each in a fresh process: Mesa sets up a
+// warmed by a single draw (warm_up()'s old way), each in a fresh process: Mesa sets up a
 // path on its first use in a process.
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "common/core/image.h"
+#include "core/image.h"
 #include "render/renderer.h"
 
 namespace {

@@ -1,4 +1,4 @@
-// isowall-peer: the ray side of the FE + Embree peer of issue 10. It reads a mesh written by
+// isowall-peer: the ray side of the FE + Embree peer. It reads a mesh written by
 // scripts/fe_mesh.py (flying edges in VTK), builds an Embree BVH over it and casts one primary
 // ray per pixel of the front full view, the view `isowall render` draws by default. Prints
 // "key value" lines for scripts/bench_scaling.py: triangles, bvh_s, rays_s, hit_pixels. With
@@ -12,10 +12,10 @@
 
 #include "bench/peer/peer_mesh.h"
 #include "bench/peer/peer_trace.h"
-#include "common/core/error.h"
-#include "common/core/image.h"
-#include "common/core/util.h"
-#include "common/io/image_io.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/util.h"
+#include "files/image_io.h"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall::peer {
 namespace {

@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "common/core/box.h"
+#include "core/box.h"
 
 namespace isowall::peer {
 

@@ -12,8 +12,8 @@
 
 #include "bench/peer/peer_mesh.h"
 #include "bench/peer/peer_trace.h"
-#include "common/core/error.h"
-#include "common/core/ray.h"
+#include "core/error.h"
+#include "core/ray.h"
 
 namespace isowall::peer {
 namespace {

@@ -14,8 +14,8 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
-#include "common/core/ray.h"
-#include "common/core/util.h"
+#include "core/ray.h"
+#include "core/util.h"
 
 namespace isowall::peer {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// The ray side of the FE + Embree peer (issue 10), the OSPRay way on a CPU: an Embree 3 BVH over
+// The ray side of the FE + Embree peer, the OSPRay way on a CPU: an Embree 3 BVH over
 // the whole extracted surface, then one primary ray per pixel in 8-wide packets
 // (rtcIntersect8), screen tiles shared by the threads. The view is isowall's own
 // (front_full_view, pixel_ray), so its hit pixels can be checked against the pixels
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "bench/peer/peer_mesh.h"
-#include "common/core/camera.h"
+#include "core/camera.h"
 
 namespace isowall::peer {
 

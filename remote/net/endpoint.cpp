@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall::remote {
 namespace {

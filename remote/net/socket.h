@@ -1,5 +1,5 @@
 #pragma once
-// TCP on POSIX sockets for `isowall serve` / `isowall view` (issue 12): an owning Socket, whole
+// TCP on POSIX sockets for `isowall serve` / `isowall view`: an owning Socket, whole
 // sends, receives that wait at most a timeout, a connect with a timeout and a listener. Every
 // failure is a NetError whose text names the peer ("127.0.0.1:5000") and the call that failed;
 // the peer going away (EOF, reset, broken pipe) is a PeerClosed, so a server can tell a client

@@ -16,7 +16,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "common/core/error.h"
+#include "core/error.h"
 
 namespace isowall::remote {
 namespace {

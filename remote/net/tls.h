@@ -1,5 +1,5 @@
 #pragma once
-// TLS for the remote-viewing protocol (issue 35), through OpenSSL: a context per side (the
+// TLS for the remote-viewing protocol, through OpenSSL: a context per side (the
 // server's certificate and key; the client's trusted authorities) and one connection's session
 // over a connected Socket.
 //

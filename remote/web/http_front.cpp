@@ -1,6 +1,6 @@
 #include "remote/web/http_front.h"
 
-#include "common/core/error.h"
+#include "core/error.h"
 #include "remote/view_framing.h"
 #include "remote/web/web_routes.h"
 

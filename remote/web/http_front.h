@@ -1,5 +1,5 @@
 #pragma once
-// `isowall serve --http PORT`: the page and the protocol over WebSocket (issue 13), beside a
+// `isowall serve --http PORT`: the page and the protocol over WebSocket, beside a
 // ViewServer's TCP listener at the same address. HTTP requests go to web_routes.h; each
 // WebSocket on /ws becomes a WebChannel the ViewServer serves like a TCP connection (its hello,
 // token, worker and interrupts; max_clients counts both kinds).

@@ -1,4 +1,4 @@
-# isowall_remote_web: HTTP and WebSocket on one port for `isowall serve --http` (issue 13), through
+# isowall_remote_web: HTTP and WebSocket on one port for `isowall serve --http`, through
 # Debian's websocketpp 0.8.2 over standalone asio. websocketpp does not compile as C++20, so this
 # target is C++17 and its header (web_server.h) includes neither library; the C++20 side
 # (isowall_remote_http in http.cmake) sees only callbacks and bytes.

@@ -1,5 +1,5 @@
 #pragma once
-// The HTTP side of `isowall serve --http` (issue 13), pure: which response each GET gets.
+// The HTTP side of `isowall serve --http`, pure: which response each GET gets.
 //   /, /index.html      the page (web/dist/index.html; RouteContext::index)
 //   /<file>             any other file of web/dist/, with its content type
 //   /datasets?token=T   {"datasets":[...],"token_required":...}; 403 {"error":"wrong token"}

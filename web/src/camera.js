@@ -1,4 +1,4 @@
-// The camera of common/core/camera.cpp, in float32 arithmetic as glm does it (every operation
+// The camera of core/camera.cpp, in float32 arithmetic as glm does it (every operation
 // rounded with Math.fround), so a view built here is the view `isowall render` builds:
 // front_full_view(bounds, aspect), orbit(yaw, pitch), zoom(f), fit_depth_range(bounds), and
 // frustum(aspect). Vectors are [x, y, z]; matrices are column-major Float32Arrays of 16 (as GL

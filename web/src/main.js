@@ -1,7 +1,7 @@
 // The page: picks a volume, connects to `isowall serve --http` over its WebSocket (/ws, one frame
 // of the TCP protocol per binary message), sends views and draws their groups as they arrive
-// (frames.js), and keeps window.isowall up to date for tests and the bench (the contract of
-// issue 13).
+// (frames.js), and keeps window.isowall up to date for tests and the bench (a contract
+// they rely on).
 import { MsgType, encodeFrame, decodeFrame, ErrorCode, LodSchedule } from './protocol.js';
 import { ready as codecReady, helloEncoding, kAdaptiveEncoding, GroupEncoding, cellsProblem } from './group_codec.js';
 import { viewCamera, cameraProblem } from './camera.js';

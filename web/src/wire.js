@@ -1,4 +1,4 @@
-// The byte format of every message (common/core/wire.h): a version byte first, then explicit
+// The byte format of every message (wire/wire.h): a version byte first, then explicit
 // little-endian fields. A Reader never trusts a length: every count is checked against the bytes
 // left before anything is allocated, and every failure throws an Error "<what>: <why>", as the
 // C++ WireError does.

@@ -1,5 +1,5 @@
 // The camera against numbers printed by the C++ (data/camera_probe.cpp, built against
-// common/core/camera.cpp; its output is data/cameras_cpp.json).
+// core/camera.cpp; its output is data/cameras_cpp.json).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';

@@ -1,4 +1,4 @@
-// The page over TLS, end to end in headless Chromium (issue 35): starts its own
+// The page over TLS, end to end in headless Chromium: starts its own
 // `isowall serve --http 0 --tls-cert --tls-key` with a certificate made here with `openssl`, then
 // checks that the page loads over https, that its WebSocket is wss, that the front view completes
 // and saves it (ISOWALL_OUT/tls_front.png: tools/run_e2e.sh compares it with `isowall render`'s),

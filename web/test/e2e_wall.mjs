@@ -1,4 +1,4 @@
-// The wall's page end to end (isowall wall --http, issue 35): a 2x2 wall under mpirun, steered
+// The wall's page end to end (isowall wall --http): a 2x2 wall under mpirun, steered
 // from two pages in headless Chromium through playwright-core.
 //   1. The first page's mosaic, once the first frame is done, equals what the wall's own full-size
 //      mosaic (a snapshot the page asks for) gives through the tiles' preview path

@@ -23,9 +23,9 @@ trap 'rm -rf "$inc"' EXIT
 ln -s /usr/include/glm "$inc/glm"
 
 # The decoder and what it calls: the units' gaps, and a coarse pass's normals from its faces
-# (common/core/mesh.cpp).
+# (core/mesh.cpp).
 sources=("$here/cells_wasm.cpp" "$root/remote/cell_codec.cpp" "$root/remote/cell_units.cpp"
-    "$root/common/core/mesh.cpp")
+    "$root/core/mesh.cpp")
 # -fwasm-exceptions: WireError unwinds through the decoder at no cost while nothing throws (the
 # JavaScript-based -fexceptions routes each call that may throw through JavaScript).
 # ENVIRONMENT web: node (the tests, the bench) runs it too, as it has atob and WebAssembly; the

@@ -23,8 +23,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 g++ -std=c++20 -O2 -DGLM_FORCE_XYZW_ONLY -DGLM_ENABLE_EXPERIMENTAL -I"$root" \
     "$web/test/data/cells_probe.cpp" "$build/remote/libisowall_remote_codec.a" \
-    "$build/common/libisowall_extract.a" "$build/common/libisowall_volume.a" \
-    "$build/common/libisowall_core.a" -lteem -lz -lbz2 -lmeshoptimizer -lzstd -o "$tmp/cells_probe"
+    "$build/extract/libisowall_extract.a" "$build/volume/libisowall_volume.a" \
+    "$build/core/libisowall_core.a" "$build/files/libisowall_files.a" -lteem -lz -lbz2 -lmeshoptimizer -lzstd -o "$tmp/cells_probe"
 # The CT head adds a real 16-bit volume's groups when the shared data is there.
 cthead=$root/../shared/data/cthead.nhdr
 [ -f "$cthead" ] || cthead=

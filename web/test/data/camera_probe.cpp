@@ -1,7 +1,7 @@
-// Prints the camera numbers web/test/camera.test.mjs checks (JSON), from common/core/camera.cpp.
+// Prints the camera numbers web/test/camera.test.mjs checks (JSON), from core/camera.cpp.
 #include <cstdio>
 #include <glm/gtx/io.hpp>
-#include "common/core/camera.h"
+#include "core/camera.h"
 using namespace isowall;
 static void vec(const char* k, glm::vec3 v) {
     std::printf("\"%s\":[%.9g,%.9g,%.9g],", k, v.x, v.y, v.z);

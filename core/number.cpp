@@ -1,0 +1,71 @@
+#include "core/number.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+
+namespace isowall {
+namespace {
+
+// Integers in full (2147483647, not 2.14748e+09).
+std::string format(double v, bool integer) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), integer ? "%.0f" : "%g", v);
+    return buf;
+}
+
+}  // namespace
+
+bool NumberRange::contains(double v) const {
+    if (!std::isfinite(v) || v > hi || v < lo || (lo_open && v == lo)) return false;
+    return !integer || v == std::floor(v);
+}
+
+std::string NumberRange::describe() const {
+    const char* what = integer ? "an integer" : "a number";
+    if (lo == limits::kAnyFinite.lo && hi == limits::kAnyFinite.hi)
+        return std::string("a finite ") + (integer ? "integer" : "number");
+    return std::string(what) + " in " + (lo_open ? "(" : "[") + format(lo, integer) + ", " +
+           format(hi, integer) + "]";
+}
+
+std::optional<double> parse_number(std::string_view text) {
+    // from_chars takes no '+' and no leading space, and reads hex only when asked to.
+    if (!text.empty() && text.front() == '+') {
+        text.remove_prefix(1);
+        if (!text.empty() && text.front() == '-') return std::nullopt;  // "+-5"
+    }
+    double v = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+        return std::nullopt;
+    return v;
+}
+
+// An integer range's ends judged on the text's own value: a double rounds 2^53 + 1 to 2^53, a
+// long double (64 bits of mantissa here) holds it.
+bool past_integer_range(std::string_view text, const NumberRange& range) {
+    if (!range.integer) return false;
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    long double v = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (error != std::errc() || end != text.data() + text.size()) return false;
+    return v > static_cast<long double>(range.hi) || v < static_cast<long double>(range.lo);
+}
+
+std::string number_problem(std::string_view text, const NumberRange& range) {
+    const auto v = parse_number(text);
+    if (v && range.contains(*v) && !past_integer_range(text, range)) return {};
+    return "expected " + range.describe() + ", got " + quote(text);
+}
+
+double checked_number(std::string_view text, const NumberRange& range, const std::string& where,
+                      const std::string& field) {
+    const std::string problem = number_problem(text, range);
+    if (!problem.empty()) throw InputError(where, field, problem);
+    return *parse_number(text);
+}
+
+}  // namespace isowall

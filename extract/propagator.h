@@ -1,0 +1,312 @@
+#pragma once
+// Limited propagation from a seed cell (chapter 2.1.2, section 3.2): breadth first over active
+// face neighbours (a face whose four corners straddle the isovalue is crossed by the surface, so
+// the cell behind it is active), bounded by
+//   max_count:    at most m cells per pass;
+//   cutoff_angle: cells whose direction from the eye is more than theta from the seed ray, and
+//                 cells where the surface folds back (their distance angle falls below the largest
+//                 of their predecessors' by more than the tolerance: Figure 2.5).
+// Each pass yields one group: an indexed face set triangulated through the interpolant cache,
+// which is reset per pass (section 3.3.4).
+// With a ResolutionMap (chapter 2.1.3) a pass runs at the level of its seed's unit: over meta-cells
+// of that level (face neighbours at stride 2^level, active by their corner signs), and it stops at
+// the resolution boundary: a neighbour that belongs to a unit of another level is not entered.
+// A unit is marked visited at its first cell with the pass's group id: units are disjoint, so a
+// unit is either wholly visited or not at all, a ray's hit names the unit's first cell, and a
+// neighbour that is not the first cell of a unit of the pass's level is not entered anyway.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include "extract/adaptive.h"
+#include "extract/group.h"
+#include "extract/marching_cubes.h"
+#include "extract/visited.h"
+
+namespace isowall {
+
+enum class PropagationMode { max_count, cutoff_angle };
+
+// Keeps a pass to the cells whose projection may touch one screen region (a wall job's region,
+// or a tile): `clip_from_voxel` maps voxel space to the clip space of that region's own frustum,
+// and a cell is entered when its centre, widened by its projected half-diagonal, falls inside
+// NDC [-1, 1]^2. A cell left out stays unvisited, so a later ray that hits it seeds it then: the
+// image is the same, but no pass extracts surface that its region cannot show.
+struct ScreenClip {
+    bool active = false;
+    glm::mat4 clip_from_voxel{1.0f};
+    float ndc_per_unit = 1;       // max(|P00|, |P11|) of the projection: NDC per view unit at w = 1
+    float half_diagonal = 0.87f;  // half the diagonal of one cell, in object units
+
+    bool may_touch(glm::vec3 centre, int stride) const {
+        const glm::vec4 c = clip_from_voxel * glm::vec4(centre, 1.0f);
+        if (c.w <= 1e-6f) return true;  // at or behind the eye: no bound
+        const float r = half_diagonal * float(stride) * ndc_per_unit / c.w;
+        return std::abs(c.x / c.w) - r <= 1.0f && std::abs(c.y / c.w) - r <= 1.0f;
+    }
+};
+
+inline constexpr float kRadiansPerDegree = 3.14159265358979f / 180.0f;
+
+struct PropagationParams {
+    PropagationMode mode = PropagationMode::max_count;
+    // Chosen over every shared volume, not one: scripts/bench_defaults.py times C = 99% (final
+    // pixels) for each volume at both README isovalues and each candidate, median of 3 rotated
+    // rounds, and picks the value whose worst ratio to each case's best is smallest (ties: the
+    // geometric mean). 2000 came from vhp_ct_head alone; the 2026-11-26 sweep picked 1000 (worst
+    // ratio 1.68 against 2000's 2.13; docs/benchmarks.md).
+    int max_count = 1000;
+    float cutoff_rad = 2.0f * kRadiansPerDegree;    // 2 degrees
+    float foldback_rad = 0.5f * kRadiansPerDegree;  // 0.5 degree
+    bool interpolant_cache = true;
+    // Visible-surface rule: a unit where the surface faces away from the eye (the
+    // gradient of its corners, against the direction to the eye, has the opposite sign to the
+    // seed's, which the seed ray saw from the front) is drawn but not propagated from. A pass
+    // then stops one unit past a silhouette instead of running on over the back of the surface;
+    // what it leaves out stays unvisited, so a later ray that sees it seeds it then.
+    bool facing_only = false;
+    // Count mode: a pass that fills max_count lists the units it had to leave out
+    // (Group::frontier), so the engine can go on from those its picture still misses
+    // (engine/beside_seeds.h).
+    bool keep_frontier = false;
+    ScreenClip clip;  // inactive: no limit on screen
+};
+
+// The most frontier units one pass lists: a pass of max_count units has a rim of a few times
+// sqrt(max_count) units, each met from one to three taken neighbours.
+inline constexpr std::size_t kMaxFrontier = 4096;
+
+// The value gradient of a unit from its eight corners (differences across the unit, voxel space
+// per unit side): the direction the surface's normal takes, up to sign.
+inline glm::vec3 corner_gradient(const double corner[8]) {
+    double g[3] = {0, 0, 0};
+    for (std::size_t k = 0; k < 8; ++k)
+        for (std::size_t a = 0; a < 3; ++a)
+            g[a] += mc::kCornerOffset[k][a] ? corner[k] : -corner[k];
+    return {static_cast<float>(g[0]), static_cast<float>(g[1]), static_cast<float>(g[2])};
+}
+
+// Without the interpolant cache every triangle gets its own three vertices (the "caching off"
+// row of Table 3.4).
+struct NoEdgeCache {
+    std::pair<std::uint32_t*, bool> find_or_insert(glm::ivec3, int) { return {&scratch, true}; }
+    std::uint32_t scratch = 0;
+};
+
+template <class T>
+class Propagator {
+  public:
+    explicit Propagator(const VolumeView<T>& v) : v_(v), cache_(v.dims, 4096) {}
+
+    // The resolution of the following passes; default-constructed: full resolution.
+    void set_resolution(const ResolutionMap& resolution) { resolution_ = resolution; }
+
+    // Seconds spent triangulating (marching cubes) in the last propagate() call; the rest of the
+    // call is the propagation proper (queue, neighbour tests, criteria).
+    double last_extract_s() const { return extract_s_; }
+
+    // `eye` and `ray_dir` in voxel space (for the angle criteria). `interrupted` is polled every
+    // few hundred cells so a long pass stops promptly when the view changes.
+    Group propagate(glm::ivec3 seed, std::uint32_t group_id, double iso, const PropagationParams& p,
+                    glm::vec3 eye, glm::vec3 ray_dir, VisitedCells& visited,
+                    const std::function<bool()>& interrupted = {}) {
+        extract_s_ = 0;
+        Group g;
+        g.id = group_id;
+        const int level = resolution_.level_of(seed);
+        const int stride = 1 << level;
+        seed &= ~(stride - 1);  // the unit's first cell
+        g.seed = seed;
+        g.level = level;
+        g.iso = iso;
+        // A border unit finer than a uniform level's is not this level's (adaptive.h).
+        if (!resolution_.finer_units() && level < resolution_.max_level()) return g;
+        if (!visited.claim(seed, group_id, level)) return g;
+        cache_.clear();
+        const glm::vec3 dir = glm::normalize(ray_dir);
+        const float cos_cutoff = std::cos(p.cutoff_rad);
+        auto centre = [](glm::ivec3 c, int l) { return glm::vec3(c) + 0.5f * float(1 << l); };
+        auto angle_of = [&](glm::ivec3 c, int l) {
+            const glm::vec3 to = glm::normalize(centre(c, l) - eye);
+            return std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
+        };
+        queue_.clear();
+        queue_.push_back(
+            {seed, p.mode == PropagationMode::cutoff_angle ? angle_of(seed, level) : 0.0f, level});
+        double timed_s = 0;
+        std::size_t timed_units = 0;
+        float seed_facing = 0;  // the seed's side, for facing_only; 0 until the seed is seen
+        int taken = 1;
+        std::size_t taken_cells = std::size_t{1} << (3 * level);
+        const glm::ivec3 cells = visited.dims();
+        // Takes the unit of `l` at `u` into this pass when the criteria allow; false when the
+        // pass is full (count mode).
+        auto take = [&](glm::ivec3 u, int l, float from_angle) {
+            if (visited.contains(u, l)) return true;
+            const int st = 1 << l;
+            if (p.clip.active && !p.clip.may_touch(centre(u, l), st)) return true;
+            float max_angle = from_angle;
+            if (p.mode == PropagationMode::max_count) {
+                if (taken >= p.max_count) {
+                    if (p.keep_frontier && g.frontier.size() < kMaxFrontier)
+                        g.frontier.push_back(u);
+                    return false;
+                }
+            } else {
+                const glm::vec3 to = glm::normalize(centre(u, l) - eye);
+                if (glm::dot(to, dir) < cos_cutoff) return true;
+                const float a = std::acos(std::clamp(glm::dot(to, dir), -1.0f, 1.0f));
+                if (a < from_angle - p.foldback_rad) return true;  // folds back
+                max_angle = std::max(max_angle, a);
+            }
+            // Another thread's pass may have taken it since contains(): the claim decides.
+            if (!visited.claim(u, group_id, l)) return true;
+            ++taken;
+            taken_cells += std::size_t{1} << (3 * l);
+            queue_.push_back({u, max_angle, l});
+            return true;
+        };
+        while (!queue_.empty()) {
+            const QueueEntry item = queue_.front();
+            queue_.pop_front();
+            g.cells.push_back(item.cell);
+            if (item.level != level && g.cell_levels.empty())
+                g.cell_levels.assign(g.cells.size() - 1, static_cast<std::uint8_t>(level));
+            if (!g.cell_levels.empty())
+                g.cell_levels.push_back(static_cast<std::uint8_t>(item.level));
+            if ((g.cells.size() & 255) == 0 && interrupted && interrupted()) break;
+            // Two clock reads cost about as much as a small cell's triangulation, so only one
+            // unit in kTimedEvery is timed and the pass's extraction time is scaled from them.
+            const bool timed = (g.cells.size() - 1) % kTimedEvery == 0;
+            const auto t0 =
+                timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+            double corner[8];
+            const int cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner);
+            if (timed) {
+                timed_s +=
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                ++timed_units;
+            }
+            const int stride = 1 << item.level;
+            if (p.facing_only) {
+                const glm::vec3 to_eye = eye - centre(item.cell, item.level);
+                const float facing = glm::dot(corner_gradient(corner), to_eye);
+                if (seed_facing == 0) seed_facing = facing;
+                if (facing * seed_facing < 0) continue;  // folds away: no neighbours from here
+            }
+            for (int f = 0; f < 6; ++f) {
+                const int axis = f >> 1, side = f & 1;
+                // The face's four corners: those with bit `axis` equal to `side`.
+                int on_face = 0;
+                for (int k = 0; k < 8; ++k)
+                    if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
+                if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
+                // The cell just across the face, at the unit's first corner.
+                glm::ivec3 nb = item.cell;
+                nb[axis] = side ? nb[axis] + stride : nb[axis] - 1;
+                if (nb[axis] < 0 || nb[axis] >= cells[axis]) continue;
+                const int nl = resolution_.max_level() > 0 ? resolution_.level_of(nb) : 0;
+                if (nl != item.level && !resolution_.cross_levels()) continue;
+                if (nl >= item.level)  // one unit across the face, as large or larger
+                    take(nb & ~((1 << nl) - 1), nl, item.max_angle);
+                else  // finer units (a resolution boundary): the pass goes on into them
+                    take_finer_across(nb, axis, stride, iso, take, item.max_angle);
+            }
+        }
+        visited.add_count(taken_cells);
+        if (timed_units > 0)
+            extract_s_ =
+                timed_s * static_cast<double>(g.cells.size()) / static_cast<double>(timed_units);
+        return g;
+    }
+
+    // The refinement group of the meta-cell of `level` at `base`: its active cells triangulated at
+    // full resolution, sharing vertices through the interpolant cache.
+    Group refine(glm::ivec3 base, int level, std::uint32_t group_id, double iso,
+                 const PropagationParams& p) {
+        const auto t0 = std::chrono::steady_clock::now();
+        Group g;
+        g.id = group_id;
+        g.seed = base;
+        g.level = level;
+        g.iso = iso;
+        g.refinement = true;
+        cache_.clear();
+        const int s = 1 << level;
+        double corner[8];
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x)
+                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh, corner);
+        extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return g;
+    }
+
+    // Marks the unit of `level` at `base` (its first cell); false when it was taken already.
+    static bool insert(VisitedCells& visited, glm::ivec3 base, int level, std::uint32_t group_id) {
+        return visited.insert(base, group_id, level);
+    }
+
+  private:
+    static constexpr std::size_t kTimedEvery = 16;
+
+    // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
+    int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh,
+                    double corner[8]) {
+        meta_cell_corners(v_, c, level, corner);
+        const int cs = cell_case(corner, iso);
+        if (p.interpolant_cache) {
+            emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
+        } else {
+            NoEdgeCache none;
+            emit_meta_cell(v_, c, level, iso, cs, corner, none, mesh);
+        }
+        return cs;
+    }
+
+    const VolumeView<T>& v_;
+    HashEdgeCache cache_;
+    ResolutionMap resolution_;
+    double extract_s_ = 0;
+    struct QueueEntry {
+        glm::ivec3 cell;  // the unit's first cell
+        float max_angle;  // largest distance angle along the path from the seed
+        int level;        // the unit's level
+    };
+
+    // The units finer than a unit of `stride` cells that touch its face, in the slab of cells
+    // at nb[axis] (nb: the cell across the face at the unit's first corner), handed to `take`
+    // when their own corners cross the isovalue. Each unit once: at its first cell on the face.
+    template <class Take>
+    bool take_finer_across(glm::ivec3 nb, int axis, int stride, double iso, Take& take,
+                           float from_angle) {
+        const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+        const glm::ivec3 cells = v_.cell_dims();
+        for (int j = 0; j < stride && nb[a2] + j < cells[a2]; ++j)
+            for (int i = 0; i < stride && nb[a1] + i < cells[a1]; ++i) {
+                glm::ivec3 q = nb;
+                q[a1] += i;
+                q[a2] += j;
+                const int l = resolution_.level_of(q);
+                const glm::ivec3 u = q & ~((1 << l) - 1);
+                if (u[a1] != q[a1] || u[a2] != q[a2]) continue;  // met at its first cell already
+                double corner[8];
+                meta_cell_corners(v_, u, l, corner);
+                const int cs = cell_case(corner, iso);
+                if (cs == 0 || cs == 255) continue;
+                if (!take(u, l, from_angle)) return false;
+            }
+        return true;
+    }
+    std::deque<QueueEntry> queue_;
+};
+
+}  // namespace isowall

@@ -1,0 +1,248 @@
+// NIfTI through niftilib (nifti2_io reads NIfTI-1 and NIfTI-2, .nii, .nii.gz and .hdr/.img
+// pairs, and swaps bytes). What it leaves to us: the scale checked as the file wrote it (the
+// library turns a NaN or infinite scl_slope into 0, which the standard reads as "no scaling"),
+// the size checked before the data is read, and the orientation turned from RAS into LPS.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <memory>
+
+#include <nifti2_io.h>
+
+#include "core/error.h"
+#include "readers/plane_stack.h"
+#include "readers/readers.h"
+#include "readers/voxel_ops.h"
+#include "volume/load_checks.h"
+
+namespace isowall::formats {
+namespace fs = std::filesystem;
+namespace {
+
+// niftilib prints its own "** ERROR" lines to stderr whatever its debug level; ours is the one
+// line a user sees, so stderr is pointed at /dev/null while a niftilib call runs. Volumes load
+// before any thread of ours prints.
+class QuietStderr {
+  public:
+    QuietStderr() : saved_(::dup(STDERR_FILENO)) {
+        std::fflush(stderr);
+        const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+        if (null >= 0) {
+            ::dup2(null, STDERR_FILENO);
+            ::close(null);
+        }
+    }
+    ~QuietStderr() {
+        std::fflush(stderr);
+        if (saved_ >= 0) {
+            ::dup2(saved_, STDERR_FILENO);
+            ::close(saved_);
+        }
+    }
+    QuietStderr(const QuietStderr&) = delete;
+    QuietStderr& operator=(const QuietStderr&) = delete;
+
+  private:
+    int saved_;
+};
+
+// The voxels must be in the file before they are read: niftilib allocates what the header says
+// first, so a short file claiming gigabytes would cost gigabytes. Uncompressed: the file's size;
+// gzip: its trailer's length (modulo 2^32), checked for volumes past 64 MiB.
+void check_data_present(const nifti_image& n, std::uint64_t data_bytes, const std::string& where) {
+    const std::string image = n.iname ? n.iname : "";
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(image, ec);
+    if (ec) throw InputError(where, "data", "cannot read the image file " + quote_bounded(image));
+    const std::uint64_t need = std::uint64_t(std::max<int64_t>(n.iname_offset, 0)) + data_bytes;
+    const bool gz = image.size() > 3 && image.compare(image.size() - 3, 3, ".gz") == 0;
+    if (!gz && size < need)
+        throw InputError(where, "dim",
+                         "the header's voxels end at byte " + std::to_string(need) +
+                             ", the file holds " + std::to_string(size));
+    if (!gz || data_bytes <= (64u << 20)) return;
+    std::ifstream in(image, std::ios::binary);
+    std::uint8_t tail[4] = {};
+    in.seekg(-4, std::ios::end);
+    in.read(reinterpret_cast<char*>(tail), 4);
+    const std::uint32_t isize = std::uint32_t(tail[0]) | std::uint32_t(tail[1]) << 8 |
+                                std::uint32_t(tail[2]) << 16 | std::uint32_t(tail[3]) << 24;
+    if (!in || isize != std::uint32_t(need))
+        throw InputError(where, "dim",
+                         "the header's voxels end at byte " + std::to_string(need) +
+                             " of the uncompressed file, which gzip says is not its length");
+}
+
+struct NiftiDeleter {
+    void operator()(nifti_image* n) const { nifti_image_free(n); }
+};
+using NiftiPtr = std::unique_ptr<nifti_image, NiftiDeleter>;
+
+std::optional<VoxelType> voxel_type_of_nifti(int datatype) {
+    switch (datatype) {
+        case DT_UINT8:
+            return VoxelType::u8;
+        case DT_INT8:
+            return VoxelType::i8;
+        case DT_UINT16:
+            return VoxelType::u16;
+        case DT_INT16:
+            return VoxelType::i16;
+        case DT_UINT32:
+            return VoxelType::u32;
+        case DT_INT32:
+            return VoxelType::i32;
+        case DT_FLOAT32:
+            return VoxelType::f32;
+        case DT_FLOAT64:
+            return VoxelType::f64;
+        default:
+            return std::nullopt;
+    }
+}
+
+// scl_slope and scl_inter as the header holds them.
+Scaling header_scaling(const fs::path& path, const std::string& where) {
+    int version = 0;
+    void* raw = nifti_read_header(path.c_str(), &version, 1);
+    if (!raw) throw InputError(where, "header", "not a NIfTI-1 or NIfTI-2 header niftilib reads");
+    Scaling s;
+    if (version == 2) {
+        const auto* h = static_cast<const nifti_2_header*>(raw);
+        s = {h->scl_slope, h->scl_inter};
+    } else {
+        const auto* h = static_cast<const nifti_1_header*>(raw);
+        s = {h->scl_slope, h->scl_inter};
+    }
+    std::free(raw);
+    if (std::isfinite(s.slope) && s.slope == 0) return {};  // the standard's "not scaled"
+    return s;
+}
+
+// The file's index-to-patient matrix: the sform when it has one, else the qform; RAS columns
+// scaled by the spacing. Nullopt when it has neither (method 1 of the standard: pixdim alone).
+std::optional<nifti_dmat44> patient_matrix(const nifti_image& n, std::string& which) {
+    if (n.sform_code > 0) {
+        which = "sform";
+        return n.sto_xyz;
+    }
+    if (n.qform_code > 0) {
+        which = "qform";
+        return n.qto_xyz;
+    }
+    return std::nullopt;
+}
+
+// Spacing from the matrix's columns and the orientation from their directions, RAS -> LPS.
+void take_geometry(const nifti_image& n, const std::string& where, Decoded& d) {
+    std::string which;
+    const std::optional<nifti_dmat44> m = patient_matrix(n, which);
+    if (!m) {
+        d.spacing = {float(std::abs(n.dx)), float(std::abs(n.dy)), float(std::abs(n.dz))};
+        d.facts.push_back({"orientation", "none in the file (sform and qform codes 0)"});
+        return;
+    }
+    for (int c = 0; c < 3; ++c) {
+        const glm::vec3 ras(float(m->m[0][c]), float(m->m[1][c]), float(m->m[2][c]));
+        const float len = glm::length(ras);
+        if (!(len > 0) || !std::isfinite(len))
+            throw InputError(
+                where, which,
+                "axis " + std::to_string(c) + " has no direction (a zero or non-finite column)");
+        d.spacing[c] = len;
+        d.orientation.axes[c] = glm::vec3(-ras.x, -ras.y, ras.z) / len;
+    }
+    d.orientation.origin = {-float(m->m[0][3]), -float(m->m[1][3]), float(m->m[2][3])};
+    d.orientation.known = true;
+    d.facts.push_back({"orientation from", which});
+}
+
+// The open image file and the header niftilib read, shared by the stack's reads.
+struct OpenImage {
+    NiftiPtr n;
+    znzFile fp = nullptr;
+    ~OpenImage() {
+        if (fp) znzclose(fp);
+    }
+};
+
+}  // namespace
+
+PlaneStack nifti_planes(const fs::path& path) {
+    const std::string where = path.string();
+    nifti_set_debug_level(0);
+    const QuietStderr quiet;
+    const Scaling scaling = header_scaling(path, where);
+    auto image = std::make_shared<OpenImage>();
+    image->n.reset(nifti_image_read(path.c_str(), 0));
+    const nifti_image* n = image->n.get();
+    if (!n) throw InputError(where, "header", "not a NIfTI file niftilib reads");
+    for (int a = 4; a <= n->dim[0] && a < 8; ++a)
+        if (n->dim[a] > 1)
+            throw InputError(where, "dim",
+                             "dimension " + std::to_string(a) + " has " +
+                                 std::to_string(n->dim[a]) +
+                                 " entries (a time series or vectors); isowall reads one 3-D "
+                                 "scalar volume");
+    const auto type = voxel_type_of_nifti(n->datatype);
+    if (!type)
+        throw InputError(where, "datatype",
+                         std::string(nifti_datatype_string(n->datatype)) +
+                             " is not a scalar type isowall reads (uint8 to int32, float32, "
+                             "float64)");
+    const std::uint64_t sizes[3] = {std::uint64_t(std::max<int64_t>(n->nx, 0)),
+                                    std::uint64_t(std::max<int64_t>(n->ny, 0)),
+                                    std::uint64_t(std::max<int64_t>(n->nz, 0))};
+    PlaneStack stack;
+    Decoded& d = stack.head;
+    d.dims = checked_dims(where, "dim", sizes, *type);
+    d.type = *type;
+    check_data_present(*n, voxel_bytes(d.dims, d.type), where);
+    take_geometry(*n, where, d);
+    d.scaling = scaling;
+    d.format = n->nifti_type >= NIFTI_FTYPE_NIFTI2_1  ? "NIfTI-2"
+               : n->nifti_type == NIFTI_FTYPE_ANALYZE ? "ANALYZE 7.5"
+                                                      : "NIfTI-1";
+    d.files = {fs::path(n->fname)};
+    if (std::string(n->iname) != n->fname) d.files.emplace_back(n->iname);
+    if (n->descrip[0])
+        d.facts.push_back({"description", std::string(n->descrip, strnlen(n->descrip, 80))});
+    stack.scaling_field = "scl_slope";
+    stack.size_field = "dim";
+    // niftilib's reads run with stderr pointed away (QuietStderr): on a thread beside the
+    // import's, that would swallow its progress bar.
+    stack.read_ahead = false;
+    // The image file is streamed once, in order (a gzip stream cannot seek back cheaply);
+    // niftilib's buffer read swaps the bytes of a file of the other byte order.
+    const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+    stack.read = [image, plane, where](int z0, int z1, std::byte* to) {
+        const QuietStderr quiet;
+        nifti_image* n = image->n.get();
+        if (!image->fp) {
+            image->fp = znzopen(n->iname, "rb", nifti_is_gzfile(n->iname));
+            if (znz_isnull(image->fp) ||
+                znzseek(image->fp, std::max<int64_t>(n->iname_offset, 0), SEEK_SET) < 0)
+                throw InputError(where, "data",
+                                 "cannot open the image file " + quote_bounded(n->iname));
+        }
+        const auto want = static_cast<int64_t>(plane * std::size_t(z1 - z0));
+        if (nifti_read_buffer(image->fp, to, want, n) != want)
+            throw InputError(where, "data",
+                             "the voxels of slices " + std::to_string(z0) + " to " +
+                                 std::to_string(z1 - 1) +
+                                 " could not be read (the file is shorter than its header "
+                                 "says, or its compression is damaged)");
+    };
+    return stack;
+}
+
+Volume read_nifti(const fs::path& path) {
+    return read_whole(nifti_planes(path), path.string());
+}
+
+}  // namespace isowall::formats

@@ -1,0 +1,144 @@
+#include "wall_spec/script.h"
+
+#include <sstream>
+
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/number.h"
+#include "files/input_file.h"
+
+namespace isowall {
+namespace {
+
+std::vector<std::string> words_of(std::string_view text) {
+    std::istringstream in{std::string(text)};
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    return words;
+}
+
+// A snapshot's name becomes NAME.png beside the mosaic: one file name, short enough for any file
+// system with the extension.
+constexpr std::size_t kMaxSnapshotName = 200;
+
+bool plain_name(const std::string& name) {
+    if (name.size() > kMaxSnapshotName) return false;
+    for (const char ch : name)
+        if (ch == '/' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F) return false;
+    return true;
+}
+
+void expect_args(const std::vector<std::string>& w, std::size_t n, const std::string& where,
+                 const std::string& usage) {
+    if (w.size() != n + 1)
+        throw InputError(
+            where, w[0],
+            "expected \"" + usage + "\", got " + std::to_string(w.size() - 1) + " argument(s)");
+}
+
+}  // namespace
+
+ScriptCommand parse_command(std::string_view text, const std::string& where) {
+    const auto w = words_of(text);
+    if (w.empty()) throw InputError(where, "command", "empty command");
+    const std::string& c = w[0];
+    auto num = [&](std::size_t i, const NumberRange& range) {
+        return checked_number(w[i], range, where, c);
+    };
+    if (c == "orbit") {
+        expect_args(w, 2, where, "orbit YAW PITCH");
+        return OrbitCmd{num(1, limits::kAngleDeg), num(2, limits::kAngleDeg)};
+    }
+    if (c == "look-at") {
+        expect_args(w, 6, where, "look-at EX EY EZ TX TY TZ");
+        auto point = [&](std::size_t i) {
+            const auto v = [&](std::size_t k) { return float(num(k, limits::kCoordinate)); };
+            return glm::vec3(v(i), v(i + 1), v(i + 2));
+        };
+        const LookAtCmd cmd{point(1), point(4)};
+        if (std::string p = eye_target_problem(cmd.eye, cmd.target); !p.empty())
+            throw InputError(where, c, p);
+        return cmd;
+    }
+    if (c == "zoom") {
+        expect_args(w, 1, where, "zoom F");
+        return ZoomCmd{float(num(1, limits::kZoom))};
+    }
+    if (c == "pan") {
+        expect_args(w, 2, where, "pan DX DY");
+        return PanCmd{float(num(1, limits::kPan)), float(num(2, limits::kPan))};
+    }
+    if (c == "iso") {
+        expect_args(w, 1, where, "iso V");
+        return IsoCmd{num(1, limits::kAnyFinite)};
+    }
+    if (c == "wait") {
+        if (w.size() == 2 && w[1] == "done") return WaitCmd{WaitCmd::Until::done, 0};
+        if (w.size() == 3 && (w[1] == "rays" || w[1] == "time")) {
+            const bool rays = w[1] == "rays";
+            return WaitCmd{rays ? WaitCmd::Until::rays : WaitCmd::Until::time,
+                           num(2, rays ? limits::kRayCount : limits::kWaitSeconds)};
+        }
+        throw InputError(where, c,
+                         "expected \"wait rays N\", \"wait time SECONDS\" or \"wait done\"");
+    }
+    if (c == "snapshot") {
+        expect_args(w, 1, where, "snapshot NAME");
+        if (!plain_name(w[1]))
+            throw InputError(where, c,
+                             "expected a plain name (no '/', no control characters, at most " +
+                                 std::to_string(kMaxSnapshotName) + " bytes), got " + quote(w[1]));
+        return SnapshotCmd{w[1]};
+    }
+    if (c == "quit") {
+        expect_args(w, 0, where, "quit");
+        return QuitCmd{};
+    }
+    throw InputError(where, "command",
+                     "unknown command " + quote(c) +
+                         " (expected orbit, look-at, zoom, pan, iso, wait, snapshot or quit)");
+}
+
+std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file) {
+    std::vector<ScriptLine> lines;
+    int n = 0;
+    std::size_t pos = 0;
+    while (pos <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', pos), text.size());
+        std::string_view line = text.substr(pos, end - pos);
+        ++n;
+        if (const auto hash = line.find('#'); hash != std::string_view::npos)
+            line = line.substr(0, hash);
+        if (line.find_first_not_of(" \t\r") != std::string_view::npos)
+            lines.push_back({n, parse_command(line, file + ":" + std::to_string(n))});
+        if (end == text.size()) break;
+        pos = end + 1;
+    }
+    return lines;
+}
+
+std::vector<ScriptLine> load_script(const std::filesystem::path& path) {
+    return parse_script(read_input_file(path, "--script", kMaxScriptBytes), path.string());
+}
+
+}  // namespace isowall
+
+namespace isowall {
+
+bool apply_camera_command(const ScriptCommand& cmd, Camera& camera, float aspect) {
+    if (const auto* c = std::get_if<OrbitCmd>(&cmd)) {
+        camera = orbit(camera, c->yaw_deg, c->pitch_deg);
+    } else if (const auto* c = std::get_if<LookAtCmd>(&cmd)) {
+        camera.eye = c->eye;
+        camera.target = c->target;
+    } else if (const auto* c = std::get_if<ZoomCmd>(&cmd)) {
+        camera = zoom(camera, c->factor);
+    } else if (const auto* c = std::get_if<PanCmd>(&cmd)) {
+        camera = pan(camera, c->dx, c->dy, aspect);
+    } else {
+        return false;
+    }
+    return true;
+}
+
+}  // namespace isowall

@@ -1,0 +1,71 @@
+#pragma once
+// Wall scripts: one command per line, the same commands the master's console takes.
+//   orbit YAW PITCH            turn the camera about the volume centre (degrees)
+//   look-at EX EY EZ TX TY TZ  eye and target in object space
+//   zoom F                     F > 1 moves closer
+//   pan DX DY                  move the view by DX screen widths right and DY heights up
+//   iso V                      new isovalue
+//   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
+//   wait time S                a pause of S seconds, whether or not the frame ends first
+//   snapshot NAME              write the mosaic as NAME.png
+//   quit
+// '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
+// frame on every tile (and interrupts the current one).
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/camera.h"
+
+namespace isowall {
+
+struct OrbitCmd {
+    double yaw_deg = 0, pitch_deg = 0;  // the camera reduces them modulo 360
+};
+struct LookAtCmd {
+    glm::vec3 eye{0}, target{0};
+};
+struct ZoomCmd {
+    float factor = 1;
+};
+struct PanCmd {
+    float dx = 0, dy = 0;
+};
+struct IsoCmd {
+    double iso = 0;
+};
+struct WaitCmd {
+    enum class Until { rays, time, done } until = Until::done;
+    double amount = 0;  // rays or seconds
+};
+struct SnapshotCmd {
+    std::string name;
+};
+struct QuitCmd {};
+
+using ScriptCommand =
+    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
+
+struct ScriptLine {
+    int line = 0;  // 1-based, for messages
+    ScriptCommand command;
+};
+
+// One command; throws InputError naming `where` (e.g. "demo.txt:3") and the command.
+ScriptCommand parse_command(std::string_view text, const std::string& where);
+// Moves `camera` as an orbit, look, zoom or pan command says (pan in screen sizes of `aspect`);
+// false, camera untouched, for any other command. The wall and the remote client share it.
+bool apply_camera_command(const ScriptCommand& cmd, Camera& camera, float aspect);
+// A whole script; blank and comment lines are skipped.
+std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file);
+// The script in `path` (a regular file of at most kMaxScriptBytes); errors name the file and
+// --script, or the file, line and command.
+std::vector<ScriptLine> load_script(const std::filesystem::path& path);
+inline constexpr std::size_t kMaxScriptBytes = 16u << 20;
+
+}  // namespace isowall
