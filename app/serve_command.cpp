@@ -8,9 +8,9 @@
 #include "cli/volume_options.h"
 #include "core/error.h"
 #include "core/number.h"
+#include "remote/http/http_front.h"
 #include "remote/net/endpoint.h"
 #include "remote/view_server.h"
-#include "remote/web/http_front.h"
 #include "volume/octree.h"
 
 namespace isowall {

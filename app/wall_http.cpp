@@ -5,8 +5,8 @@
 #include "core/error.h"
 #include "master/control_input.h"
 #include "master/control_view.h"
+#include "remote/http/web_routes.h"
 #include "remote/view_server.h"
-#include "remote/web/web_routes.h"
 
 namespace isowall {
 namespace {

@@ -27,8 +27,8 @@
 #include "core/util.h"
 #include "master/steering.h"
 #include "master/wall_page.h"
+#include "remote/http/web_server.h"
 #include "remote/net/tls.h"
-#include "remote/web/web_server.h"
 #include "wall_spec/control_layout.h"
 
 namespace isowall {
@@ -39,6 +39,8 @@ struct WallHttpOptions {
     std::string token;                              // --token: every page must present it
     std::shared_ptr<const remote::TlsContext> tls;  // https and wss; null: plain
     std::string out = "mosaic.png";                 // snapshots go beside it
+    // The wall file's name as the pages show it: the name alone, not the master's folders, which
+    // a page on another machine has no use for.
     std::string wall_name;
     std::size_t max_pages = 16;  // pages connected at once; more are turned away
 };

@@ -24,7 +24,7 @@
 #include "render/renderer.h"
 #include "store/open_store.h"
 #include "tile/preview_show.h"
-#include "tile/remote_store.h"
+#include "tile/store_client.h"
 #include "tile/tile_loop.h"
 #include "tile/tile_window.h"
 #include "volume/phantom.h"
@@ -120,7 +120,8 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     std::optional<WallHttp> http;
     if (o.http_port >= 0)
         http.emplace(spec, WallHttpOptions{o.http_listen, o.http_port, o.token,
-                                           server_tls(o.tls_cert, o.tls_key), o.out, o.wall});
+                                           server_tls(o.tls_cert, o.tls_key), o.out,
+                                           std::filesystem::path(o.wall).filename().string()});
     master.start();
     const std::string where = o.script.empty() ? std::string("--script") : o.script;
     bool quit = false;
@@ -149,29 +150,23 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
 // A tile rank's volume: read on its own host, or, where the host cannot see the store given as
 // --volume (or with --bricks-from master), the master's store through `remote`.
 OpenedVolume open_tile_volume(const WallOptions& o, Comm& comm,
-                              std::optional<RemoteStore>& remote) {
+                              std::optional<StoreClient>& remote) {
     const VolumeUse use{.copies_on_host = comm.ranks_on_host()};
     const std::string& path = o.volume.path;
     std::error_code ec;
     if (path.empty() || (o.bricks_from != "master" && std::filesystem::exists(path, ec)))
         return open_volume(o.volume, /*quiet=*/true, use);
     remote.emplace(comm, o.timeout_s);
-    OpenedVolume ov;
-    ov.cache_dir = cache_dir(o.volume);
     // The octree's copy lives in the cache folder (a temporary one with --no-cache).
+    const std::filesystem::path cache = cache_dir(o.volume);
     const std::filesystem::path dir =
-        ov.cache_dir.empty() ? std::filesystem::temp_directory_path() : ov.cache_dir;
+        cache.empty() ? std::filesystem::temp_directory_path() : cache;
     auto reader = remote->open(path, dir);
-    store::OpenedStore s =
-        store::open_store(reader, remote->octree_file(), memory_limit(o.volume, use));
-    ov.volume = std::move(s.volume);
-    ov.pager = std::move(s.pager);
-    ov.file = std::filesystem::path(path);
-    return ov;
+    return open_volume(o.volume, std::move(reader), remote->octree_file(), use);
 }
 
 int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
-    std::optional<RemoteStore> remote;
+    std::optional<StoreClient> remote;
     const OpenedVolume ov = open_tile_volume(o, comm, remote);
     auto extractor = open_extractor(ov, budget);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
@@ -194,7 +189,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
     if (ov.pager) setup.io_cpu_s = [pager = ov.pager] { return pager->stats().cpu_s; };
-    if (remote) setup.remote_store = &*remote;
+    if (remote) setup.store_client = &*remote;
     std::optional<TileWindow> window;
     if (o.windows) {
         const int t = tile_of_rank(spec, comm.rank());

@@ -11,7 +11,7 @@
 #include "cli/volume_options.h"
 #include "comm/comm.h"
 #include "core/test_fault.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -4,6 +4,7 @@
 
 #include "cli/cli_checks.h"
 #include "core/error.h"
+#include "core/number.h"
 #include "core/util.h"
 #include "readers/read_volume.h"
 #include "store/open_store.h"
@@ -83,7 +84,7 @@ std::optional<RawSpec> raw_spec(const VolumeOptions& o) {
 
 std::uint64_t memory_limit(const VolumeOptions& o, VolumeUse use) {
     if (o.memory_limit.empty()) return store::default_memory_limit(use.copies_on_host);
-    const auto parsed = store::parse_byte_size(o.memory_limit);
+    const auto parsed = parse_byte_size(o.memory_limit);
     if (!parsed)
         throw InputError("--memory-limit", "value",
                          "expected a size such as 512M or 8G, got " + quote(o.memory_limit));
@@ -99,6 +100,17 @@ std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
     if (o.path.empty() || store::is_store(o.path)) return nullptr;
     check_no_memory_limit(o);
     return formats::open_planes(o.path, raw_spec(o));
+}
+
+OpenedVolume open_volume(const VolumeOptions& o, std::shared_ptr<const store::StoreReader> reader,
+                         const std::filesystem::path& octree, VolumeUse use) {
+    OpenedVolume out;
+    out.cache_dir = cache_dir(o);
+    store::OpenedStore s = store::open_store(std::move(reader), octree, memory_limit(o, use));
+    out.volume = std::move(s.volume);
+    out.pager = std::move(s.pager);
+    out.file = std::filesystem::path(o.path);
+    return out;
 }
 
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {

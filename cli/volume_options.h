@@ -60,6 +60,12 @@ std::filesystem::path cache_dir(const VolumeOptions& opts);
 // Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,
 // and prints one line about it.
 OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false, VolumeUse use = {});
+// The store named by `opts` read through `reader` where this host cannot see it (a wall rank's
+// bricks from the master, tile/store_client.h), its octree copied to the file `octree`: the
+// memory limit and cache folder are `opts`'s, as for a store open_volume reads itself.
+OpenedVolume open_volume(const VolumeOptions& opts,
+                         std::shared_ptr<const store::StoreReader> reader,
+                         const std::filesystem::path& octree, VolumeUse use);
 
 // The volume's planes for `isowall import` to stream (readers/read_volume.h: open_planes),
 // or null where open_volume serves (the phantom, a store, raw data and raw NRRD it maps).

@@ -3,7 +3,7 @@
 // OSPRay's MPI_CALL). Two transports: MPI (comm/mpi_comm.cpp, the only file that includes mpi.h)
 // and in-process (comm/inproc_comm.h: every rank a thread, for tests). A Comm carries bytes under
 // a Tag and knows no message: the wall's typed messages, the Tag's values and send_message are
-// protocol/protocol.h's.
+// wall_protocol/protocol.h's.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -16,7 +16,7 @@
 
 namespace isowall {
 
-// A message's kind on the wire (an MPI tag). Declared here without values: protocol/protocol.h
+// A message's kind on the wire (an MPI tag). Declared here without values: wall_protocol/protocol.h
 // defines them, so this layer moves any tag it is given and never looks inside the bytes.
 enum class Tag : std::int32_t;
 

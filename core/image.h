@@ -5,7 +5,7 @@
 
 namespace isowall {
 
-// Largest image side a message may carry (wire/wire_pieces.h reads sides against it). A
+// Largest image side a message may carry (wire/message_fields.h reads sides against it). A
 // message over 2 GiB cannot travel (MPI counts are int); a tile is far smaller (a 4K display is
 // 32 MiB of RGBA).
 inline constexpr int kMaxImageSide = 32768;

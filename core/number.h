@@ -3,6 +3,7 @@
 // whole text must spell one finite number, and the number must lie in a documented range. NaN,
 // infinity, "1e999" and values that would make the view degenerate stop at the door with one line
 // naming the source and the field, instead of a black image and exit 0.
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -51,5 +52,9 @@ std::string number_problem(std::string_view text, const NumberRange& range);
 // The number, or InputError(where, field, number_problem(...)).
 double checked_number(std::string_view text, const NumberRange& range, const std::string& where,
                       const std::string& field);
+
+// A size in bytes as an option gives it (--memory-limit): "512M", "8G", "1.5GiB", "1048576";
+// nullopt for anything else (or zero).
+std::optional<std::uint64_t> parse_byte_size(std::string_view text);
 
 }  // namespace isowall

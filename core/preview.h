@@ -13,7 +13,7 @@ namespace isowall {
 inline constexpr int kMaxPreviewSide = 1024;
 
 // What a tile shows, small: RGB, not RGBA (a preview is only looked at). It travels to the master
-// as protocol/protocol.h's PreviewMsg.
+// as wall_protocol/protocol.h's PreviewMsg.
 struct Preview {
     std::uint64_t generation = 0;            // of the view the tile shows
     std::int32_t width = 1, height = 1;      // 1..kMaxPreviewSide each

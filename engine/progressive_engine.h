@@ -1,8 +1,8 @@
 #pragma once
 // The progressive view-dependent engine (chapters 2-3): fills a region of one view's pixels (a
-// whole tile, or later a screen-region job) ray by ray in a progressive order until every pixel of
-// the region that the volume covers has had its ray, or until it is stopped. Each ray that finds an
-// unvisited seed starts a propagation pass; the pass's group goes at once to a group sink
+// whole screen, a wall tile or a screen-region job) ray by ray in a progressive order until every
+// pixel of the region that the volume covers has had its ray, or until it is stopped. Each ray that
+// finds an unvisited seed starts a propagation pass; the pass's group goes at once to a group sink
 // (extract/group_sink.h: drawn into the frame being built, with no clear and no redraw of older
 // groups, so drawing cost follows new triangles only; recorded for the replay; streamed to a
 // client). The engine draws nothing and sees no renderer.

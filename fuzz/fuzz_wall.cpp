@@ -17,7 +17,7 @@ namespace {
 using isowall::fuzz::check;
 
 constexpr int kMaxTileSide =
-    32768;  // protocol/protocol.h's kMaxImageSide; wall_spec/ cannot see it
+    32768;  // wall_protocol/protocol.h's kMaxImageSide; wall_spec/ cannot see it
 
 bool fits_int(std::int64_t v) {
     return v >= INT_MIN && v <= INT_MAX;
@@ -28,7 +28,7 @@ bool fits_int(std::int64_t v) {
 void check_sizes(const isowall::WallSpec& s) {
     check(s.columns >= 1 && s.rows >= 1, "at least one column and one row");
     // A tile's image travels to the master in an image message, whose sides are at most
-    // kMaxImageSide (protocol/protocol.h): a larger tile would fail only at its first frame.
+    // kMaxImageSide (wall_protocol/protocol.h): a larger tile would fail only at its first frame.
     check(s.tile_width_px >= 1 && s.tile_height_px >= 1, "positive tile size");
     check(s.tile_width_px <= kMaxTileSide && s.tile_height_px <= kMaxTileSide,
           "a tile no larger than an image message carries");

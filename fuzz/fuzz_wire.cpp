@@ -1,8 +1,8 @@
-// Harness: the wire messages (protocol/protocol.h, protocol/protocol_jobs.h). The first byte is the
-// tag (any value, so unknown tags are fuzzed too), the rest the message. A message that decodes
-// must encode back to exactly its bytes (every field is read, nothing is normalised) and decode
-// again to a message of the same tag; a decoder never allocates much more than the message holds
-// (fuzz.sh runs this harness with a small -malloc_limit_mb).
+// Harness: the wire messages (wall_protocol/protocol.h, wall_protocol/protocol_jobs.h). The first
+// byte is the tag (any value, so unknown tags are fuzzed too), the rest the message. A message that
+// decodes must encode back to exactly its bytes (every field is read, nothing is normalised) and
+// decode again to a message of the same tag; a decoder never allocates much more than the message
+// holds (fuzz.sh runs this harness with a small -malloc_limit_mb).
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fuzz/fuzz_check.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace {
 

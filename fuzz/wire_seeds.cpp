@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace {
 

@@ -21,7 +21,7 @@
 #include "core/box.h"
 #include "core/camera.h"
 #include "core/view.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -1,13 +1,13 @@
 #pragma once
-// The master's side of a store that some tile ranks cannot see (tile/remote_store.h): the answer
+// The master's side of a store that some tile ranks cannot see (tile/store_client.h): the answer
 // to each store_ask, read from the master's own copy.
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 
 #include "comm/comm.h"
-#include "protocol/protocol.h"
 #include "store/store_reader.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -55,7 +55,7 @@ struct MasterOptions {
     bool measure = false;    // tiles report emulated correctness curves
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
     // The volume when it is a store (null otherwise), and its octree file: sent to a tile rank
-    // that asks because its host cannot see them (tile/remote_store.h).
+    // that asks because its host cannot see them (tile/store_client.h).
     std::shared_ptr<const store::StoreReader> store;
     std::filesystem::path store_octree;
 };

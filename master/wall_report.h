@@ -9,7 +9,7 @@
 #include "master/dispatch_order.h"
 #include "master/job_board.h"
 #include "progressive/trace.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 #include "wall_spec/wall.h"
 
 namespace isowall {

@@ -55,12 +55,6 @@ void TraceRecorder::close() {
     open_ = false;
 }
 
-std::vector<double> TraceRecorder::cpu_by_stage() const {
-    std::vector<double> sum(std::size(kTraceStages), 0.0);
-    for (const TraceSpan& s : spans_) sum[s.stage] += s.cpu_s;
-    return sum;
-}
-
 namespace {
 
 // Opens `temporary` (staged for `path`, which errors name), lets `body` write, checks the stream.

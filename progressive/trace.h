@@ -62,8 +62,6 @@ class TraceRecorder {
         if (open_) cpu0_ -= cpu_s;
     }
     const std::vector<TraceSpan>& spans() const { return spans_; }
-    // CPU seconds per stage, summed over the spans.
-    std::vector<double> cpu_by_stage() const;
 
   private:
     std::vector<TraceSpan> spans_;

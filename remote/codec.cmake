@@ -6,7 +6,7 @@ add_library(isowall_remote_codec group_codec.cpp compact_mesh.cpp cell_codec.cpp
     encoding_choice.cpp)
 target_include_directories(isowall_remote_codec PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_codec
-    PUBLIC isowall_core isowall_extract
+    PUBLIC isowall_core isowall_wire isowall_extract
     PRIVATE isowall_warnings meshoptimizer::meshoptimizer PkgConfig::ZSTD)
 
 # Bytes a triangle, encode and decode time of each encoding on one frame's groups (not a test).

@@ -1,6 +1,6 @@
 #pragma once
 // The seam between a client of `isowall serve` and how its messages travel: a TCP connection
-// (TcpChannel, one framed byte stream) or a WebSocket (remote/web/, one frame per binary
+// (TcpChannel, one framed byte stream) or a WebSocket (remote/http/, one frame per binary
 // message). ViewServer's per-connection logic (hello, worker, interrupts) sees only this.
 //
 // Threads, as for Connection: any number of senders, one receiver, shutdown() from anywhere.

@@ -3,7 +3,7 @@
 // listens on TCP, and each connection gets two threads: a reader, which checks every message and
 // raises the stop flag when a new request arrives (Figure 4.3: a request interrupts the current
 // one at once), and a worker, which runs the connection's ServerSession on the latest request.
-// Both see the connection as a MessageChannel, so a WebSocket (remote/web/, `serve --http`)
+// Both see the connection as a MessageChannel, so a WebSocket (remote/http/, `serve --http`)
 // handed to adopt() is served by the same code as a TCP connection.
 //
 // A connection begins with a hello within hello_timeout_s: protocol version, dataset, token

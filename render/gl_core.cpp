@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -9,54 +10,15 @@
 
 #include "render/gl_functions.h"
 #include "render/renderer.h"
+#include "render/shader_sources.h"
 
 namespace isowall {
 namespace {
 
-constexpr const char* kVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-uniform mat4 model_view;
-uniform mat4 projection;
-uniform mat3 normal_matrix;
-out vec3 view_position;
-out vec3 view_normal;
-void main() {
-    vec4 p = model_view * vec4(position, 1.0);
-    view_position = p.xyz;
-    view_normal = normal_matrix * normal;
-    gl_Position = projection * p;
-}
-)";
-
-// Headlight Phong: the light sits at the eye, so the light and view directions coincide and the
-// half vector is the light direction itself. Back faces (seen through holes in an open surface)
-// get their normal flipped and a cooler colour, so inside and outside are told apart.
-constexpr const char* kFragmentShader = R"(#version 330 core
-in vec3 view_position;
-in vec3 view_normal;
-uniform bool orthographic;
-out vec4 colour;
-const vec3 kFrontColour = vec3(0.9, 0.85, 0.75);
-const vec3 kBackColour = vec3(0.6, 0.68, 0.85);
-const float kAmbient = 0.08;
-const float kDiffuse = 0.85;
-const float kSpecular = 0.25;
-const float kShininess = 40.0;
-void main() {
-    vec3 n = normalize(view_normal);
-    vec3 base = kFrontColour;
-    if (!gl_FrontFacing) {
-        n = -n;
-        base = kBackColour;
-    }
-    // An orthographic eye is at infinity along +z of view space.
-    vec3 to_light = orthographic ? vec3(0.0, 0.0, 1.0) : normalize(-view_position);
-    float lambert = max(dot(n, to_light), 0.0);
-    float highlight = kSpecular * pow(lambert, kShininess);
-    colour = vec4(base * (kAmbient + kDiffuse * lambert) + vec3(highlight), 1.0);
-}
-)";
+// The surface's shaders, one definition for this renderer and the page (render/shaders/), as
+// GLSL 3.30 core.
+const std::string kVertexShader = std::string("#version 330 core\n") + shaders::kSurfaceVert;
+const std::string kFragmentShader = std::string("#version 330 core\n") + shaders::kHeadlightFrag;
 
 std::string gl_error_name(GLenum error) {
     switch (error) {
@@ -101,8 +63,8 @@ GlCore::GlCore(std::string_view backend, GlLoader loader)
              "OpenGL 3.3 required, context has " + std::string(version ? version : "none"));
     }
 
-    const GLuint vertex = compile_shader(GL_VERTEX_SHADER, kVertexShader);
-    const GLuint fragment = compile_shader(GL_FRAGMENT_SHADER, kFragmentShader);
+    const GLuint vertex = compile_shader(GL_VERTEX_SHADER, kVertexShader.c_str());
+    const GLuint fragment = compile_shader(GL_FRAGMENT_SHADER, kFragmentShader.c_str());
     program_ = gl_->CreateProgram();
     gl_->AttachShader(program_, vertex);
     gl_->AttachShader(program_, fragment);

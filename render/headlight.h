@@ -1,7 +1,8 @@
 #pragma once
 // The headlight's shading in C++, for code that predicts a picture's colours without drawing it
-// (the remote server's choice of levels of detail, remote/lod_choice.h). Its constants are the
-// fragment shader's (gl_core.cpp; web/test/shaders.test.mjs checks that they stay so).
+// (the remote server's choice of levels of detail, remote/lod_choice.h). It computes what the
+// fragment shader (render/shaders/headlight.frag) draws: tests/renderer_test.cpp draws faces at
+// several angles, front and back, and compares the pixels with colour().
 // Headlight Phong: the light sits at the eye, so the light and view directions coincide and the
 // half vector is the light direction. A back face (seen through a hole in an open surface) gets
 // its normal flipped and a cooler colour.

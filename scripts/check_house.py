@@ -15,7 +15,7 @@ PROMPT_FILE_LINES = 800
 MAX_FUNCTION_LINES = 80
 GENERATED = {"extract/mc_tables.h"}
 FOLDERS = ["core", "files", "wire", "volume", "progressive", "wall_spec", "extract", "readers",
-           "store", "comm", "render", "display", "engine", "protocol", "cli", "tile", "master",
+           "store", "comm", "render", "display", "engine", "wall_protocol", "cli", "tile", "master",
            "remote", "app", "fuzz", "tests", "bench"]
 
 

@@ -18,7 +18,7 @@ FLOORS = [
     ["volume", "progressive", "wall_spec"],
     ["extract", "readers", "store"],
     ["comm", "render", "display", "engine"],
-    ["protocol", "cli"],
+    ["wall_protocol", "cli"],
     ["tile", "master", "remote"],
     ["app"],
 ]

@@ -329,34 +329,4 @@ bool is_store(const fs::path& path) {
            fs::exists(path / "0" / ".zarray", ec);
 }
 
-std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
-    std::string s(text);
-    std::size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(s, &used);
-    } catch (const std::exception&) {
-        return std::nullopt;
-    }
-    std::string unit = s.substr(used);
-    std::transform(unit.begin(), unit.end(), unit.begin(),
-                   [](unsigned char c) { return char(std::toupper(c)); });
-    double scale = 1;
-    if (unit.empty() || unit == "B")
-        scale = 1;
-    else if (unit == "K" || unit == "KB" || unit == "KIB")
-        scale = 1024.0;
-    else if (unit == "M" || unit == "MB" || unit == "MIB")
-        scale = 1024.0 * 1024;
-    else if (unit == "G" || unit == "GB" || unit == "GIB")
-        scale = 1024.0 * 1024 * 1024;
-    else if (unit == "T" || unit == "TB" || unit == "TIB")
-        scale = 1024.0 * 1024 * 1024 * 1024;
-    else
-        return std::nullopt;
-    const double bytes = v * scale;
-    if (!std::isfinite(bytes) || bytes < 1 || bytes > 1.8e19) return std::nullopt;
-    return static_cast<std::uint64_t>(bytes);
-}
-
 }  // namespace isowall::store

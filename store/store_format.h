@@ -132,7 +132,4 @@ std::filesystem::path store_path(const std::string& text);
 // True when `path` is a folder that looks like a store (holds .zattrs and 0/.zarray).
 bool is_store(const std::filesystem::path& path);
 
-// "512M", "8G", "1.5GiB", "1048576": bytes; nullopt for anything else (or zero).
-std::optional<std::uint64_t> parse_byte_size(std::string_view text);
-
 }  // namespace isowall::store

@@ -4,7 +4,7 @@
 
 #include "core/image_ops.h"
 #include "core/preview.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 namespace {

@@ -4,7 +4,7 @@
 // in a named namespace, so a test file that uses only some of it draws no unused-function warning.
 #pragma once
 
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,8 @@
 
 namespace isowall {
 
-// ---- equality and printing for the tests only (protocol/protocol.h stays free of them) ----------
+// ---- equality and printing for the tests only (wall_protocol/protocol.h stays free of them)
+// ----------
 
 inline bool operator==(const Camera& a, const Camera& b) {
     return a.eye == b.eye && a.target == b.target && a.up == b.up && a.projection == b.projection &&

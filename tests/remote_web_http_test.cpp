@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "remote/http/web_routes.h"
+#include "remote/http/web_server.h"
 #include "remote/net/socket.h"
-#include "remote/web/web_routes.h"
-#include "remote/web/web_server.h"
 #include "tests/remote_web_util.h"
 
 namespace isowall::test {

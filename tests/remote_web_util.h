@@ -5,7 +5,7 @@
 #include <map>
 #include <string>
 
-#include "remote/web/http_front.h"
+#include "remote/http/http_front.h"
 #include "tests/remote_view_util.h"
 
 namespace isowall::test {

@@ -17,6 +17,7 @@
 #include "core/image.h"
 #include "core/mesh.h"
 #include "files/image_io.h"
+#include "render/headlight.h"
 #include "render/renderer.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
@@ -391,6 +392,40 @@ TEST(Renderer, BackFacesAreLitInTheirOwnColour) {
         EXPECT_GT(front[0], front[2]);
         EXPECT_GT(back[2], back[0]);
         EXPECT_GT(back[2], 180) << "back face is not lit";
+    }
+}
+
+// render/headlight.h is the C++ twin of the fragment shader (render/shaders/headlight.frag), for
+// a server that predicts a picture's colours without drawing it: what GL draws for a face whose
+// shading normal meets the eye at a given angle, front or back, is headlight::colour's, to the
+// 8-bit rounding. Orthographic, so the light's direction is the view's everywhere.
+TEST(Renderer, HeadlightColoursAreTheShadersOwn) {
+    constexpr int kSide = 16;
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        auto renderer = make_renderer(backend);
+        for (const float deg : {0.0f, 25.0f, 50.0f, 75.0f, 88.0f}) {
+            for (const bool front : {true, false}) {
+                SCOPED_TRACE(testing::Message()
+                             << deg << " degrees, " << (front ? "front" : "back"));
+                const float a = glm::radians(deg);
+                const float z = front ? 1.0f : -1.0f;
+                Mesh quad;
+                quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+                // The shading normal leans from the face's own normal (+z front, -z back).
+                quad.normals.assign(4, glm::vec3(std::sin(a), 0, z * std::cos(a)));
+                quad.indices = front ? std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}
+                                     : std::vector<std::uint32_t>{0, 2, 1, 0, 3, 2};
+                Camera camera = looking_down_z(3.0f, Projection::orthographic, quad.bounds());
+                camera.ortho_height = 1.0f;
+                const Image image = render(*renderer, quad, camera, kSide, kSide);
+                ASSERT_TRUE(image.covered(kSide / 2, kSide / 2));
+                const std::uint8_t* got = pixel(image, kSide / 2, kSide / 2);
+                const glm::vec3 want = glm::clamp(headlight::colour(z * std::cos(a)), 0.0f, 1.0f);
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(double(got[c]), double(want[c]) * 255.0, 1.0) << "channel " << c;
+            }
+        }
     }
 }
 

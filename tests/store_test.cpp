@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/number.h"
 #include "extract/surface_extractor.h"
 #include "store/open_store.h"
 #include "store/store_writer.h"
@@ -34,7 +35,7 @@ void expect_line(const std::function<void()>& f, std::initializer_list<std::stri
     }
 }
 
-TEST(StoreFormat, ByteSizesParseAndNonsenseDoesNot) {
+TEST(ByteSize, ByteSizesParseAndNonsenseDoesNot) {
     EXPECT_EQ(parse_byte_size("512M"), 512ull << 20);
     EXPECT_EQ(parse_byte_size("8G"), 8ull << 30);
     EXPECT_EQ(parse_byte_size("1.5GiB"), 3ull << 29);

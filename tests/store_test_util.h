@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the store tests (store_test.cpp, remote_store_test.cpp).
+// Shared by the store tests (store_test.cpp, store_client_test.cpp).
 #include <cstdint>
 #include <vector>
 

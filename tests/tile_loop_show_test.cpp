@@ -8,11 +8,11 @@
 #include <mutex>
 
 #include "comm/inproc_comm.h"
-#include "protocol/protocol.h"
 #include "render/renderer.h"
 #include "tests/engine_util.h"
 #include "tile/tile_loop.h"
 #include "volume/phantom.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 namespace {

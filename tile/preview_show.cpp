@@ -1,7 +1,7 @@
 #include "tile/preview_show.h"
 
 #include "core/preview.h"
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -12,7 +12,7 @@
 #include <mutex>
 #include <optional>
 
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -22,8 +22,8 @@
 
 #include "core/box.h"
 #include "engine/progressive_engine.h"
-#include "protocol/protocol.h"
 #include "render/renderer_sink.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 

@@ -13,7 +13,7 @@
 #include "core/pacer.h"
 #include "core/util.h"
 #include "progressive/trace.h"
-#include "tile/remote_store.h"
+#include "tile/store_client.h"
 #include "tile/tile_inbox.h"
 #include "tile/tile_jobs.h"
 #include "tile/tile_receiver.h"
@@ -40,7 +40,7 @@ class TileRank {
             comm_, kMasterRank,
             TileHelloMsg{comm_.host(),
                          static_cast<std::uint32_t>(std::max(1, setup_.engine.threads)), true});
-        Receiver receiver(comm_, inbox_, setup_.timeout_s, setup_.remote_store);
+        Receiver receiver(comm_, inbox_, setup_.timeout_s, setup_.store_client);
         bool quit = false;
         for (;;) {
             trace_.switch_to(Stage::idle);

@@ -19,7 +19,7 @@
 
 namespace isowall {
 
-class RemoteStore;  // tile/remote_store.h
+class StoreClient;  // tile/store_client.h
 
 struct TileSetup {
     SurfaceExtractor& extractor;
@@ -37,7 +37,7 @@ struct TileSetup {
     // charged to the trace's io stage; empty for a volume in memory.
     std::function<double()> io_cpu_s = {};
     // The store's chunks when this rank's host cannot see it: the master's answers go here.
-    RemoteStore* remote_store = nullptr;
+    StoreClient* store_client = nullptr;
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

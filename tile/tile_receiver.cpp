@@ -8,9 +8,9 @@
 #include <string>
 
 #include "core/util.h"
-#include "protocol/protocol.h"
-#include "tile/remote_store.h"
+#include "tile/store_client.h"
 #include "tile/tile_loop.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 namespace {
@@ -20,7 +20,7 @@ constexpr double kReceivePollS = 0.05;
 
 }  // namespace
 
-Receiver::Receiver(Comm& comm, TileInbox& inbox, double timeout_s, RemoteStore* store)
+Receiver::Receiver(Comm& comm, TileInbox& inbox, double timeout_s, StoreClient* store)
     : comm_(comm), inbox_(inbox), timeout_s_(timeout_s), store_(store), thread_([this] {
           loop();
       }) {}

@@ -10,7 +10,7 @@
 
 namespace isowall {
 
-class RemoteStore;  // tile/remote_store.h
+class StoreClient;  // tile/store_client.h
 
 // The communication thread: every message for this rank into the inbox, until release (the last
 // message a master sends a tile) or until told to end. It tells the master it is alive every
@@ -19,7 +19,7 @@ class RemoteStore;  // tile/remote_store.h
 // that error, so the frame thread reports it.
 class Receiver {
   public:
-    Receiver(Comm& comm, TileInbox& inbox, double timeout_s, RemoteStore* store);
+    Receiver(Comm& comm, TileInbox& inbox, double timeout_s, StoreClient* store);
     ~Receiver();
     // The CPU seconds this thread has used so far (its clock read from the frame thread; once
     // it has ended, its last reading).
@@ -33,7 +33,7 @@ class Receiver {
     Comm& comm_;
     TileInbox& inbox_;
     double timeout_s_;
-    RemoteStore* store_;
+    StoreClient* store_;
     std::atomic<bool> ending_{false};
     std::atomic<double> final_cpu_s_{0};  // this thread's clock when it took the release or failed
     std::thread thread_;

@@ -82,7 +82,7 @@ function getIntIn(r, field, lo, hi) {
   return v;
 }
 
-// ---- frame view (wire/wire_pieces.cpp) -------------------------------------------------------
+// ---- frame view (wire/message_fields.cpp) -------------------------------------------------------
 
 function getProjection(r, field) {
   const v = r.i32();

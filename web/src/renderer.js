@@ -1,52 +1,13 @@
-// WebGL2 drawing with the shaders of render/gl_core.cpp (headlight Phong, front and back colours),
-// ported to GLSL ES 3.00: depth test LESS, no culling (open surfaces show both sides), black
-// background, drawing straight into the canvas (preserveDrawingBuffer keeps it between frames).
+// WebGL2 drawing with the surface's shaders (render/shaders/: headlight Phong, front and back
+// colours) as GLSL ES 3.00 (src/shaders.js, made by tools/shaders.mjs): depth test LESS, no
+// culling (open surfaces show both sides), black background, drawing straight into the canvas
+// (preserveDrawingBuffer keeps it between frames).
 // Each mesh is uploaded once (positions, normals, uint32 indices) and kept while the client holds
 // it; collect() frees the buffers of meshes no longer held.
 import { normalMatrix } from './camera.js';
+import { kFragmentShader, kVertexShader } from './shaders.js';
 
-export const kVertexShader = `#version 300 es
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-uniform mat4 model_view;
-uniform mat4 projection;
-uniform mat3 normal_matrix;
-out vec3 view_position;
-out vec3 view_normal;
-void main() {
-    vec4 p = model_view * vec4(position, 1.0);
-    view_position = p.xyz;
-    view_normal = normal_matrix * normal;
-    gl_Position = projection * p;
-}
-`;
-
-export const kFragmentShader = `#version 300 es
-precision highp float;
-in vec3 view_position;
-in vec3 view_normal;
-uniform bool orthographic;
-out vec4 colour;
-const vec3 kFrontColour = vec3(0.9, 0.85, 0.75);
-const vec3 kBackColour = vec3(0.6, 0.68, 0.85);
-const float kAmbient = 0.08;
-const float kDiffuse = 0.85;
-const float kSpecular = 0.25;
-const float kShininess = 40.0;
-void main() {
-    vec3 n = normalize(view_normal);
-    vec3 base = kFrontColour;
-    if (!gl_FrontFacing) {
-        n = -n;
-        base = kBackColour;
-    }
-    // A headlight: the light sits at the eye (perspective) or shines along the view (orthographic).
-    vec3 to_light = orthographic ? vec3(0.0, 0.0, 1.0) : normalize(-view_position);
-    float lambert = max(dot(n, to_light), 0.0);
-    float highlight = kSpecular * pow(lambert, kShininess);
-    colour = vec4(base * (kAmbient + kDiffuse * lambert) + vec3(highlight), 1.0);
-}
-`;
+export { kFragmentShader, kVertexShader };
 
 export class RendererError extends Error {}
 

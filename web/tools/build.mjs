@@ -3,9 +3,10 @@
 // wall.html and wall.css. Deterministic: the same sources give the same bytes.
 // `node tools/build.mjs DIR` builds into DIR instead (tools/check_dist.mjs compares the two).
 import { build } from 'esbuild';
-import { copyFileSync, mkdirSync, readdirSync, rmSync } from 'node:fs';
+import { copyFileSync, mkdirSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { kShadersModule, shadersModule } from './shaders.mjs';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
 const dist = process.argv[2] ? resolve(process.argv[2]) : join(root, 'dist');
@@ -33,6 +34,9 @@ async function style(entry, out) {
   await build({ entryPoints: [join(root, entry)], outfile: join(dist, out), minify: true, logLevel: 'warning' });
 }
 
+// The shaders first: src/shaders.js is made from render/shaders/ (tools/shaders.mjs).
+const shaders = shadersModule();
+if (readFileSync(kShadersModule, { encoding: 'utf8', flag: 'a+' }) !== shaders) writeFileSync(kShadersModule, shaders);
 await bundle('src/main.js', 'app.js');
 await style('src/app.css', 'app.css');
 // The wall's page (isowall wall --http).

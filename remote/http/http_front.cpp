@@ -1,8 +1,8 @@
-#include "remote/web/http_front.h"
+#include "remote/http/http_front.h"
 
 #include "core/error.h"
+#include "remote/http/web_routes.h"
 #include "remote/view_framing.h"
-#include "remote/web/web_routes.h"
 
 namespace isowall::remote {
 

@@ -1,7 +1,7 @@
 // The store messages (tags 12..14): a tile rank that cannot see the store asks the master for its
 // metadata, octree and chunks. Each encoder sits right above its decoder; the decoders check
 // what the tile will use (the part, the sizes) so that no caller repeats the checks.
-#include "protocol/protocol_store.h"
+#include "wall_protocol/protocol_store.h"
 
 #include <string>
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "remote/web/web_server.h"
+#include "remote/http/web_server.h"
 
 namespace isowall::web {
 

@@ -11,8 +11,8 @@
 #include <string_view>
 #include <vector>
 
-#include "remote/web/web_assets.h"
-#include "remote/web/web_server.h"
+#include "remote/http/web_assets.h"
+#include "remote/http/web_server.h"
 
 namespace isowall::remote {
 

@@ -1,7 +1,8 @@
 #pragma once
-// Pieces of the wire format shared by several messages (protocol/protocol.cpp and
-// protocol/protocol_jobs.cpp): cameras, frustums, frame views and pixel rectangles, each written
-// and read with its value checks, so that every message carrying one checks it the same way.
+// Pieces of the wire format shared by several messages (wall_protocol/protocol.cpp and
+// wall_protocol/protocol_jobs.cpp): cameras, frustums, frame views and pixel rectangles, each
+// written and read with its value checks, so that every message carrying one checks it the same
+// way.
 #include <cstdint>
 #include <string>
 
@@ -10,7 +11,7 @@
 #include "core/view.h"
 #include "wire/wire.h"
 
-namespace isowall::wire_pieces {
+namespace isowall::message_fields {
 
 // A NaN or an infinity in a camera, frustum or isovalue gives a blank or garbage tile with no
 // error anywhere, so the wire refuses them and names the field.
@@ -41,4 +42,4 @@ void put_pixels(MessageWriter& w, const std::vector<std::uint8_t>& rgba,
 void get_pixels(MessageReader& r, std::uint64_t pixels, bool depth_optional,
                 std::vector<std::uint8_t>& rgba, std::vector<float>& depth);
 
-}  // namespace isowall::wire_pieces
+}  // namespace isowall::message_fields

@@ -1,10 +1,10 @@
 // WebServer (web_server.h): the endpoint of web_endpoint.cpp, plain or TLS, behind one face.
 // Built as C++17 with the rest of isowall_remote_web.
-#include "remote/web/web_server.h"
+#include "remote/http/web_server.h"
 
 #include <utility>
 
-#include "remote/web/web_endpoint.h"
+#include "remote/http/web_endpoint.h"
 
 namespace isowall::web {
 

@@ -1,15 +1,15 @@
 // The screen-region scheduler's messages (tags 16..19), and release, start and alive (8..10), each
 // encoder right above its decoder, with the same value checks as the frame messages in
 // protocol.cpp.
-#include "protocol/protocol_jobs.h"
+#include "wall_protocol/protocol_jobs.h"
 
 #include <string>
 
-#include "wire/wire_pieces.h"
+#include "wire/message_fields.h"
 
 namespace isowall {
 
-using namespace wire_pieces;
+using namespace message_fields;
 
 std::vector<std::byte> encode(const ReleaseMsg&) {
     return MessageWriter(ReleaseMsg::kVersion).take();

@@ -1,10 +1,10 @@
 #pragma once
-// The decoders of the scheduler's messages (protocol/protocol_jobs.cpp), for decode_message only:
-// callers decode through decode_message, which picks one by tag.
+// The decoders of the scheduler's messages (wall_protocol/protocol_jobs.cpp), for decode_message
+// only: callers decode through decode_message, which picks one by tag.
 #include <cstddef>
 #include <span>
 
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall::job_wire {
 

@@ -2,9 +2,9 @@
 // A tile rank's store when its host cannot see the folder (a display node without the shared file
 // system, as on the dissertation's wall): the store's metadata and octree come from the master at
 // start-up, and while frames run every chunk the rank's pager needs comes from the master too
-// (protocol/protocol.h: store_ask, store_meta, store_part). The chunks arrive compressed, as on the
-// master's disk, and the reader checks each as if it had read it: a damaged chunk is still one
-// line naming the store and the chunk.
+// (wall_protocol/protocol.h: store_ask, store_meta, store_part). The chunks arrive compressed, as
+// on the master's disk, and the reader checks each as if it had read it: a damaged chunk is still
+// one line naming the store and the chunk.
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
@@ -16,15 +16,15 @@
 #include <vector>
 
 #include "comm/comm.h"
-#include "protocol/protocol.h"
 #include "store/store_reader.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 
-class RemoteStore {
+class StoreClient {
   public:
     // `timeout_s`: how long one answer may take (--timeout) before the rank gives up.
-    RemoteStore(Comm& comm, double timeout_s) : comm_(comm), timeout_s_(timeout_s) {}
+    StoreClient(Comm& comm, double timeout_s) : comm_(comm), timeout_s_(timeout_s) {}
 
     // At start-up, before the communication thread runs (this thread receives): the master's
     // store named `name`, with its octree copied into the folder `dir` (octree_file(); a copy of

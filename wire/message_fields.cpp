@@ -1,10 +1,10 @@
-#include "wire/wire_pieces.h"
+#include "wire/message_fields.h"
 
 #include <cmath>
 
 #include "core/image.h"
 
-namespace isowall::wire_pieces {
+namespace isowall::message_fields {
 namespace {
 
 glm::vec3 get_finite_vec3(MessageReader& r, const char* field) {
@@ -160,4 +160,4 @@ void get_pixels(MessageReader& r, std::uint64_t pixels, bool depth_optional,
                std::to_string(pixels) + " values, got " + std::to_string(depth.size()));
 }
 
-}  // namespace isowall::wire_pieces
+}  // namespace isowall::message_fields

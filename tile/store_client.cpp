@@ -1,4 +1,4 @@
-#include "tile/remote_store.h"
+#include "tile/store_client.h"
 
 #include <chrono>
 #include <cstdio>
@@ -23,7 +23,7 @@ std::string seconds(double s) {
 
 }  // namespace
 
-Message RemoteStore::ask_now(const StoreAskMsg& ask) {
+Message StoreClient::ask_now(const StoreAskMsg& ask) {
     send_message(comm_, kMasterRank, ask);
     Stopwatch waited;
     while (waited.seconds() < timeout_s_) {
@@ -44,7 +44,7 @@ Message RemoteStore::ask_now(const StoreAskMsg& ask) {
                              seconds(timeout_s_) + " (--timeout)");
 }
 
-std::shared_ptr<const store::StoreReader> RemoteStore::open(const std::string& name,
+std::shared_ptr<const store::StoreReader> StoreClient::open(const std::string& name,
                                                             const std::filesystem::path& dir) {
     const StoreMetaMsg meta = std::get<StoreMetaMsg>(ask_now({StorePart::meta, 0}));
     if (!meta.is_store)
@@ -64,7 +64,7 @@ std::shared_ptr<const store::StoreReader> RemoteStore::open(const std::string& n
     return reader;
 }
 
-void RemoteStore::copy_octree(const StoreMetaMsg& meta, const std::filesystem::path& octree) {
+void StoreClient::copy_octree(const StoreMetaMsg& meta, const std::filesystem::path& octree) {
     std::error_code ec;
     if (std::filesystem::file_size(octree, ec) == meta.octree_bytes && !ec) return;
     if (meta.octree_bytes == 0) return;  // none on the master yet: this rank builds its own
@@ -98,7 +98,7 @@ void RemoteStore::copy_octree(const StoreMetaMsg& meta, const std::filesystem::p
     if (ec) std::filesystem::remove(tmp, ec);
 }
 
-std::vector<std::byte> RemoteStore::chunk(glm::ivec3 b) {
+std::vector<std::byte> StoreClient::chunk(glm::ivec3 b) {
     const std::uint64_t index = layout_.brick_index(b);
     std::unique_lock lock(mutex_);
     if (failed_) throw std::runtime_error(*failed_);
@@ -122,7 +122,7 @@ std::vector<std::byte> RemoteStore::chunk(glm::ivec3 b) {
     return bytes;
 }
 
-void RemoteStore::deliver(StorePartMsg&& part) {
+void StoreClient::deliver(StorePartMsg&& part) {
     std::lock_guard lock(mutex_);
     auto it = waiting_.find(part.index);
     if (part.part != StorePart::chunk || it == waiting_.end() || it->second)
@@ -132,13 +132,13 @@ void RemoteStore::deliver(StorePartMsg&& part) {
     arrived_.notify_all();
 }
 
-void RemoteStore::fail(const std::string& why) {
+void StoreClient::fail(const std::string& why) {
     std::lock_guard lock(mutex_);
     if (!failed_) failed_ = why;
     arrived_.notify_all();
 }
 
-std::uint64_t RemoteStore::chunks_fetched() const {
+std::uint64_t StoreClient::chunks_fetched() const {
     std::lock_guard lock(mutex_);
     return fetched_;
 }

@@ -1,4 +1,4 @@
-// A store read by a rank that cannot see it (bricks over MPI): the tile's RemoteStore
+// A store read by a rank that cannot see it (bricks over MPI): the tile's StoreClient
 // asks, the master's answer_store_ask answers, over the in-process transport. Every voxel comes
 // back as imported, the octree is copied, and each failure is one line: a master whose volume is
 // not a store, a damaged chunk on the master, a master that does not answer, an answer nobody
@@ -16,7 +16,7 @@
 #include "store/store_writer.h"
 #include "tests/store_test_util.h"
 #include "tests/test_util.h"
-#include "tile/remote_store.h"
+#include "tile/store_client.h"
 #include "wire/wire.h"
 
 namespace isowall {
@@ -50,9 +50,9 @@ void serve(Comm& comm, const store::StoreReader* store, const fs::path& octree) 
     }
 }
 
-// Rank 1's communication thread, as the tile's Receiver does it: store parts to the RemoteStore.
+// Rank 1's communication thread, as the tile's Receiver does it: store parts to the StoreClient.
 struct Delivery {
-    Delivery(Comm& comm, RemoteStore& r)
+    Delivery(Comm& comm, StoreClient& r)
         : thread([&comm, &r, this] {
               while (!done) {
                   auto e = comm.receive(0, 0.02);
@@ -68,7 +68,7 @@ struct Delivery {
     std::thread thread;
 };
 
-TEST(RemoteStore, EveryVoxelAndTheOctreeComeFromTheMaster) {
+TEST(StoreClient, EveryVoxelAndTheOctreeComeFromTheMaster) {
     const Volume v = pattern_volume({150, 130, 100});
     const fs::path path = make_store(v, "remote_store");
     const store::StoreReader local(path);
@@ -78,7 +78,7 @@ TEST(RemoteStore, EveryVoxelAndTheOctreeComeFromTheMaster) {
     std::thread master([&] { serve(*world.comm(0), &local, store::octree_file(path)); });
     {
         auto comm = world.comm(1);
-        RemoteStore remote(*comm, 30);
+        StoreClient remote(*comm, 30);
         auto reader = remote.open("far/store", cache);
         EXPECT_EQ(reader->layout().dims, v.dims());
         EXPECT_EQ(reader->bytes_on_disk(), local.bytes_on_disk());
@@ -102,11 +102,11 @@ TEST(RemoteStore, EveryVoxelAndTheOctreeComeFromTheMaster) {
     std::printf("%llu chunks fetched from the master\n", static_cast<unsigned long long>(fetched));
 }
 
-TEST(RemoteStore, AMasterWhoseVolumeIsNotAStoreIsOneLine) {
+TEST(StoreClient, AMasterWhoseVolumeIsNotAStoreIsOneLine) {
     InProcWorld world(2);
     std::thread master([&] { serve(*world.comm(0), nullptr, {}); });
     auto comm = world.comm(1);
-    RemoteStore remote(*comm, 30);
+    StoreClient remote(*comm, 30);
     try {
         remote.open("/data/head.nrrd", test::scratch_dir("remote_not_store"));
         ADD_FAILURE() << "no error";
@@ -119,7 +119,7 @@ TEST(RemoteStore, AMasterWhoseVolumeIsNotAStoreIsOneLine) {
     master.join();
 }
 
-TEST(RemoteStore, ADamagedChunkOnTheMasterNamesTheStoreAndTheChunk) {
+TEST(StoreClient, ADamagedChunkOnTheMasterNamesTheStoreAndTheChunk) {
     const fs::path path = make_store(pattern_volume({70, 40, 40}), "remote_damaged");
     const store::StoreReader local(path);
     fs::remove(path / store::chunk_key({1, 0, 0}));
@@ -156,19 +156,19 @@ TEST(RemoteStore, ADamagedChunkOnTheMasterNamesTheStoreAndTheChunk) {
     EXPECT_THROW(answer_store_ask({StorePart::chunk, 0}, nullptr, {}), WireError);
 }
 
-TEST(RemoteStore, AMasterThatDoesNotAnswerAndAnAnswerNobodyAskedForAreErrors) {
+TEST(StoreClient, AMasterThatDoesNotAnswerAndAnAnswerNobodyAskedForAreErrors) {
     const fs::path path = make_store(pattern_volume({40, 40, 40}), "remote_silent");
     const store::StoreReader local(path);
     InProcWorld world(2);
     std::thread master([&] { serve(*world.comm(0), &local, store::octree_file(path)); });
     auto comm = world.comm(1);
     {
-        RemoteStore opened(*comm, 30);  // the open's answers may take a while under sanitizers
+        StoreClient opened(*comm, 30);  // the open's answers may take a while under sanitizers
         (void)opened.open("far", path.parent_path() / "cache");
     }
     send_message(*comm, 0, QuitMsg{});
     master.join();
-    RemoteStore remote(*comm, 0.3);
+    StoreClient remote(*comm, 0.3);
     // The master has stopped answering: the chunk's wait ends at the timeout, naming the chunk.
     try {
         remote.chunk({0, 0, 0});

@@ -1,4 +1,4 @@
-#include "remote/web/web_routes.h"
+#include "remote/http/web_routes.h"
 
 #include <array>
 #include <cstdio>

@@ -1,7 +1,7 @@
 # isowall_remote_web: HTTP and WebSocket on one port for `isowall serve --http`, through
 # Debian's websocketpp 0.8.2 over standalone asio. websocketpp does not compile as C++20, so this
 # target is C++17 and its header (web_server.h) includes neither library; the C++20 side
-# (isowall_remote_http in http.cmake) sees only callbacks and bytes.
+# (isowall_remote_http below) sees only callbacks and bytes.
 find_path(WEBSOCKETPP_INCLUDE_DIR websocketpp/server.hpp REQUIRED)
 find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)
 

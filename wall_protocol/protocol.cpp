@@ -2,11 +2,11 @@
 // other. Decoders check values, not only lengths: a message that decodes is one the receiver can
 // use as is (sizes within limits, the region inside its screen, finite camera numbers), so no
 // caller repeats the checks and none forgets them.
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
-#include "protocol/protocol_jobs.h"
-#include "protocol/protocol_store.h"
-#include "wire/wire_pieces.h"
+#include "wall_protocol/protocol_jobs.h"
+#include "wall_protocol/protocol_store.h"
+#include "wire/message_fields.h"
 
 #include <cmath>
 #include <iterator>
@@ -16,7 +16,7 @@
 
 namespace isowall {
 
-using namespace wire_pieces;
+using namespace message_fields;
 
 namespace {
 

@@ -1,10 +1,10 @@
 #pragma once
-// The decoders of the store messages (protocol/protocol_store.cpp), for decode_message only:
+// The decoders of the store messages (wall_protocol/protocol_store.cpp), for decode_message only:
 // callers decode through decode_message, which picks one by tag.
 #include <cstddef>
 #include <span>
 
-#include "protocol/protocol.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall::store_wire {
 

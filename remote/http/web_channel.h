@@ -15,9 +15,9 @@
 #include <mutex>
 #include <string>
 
+#include "remote/http/web_server.h"
 #include "remote/message_channel.h"
 #include "remote/net/token_bucket.h"
-#include "remote/web/web_server.h"
 
 namespace isowall::remote {
 

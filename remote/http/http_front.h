@@ -7,9 +7,9 @@
 #include <memory>
 #include <mutex>
 
+#include "remote/http/web_channel.h"
+#include "remote/http/web_server.h"
 #include "remote/view_server.h"
-#include "remote/web/web_channel.h"
-#include "remote/web/web_server.h"
 
 namespace isowall::remote {
 

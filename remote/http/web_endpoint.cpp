@@ -1,6 +1,6 @@
 // websocketpp behind web_server.h, plain or TLS. Built as C++17 (websocketpp 0.8.2 is not C++20
 // code).
-#include "remote/web/web_endpoint.h"
+#include "remote/http/web_endpoint.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "remote/web/web_channel.h"
+#include "remote/http/web_channel.h"
 
 #include "remote/net/tcp_progress.h"
 

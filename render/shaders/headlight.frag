@@ -1,0 +1,27 @@
+// Headlight Phong: the light sits at the eye, so the light and view directions coincide and the
+// half vector is the light direction itself. Back faces (seen through holes in an open surface)
+// get their normal flipped and a cooler colour, so inside and outside are told apart.
+// render/headlight.h computes the same colours in C++ (tests/renderer_test.cpp draws both).
+in vec3 view_position;
+in vec3 view_normal;
+uniform bool orthographic;
+out vec4 colour;
+const vec3 kFrontColour = vec3(0.9, 0.85, 0.75);
+const vec3 kBackColour = vec3(0.6, 0.68, 0.85);
+const float kAmbient = 0.08;
+const float kDiffuse = 0.85;
+const float kSpecular = 0.25;
+const float kShininess = 40.0;
+void main() {
+    vec3 n = normalize(view_normal);
+    vec3 base = kFrontColour;
+    if (!gl_FrontFacing) {
+        n = -n;
+        base = kBackColour;
+    }
+    // An orthographic eye is at infinity along +z of view space.
+    vec3 to_light = orthographic ? vec3(0.0, 0.0, 1.0) : normalize(-view_position);
+    float lambert = max(dot(n, to_light), 0.0);
+    float highlight = kSpecular * pow(lambert, kShininess);
+    colour = vec4(base * (kAmbient + kDiffuse * lambert) + vec3(highlight), 1.0);
+}

@@ -1,0 +1,14 @@
+// The surface's vertex shader: positions to view space, normals by the normal matrix.
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+uniform mat4 model_view;
+uniform mat4 projection;
+uniform mat3 normal_matrix;
+out vec3 view_position;
+out vec3 view_normal;
+void main() {
+    vec4 p = model_view * vec4(position, 1.0);
+    view_position = p.xyz;
+    view_normal = normal_matrix * normal;
+    gl_Position = projection * p;
+}
