@@ -329,28 +329,6 @@ static ByeMsg decode_bye(std::span<const std::byte> bytes) {
     return {};
 }
 
-// ---- dispatch ----------------------------------------------------------------------------------
-
-ErrorMsg make_error(ErrorCode code, std::string_view text) {
-    ErrorMsg m{code, std::string(text.substr(0, kMaxErrorTextBytes))};
-    for (char& c : m.text)
-        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
-    return m;
-}
-
-const char* to_string(RemoteTag type) {
-    static constexpr const char* kNames[] = {"hello",   "ready",        "request", "group",
-                                             "visible", "end_of_frame", "error",   "bye",
-                                             "session", "decode_rate",  "exact"};
-    static_assert(std::size(kNames) == kLastRemoteTag, "a name for every message type");
-    const auto t = static_cast<std::size_t>(type);
-    return t >= 1 && t <= kLastRemoteTag ? kNames[t - 1] : "unknown";
-}
-
-std::vector<std::byte> encode_payload(const RemoteMessage& m) {
-    return std::visit([](const auto& msg) { return encode(msg); }, m);
-}
-
 // ---- the messages that carry groups ---------------------------------------------------------
 
 // A group's bytes (GroupMsg::encoded, ExactMsg::bits): checked against kMaxGroupBytes before a
@@ -417,6 +395,28 @@ static ExactMsg decode_exact(std::span<const std::byte> bytes) {
     m.bits = get_group_bytes(r, "bits");
     r.finish();
     return m;
+}
+
+// ---- dispatch ----------------------------------------------------------------------------------
+
+ErrorMsg make_error(ErrorCode code, std::string_view text) {
+    ErrorMsg m{code, std::string(text.substr(0, kMaxErrorTextBytes))};
+    for (char& c : m.text)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+    return m;
+}
+
+const char* to_string(RemoteTag type) {
+    static constexpr const char* kNames[] = {"hello",   "ready",        "request", "group",
+                                             "visible", "end_of_frame", "error",   "bye",
+                                             "session", "decode_rate",  "exact"};
+    static_assert(std::size(kNames) == kLastRemoteTag, "a name for every message type");
+    const auto t = static_cast<std::size_t>(type);
+    return t >= 1 && t <= kLastRemoteTag ? kNames[t - 1] : "unknown";
+}
+
+std::vector<std::byte> encode_payload(const RemoteMessage& m) {
+    return std::visit([](const auto& msg) { return encode(msg); }, m);
 }
 
 RemoteTag type_of(const RemoteMessage& m) {
