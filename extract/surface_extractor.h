@@ -2,7 +2,7 @@
 // One volume with its octree, behind a voxel-type-free interface: the per-type cores (RayCaster,
 // Propagator, extract_full) are instantiated once per voxel type in surface_extractor.cpp, so
 // callers (the progressive engine, the CLI, the wall) are not templates. Inside, an extractor is
-// shared read-only data, one frame state and per-thread workers (extractor_parts.h).
+// shared read-only data, one frame state and per-thread workers (surface_extractor.cpp).
 #include <cstdint>
 #include <functional>
 #include <limits>

@@ -10,4 +10,4 @@ add_library(isowall_remote_view
     ${CMAKE_CURRENT_LIST_DIR}/client_frames.cpp ${CMAKE_CURRENT_LIST_DIR}/view_client.cpp)
 target_include_directories(isowall_remote_view PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(isowall_remote_view
-    PUBLIC isowall_engine isowall_remote_codec isowall_remote_net PRIVATE isowall_warnings)
+    PUBLIC isowall_engine isowall_renderer isowall_remote_codec isowall_remote_net PRIVATE isowall_warnings)
