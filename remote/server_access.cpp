@@ -2,6 +2,8 @@
 // addresses, and what an address off loopback needs (TLS and a token).
 #include "remote/view_server.h"
 
+#include "remote/net/endpoint.h"
+
 namespace isowall::remote {
 
 bool same_token(const std::string& a, const std::string& b) {
@@ -12,12 +14,8 @@ bool same_token(const std::string& a, const std::string& b) {
     return diff == 0;
 }
 
-bool is_loopback(const std::string& address) {
-    return address == "localhost" || address == "::1" || address.rfind("127.", 0) == 0;
-}
-
 std::string exposure_problem(const ServerOptions& o, const std::string& what) {
-    if (is_loopback(o.address) || (!o.token.empty() && o.tls)) return "";
+    if ((!o.token.empty() && o.tls) || listens_on_loopback_only(o.address)) return "";
     return what + " on " + o.address +
            " (not loopback) needs TLS (--tls-cert and --tls-key) and --token, which every "
            "client must present: anyone on the path could read the surfaces and the token";

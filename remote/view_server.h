@@ -43,8 +43,6 @@ namespace isowall::remote {
 
 // Equal tokens, in time that does not depend on where they differ.
 bool same_token(const std::string& a, const std::string& b);
-// Whether listening on `address` reaches this machine only (no token needed there).
-bool is_loopback(const std::string& address);
 
 struct Dataset {
     std::string name;  // what a hello names

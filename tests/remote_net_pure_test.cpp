@@ -1,6 +1,10 @@
 // The pure parts of remote/net/: the emulated link's token bucket (delays, burst, debt, the
-// long-run rate) on a clock the test keeps, and HOST:PORT endpoints, good and bad.
+// long-run rate) on a clock the test keeps, HOST:PORT endpoints, good and bad, and which
+// addresses and listen names reach this machine only.
 #include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
 
 #include <limits>
 #include <random>
@@ -145,6 +149,37 @@ TEST(Endpoint, ErrorSaysWhatWasWrong) {
         << message("h:70000");
     EXPECT_NE(message("::1:5").find("brackets"), std::string::npos) << message("::1:5");
     EXPECT_NE(message("nohost").find("expected HOST:PORT"), std::string::npos) << message("nohost");
+}
+
+sockaddr_storage address(const char* text) {
+    sockaddr_storage s{};
+    if (auto* v4 = reinterpret_cast<sockaddr_in*>(&s);
+        ::inet_pton(AF_INET, text, &v4->sin_addr) == 1) {
+        v4->sin_family = AF_INET;
+        return s;
+    }
+    auto* v6 = reinterpret_cast<sockaddr_in6*>(&s);
+    EXPECT_EQ(::inet_pton(AF_INET6, text, &v6->sin6_addr), 1) << text;
+    v6->sin6_family = AF_INET6;
+    return s;
+}
+
+TEST(Loopback, AnAddressIsLoopbackBy127Slash8OrIpv6sOwn) {
+    for (const char* yes : {"127.0.0.1", "127.255.3.4", "::1", "::ffff:127.0.0.1"})
+        EXPECT_TRUE(is_loopback_address(address(yes))) << yes;
+    for (const char* no : {"0.0.0.0", "10.0.0.1", "128.0.0.1", "::", "::ffff:10.0.0.1", "fe80::1"})
+        EXPECT_FALSE(is_loopback_address(address(no))) << no;
+    EXPECT_FALSE(is_loopback_address(sockaddr_storage{}));  // no family
+}
+
+// The gate decides on what a name resolves to, never on its spelling: a name that starts with
+// "127." or "localhost" may resolve anywhere (scripts/loopback_gate_test.sh maps one to
+// 0.0.0.0), and one that resolves to nothing is not loopback either.
+TEST(Loopback, AListenNameIsLoopbackOnlyWhenEveryAddressItResolvesToIs) {
+    for (const char* yes : {"127.0.0.1", "127.1.2.3", "::1", "localhost"})
+        EXPECT_TRUE(listens_on_loopback_only(yes)) << yes;
+    for (const char* no : {"0.0.0.0", "::", "", "127.example.invalid", "localhost.invalid"})
+        EXPECT_FALSE(listens_on_loopback_only(no)) << no;
 }
 
 }  // namespace

@@ -1,6 +1,11 @@
 #include "remote/net/endpoint.h"
 
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+
 #include <algorithm>
+#include <cstring>
 #include <string>
 
 #include "core/error.h"
@@ -111,6 +116,34 @@ std::string host_port(std::string_view host, int port) {
 
 std::string to_string(const Endpoint& e) {
     return host_port(e.host, e.port);
+}
+
+bool is_loopback_address(const sockaddr_storage& a) {
+    if (a.ss_family == AF_INET)
+        return (ntohl(reinterpret_cast<const sockaddr_in&>(a).sin_addr.s_addr) >> 24) == 127;
+    if (a.ss_family != AF_INET6) return false;
+    const in6_addr& v6 = reinterpret_cast<const sockaddr_in6&>(a).sin6_addr;
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    // ::ffff:127.x.y.z
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;
+}
+
+bool listens_on_loopback_only(const std::string& host) {
+    // The hints of a listener's resolve (socket.cpp: Listener::open).
+    addrinfo hints{};
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+    addrinfo* out = nullptr;
+    if (::getaddrinfo(host.c_str(), "0", &hints, &out) != 0) return false;
+    bool all = out != nullptr;
+    for (const addrinfo* a = out; a; a = a->ai_next) {
+        sockaddr_storage s{};
+        std::memcpy(&s, a->ai_addr, std::min<std::size_t>(a->ai_addrlen, sizeof s));
+        all = all && is_loopback_address(s);
+    }
+    ::freeaddrinfo(out);
+    return all;
 }
 
 }  // namespace isowall::remote

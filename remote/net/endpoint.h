@@ -1,5 +1,7 @@
 #pragma once
 // "HOST:PORT" as a user writes it on the command line (`isowall view 127.0.0.1:5000`).
+#include <sys/socket.h>
+
 #include <string>
 #include <string_view>
 
@@ -20,6 +22,15 @@ Endpoint parse_endpoint(std::string_view text, std::string_view source, std::str
 // IPv6 address such as "::1"): it is then `default_port`. Throws InputError as parse_endpoint.
 Endpoint parse_listen_endpoint(std::string_view text, int default_port, std::string_view source,
                                std::string_view field);
+
+// Whether `address` (a sockaddr_in or sockaddr_in6) is this machine's loopback: 127.0.0.0/8, ::1,
+// or ::ffff:127.x.y.z.
+bool is_loopback_address(const sockaddr_storage& address);
+
+// Whether listening on `host` reaches this machine only: every address it resolves to, as a
+// listener binds it, is loopback. Decided on the addresses, never on the spelling: a name such as
+// "127.example" or "localhost.example" may resolve anywhere. False when it resolves to nothing.
+bool listens_on_loopback_only(const std::string& host);
 
 // "host:port", with an IPv6 host in brackets: the name of a peer in error lines.
 std::string to_string(const Endpoint& e);

@@ -1,5 +1,7 @@
 #include "remote/net/tcp_progress.h"
 
+#include "remote/net/endpoint.h"
+
 #include <arpa/inet.h>
 
 #include <cstddef>
@@ -14,16 +16,6 @@
 
 namespace isowall::remote {
 namespace {
-
-bool is_loopback(const sockaddr_storage& a) {
-    if (a.ss_family == AF_INET)
-        return (ntohl(reinterpret_cast<const sockaddr_in&>(a).sin_addr.s_addr) >> 24) == 127;
-    if (a.ss_family != AF_INET6) return false;
-    const in6_addr& v6 = reinterpret_cast<const sockaddr_in6&>(a).sin6_addr;
-    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
-    // ::ffff:127.x.y.z
-    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;
-}
 
 bool same_address(const sockaddr_storage& a, const sockaddr_storage& b) {
     if (a.ss_family != b.ss_family) return false;
@@ -43,7 +35,7 @@ bool same_host(int fd) {
     if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &peer_size) != 0 ||
         ::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &self_size) != 0)
         return false;
-    return is_loopback(peer) || same_address(peer, self);
+    return is_loopback_address(peer) || same_address(peer, self);
 }
 
 }  // namespace
