@@ -6,7 +6,9 @@ Usage: /usr/bin/python3 scripts/check_doc_paths.py   (from anywhere; the root is
 A path is checked when it is named
   - inside backticks: a token holding a '/' whose first part is one of the root's entries (listed
     when the script runs; build output, out/ and .git aside), or a token that is a root entry's
-    name itself (`README.md`); a trailing ':LINE' or '/' is dropped;
+    name itself (`README.md`), or a source file (.h .cpp .py .sh .mjs .cmake) under any folder, so
+    that a path into a folder since renamed or removed is caught; a trailing ':LINE' or '/' is
+    dropped;
   - as a markdown link or image target, `[text](target)`: resolved from the file's own folder, as
     a markdown viewer does, and a '#anchor' must name a heading of the target (or of the file).
 Left alone: URLs, tokens with spaces, `$VARS`, globs and patterns (* ? { } [ ] < > |), and paths
@@ -26,6 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 NOT_SOURCE = re.compile(r"^(build.*|out|scratch|node_modules|\.git)$")
 BACKTICK = re.compile(r"`([^`\n]+)`")
 LINK = re.compile(r"\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
+SOURCE_SUFFIXES = (".h", ".cpp", ".py", ".sh", ".mjs", ".cmake")
 FENCE = re.compile(r"^\s*(```|~~~)")
 
 
@@ -47,7 +50,10 @@ def backtick_path(token, entries):
         return None
     token = re.sub(r":\d+(-\d+)?$", "", token)  # file.cpp:12 names file.cpp
     first = token.split("/", 1)[0]
-    if first not in entries:
+    # A source file under a folder the root no longer has (a folder renamed or removed) is still
+    # a path: checked, so that a doc naming the old place fails.
+    if first not in entries and not ("/" in token and token.endswith(SOURCE_SUFFIXES)
+                                     and not NOT_SOURCE.match(first)):
         return None
     if "/" not in token and token != first:
         return None

@@ -3,7 +3,9 @@
 // wall.html and wall.css. Deterministic: the same sources give the same bytes.
 // `node tools/build.mjs DIR` builds into DIR instead (tools/check_dist.mjs compares the two).
 import { build } from 'esbuild';
-import { copyFileSync, mkdirSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
+import {
+  copyFileSync, existsSync, mkdirSync, readFileSync, readdirSync, rmSync, writeFileSync,
+} from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { kShadersModule, shadersModule } from './shaders.mjs';
@@ -36,7 +38,9 @@ async function style(entry, out) {
 
 // The shaders first: src/shaders.js is made from render/shaders/ (tools/shaders.mjs).
 const shaders = shadersModule();
-if (readFileSync(kShadersModule, { encoding: 'utf8', flag: 'a+' }) !== shaders) writeFileSync(kShadersModule, shaders);
+if (!existsSync(kShadersModule) || readFileSync(kShadersModule, 'utf8') !== shaders) {
+  writeFileSync(kShadersModule, shaders);
+}
 await bundle('src/main.js', 'app.js');
 await style('src/app.css', 'app.css');
 // The wall's page (isowall wall --http).
