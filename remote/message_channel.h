@@ -11,6 +11,7 @@
 
 #include "remote/encoding_choice.h"
 #include "remote/net/connection.h"
+#include "remote/net/tls.h"
 #include "remote/view_protocol.h"
 
 namespace isowall::remote {

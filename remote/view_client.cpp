@@ -3,15 +3,14 @@
 #include "remote/encoding_choice.h"
 #include "remote/net/endpoint.h"
 #include "remote/net/socket.h"
+#include "remote/net/tls.h"
 
 namespace isowall::remote {
 
 ViewClient::ViewClient(Renderer& renderer, const ClientHello& h) : frames_(renderer) {
     Socket s = connect_tcp(h.host, h.port, h.connect_timeout_s);
     conn_ = std::make_unique<Connection>(std::move(s), host_port(h.host, h.port));
-    if (h.tls)
-        conn_->start_tls(TlsSession::connect(*h.tls, conn_->socket(), h.host, conn_->peer(),
-                                             h.connect_timeout_s));
+    if (h.tls) connect_tls(conn_->socket(), *h.tls, h.host, conn_->peer(), h.connect_timeout_s);
     HelloMsg hello;
     hello.dataset = h.dataset;
     hello.token = h.token;

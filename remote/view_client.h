@@ -9,6 +9,7 @@
 #include "remote/client_frames.h"
 #include "remote/group_codec.h"
 #include "remote/net/connection.h"
+#include "remote/net/tls.h"
 
 namespace isowall::remote {
 

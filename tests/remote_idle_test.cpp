@@ -96,7 +96,7 @@ TEST(RemoteIdle, AClientThatStopsReadingIsDroppedAndTheNextGetsIn) {
     TestServer server(o);
     Socket s = connect_tcp("127.0.0.1", server.port(), 5);
     const int small = 4096;
-    ::setsockopt(s.fd(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    ::setsockopt(s.native_handle(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
     Connection deaf(std::move(s), "server");
     deaf.send(phantom_hello(0));  // triangles as separate vertices: the largest frame
     const std::optional<RemoteMessage> ready = deaf.receive(kTimeoutS);

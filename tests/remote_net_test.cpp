@@ -4,6 +4,7 @@
 // way the header says, quickly. Every blocking call has a timeout, so no failure hangs the test.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -57,7 +58,7 @@ TEST(RemoteNet, ListenerTakesAnEphemeralPortAndNamesThePeer) {
 
 TEST(RemoteNet, TcpProgressCountsWhatThePeerTook) {
     Loopback lo;
-    const std::optional<TcpProgress> before = tcp_progress(lo.server.fd());
+    const std::optional<TcpProgress> before = tcp_progress(lo.server.native_handle());
     ASSERT_TRUE(before.has_value());
     EXPECT_TRUE(before->same_host);  // 127.0.0.1: no link between
     const Bytes bytes(100000, std::byte{7});
@@ -66,7 +67,7 @@ TEST(RemoteNet, TcpProgressCountsWhatThePeerTook) {
     std::optional<TcpProgress> after;
     const auto start = std::chrono::steady_clock::now();
     do {
-        after = tcp_progress(lo.server.fd());
+        after = tcp_progress(lo.server.native_handle());
         ASSERT_TRUE(after.has_value());
     } while (after->acked < before->acked + bytes.size() && seconds_since(start) < kTimeout_s);
     EXPECT_EQ(after->acked, before->acked + bytes.size());
@@ -286,6 +287,60 @@ TEST(RemoteNet, ConcurrentSendersNeverInterleaveFrames) {
     b.join();
     EXPECT_EQ(groups, kEach);
     EXPECT_EQ(errors, kEach);
+}
+
+// A receive that runs out of time leaves its read pending on the net thread: what arrives after
+// it goes to the next receive, whole and in order. A peek shows bytes without taking them.
+TEST(RemoteNet, ATimedOutReceiveLosesNoByteAndAPeekTakesNone) {
+    Loopback link;
+    std::array<std::byte, 16> buf{};
+    std::size_t got = 99;
+    EXPECT_FALSE(recv_some(link.server, buf, 0, got, "client"));
+    EXPECT_EQ(got, 0u);
+    const Bytes first = {std::byte{1}, std::byte{2}, std::byte{3}};
+    send_all(link.client, first, "server");
+    const std::optional<Bytes> peeked = link.server.peek(kTimeout_s, "client");
+    ASSERT_TRUE(peeked.has_value());
+    ASSERT_FALSE(peeked->empty());
+    EXPECT_EQ(peeked->front(), std::byte{1});
+    const Bytes second = {std::byte{4}, std::byte{5}};
+    send_all(link.client, second, "server");
+    Bytes all;
+    while (all.size() < first.size() + second.size()) {
+        ASSERT_TRUE(recv_some(link.server, std::span(buf).first(2), kTimeout_s, got, "client"));
+        all.insert(all.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(got));
+    }
+    EXPECT_EQ(all, (Bytes{std::byte{1}, std::byte{2}, std::byte{3}, std::byte{4}, std::byte{5}}));
+}
+
+// A send the peer never reads fills the sockets' buffers and waits; a shutdown from another
+// thread ends it with PeerClosed, and so every later send.
+TEST(RemoteNet, ShutdownWakesASendThePeerNeverReads) {
+    Loopback link;
+    const std::optional<TcpProgress> before = tcp_progress(link.client.native_handle());
+    ASSERT_TRUE(before.has_value());
+    const Bytes huge(64u << 20, std::byte{9});  // far more than loopback's buffers hold
+    std::string error;
+    std::thread sender([&] {
+        try {
+            send_all(link.client, huge, "server");
+            error = "returned";
+        } catch (const PeerClosed& e) {
+            error = e.what();
+        }
+    });
+    // The send has begun: the kernel holds some of its bytes (acknowledged or not).
+    for (;;) {
+        const std::optional<TcpProgress> now = tcp_progress(link.client.native_handle());
+        ASSERT_TRUE(now.has_value());
+        if (now->acked + now->unacked > before->acked + before->unacked) break;
+        std::this_thread::yield();
+    }
+    link.client.shutdown_both();
+    sender.join();
+    EXPECT_NE(error, "returned");
+    EXPECT_NE(error.find("shut down"), std::string::npos) << error;
+    EXPECT_THROW(send_all(link.client, Bytes(1), "server"), PeerClosed);
 }
 
 }  // namespace

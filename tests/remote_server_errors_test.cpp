@@ -27,7 +27,7 @@ std::vector<std::byte> frame_of(const RemoteMessage& m) {
 ErrorMsg error_after(int port, const std::vector<std::byte>& bytes, bool half_close = false) {
     Socket s = connect_tcp("127.0.0.1", port, 5);
     send_all(s, bytes, "server");
-    if (half_close) ::shutdown(s.fd(), SHUT_WR);
+    if (half_close) ::shutdown(s.native_handle(), SHUT_WR);
     Connection conn(std::move(s), "server");
     std::optional<RemoteMessage> m = conn.receive(20);
     if (!m) throw std::runtime_error("no answer within 20 s");

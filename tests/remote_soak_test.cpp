@@ -196,7 +196,7 @@ void slow_reader(Soak& s, bool ws) {
     Socket& socket = connect_client(s, ws, w, tcp);
     Registered reg(s, socket);
     const int small = 4096;
-    ::setsockopt(socket.fd(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    ::setsockopt(socket.native_handle(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
     RequestMsg r = s.requests.front();
     r.request_id = 1;
     r.view.width = 800;

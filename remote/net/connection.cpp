@@ -72,10 +72,7 @@ std::size_t Connection::send(const RemoteMessage& m) {
             bucket_.limited() ? std::min(rest.size(), kPaceChunkBytes) : rest.size();
         if (bucket_.limited()) pace(n);
         try {
-            if (tls_)
-                tls_->write_all(socket_, rest.first(n), peer_);
-            else
-                send_all(socket_, rest.first(n), peer_);
+            send_all(socket_, rest.first(n), peer_);
         } catch (const NetError&) {
             if (shut_down_) throw_shut_down();
             throw;
@@ -108,9 +105,7 @@ std::optional<RemoteMessage> Connection::receive(double timeout_s) {
         const double left_s = forever ? -1 : std::max(0.0, deadline_s - steady_now_s());
         std::size_t got = 0;
         try {
-            const bool came = tls_ ? tls_->read_some(socket_, recv_buffer_, left_s, got, peer_)
-                                   : recv_some(socket_, recv_buffer_, left_s, got, peer_);
-            if (!came) return std::nullopt;
+            if (!recv_some(socket_, recv_buffer_, left_s, got, peer_)) return std::nullopt;
         } catch (const PeerClosed&) {
             if (shut_down_) throw_shut_down();
             if (parser_.pending_bytes() > 0)

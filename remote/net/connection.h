@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "remote/net/socket.h"
-#include "remote/net/tls.h"
 #include "remote/net/token_bucket.h"
 #include "remote/view_framing.h"
 
@@ -69,17 +68,11 @@ class Connection {
     Socket& socket() { return socket_; }
     const Socket& socket() const { return socket_; }
 
-    // From now on every byte goes through `session` (a handshake done on socket()). Before any
-    // message, from the thread that owns the connection.
-    void start_tls(std::unique_ptr<TlsSession> session) { tls_ = std::move(session); }
-    TlsSession* tls() const { return tls_.get(); }
-
   private:
     void pace(std::size_t bytes);  // waits until `bytes` may go, then takes them; send_mutex_ held
     [[noreturn]] void throw_shut_down() const;
 
-    Socket socket_;
-    std::unique_ptr<TlsSession> tls_;  // null: plain TCP
+    Socket socket_;  // plain, or TLS after a handshake on it (tls.h), before any message
     std::string peer_;
     FrameParser parser_;
     std::vector<std::byte> recv_buffer_;

@@ -1,251 +1,392 @@
 #include "remote/net/socket.h"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netdb.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <chrono>
+#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <memory>
 #include <sstream>
+#include <thread>
 
 #include "remote/net/endpoint.h"
+#include "remote/net/net_stream.h"
 
 namespace isowall::remote {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using asio::ip::tcp;
 
-// "peer: what: strerror", as a PeerClosed when the error means the peer went away.
-[[noreturn]] void throw_errno(const std::string& peer, const char* what, int err) {
-    const std::string text = peer + ": " + what + ": " + std::strerror(err);
-    if (err == EPIPE || err == ECONNRESET) throw PeerClosed(text);
-    throw NetError(text);
-}
+// One read into a stream's read-ahead buffer takes at most this much: a large message arrives in
+// several reads, never one allocation sized by the peer.
+constexpr std::size_t kReadAheadBytes = 64 * 1024;
 
-// poll's timeout for what is left until `deadline` (-1 = forever), rounded up so that a wait
-// never ends before its deadline.
-int poll_ms(std::optional<Clock::time_point> deadline) {
-    if (!deadline) return -1;
-    const auto left = *deadline - Clock::now();
-    if (left <= Clock::duration::zero()) return 0;
-    const auto ms = std::chrono::ceil<std::chrono::milliseconds>(left).count();
-    return ms > 1'000'000'000 ? 1'000'000'000 : static_cast<int>(ms);
-}
-
-std::optional<Clock::time_point> deadline_after(double timeout_s) {
-    if (!(timeout_s >= 0) || std::isinf(timeout_s) || timeout_s > 1e9) return std::nullopt;
-    return Clock::now() +
-           std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-}
-
-// Waits for `events` on `fd` until `deadline`: the revents, or 0 when the time ran out.
-short wait_for(int fd, short events, std::optional<Clock::time_point> deadline,
-               const std::string& peer) {
-    for (;;) {
-        pollfd p{fd, events, 0};
-        const int n = ::poll(&p, 1, poll_ms(deadline));
-        if (n > 0) return p.revents;
-        if (n == 0) {
-            if (!deadline || Clock::now() >= *deadline) return 0;
-            continue;  // poll's millisecond rounding woke us a little early
-        }
-        if (errno != EINTR) throw_errno(peer, "poll", errno);
+// Never destroyed: a socket closed during the process's exit still posts its close here.
+struct NetThread {
+    asio::io_context io;
+    asio::executor_work_guard<asio::io_context::executor_type> work{io.get_executor()};
+    NetThread() {
+        std::thread([this] { io.run(); }).detach();
     }
-}
-
-void set_nodelay(int fd) {
-    const int on = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);  // only latency if it fails
-}
-
-struct AddrInfoFree {
-    void operator()(addrinfo* a) const { ::freeaddrinfo(a); }
 };
-using AddrInfo = std::unique_ptr<addrinfo, AddrInfoFree>;
 
-AddrInfo resolve(const std::string& host, int port, int flags, const std::string& peer) {
-    addrinfo hints{};
-    hints.ai_family = AF_UNSPEC;
-    hints.ai_socktype = SOCK_STREAM;
-    hints.ai_flags = flags | AI_NUMERICSERV;
-    addrinfo* out = nullptr;
-    const int rc = ::getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &out);
-    if (rc != 0) {
-        throw NetError(
-            peer + ": resolve: " + (rc == EAI_SYSTEM ? std::strerror(errno) : ::gai_strerror(rc)));
-    }
-    return AddrInfo(out);
+bool peer_went_away(const asio::error_code& e) {
+    return e == asio::error::eof || e == asio::error::connection_reset ||
+           e == asio::error::broken_pipe || e == asio::error::operation_aborted ||
+           e == asio::error::shut_down || e == asio::ssl::error::stream_truncated;
 }
 
-std::string numeric_peer(const sockaddr* addr, socklen_t len) {
-    char host[NI_MAXHOST], serv[NI_MAXSERV];
-    if (::getnameinfo(addr, len, host, sizeof host, serv, sizeof serv,
-                      NI_NUMERICHOST | NI_NUMERICSERV) != 0)
-        return "unknown peer";
-    return host_port(host, std::atoi(serv));
+void set_nodelay(tcp::socket& s) {
+    asio::error_code ignored;  // only latency if it fails
+    s.set_option(tcp::no_delay(true), ignored);
 }
 
-// One address of connect_tcp: a connected blocking socket, or the errno of the failure (0 with
-// no socket when the deadline passed).
-Socket connect_one(const addrinfo& a, std::optional<Clock::time_point> deadline,
-                   const std::string& peer, int& err) {
-    Socket s(::socket(a.ai_family, a.ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a.ai_protocol));
-    if (!s.valid()) {
-        err = errno;
-        return {};
-    }
-    if (::connect(s.fd(), a.ai_addr, a.ai_addrlen) != 0) {
-        if (errno != EINPROGRESS && errno != EINTR) {
-            err = errno;
-            return {};
-        }
-        if (wait_for(s.fd(), POLLOUT, deadline, peer) == 0) {
-            err = 0;
-            return {};
-        }
-        socklen_t len = sizeof err;
-        if (::getsockopt(s.fd(), SOL_SOCKET, SO_ERROR, &err, &len) != 0) err = errno;
-        if (err != 0) return {};
-    }
-    const int flags = ::fcntl(s.fd(), F_GETFL);
-    if (flags < 0 || ::fcntl(s.fd(), F_SETFL, flags & ~O_NONBLOCK) != 0) {
-        err = errno;
-        return {};
-    }
-    set_nodelay(s.fd());
-    return s;
+tcp::resolver::results_type resolve(const std::string& host, int port, tcp::resolver::flags flags,
+                                    const std::string& where) {
+    tcp::resolver resolver(net_context());
+    asio::error_code e;
+    // No address_configured: on a host with only loopback up it would hide "localhost" itself.
+    auto results =
+        resolver.resolve(host, std::to_string(port), flags | tcp::resolver::numeric_service, e);
+    if (e) throw NetError(where + ": resolve: " + e.message());
+    return results;
+}
+
+std::string numeric_peer(const tcp::socket& s) {
+    asio::error_code e;
+    const tcp::endpoint p = s.remote_endpoint(e);
+    if (e) return "unknown peer";
+    return host_port(p.address().to_string(), p.port());
 }
 
 }  // namespace
 
+asio::io_context& net_context() {
+    static NetThread* const thread = new NetThread;
+    return thread->io;
+}
+
+std::optional<NetClock::time_point> deadline_after(double timeout_s) {
+    if (!(timeout_s >= 0) || std::isinf(timeout_s) || timeout_s > 1e9) return std::nullopt;
+    return NetClock::now() +
+           std::chrono::duration_cast<NetClock::duration>(std::chrono::duration<double>(timeout_s));
+}
+
+void Completion::finish(const asio::error_code& e, std::size_t n) {
+    {
+        std::lock_guard lock(mutex);
+        error = e;
+        bytes = n;
+        done = true;
+    }
+    done_cv.notify_all();
+}
+
+bool Completion::wait(std::optional<NetClock::time_point> deadline) {
+    std::unique_lock lock(mutex);
+    if (!deadline) {
+        done_cv.wait(lock, [this] { return done; });
+        return true;
+    }
+    return done_cv.wait_until(lock, *deadline, [this] { return done; });
+}
+
+[[noreturn]] void throw_net_error(const asio::error_code& e, bool shut, const std::string& peer,
+                                  const char* what) {
+    if (shut) throw PeerClosed(peer + ": the connection was shut down");
+    if (e == asio::error::eof || e == asio::ssl::error::stream_truncated)
+        throw PeerClosed(peer + ": the peer closed the connection");
+    if (peer_went_away(e)) throw PeerClosed(peer + ": " + what + ": " + e.message());
+    const std::string reason = tls_reason(e);
+    if (!reason.empty()) throw NetError(peer + ": TLS: " + reason);
+    throw NetError(peer + ": " + what + ": " + e.message());
+}
+
+Stream::Stream(tcp::socket s)
+    : tcp(std::move(s)), fd(tcp.native_handle()), ahead(kReadAheadBytes) {}
+
+void Stream::read_ahead_locked() {
+    if (reading || ahead_begin < ahead_end || read_error || shut) return;
+    reading = true;
+    asio::post(net_context(), [self = shared_from_this()] {
+        auto done = [self](const asio::error_code& e, std::size_t n) {
+            {
+                std::lock_guard lock(self->mutex);
+                self->reading = false;
+                self->ahead_begin = 0;
+                self->ahead_end = n;
+                if (e && n == 0) self->read_error = e;
+            }
+            self->read_cv.notify_all();
+        };
+        const auto buffer = asio::buffer(self->ahead);
+        if (self->tls && !self->tls_closed)
+            self->tls->async_read_some(buffer, done);
+        else
+            self->tcp.async_read_some(buffer, done);
+    });
+}
+
+bool Stream::wait_ahead(std::unique_lock<std::mutex>& lock,
+                        std::optional<NetClock::time_point> deadline, const std::string& peer) {
+    for (;;) {
+        if (shut) throw_net_error({}, true, peer, "recv");
+        if (ahead_begin < ahead_end) return true;
+        if (read_error) throw_net_error(read_error, false, peer, "recv");
+        read_ahead_locked();
+        const auto ready = [this] { return shut || ahead_begin < ahead_end || !reading; };
+        if (!deadline) {
+            read_cv.wait(lock, ready);
+        } else if (!read_cv.wait_until(lock, *deadline, ready)) {
+            return false;
+        }
+    }
+}
+
+void Stream::cancel_and_settle() {
+    asio::post(net_context(), [self = shared_from_this()] {
+        asio::error_code ignored;
+        self->tcp.cancel(ignored);
+    });
+    std::unique_lock lock(mutex);
+    read_cv.wait(lock, [this] { return !reading; });
+}
+
+Socket::Socket(std::shared_ptr<Stream> stream) : stream_(std::move(stream)) {}
+
+Socket::~Socket() {
+    close();
+}
+
 Socket& Socket::operator=(Socket&& other) noexcept {
     if (this != &other) {
         close();
-        fd_ = other.fd_;
-        other.fd_ = -1;
+        stream_ = std::move(other.stream_);
     }
     return *this;
 }
 
 void Socket::close() {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
+    if (!stream_) return;
+    // On the net thread, after anything already posted for this socket; the stream itself lives
+    // until the last pending operation has ended.
+    asio::post(net_context(), [s = std::move(stream_)] {
+        asio::error_code ignored;
+        s->tcp.close(ignored);
+    });
+    stream_.reset();
 }
 
 void Socket::shutdown_both() {
-    if (fd_ >= 0) ::shutdown(fd_, SHUT_RDWR);  // ENOTCONN (never connected, already shut): fine
+    if (!stream_) return;
+    {
+        std::lock_guard lock(stream_->mutex);
+        stream_->shut = true;
+    }
+    stream_->read_cv.notify_all();
+    asio::post(net_context(), [s = stream_] {
+        asio::error_code ignored;  // not connected, or shut already: fine
+        s->tcp.shutdown(tcp::socket::shutdown_both, ignored);
+        s->tcp.cancel(ignored);
+    });
 }
 
-void send_all(const Socket& s, std::span<const std::byte> bytes, const std::string& peer) {
-    while (!bytes.empty()) {
-        const ssize_t n = ::send(s.fd(), bytes.data(), bytes.size(), MSG_NOSIGNAL);
-        if (n > 0) {
-            bytes = bytes.subspan(static_cast<std::size_t>(n));
-        } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-            wait_for(s.fd(), POLLOUT, std::nullopt, peer);  // a non-blocking socket: wait for room
-        } else if (n < 0 && errno != EINTR) {
-            throw_errno(peer, "send", errno);
+int Socket::native_handle() const {
+    return stream_ ? stream_->fd : -1;
+}
+
+std::optional<std::vector<std::byte>> Socket::peek(double timeout_s, const std::string& peer) {
+    if (!stream_) throw NetError(peer + ": recv: the socket is closed");
+    Stream& s = *stream_;
+    std::unique_lock lock(s.mutex);
+    if (!s.wait_ahead(lock, deadline_after(timeout_s), peer)) return std::nullopt;
+    return std::vector<std::byte>(s.ahead.begin() + static_cast<std::ptrdiff_t>(s.ahead_begin),
+                                  s.ahead.begin() + static_cast<std::ptrdiff_t>(s.ahead_end));
+}
+
+void Socket::finish(double timeout_s, std::size_t max_bytes) {
+    if (!stream_) return;
+    Stream& s = *stream_;
+    const auto deadline = deadline_after(timeout_s);
+    if (s.tls && !s.tls_closed) {
+        // A pending read and the shutdown's own read may not share the TLS session.
+        s.cancel_and_settle();
+        {
+            std::lock_guard lock(s.mutex);
+            s.read_error.clear();
+            s.ahead_begin = s.ahead_end = 0;
         }
+        std::shared_ptr<Stream> self = stream_;
+        run_on_net([self](auto done) { self->tls->async_shutdown([done](auto e) { done(e, 0); }); },
+                   [self] {
+                       asio::error_code ignored;
+                       self->tcp.cancel(ignored);
+                   },
+                   deadline);
+        std::lock_guard lock(s.mutex);
+        s.tls_closed = true;
+    }
+    asio::post(net_context(), [self = stream_] {
+        asio::error_code ignored;
+        self->tcp.shutdown(tcp::socket::shutdown_send, ignored);
+    });
+    std::vector<std::byte> sink(4096);
+    try {
+        for (std::size_t total = 0; total < max_bytes;) {
+            std::size_t got = 0;
+            const double left =
+                deadline ? std::chrono::duration<double>(*deadline - NetClock::now()).count()
+                         : -1.0;
+            if ((deadline && left <= 0) || !recv_some(*this, sink, left, got, "peer")) break;
+            total += got;
+        }
+    } catch (const NetError&) {  // EOF or reset: the peer is gone, as it should be
     }
 }
 
-bool recv_some(const Socket& s, std::span<std::byte> buf, double timeout_s, std::size_t& got,
+void send_all(const Socket& socket, std::span<const std::byte> bytes, const std::string& peer) {
+    Stream* s = socket.stream();
+    if (!s) throw NetError(peer + ": send: the socket is closed");
+    std::lock_guard one_send(s->send_mutex);
+    {
+        std::lock_guard lock(s->mutex);
+        if (s->shut) throw_net_error({}, true, peer, "send");
+    }
+    std::shared_ptr<Stream> self = socket.shared_stream();
+    const asio::const_buffer buffer(bytes.data(), bytes.size());
+    const asio::error_code e = run_on_net(
+        [self, buffer](auto done) {
+            if (self->tls && !self->tls_closed)
+                asio::async_write(*self->tls, buffer, done);
+            else
+                asio::async_write(self->tcp, buffer, done);
+        },
+        [] {}, std::nullopt);
+    if (e) {
+        bool shut = false;
+        {
+            std::lock_guard lock(s->mutex);
+            shut = s->shut;
+        }
+        throw_net_error(e, shut, peer, "send");
+    }
+}
+
+bool recv_some(const Socket& socket, std::span<std::byte> buf, double timeout_s, std::size_t& got,
                const std::string& peer) {
     got = 0;
-    const auto deadline = deadline_after(timeout_s);
-    for (;;) {
-        if (wait_for(s.fd(), POLLIN, deadline, peer) == 0) return false;
-        // MSG_DONTWAIT: poll said readable, but never block past the deadline if it was wrong.
-        const ssize_t n = ::recv(s.fd(), buf.data(), buf.size(), MSG_DONTWAIT);
-        if (n > 0) {
-            got = static_cast<std::size_t>(n);
-            return true;
-        }
-        if (n == 0) {
-            if (buf.empty()) return true;
-            throw PeerClosed(peer + ": the peer closed the connection");
-        }
-        if (errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK)
-            throw_errno(peer, "recv", errno);
-    }
-}
-
-bool wait_ready(const Socket& s, bool for_write, double timeout_s, const std::string& peer) {
-    return wait_for(s.fd(), for_write ? POLLOUT : POLLIN, deadline_after(timeout_s), peer) != 0;
+    Stream* s = socket.stream();
+    if (!s) throw NetError(peer + ": recv: the socket is closed");
+    std::unique_lock lock(s->mutex);
+    if (!s->wait_ahead(lock, deadline_after(timeout_s), peer)) return false;
+    got = std::min(buf.size(), s->ahead_end - s->ahead_begin);
+    std::memcpy(buf.data(), s->ahead.data() + s->ahead_begin, got);
+    s->ahead_begin += got;
+    return true;
 }
 
 Socket connect_tcp(const std::string& host, int port, double timeout_s) {
     const std::string peer = host_port(host, port);
     const auto deadline = deadline_after(timeout_s);
     if (port < 1 || port > 65535) throw NetError(peer + ": connect: expected a port 1..65535");
-    // No AI_ADDRCONFIG: on a host with only loopback up it would hide "localhost" itself.
-    const AddrInfo addrs = resolve(host, port, 0, peer);
-    int err = 0;
-    for (const addrinfo* a = addrs.get(); a != nullptr; a = a->ai_next) {
-        Socket s = connect_one(*a, deadline, peer, err);
-        if (s.valid()) return s;
-        if (err == 0) break;  // out of time
-    }
-    if (err == 0) {
+    const auto addresses = resolve(host, port, {}, peer);
+    auto socket = std::make_shared<tcp::socket>(net_context());
+    bool timed_out = false;
+    const asio::error_code e = run_on_net(
+        [socket, addresses](auto done) {
+            asio::async_connect(
+                *socket, addresses,
+                [done](const asio::error_code& e, const tcp::endpoint&) { done(e, 0); });
+        },
+        [socket] {
+            asio::error_code ignored;
+            socket->close(ignored);
+        },
+        deadline, &timed_out);
+    if (timed_out) {
         std::ostringstream text;
         text << peer << ": connect: no answer within " << timeout_s << " s";
         throw NetError(text.str());
     }
-    throw_errno(peer, "connect", err);
+    if (e) throw NetError(peer + ": connect: " + e.message());
+    set_nodelay(*socket);
+    return Socket(std::make_shared<Stream>(std::move(*socket)));
+}
+
+void Acceptor::accept_locked() {
+    if (accepting || ready || error) return;
+    accepting = true;
+    asio::post(net_context(), [self = shared_from_this()] {
+        self->acceptor.async_accept([self](const asio::error_code& e, tcp::socket s) {
+            {
+                std::lock_guard lock(self->mutex);
+                self->accepting = false;
+                // A connection reset before it was taken: wait for the next one.
+                if (!e)
+                    self->ready.emplace(std::move(s));
+                else if (e != asio::error::connection_aborted && e != asio::error::interrupted &&
+                         e != asio::error::try_again)
+                    self->error = e;
+            }
+            self->cv.notify_all();
+        });
+    });
+}
+
+Listener::Listener(std::shared_ptr<Acceptor> a, std::string address, int port)
+    : acceptor_(std::move(a)), address_(std::move(address)), port_(port) {}
+
+Listener::~Listener() {
+    close();
 }
 
 Listener Listener::open(const std::string& address, int port, int backlog) {
     const std::string where = host_port(address, port);
     if (port < 0 || port > 65535) throw NetError(where + ": listen: expected a port 0..65535");
-    const AddrInfo addrs = resolve(address, port, AI_PASSIVE, where);
-    const addrinfo& a = *addrs;
-    Socket s(::socket(a.ai_family, a.ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a.ai_protocol));
-    if (!s.valid()) throw_errno(where, "socket", errno);
-    const int on = 1;
-    if (::setsockopt(s.fd(), SOL_SOCKET, SO_REUSEADDR, &on, sizeof on) != 0)
-        throw_errno(where, "setsockopt(SO_REUSEADDR)", errno);
-    if (::bind(s.fd(), a.ai_addr, a.ai_addrlen) != 0) throw_errno(where, "bind", errno);
-    if (::listen(s.fd(), backlog) != 0) throw_errno(where, "listen", errno);
-    sockaddr_storage bound{};
-    socklen_t len = sizeof bound;
-    if (::getsockname(s.fd(), reinterpret_cast<sockaddr*>(&bound), &len) != 0)
-        throw_errno(where, "getsockname", errno);
-    const int bound_port =
-        ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<const sockaddr_in6&>(bound).sin6_port
-                                          : reinterpret_cast<const sockaddr_in&>(bound).sin_port);
-    return Listener(std::move(s), address, bound_port);
+    const auto addresses = resolve(address, port, tcp::resolver::passive, where);
+    const tcp::endpoint endpoint = addresses.begin()->endpoint();
+    tcp::acceptor a(net_context());
+    asio::error_code e;
+    if (a.open(endpoint.protocol(), e); e) throw NetError(where + ": socket: " + e.message());
+    if (a.set_option(tcp::acceptor::reuse_address(true), e); e)
+        throw NetError(where + ": setsockopt(SO_REUSEADDR): " + e.message());
+    if (a.bind(endpoint, e); e) throw NetError(where + ": bind: " + e.message());
+    if (a.listen(backlog, e); e) throw NetError(where + ": listen: " + e.message());
+    const int bound_port = a.local_endpoint(e).port();
+    if (e) throw NetError(where + ": getsockname: " + e.message());
+    return Listener(std::make_shared<Acceptor>(std::move(a)), address, bound_port);
 }
 
 std::optional<Socket> Listener::accept(double timeout_s, std::string* peer) {
     const std::string where = host_port(address_, port_);
-    if (!socket_.valid()) throw NetError(where + ": accept: the listener is closed");
+    if (!acceptor_) throw NetError(where + ": accept: the listener is closed");
+    Acceptor& a = *acceptor_;
     const auto deadline = deadline_after(timeout_s);
+    std::unique_lock lock(a.mutex);
+    a.accept_locked();
+    const auto ready = [&a] { return a.ready || a.error || !a.accepting; };
     for (;;) {
-        if (wait_for(socket_.fd(), POLLIN, deadline, where) == 0) return std::nullopt;
-        sockaddr_storage addr{};
-        socklen_t len = sizeof addr;
-        // The listening socket is non-blocking, so a connection that went away between poll and
-        // accept4 cannot block this call; the accepted socket is blocking, like connect_tcp's.
-        Socket s(::accept4(socket_.fd(), reinterpret_cast<sockaddr*>(&addr), &len, SOCK_CLOEXEC));
-        if (s.valid()) {
-            set_nodelay(s.fd());
-            if (peer) *peer = numeric_peer(reinterpret_cast<const sockaddr*>(&addr), len);
-            return s;
+        if (!deadline) {
+            a.cv.wait(lock, ready);
+        } else if (!a.cv.wait_until(lock, *deadline, ready)) {
+            return std::nullopt;
         }
-        // A connection reset before accept, a signal, or one taken by another thread: wait on.
-        if (errno != ECONNABORTED && errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK &&
-            errno != EPROTO)
-            throw_errno(where, "accept", errno);
+        if (a.error) throw NetError(where + ": accept: " + a.error.message());
+        if (a.ready) break;
+        a.accept_locked();  // the last one was reset before it was taken
     }
+    tcp::socket s = std::move(*a.ready);
+    a.ready.reset();
+    lock.unlock();
+    set_nodelay(s);
+    if (peer) *peer = numeric_peer(s);
+    return Socket(std::make_shared<Stream>(std::move(s)));
+}
+
+void Listener::close() {
+    if (!acceptor_) return;
+    asio::post(net_context(), [a = std::move(acceptor_)] {
+        asio::error_code ignored;
+        a->acceptor.close(ignored);
+    });
+    acceptor_.reset();
 }
 
 }  // namespace isowall::remote

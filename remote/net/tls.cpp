@@ -1,27 +1,20 @@
 #include "remote/net/tls.h"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
 #include <openssl/err.h>
 #include <openssl/ssl.h>
 #include <openssl/x509v3.h>
-#include <pthread.h>
-#include <signal.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
-#include <climits>
-#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 
 #include "core/error.h"
+#include "remote/net/net_stream.h"
 
 namespace isowall::remote {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // The reason of OpenSSL's error in words ("wrong version number"), the queue emptied; `fallback`
 // when it held none. The first reason queued, unless a later one says more than a generic one
@@ -48,87 +41,93 @@ std::shared_ptr<ssl_ctx_st> new_context(bool server) {
     if (!ctx) throw NetError("TLS: cannot make a context: " + take_reason("out of memory"));
     std::shared_ptr<ssl_ctx_st> owned(ctx, SSL_CTX_free);
     SSL_CTX_set_min_proto_version(ctx, TLS1_2_VERSION);
-    // Writes may end part way (the socket is non-blocking) and are retried from a buffer that
-    // has moved on by the part written.
-    SSL_CTX_set_mode(ctx, SSL_MODE_ENABLE_PARTIAL_WRITE | SSL_MODE_ACCEPT_MOVING_WRITE_BUFFER);
     return owned;
 }
 
 bool is_numeric_address(const std::string& host) {
-    unsigned char buf[sizeof(in6_addr)];
-    return ::inet_pton(AF_INET, host.c_str(), buf) == 1 ||
-           ::inet_pton(AF_INET6, host.c_str(), buf) == 1;
-}
-
-void make_non_blocking(const Socket& s, const std::string& peer) {
-    const int flags = ::fcntl(s.fd(), F_GETFL);
-    if (flags < 0 || ::fcntl(s.fd(), F_SETFL, flags | O_NONBLOCK) != 0)
-        throw NetError(peer + ": fcntl(O_NONBLOCK): " + std::strerror(errno));
-}
-
-// OpenSSL writes to the socket with write(), which raises SIGPIPE when the peer has gone (the
-// plain path uses send's MSG_NOSIGNAL). Each call that may write blocks SIGPIPE in its thread and
-// takes a SIGPIPE it raised, so the peer going away is an error (EPIPE), never the end of the
-// process, and no signal handler of the program is touched.
-class NoSigpipe {
-  public:
-    NoSigpipe() {
-        sigemptyset(&pipe_);
-        sigaddset(&pipe_, SIGPIPE);
-        sigset_t pending;
-        sigpending(&pending);
-        was_pending_ = sigismember(&pending, SIGPIPE) == 1;
-        pthread_sigmask(SIG_BLOCK, &pipe_, &old_);
-    }
-    ~NoSigpipe() {
-        if (!was_pending_) {
-            sigset_t pending;
-            sigpending(&pending);
-            if (sigismember(&pending, SIGPIPE) == 1) {
-                const timespec zero{0, 0};
-                sigtimedwait(&pipe_, nullptr, &zero);
-            }
-        }
-        pthread_sigmask(SIG_SETMASK, &old_, nullptr);
-    }
-    NoSigpipe(const NoSigpipe&) = delete;
-    NoSigpipe& operator=(const NoSigpipe&) = delete;
-
-  private:
-    sigset_t pipe_, old_;
-    bool was_pending_ = false;
-};
-
-// Whether OpenSSL's error is the connection ending without TLS's close_notify (OpenSSL 3 calls
-// an EOF that: a peer that went away, or this side's shutdown_both()).
-bool peer_gone() {
-    return ERR_GET_REASON(ERR_peek_error()) == SSL_R_UNEXPECTED_EOF_WHILE_READING;
-}
-
-double seconds_left(Clock::time_point deadline) {
-    return std::max(0.0, std::chrono::duration<double>(deadline - Clock::now()).count());
+    asio::error_code e;
+    asio::ip::make_address(host, e);
+    return !e;
 }
 
 // Why a client's handshake failed, in words a user can act on.
-std::string client_failure(ssl_st* ssl, int ssl_error, const std::string& host) {
+std::string client_failure(SSL* ssl, const asio::error_code& e, const std::string& host) {
     const long verify = SSL_get_verify_result(ssl);
-    if (verify == X509_V_ERR_HOSTNAME_MISMATCH || verify == X509_V_ERR_IP_ADDRESS_MISMATCH) {
-        ERR_clear_error();
+    if (verify == X509_V_ERR_HOSTNAME_MISMATCH || verify == X509_V_ERR_IP_ADDRESS_MISMATCH)
         return "the server's certificate does not name " + host;
-    }
-    if (verify != X509_V_OK) {
-        ERR_clear_error();
+    if (verify != X509_V_OK)
         return std::string("the server's certificate is not trusted (") +
                X509_verify_cert_error_string(verify) +
                "): name the authority that signed it with --tls-ca FILE";
-    }
-    const std::string reason = take_reason("");
-    if (ssl_error == SSL_ERROR_SYSCALL || ssl_error == SSL_ERROR_ZERO_RETURN || reason.empty() ||
-        reason == "wrong version number" || reason == "packet length too long" ||
+    const std::string reason = tls_reason(e);
+    if (reason.empty() || reason == "wrong version number" || reason == "packet length too long" ||
         reason == "record layer failure")
         return "the server does not answer in TLS" + (reason.empty() ? "" : " (" + reason + ")") +
                ": is it a plain port (serve without --tls-cert)?";
     return reason;
+}
+
+// Why a server's handshake failed.
+std::string server_failure(const asio::error_code& e) {
+    const std::string reason = tls_reason(e);
+    if (reason.empty()) return "the client closed the connection";
+    if (reason.find("alert") != std::string::npos) return "the client refused it (" + reason + ")";
+    return reason;
+}
+
+// The handshake on `socket`, as the server (`host` empty: with the bytes peek() showed as its
+// first) or as the client of `host`.
+void handshake(Socket& socket, const TlsContext& ctx, const std::string& host,
+               const std::string& peer, double timeout_s) {
+    const bool server = host.empty();
+    if (!socket.valid()) throw NetError(peer + ": TLS: the socket is closed");
+    std::shared_ptr<Stream> s = socket.shared_stream();
+    std::vector<std::byte> first;
+    {
+        // Nothing is pending on the stream: the server's peek ended its read, the client has
+        // not read yet.
+        std::lock_guard lock(s->mutex);
+        first.assign(s->ahead.begin() + static_cast<std::ptrdiff_t>(s->ahead_begin),
+                     s->ahead.begin() + static_cast<std::ptrdiff_t>(s->ahead_end));
+        s->ahead_begin = s->ahead_end = 0;
+    }
+    SSL_CTX_up_ref(ctx.native());  // the asio context below takes this reference
+    asio::ssl::context context(ctx.native());
+    s->tls = std::make_unique<TlsStream>(s->tcp, context);
+    SSL* ssl = s->tls->native_handle();
+    if (!server) {
+        if (is_numeric_address(host)) {
+            X509_VERIFY_PARAM_set1_ip_asc(SSL_get0_param(ssl), host.c_str());
+        } else {
+            SSL_set1_host(ssl, host.c_str());
+            SSL_set_tlsext_host_name(ssl, host.c_str());
+        }
+    }
+    bool timed_out = false;
+    const asio::error_code e = run_on_net(
+        [s, server, first = std::make_shared<std::vector<std::byte>>(std::move(first))](auto done) {
+            if (server)  // `first` lives until the handshake has taken it
+                s->tls->async_handshake(
+                    asio::ssl::stream_base::server, asio::buffer(*first),
+                    [done, first](const asio::error_code& e, std::size_t n) { done(e, n); });
+            else
+                s->tls->async_handshake(asio::ssl::stream_base::client,
+                                        [done](const asio::error_code& e) { done(e, 0); });
+        },
+        [s] {
+            asio::error_code ignored;
+            s->tcp.cancel(ignored);
+        },
+        deadline_after(timeout_s), &timed_out);
+    if (timed_out) {
+        std::ostringstream text;
+        text << peer << ": TLS handshake: no answer within " << timeout_s << " s";
+        throw TlsHandshakeError(text.str());
+    }
+    if (e)
+        throw TlsHandshakeError(peer + ": TLS handshake: " +
+                                (server ? server_failure(e) : client_failure(ssl, e, host)));
+    s->tls_description = std::string(SSL_get_version(ssl)) + " " + SSL_get_cipher_name(ssl);
 }
 
 }  // namespace
@@ -220,157 +219,23 @@ TlsContext TlsContext::client(const std::string& ca_file) {
     return TlsContext(std::move(ctx), false);
 }
 
-TlsSession::~TlsSession() {
-    SSL_free(ssl_);
+void accept_tls(Socket& s, const TlsContext& ctx, const std::string& peer, double timeout_s) {
+    handshake(s, ctx, "", peer, timeout_s);
 }
 
-std::unique_ptr<TlsSession> TlsSession::start(const TlsContext& ctx, const Socket& s,
-                                              const std::string& peer) {
-    SSL* ssl = SSL_new(ctx.native());
-    if (!ssl) throw NetError(peer + ": TLS: " + take_reason("out of memory"));
-    std::unique_ptr<TlsSession> session(new TlsSession(ssl));
-    if (SSL_set_fd(ssl, s.fd()) != 1) throw NetError(peer + ": TLS: " + take_reason("set_fd"));
-    return session;
+void connect_tls(Socket& s, const TlsContext& ctx, const std::string& host, const std::string& peer,
+                 double timeout_s) {
+    handshake(s, ctx, host.empty() ? "localhost" : host, peer, timeout_s);
 }
 
-std::unique_ptr<TlsSession> TlsSession::accept(const TlsContext& ctx, const Socket& s,
-                                               const std::string& peer, double timeout_s) {
-    return handshake(start(ctx, s, peer), s, "", peer, timeout_s);
+std::string tls_description(const Socket& s) {
+    return s.valid() ? s.stream()->tls_description : "";
 }
 
-std::unique_ptr<TlsSession> TlsSession::connect(const TlsContext& ctx, const Socket& s,
-                                                const std::string& host, const std::string& peer,
-                                                double timeout_s) {
-    std::unique_ptr<TlsSession> session = start(ctx, s, peer);
-    SSL* ssl = session->ssl_;
-    if (is_numeric_address(host)) {
-        X509_VERIFY_PARAM_set1_ip_asc(SSL_get0_param(ssl), host.c_str());
-    } else {
-        SSL_set1_host(ssl, host.c_str());
-        SSL_set_tlsext_host_name(ssl, host.c_str());
-    }
-    return handshake(std::move(session), s, host, peer, timeout_s);
-}
-
-std::unique_ptr<TlsSession> TlsSession::handshake(std::unique_ptr<TlsSession> session,
-                                                  const Socket& s, const std::string& host,
-                                                  const std::string& peer, double timeout_s) {
-    const bool server = host.empty();
-    make_non_blocking(s, peer);
-    const auto deadline =
-        Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(std::min(timeout_s, 1e6)));
-    SSL* ssl = session->ssl_;
-    for (;;) {
-        ERR_clear_error();
-        errno = 0;
-        int rc = 0, err = 0;
-        {
-            const NoSigpipe no_sigpipe;
-            rc = server ? SSL_accept(ssl) : SSL_connect(ssl);
-            if (rc == 1) return session;
-            err = SSL_get_error(ssl, rc);
-        }
-        if (err == SSL_ERROR_WANT_READ || err == SSL_ERROR_WANT_WRITE) {
-            if (!wait_ready(s, err == SSL_ERROR_WANT_WRITE, seconds_left(deadline), peer))
-                throw TlsHandshakeError(peer + ": TLS handshake: no answer within " +
-                                        std::to_string(timeout_s) + " s");
-            continue;
-        }
-        if (!server)
-            throw TlsHandshakeError(peer + ": TLS handshake: " + client_failure(ssl, err, host));
-        const std::string reason = take_reason("");
-        const bool alert = reason.find("alert") != std::string::npos;
-        throw TlsHandshakeError(peer + ": TLS handshake: " +
-                                (reason.empty() ? std::string("the client closed the connection")
-                                 : alert        ? "the client refused it (" + reason + ")"
-                                                : reason));
-    }
-}
-
-void TlsSession::write_all(const Socket& s, std::span<const std::byte> bytes,
-                           const std::string& peer) {
-    while (!bytes.empty()) {
-        int err = 0;
-        {
-            std::lock_guard lock(mutex_);
-            const NoSigpipe no_sigpipe;
-            ERR_clear_error();
-            errno = 0;
-            const int n = SSL_write(ssl_, bytes.data(),
-                                    static_cast<int>(std::min<std::size_t>(bytes.size(), INT_MAX)));
-            if (n > 0) {
-                bytes = bytes.subspan(static_cast<std::size_t>(n));
-                continue;
-            }
-            err = SSL_get_error(ssl_, n);
-        }
-        if (err == SSL_ERROR_WANT_WRITE) {
-            wait_ready(s, true, -1, peer);  // a shutdown_both() wakes it
-        } else if (err == SSL_ERROR_WANT_READ) {
-            // Short waits: the reader may take the bytes this write waits for.
-            wait_ready(s, false, 0.05, peer);
-        } else if (err == SSL_ERROR_SYSCALL && errno != 0 && errno != EPIPE &&
-                   errno != ECONNRESET) {
-            throw NetError(peer + ": send: " + std::strerror(errno));
-        } else if (err == SSL_ERROR_SSL && !peer_gone()) {
-            throw NetError(peer + ": TLS: " + take_reason("write failed"));
-        } else {
-            ERR_clear_error();
-            throw PeerClosed(peer + ": the peer closed the connection");
-        }
-    }
-}
-
-bool TlsSession::read_some(const Socket& s, std::span<std::byte> buf, double timeout_s,
-                           std::size_t& got, const std::string& peer) {
-    got = 0;
-    const bool forever = !(timeout_s >= 0) || std::isinf(timeout_s) || timeout_s > 1e9;
-    const auto deadline = forever ? Clock::time_point::max()
-                                  : Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                       std::chrono::duration<double>(timeout_s));
-    for (;;) {
-        int err = 0;
-        {
-            std::lock_guard lock(mutex_);
-            const NoSigpipe no_sigpipe;  // a read may write (TLS 1.3's key updates, alerts)
-            ERR_clear_error();
-            errno = 0;
-            const int n = SSL_read(ssl_, buf.data(),
-                                   static_cast<int>(std::min<std::size_t>(buf.size(), INT_MAX)));
-            if (n > 0) {
-                got = static_cast<std::size_t>(n);
-                return true;
-            }
-            err = SSL_get_error(ssl_, n);
-        }
-        if (err == SSL_ERROR_WANT_READ || err == SSL_ERROR_WANT_WRITE) {
-            const double left = forever ? 1.0 : seconds_left(deadline);
-            if (left <= 0) return false;
-            // At most a second per wait: a writer may have taken what this read waits for. The
-            // next turn reads again, and ends when the time has run out.
-            wait_ready(s, err == SSL_ERROR_WANT_WRITE, std::min(left, 1.0), peer);
-            continue;
-        }
-        if (err == SSL_ERROR_SYSCALL && errno != 0 && errno != EPIPE && errno != ECONNRESET)
-            throw NetError(peer + ": recv: " + std::strerror(errno));
-        if (err == SSL_ERROR_SSL && !peer_gone())
-            throw NetError(peer + ": TLS: " + take_reason("read failed"));
-        ERR_clear_error();
-        throw PeerClosed(peer + ": the peer closed the connection");
-    }
-}
-
-void TlsSession::close_notify() {
-    std::lock_guard lock(mutex_);
-    const NoSigpipe no_sigpipe;
-    ERR_clear_error();
-    SSL_shutdown(ssl_);  // may not go out on a full socket: the peer then sees an EOF
-    ERR_clear_error();
-}
-
-std::string TlsSession::describe() const {
-    return std::string(SSL_get_version(ssl_)) + " " + SSL_get_cipher_name(ssl_);
+std::string tls_reason(const asio::error_code& e) {
+    if (e.category() != asio::error::get_ssl_category()) return "";
+    const char* reason = ERR_reason_error_string(static_cast<unsigned long>(e.value()));
+    return reason ? reason : e.message();
 }
 
 }  // namespace isowall::remote

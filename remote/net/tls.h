@@ -1,25 +1,19 @@
 #pragma once
-// TLS for the remote-viewing protocol, through OpenSSL: a context per side (the
-// server's certificate and key; the client's trusted authorities) and one connection's session
-// over a connected Socket.
-//
-// A session works on a non-blocking socket: every OpenSSL call holds the session's mutex and
-// never blocks, and a call that must wait for the network releases the mutex and polls. So one
-// reader and one writer (Connection's threads) may use a session at once, and Socket::
-// shutdown_both() from a third thread wakes both (they then throw PeerClosed).
+// TLS for the remote-viewing protocol: a context per side (the server's certificate and key,
+// checked through OpenSSL so that a bad file is named; the client's trusted authorities) and the
+// handshake that turns a connected Socket into a TLS one (asio::ssl on the net thread). After it
+// the Socket's sends and receives go through TLS with the same threads, errors and timeouts.
 //
 // Bad files are InputErrors naming the file and the option (--tls-cert, --tls-key, --tls-ca);
 // a handshake that fails is a TlsHandshakeError naming the peer and, in words, why.
 #include <cstddef>
 #include <memory>
-#include <mutex>
 #include <span>
 #include <string>
 
 #include "remote/net/socket.h"
 
 struct ssl_ctx_st;
-struct ssl_st;
 
 namespace isowall::remote {
 
@@ -50,43 +44,16 @@ class TlsContext {
     bool server_ = false;
 };
 
-class TlsSession {
-  public:
-    ~TlsSession();
-    TlsSession(const TlsSession&) = delete;
-    TlsSession& operator=(const TlsSession&) = delete;
-
-    // The server's handshake on an accepted socket (made non-blocking), within `timeout_s`.
-    static std::unique_ptr<TlsSession> accept(const TlsContext& ctx, const Socket& s,
-                                              const std::string& peer, double timeout_s);
-    // The client's handshake: `host` is the name (or numeric address) the certificate must
-    // carry, and the name sent for SNI.
-    static std::unique_ptr<TlsSession> connect(const TlsContext& ctx, const Socket& s,
-                                               const std::string& host, const std::string& peer,
-                                               double timeout_s);
-
-    // As send_all and recv_some (socket.h), through TLS: the same errors, the same timeouts.
-    void write_all(const Socket& s, std::span<const std::byte> bytes, const std::string& peer);
-    bool read_some(const Socket& s, std::span<std::byte> buf, double timeout_s, std::size_t& got,
-                   const std::string& peer);
-    // Sends the close_notify alert if the socket takes it at once; never waits.
-    void close_notify();
-    // "TLSv1.3 TLS_AES_256_GCM_SHA384": for log lines.
-    std::string describe() const;
-
-  private:
-    explicit TlsSession(ssl_st* ssl) : ssl_(ssl) {}
-    // A session of `ctx` on `s`, before its handshake.
-    static std::unique_ptr<TlsSession> start(const TlsContext& ctx, const Socket& s,
-                                             const std::string& peer);
-    // The server's handshake when `host` is empty, else the client's.
-    static std::unique_ptr<TlsSession> handshake(std::unique_ptr<TlsSession> session,
-                                                 const Socket& s, const std::string& host,
-                                                 const std::string& peer, double timeout_s);
-
-    ssl_st* ssl_ = nullptr;
-    std::mutex mutex_;
-};
+// The server's handshake on an accepted socket, within `timeout_s`: from then on every byte of
+// `s` goes through TLS. The bytes Socket::peek showed are the handshake's first. Throws
+// TlsHandshakeError naming `peer` and, in words, why.
+void accept_tls(Socket& s, const TlsContext& ctx, const std::string& peer, double timeout_s);
+// The client's: `host` is the name (or numeric address) the certificate must carry, and the name
+// sent for SNI.
+void connect_tls(Socket& s, const TlsContext& ctx, const std::string& host, const std::string& peer,
+                 double timeout_s);
+// "TLSv1.3 TLS_AES_256_GCM_SHA384" once a handshake has run on `s`, for log lines; "" before.
+std::string tls_description(const Socket& s);
 
 // Whether the first bytes a client sent open a TLS handshake record (content type 22, version
 // 3.x): how a TLS port tells a client that speaks plain text, to answer it in plain text.
