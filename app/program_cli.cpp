@@ -105,6 +105,7 @@ void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
                         "The page over https and wss: this PEM certificate chain, with --tls-key");
     wall_cmd.add_option("--tls-key", wall.tls_key,
                         "The PEM private key of --tls-cert (no passphrase)");
+    add_allow_host_option(wall_cmd, wall.allow_hosts, "--http");
 }
 
 // What each rank of a wall may use: its threads, and where it reads a store.

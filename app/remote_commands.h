@@ -24,7 +24,8 @@ struct ServeCommand {
     int port = -1;       // --port; -1: not given (the port in --listen, else kServePort)
     int http_port = -1;  // --http: the page and WebSocket on this port (0: any free); -1: none
     std::string token;
-    std::string tls_cert, tls_key;  // PEM files; both or neither (TLS on every port)
+    std::string tls_cert, tls_key;         // PEM files; both or neither (TLS on every port)
+    std::vector<std::string> allow_hosts;  // --allow-host: more names the page may be reached by
     double rate_mbps = 0;
     int max_clients = 8;
     // Shared sessions (remote/shared_session.h): how many, members each, a follower's queue.
@@ -66,6 +67,11 @@ struct ViewCommand {
 
 // --tls-cert and --tls-key of serve and wall: both or neither (InputError naming the one given);
 // null when neither.
+// --allow-host NAME (repeatable): a name the page is reached by besides its addresses, localhost,
+// the listen name, this machine's name and the certificate's (remote::served_host_names); each
+// checked as a host name. `page` names the option that serves the page.
+void add_allow_host_option(CLI::App& cmd, std::vector<std::string>& names, const char* page);
+
 std::shared_ptr<const remote::TlsContext> server_tls(const std::string& cert,
                                                      const std::string& key);
 

@@ -52,6 +52,24 @@ remote::Endpoint listen_endpoint(const ServeCommand& o) {
 
 }  // namespace
 
+void add_allow_host_option(CLI::App& cmd, std::vector<std::string>& names, const char* page) {
+    cmd.add_option("--allow-host", names,
+                   std::string("A name the page (") + page +
+                       ") may be reached by beyond its addresses, localhost, this machine's name "
+                       "and the certificate's, e.g. behind a proxy; repeat for more. A page "
+                       "reached by any other name is refused (a site of another owner may point "
+                       "its own name here)")
+        ->check([](const std::string& name) -> std::string {
+            try {
+                const remote::Endpoint e =
+                    remote::parse_listen_endpoint(name, 0, "--allow-host", "name");
+                if (e.port == 0 && e.host == name) return "";
+            } catch (const InputError&) {
+            }
+            return "expected a host name without a port, got " + quote(name);
+        });
+}
+
 std::shared_ptr<const remote::TlsContext> server_tls(const std::string& cert,
                                                      const std::string& key) {
     if (cert.empty() != key.empty())
@@ -87,6 +105,7 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
                   "TLS on every port (the protocol, the page and its WebSocket): this PEM "
                   "certificate chain, with --tls-key");
     c->add_option("--tls-key", o.tls_key, "The PEM private key of --tls-cert (no passphrase)");
+    add_allow_host_option(*c, o.allow_hosts, "--http");
     c->add_option("--rate-mbps", o.rate_mbps,
                   "Emulate a link of this many Mbit/s (token bucket on every send); 0: no limit")
         ->transform(number_in({0, 1e6}))
@@ -129,6 +148,7 @@ int run_serve(const ServeCommand& o) {
     so.port = at.port;
     so.token = o.token;
     so.tls = server_tls(o.tls_cert, o.tls_key);
+    so.allowed_hosts = o.allow_hosts;
     // Before the datasets load (a large one takes a while): ViewServer checks it again.
     if (std::string p = remote::exposure_problem(so, "listening"); !p.empty())
         throw InputError("--listen", "address", p);

@@ -118,8 +118,8 @@ struct Viewer {
     bool execute(const ScriptCommand& cmd, const std::string& where) {
         if (apply_camera_command(cmd, camera, float(size.x) / float(size.y))) {
         } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
-            check_iso(c->iso, where, "iso");
-            iso = c->iso;
+            const ReadyMsg& r = client.ready();
+            iso = checked_isovalue(c->iso, r.value_min, r.value_max, where, "iso");
         } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
             if (c->until == WaitCmd::Until::time)
                 client.receive_for(c->amount);
@@ -140,17 +140,6 @@ struct Viewer {
             throw InputError(where, "camera", p);
         send();
         return true;
-    }
-
-    void check_iso(double v, const std::string& where, const std::string& field) const {
-        const ReadyMsg& r = client.ready();
-        if (!(v >= r.value_min && v <= r.value_max)) {
-            char msg[160];
-            std::snprintf(msg, sizeof(msg),
-                          "isovalue %g is outside the dataset's value range [%g, %g]", v,
-                          r.value_min, r.value_max);
-            throw InputError(where, field, msg);
-        }
     }
 };
 

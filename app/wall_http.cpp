@@ -19,22 +19,29 @@ constexpr double kStateIntervalS = 0.25;
 // up: each replaces the last).
 constexpr std::size_t kMaxQueuedTexts = 256;
 
+// Who may reach the page, in the terms of `serve`'s (remote/view_server.h).
+remote::ServerOptions access_options(const WallHttpOptions& o) {
+    remote::ServerOptions so;
+    so.address = o.address;
+    so.token = o.token;
+    so.tls = o.tls;
+    so.allowed_hosts = o.allowed_hosts;
+    return so;
+}
+
 web::WebOptions web_options(const WallHttpOptions& o) {
     web::WebOptions w;
     w.address = o.address;
     w.port = o.port;
     w.max_message_bytes = kMaxPageMessage;
     if (o.tls) w.tls = o.tls->native();
+    w.host_names = remote::served_host_names(access_options(o));
     return w;
 }
 
 void check_exposure(const WallHttpOptions& o) {
-    remote::ServerOptions so;
-    so.address = o.address;
-    so.token = o.token;
-    so.tls = o.tls;
-    if (std::string p = remote::exposure_problem(so, "serving the wall's page"); !p.empty())
-        throw InputError("--http-listen", "address", p);
+    const std::string p = remote::exposure_problem(access_options(o), "serving the wall's page");
+    if (!p.empty()) throw InputError("--http-listen", "address", p);
 }
 
 }  // namespace

@@ -38,6 +38,7 @@ struct WallHttpOptions {
     int port = 0;                                   // --http (0: any free port, printed)
     std::string token;                              // --token: every page must present it
     std::shared_ptr<const remote::TlsContext> tls;  // https and wss; null: plain
+    std::vector<std::string> allowed_hosts;         // --allow-host
     std::string out = "mosaic.png";                 // snapshots go beside it
     // The wall file's name as the pages show it: the name alone, not the master's folders, which
     // a page on another machine has no use for.

@@ -77,6 +77,7 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
         for (const auto& [given, name] : {std::pair{!o.token.empty(), "--token"},
                                           {!o.tls_cert.empty(), "--tls-cert"},
                                           {!o.tls_key.empty(), "--tls-key"},
+                                          {!o.allow_hosts.empty(), "--allow-host"},
                                           {o.http_listen != "127.0.0.1", "--http-listen"}})
             if (given) throw InputError(name, "value", "applies to the page: give --http PORT");
     // A folder, a device or a missing file is an error naming --script (a folder read as empty).
@@ -120,7 +121,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     std::optional<WallHttp> http;
     if (o.http_port >= 0)
         http.emplace(spec, WallHttpOptions{o.http_listen, o.http_port, o.token,
-                                           server_tls(o.tls_cert, o.tls_key), o.out,
+                                           server_tls(o.tls_cert, o.tls_key), o.allow_hosts, o.out,
                                            std::filesystem::path(o.wall).filename().string()});
     master.start();
     const std::string where = o.script.empty() ? std::string("--script") : o.script;

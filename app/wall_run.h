@@ -36,10 +36,11 @@ struct WallOptions {
     std::string http_listen = "127.0.0.1";
     std::string token;
     std::string tls_cert, tls_key;
-    double timeout_s = 120;          // a wall silent this long ends the job
-    double startup_timeout_s = 600;  // the same while the tiles load the volume and start
-    std::string trace;               // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
-    std::vector<float> orbit, pan;   // the first view: yaw pitch; dx dy (empty: none)
+    std::vector<std::string> allow_hosts;  // --allow-host
+    double timeout_s = 120;                // a wall silent this long ends the job
+    double startup_timeout_s = 600;        // the same while the tiles load the volume and start
+    std::string trace;                     // prefix: PREFIX.json (Chrome trace) and PREFIX.csv
+    std::vector<float> orbit, pan;         // the first view: yaw pitch; dx dy (empty: none)
     float zoom = 1;
     bool balance = true;  // the screen-region scheduler migrates jobs
     // "auto": regions planned from the work (master/region_plan.h); WxH a fixed grid, or "tile"

@@ -20,13 +20,7 @@ double checked_iso(const std::optional<double>& iso, const IsoSource& source) {
         if (source.phantom) return kPhantomSkinIso;
         throw InputError(source.where, "--iso", "an isovalue is required (see `isowall info`)");
     }
-    if (!(*iso >= source.lo && *iso <= source.hi)) {
-        char msg[160];
-        std::snprintf(msg, sizeof(msg), "isovalue %g is outside the value range [%g, %g]", *iso,
-                      source.lo, source.hi);
-        throw InputError(source.where, "--iso", msg);
-    }
-    return *iso;
+    return checked_isovalue(*iso, source.lo, source.hi, source.where, "--iso");
 }
 
 }  // namespace isowall

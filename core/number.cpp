@@ -65,6 +65,14 @@ std::string number_problem(std::string_view text, const NumberRange& range) {
     return "expected " + range.describe() + ", got " + quote(text);
 }
 
+double checked_isovalue(double iso, double lo, double hi, const std::string& where,
+                        const std::string& field) {
+    if (iso >= lo && iso <= hi) return iso;
+    char msg[160];
+    std::snprintf(msg, sizeof(msg), "isovalue %g is outside the value range [%g, %g]", iso, lo, hi);
+    throw InputError(where, field, msg);
+}
+
 double checked_number(std::string_view text, const NumberRange& range, const std::string& where,
                       const std::string& field) {
     const std::string problem = number_problem(text, range);

@@ -53,6 +53,12 @@ std::string number_problem(std::string_view text, const NumberRange& range);
 double checked_number(std::string_view text, const NumberRange& range, const std::string& where,
                       const std::string& field);
 
+// The isovalue `iso`, or InputError(where, field, "isovalue 300 is outside the value range
+// [0, 220]") when it lies outside [lo, hi]: no surface there, a blank picture. The one check of an
+// isovalue, from --iso or a script's `iso` line, against a volume or a served dataset.
+double checked_isovalue(double iso, double lo, double hi, const std::string& where,
+                        const std::string& field);
+
 // A size in bytes as an option gives it (--memory-limit): "512M", "8G", "1.5GiB", "1048576";
 // nullopt for anything else (or zero).
 std::optional<std::uint64_t> parse_byte_size(std::string_view text);

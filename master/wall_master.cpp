@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/number.h"
 #include "files/image_io.h"
 #include "master/wall_report.h"
 
@@ -259,14 +260,7 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
 bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where) {
     if (apply_camera_command(cmd, camera_, aspect_)) {
     } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
-        if (!(c->iso >= lo_ && c->iso <= hi_)) {
-            char msg[160];
-            std::snprintf(msg, sizeof(msg),
-                          "isovalue %g is outside the volume's value range [%g, %g]", c->iso, lo_,
-                          hi_);
-            throw InputError(where, "iso", msg);
-        }
-        iso_ = c->iso;
+        iso_ = checked_isovalue(c->iso, lo_, hi_, where, "iso");
     } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
         wait(*c);
         return false;

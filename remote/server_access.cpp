@@ -2,7 +2,12 @@
 // addresses, and what an address off loopback needs (TLS and a token).
 #include "remote/view_server.h"
 
+#include <unistd.h>
+
+#include <climits>
+
 #include "remote/net/endpoint.h"
+#include "remote/net/tls.h"
 
 namespace isowall::remote {
 
@@ -19,6 +24,19 @@ std::string exposure_problem(const ServerOptions& o, const std::string& what) {
     return what + " on " + o.address +
            " (not loopback) needs TLS (--tls-cert and --tls-key) and --token, which every "
            "client must present: anyone on the path could read the surfaces and the token";
+}
+
+std::vector<std::string> served_host_names(const ServerOptions& o) {
+    std::vector<std::string> names = o.allowed_hosts;
+    names.push_back(o.address);  // an address is allowed anyway; a name is one of ours
+    char host[HOST_NAME_MAX + 1] = "";
+    if (::gethostname(host, sizeof host) == 0) {
+        host[HOST_NAME_MAX] = '\0';
+        names.emplace_back(host);
+    }
+    if (o.tls)
+        for (const std::string& n : o.tls->certificate_dns_names()) names.push_back(n);
+    return names;
 }
 
 }  // namespace isowall::remote

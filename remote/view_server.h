@@ -56,6 +56,9 @@ struct ServerOptions {
     std::string token;  // empty: none asked for (only allowed on a loopback address)
     // The TCP protocol over TLS with this server context; null: plain TCP (loopback only).
     std::shared_ptr<const TlsContext> tls;
+    // Names the page's Host header may carry besides those served_host_names finds (--allow-host:
+    // a name the machine is reached by that it does not know, e.g. behind a proxy).
+    std::vector<std::string> allowed_hosts;
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
     int max_clients = 8;
     double hello_timeout_s = 10;
@@ -73,6 +76,12 @@ struct ServerOptions {
 // needs TLS and a token. For InputError("--listen", "address", ...); `what` is "listening"
 // or "serving the page".
 std::string exposure_problem(const ServerOptions& o, const std::string& what);
+
+// The names a page may reach the server by (its Host header), besides IP addresses and
+// localhost: the listen address when it is a name, this machine's host name, the TLS
+// certificate's DNS names and `allowed_hosts`. Any other name is a page of another site that
+// made its own name resolve here (DNS rebinding), refused by the HTTP server.
+std::vector<std::string> served_host_names(const ServerOptions& o);
 
 class ViewServer {
   public:

@@ -4,6 +4,7 @@
 // and the option; framed connections over TLS carry large messages and wake on shutdown.
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -167,6 +168,21 @@ TEST(RemoteTls, AStalledHandshakeEndsAtTheHelloLimitAndBlocksNoOne) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_TRUE(closed) << "the server did not close the stalled connection within 30 s";
     EXPECT_LT(waited, 20) << "the stalled handshake was held past the hello's limit";
+}
+
+// The names a certificate carries are names its page may be reached by (the Host rule), beside
+// the listen name, this machine's name and --allow-host.
+TEST(RemoteTls, TheCertificatesNamesAreNamesThePageMayBeReachedBy) {
+    const TestCert named =
+        make_test_cert(scratch_dir("tls_page_names"), "page", "DNS:wall.test,DNS:node7.test");
+    ServerOptions o;
+    o.address = "wall-listen.test";
+    o.allowed_hosts = {"proxy.test"};
+    o.tls = std::make_shared<const TlsContext>(TlsContext::server(named.cert, named.key));
+    const std::vector<std::string> names = served_host_names(o);
+    for (const char* name : {"wall.test", "node7.test", "wall-listen.test", "proxy.test"})
+        EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    EXPECT_EQ(TlsContext::client("").certificate_dns_names().size(), 0u);
 }
 
 TEST(RemoteTls, BadCertificateFilesNameTheFileAndTheOption) {

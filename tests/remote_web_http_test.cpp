@@ -1,6 +1,6 @@
 // `isowall serve --http`: the HTTP side. The routes as pure functions, then over
 // loopback: the page, its content type, /datasets with and without a token, 404 and 405, and
-// the WebSocket upgrade's Origin and path rules.
+// the WebSocket upgrade's Host, Origin and path rules.
 #include <cctype>
 #include <fstream>
 #include <sstream>
@@ -141,8 +141,10 @@ TEST(RemoteWebHttp, DatasetsWithAndWithoutAToken) {
 }
 
 // A WebSocket handshake by hand, to see the status of a refused one.
-int upgrade_status(int port, const std::string& path, const std::string& origin) {
-    std::string head = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+int upgrade_status(int port, const std::string& path, const std::string& origin,
+                   const std::string& host = "") {
+    std::string head = "GET " + path + " HTTP/1.1\r\nHost: " +
+                       (host.empty() ? "127.0.0.1:" + std::to_string(port) : host) +
                        "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13";
     if (!origin.empty()) head += "\r\nOrigin: " + origin;
@@ -169,6 +171,43 @@ TEST(RemoteWebHttp, OverTlsTheSameOriginIsHttps) {
     EXPECT_FALSE(web::origin_allowed("https://evil.example", "127.0.0.1:8443", true));
     EXPECT_FALSE(web::origin_allowed("https://127.0.0.1:8443", "", true));
     EXPECT_FALSE(web::origin_allowed("https://127.0.0.1:8443", "127.0.0.1:8443", false));
+}
+
+// DNS rebinding: a page of evil.example whose name now resolves to this server sends
+// Host: evil.example:PORT, and its own Origin, which then matches that Host. Every request by a
+// name the server does not serve is refused, plain or upgrade, before any route answers.
+TEST(RemoteWebHttp, APageReachingTheServerByAForeignNameIsRefused) {
+    remote::ServerOptions o;
+    o.allowed_hosts = {"wall.example.org"};
+    WebTestServer server(o);
+    const int port = server.http_port();
+    const std::string p = ":" + std::to_string(port);
+    const auto get = [&](const std::string& host) {
+        return http_exchange(port,
+                             "GET /datasets HTTP/1.1\r\nHost: " + host + "\r\nConnection: close");
+    };
+    const HttpReply evil = get("evil.example" + p);
+    EXPECT_EQ(evil.status, 403);
+    EXPECT_NE(evil.body.find("Host evil.example"), std::string::npos) << evil.body;
+    EXPECT_NE(evil.body.find("--allow-host"), std::string::npos) << evil.body;
+    EXPECT_EQ(evil.body.find("phantom"), std::string::npos) << "the dataset list went out";
+    EXPECT_EQ(upgrade_status(port, "/ws", "http://evil.example" + p, "evil.example" + p), 403);
+    EXPECT_EQ(get("localhost" + p).status, 200);
+    EXPECT_EQ(get("WALL.example.org" + p).status, 200);
+    EXPECT_EQ(get("127.0.0.1" + p).status, 200);
+}
+
+TEST(RemoteWebHttp, TheHostRuleTakesAddressesLocalhostAndServedNamesOnly) {
+    const std::vector<std::string> names = {"wall.example.org", "Node7."};
+    for (const char* ok :
+         {"127.0.0.1:8080", "10.1.2.3", "[::1]:8080", "[fe80::1]", "localhost", "LocalHost:80",
+          "page.localhost:80", "wall.example.org:443", "wall.example.org.", "node7:80", "NODE7"})
+        EXPECT_TRUE(web::host_allowed(ok, names)) << ok;
+    for (const char* refused :
+         {"", "evil.example", "evil.example:8080", "wall.example.org.evil.example",
+          "localhost.evil", "127.0.0.1.evil.example", "[::1", "[evil]:80", "[::1]x",
+          "wall.example.org:80x", ":80", "node7:80:80"})
+        EXPECT_FALSE(web::host_allowed(refused, names)) << refused;
 }
 
 TEST(RemoteWebHttp, APortInUseNamesHttp) {

@@ -5,6 +5,7 @@
 // against a wall under mpirun.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -12,6 +13,7 @@
 #include "app/wall_http.h"
 #include "comm/inproc_comm.h"
 #include "core/error.h"
+#include "remote/net/socket.h"
 #include "tests/test_util.h"
 #include "tests/ws_test_client.h"
 #include "wall_spec/wall.h"
@@ -156,6 +158,32 @@ TEST(WallHttp, PagesPastTheBoundAreTurnedAway) {
     WsTestClient c(http.port());
     EXPECT_TRUE(c.wait_closed(5));
     EXPECT_FALSE(a.wait_closed(0.2));
+}
+
+// The page's Host rule (remote/http/web_server.h) holds on the wall too: a page that reaches it
+// by a foreign name (DNS rebinding) is refused before the page's files.
+TEST(WallHttp, APageReachingTheWallByAForeignNameIsRefused) {
+    Fixture f;
+    WallHttp http(f.spec, options());
+    const auto status_for = [&](const std::string& host) {
+        remote::Socket s = remote::connect_tcp("127.0.0.1", http.port(), 10);
+        const std::string request =
+            "GET / HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
+        remote::send_all(s, std::as_bytes(std::span(request.data(), request.size())), "wall");
+        std::string reply;
+        std::array<std::byte, 4096> buf;
+        std::size_t got = 0;
+        try {
+            while (reply.find("\r\n") == std::string::npos &&
+                   remote::recv_some(s, buf, 10, got, "wall"))
+                reply.append(reinterpret_cast<const char*>(buf.data()), got);
+        } catch (const remote::PeerClosed&) {
+        }
+        return reply.substr(0, reply.find("\r\n"));
+    };
+    const std::string port = ":" + std::to_string(http.port());
+    EXPECT_NE(status_for("evil.example" + port).find(" 403"), std::string::npos);
+    EXPECT_NE(status_for("127.0.0.1" + port).find(" 200"), std::string::npos);
 }
 
 TEST(WallHttp, AnAddressOffLoopbackNeedsTlsAndAToken) {

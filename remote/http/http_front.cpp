@@ -13,6 +13,7 @@ HttpFrontEnd::HttpFrontEnd(ViewServer& server, int port) : server_(server) {
     web::WebOptions wo;
     if (so.tls) wo.tls = so.tls->native();
     wo.address = so.address;
+    wo.host_names = served_host_names(so);
     wo.port = port;
     wo.max_message_bytes = kHeaderBytes + so.max_payload_bytes;
     // The cap on a connection's queue: the back-pressure limit and the largest message a session

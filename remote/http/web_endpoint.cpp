@@ -131,9 +131,26 @@ void Server<Config>::install_handlers() {
     });
 }
 
+namespace {
+
+// The Host check's refusal: one line a user can act on.
+std::string foreign_host(const std::string& host) {
+    return "Host " + (host.empty() ? std::string("(none)") : host) +
+           " does not name this server (a page of another site reaching it through a name of its "
+           "own?): open it by an address, localhost or a name it serves, or add the name with "
+           "--allow-host NAME";
+}
+
+}  // namespace
+
 template <class Config>
 bool Server<Config>::validate(Handle h) {
     const ConnectionPtr con = endpoint.get_con_from_hdl(h);
+    if (const std::string host = con->get_request_header("Host");
+        !host_allowed(host, options.host_names)) {
+        refuse(con, status::forbidden, foreign_host(host));
+        return false;
+    }
     std::string path, query;
     split_resource(con->get_resource(), path, query);
     if (path != options.ws_path) {
@@ -152,6 +169,11 @@ bool Server<Config>::validate(Handle h) {
 template <class Config>
 void Server<Config>::serve_http(Handle h) {
     const ConnectionPtr con = endpoint.get_con_from_hdl(h);
+    if (const std::string host = con->get_request_header("Host");
+        !host_allowed(host, options.host_names)) {
+        refuse(con, status::forbidden, foreign_host(host));
+        return;
+    }
     HttpRequest request;
     request.method = con->get_request().get_method();
     split_resource(con->get_resource(), request.path, request.query);

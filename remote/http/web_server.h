@@ -6,9 +6,12 @@
 //
 // With a TLS context (WebOptions::tls) every request and WebSocket goes over TLS (https, wss).
 //
-// Upgrades are accepted only on `ws_path`, and only when the Origin header is absent or is
-// http://<Host header> (https:// with TLS) (a page of another site cannot drive the server);
-// anything else is refused (403 for the Origin, 404 for the path) before the handshake completes.
+// Every request, plain or upgrade, must carry a Host header that names this server
+// (host_allowed): a page of another site that made its own name resolve to this server's address
+// (DNS rebinding) sends its own name there, and gets 403. Upgrades are accepted only on `ws_path`,
+// and only when the Origin header is absent or is http://<Host header> (https:// with TLS) (a
+// page of another site cannot drive the server); anything else is refused (403 for the Host or
+// the Origin, 404 for the path) before the handshake completes.
 // Plain HTTP requests go to the `http` callback. Every WebSocket message over `max_message_bytes`
 // closes its connection (1009, message too big) without reaching `message`.
 //
@@ -24,6 +27,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 struct ssl_ctx_st;  // OpenSSL's SSL_CTX
 
@@ -67,7 +71,14 @@ struct WebOptions {
     // HTTPS and wss with this OpenSSL context (the server's certificate and key, as
     // remote::TlsContext::server made it; the server holds a reference of its own); null: plain.
     ssl_ctx_st* tls = nullptr;
+    // The names a Host header may carry besides an IP address and localhost (host_allowed).
+    std::vector<std::string> host_names;
 };
+
+// Whether a Host header ("wall.example.org:8080", "[::1]:80") names this server: an IP address,
+// localhost or a name under .localhost (which browsers never look up), or one of `names` (case
+// and a final dot aside). "" and malformed headers do not.
+bool host_allowed(const std::string& host_header, const std::vector<std::string>& names);
 
 // Whether a WebSocket upgrade with these headers may go on ("" when a header is absent): the
 // page's own origin, https:// on a TLS server.

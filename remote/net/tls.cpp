@@ -130,6 +130,28 @@ void handshake(Socket& socket, const TlsContext& ctx, const std::string& host,
     s->tls_description = std::string(SSL_get_version(ssl)) + " " + SSL_get_cipher_name(ssl);
 }
 
+// A certificate's subjectAltName entries a user reads: "DNS:wall.example.org", "IP:10.0.0.5".
+std::vector<std::string> subject_alt_names(X509* cert) {
+    std::vector<std::string> out;
+    auto* names =
+        static_cast<GENERAL_NAMES*>(X509_get_ext_d2i(cert, NID_subject_alt_name, nullptr, nullptr));
+    if (!names) return out;
+    for (int i = 0; i < sk_GENERAL_NAME_num(names); ++i) {
+        const GENERAL_NAME* n = sk_GENERAL_NAME_value(names, i);
+        if (n->type == GEN_DNS) {
+            const auto* data = reinterpret_cast<const char*>(ASN1_STRING_get0_data(n->d.dNSName));
+            out.push_back("DNS:" + std::string(data, static_cast<std::size_t>(std::max(
+                                                         0, ASN1_STRING_length(n->d.dNSName)))));
+        } else if (n->type == GEN_IPADD && ASN1_STRING_length(n->d.iPAddress) == 4) {
+            const unsigned char* a = ASN1_STRING_get0_data(n->d.iPAddress);
+            out.push_back("IP:" + std::to_string(a[0]) + "." + std::to_string(a[1]) + "." +
+                          std::to_string(a[2]) + "." + std::to_string(a[3]));
+        }
+    }
+    GENERAL_NAMES_free(names);
+    return out;
+}
+
 }  // namespace
 
 bool looks_like_tls(std::span<const std::byte> first) {
@@ -175,24 +197,10 @@ std::string TlsContext::certificate_summary() const {
     char subject[256] = "";
     X509_NAME_oneline(X509_get_subject_name(cert), subject, sizeof subject);
     text += subject;
-    if (auto* names = static_cast<GENERAL_NAMES*>(
-            X509_get_ext_d2i(cert, NID_subject_alt_name, nullptr, nullptr))) {
-        std::string list;
-        for (int i = 0; i < sk_GENERAL_NAME_num(names); ++i) {
-            const GENERAL_NAME* n = sk_GENERAL_NAME_value(names, i);
-            if (n->type == GEN_DNS) {
-                list += (list.empty() ? "" : " ") + std::string("DNS:") +
-                        reinterpret_cast<const char*>(ASN1_STRING_get0_data(n->d.dNSName));
-            } else if (n->type == GEN_IPADD && ASN1_STRING_length(n->d.iPAddress) == 4) {
-                const unsigned char* a = ASN1_STRING_get0_data(n->d.iPAddress);
-                list += (list.empty() ? "" : " ") + std::string("IP:") + std::to_string(a[0]) +
-                        "." + std::to_string(a[1]) + "." + std::to_string(a[2]) + "." +
-                        std::to_string(a[3]);
-            }
-        }
-        GENERAL_NAMES_free(names);
-        if (!list.empty()) text += ", names " + list;
-    }
+    std::string list;
+    for (const std::string& name : subject_alt_names(cert))
+        list += (list.empty() ? "" : " ") + name;
+    if (!list.empty()) text += ", names " + list;
     if (BIO* bio = BIO_new(BIO_s_mem())) {
         ASN1_TIME_print(bio, X509_get0_notAfter(cert));
         char* data = nullptr;
@@ -201,6 +209,15 @@ std::string TlsContext::certificate_summary() const {
         BIO_free(bio);
     }
     return text;
+}
+
+std::vector<std::string> TlsContext::certificate_dns_names() const {
+    std::vector<std::string> out;
+    X509* cert = server_ ? SSL_CTX_get0_certificate(ctx_.get()) : nullptr;
+    if (!cert) return out;
+    for (const std::string& name : subject_alt_names(cert))
+        if (name.rfind("DNS:", 0) == 0) out.push_back(name.substr(4));
+    return out;
 }
 
 TlsContext TlsContext::client(const std::string& ca_file) {

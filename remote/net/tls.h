@@ -10,6 +10,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "remote/net/socket.h"
 
@@ -35,6 +36,9 @@ class TlsContext {
     // A server's certificate in one line for its start-up log: "subject CN=wall.example.org,
     // names DNS:wall.example.org, valid until Nov 28 09:41:02 2027 GMT" ("" for a client).
     std::string certificate_summary() const;
+    // The server certificate's DNS names (subjectAltName), the names clients may reach it by;
+    // empty for a client.
+    std::vector<std::string> certificate_dns_names() const;
     ssl_ctx_st* native() const { return ctx_.get(); }
 
   private:
