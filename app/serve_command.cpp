@@ -17,7 +17,9 @@ namespace isowall {
 namespace {
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int) {
+std::atomic<int> g_stop_signal{0};
+extern "C" void on_stop_signal(int sig) {
+    g_stop_signal.store(sig);
     g_stop.store(true);
 }
 
@@ -173,24 +175,33 @@ int run_serve(const ServeCommand& o) {
                 throw InputError("--dataset", "value", "the name " + quote(name) + " is taken");
         datasets.push_back(load_dataset(name, spec.substr(eq + 1), o.cache_dir));
     }
-    remote::ViewServer server(std::move(datasets), so);
-    // After the server, so it goes first: no WebSocket is handed to a server being destroyed.
-    // A port in use throws here, and the TCP listener closes with `server`.
-    std::optional<remote::HttpFrontEnd> http;
-    if (o.http_port >= 0) http.emplace(server, o.http_port);
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-    std::printf(
-        "serve: listening on %s%s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
-        so.tls ? " (TLS)" : "", o.token.empty() ? "" : " (token required)",
-        o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
-    if (so.tls) std::printf("serve: TLS certificate: %s\n", so.tls->certificate_summary().c_str());
-    if (http)
-        std::printf("serve: page at %s://%s/ (WebSocket /ws)\n", so.tls ? "https" : "http",
-                    remote::host_port(at.host, http->port()).c_str());
-    std::fflush(stdout);
-    server.serve(g_stop);
-    std::printf("serve: stopped after %d connection(s)\n", server.accepted());
+    {
+        remote::ViewServer server(std::move(datasets), so);
+        // After the server, so it goes first: no WebSocket is handed to a server being
+        // destroyed. A port in use throws here, and the TCP listener closes with `server`.
+        std::optional<remote::HttpFrontEnd> http;
+        if (o.http_port >= 0) http.emplace(server, o.http_port);
+        for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_stop_signal);
+        std::printf(
+            "serve: listening on %s%s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
+            so.tls ? " (TLS)" : "", o.token.empty() ? "" : " (token required)",
+            o.rate_mbps > 0 ? (", link " + std::to_string(o.rate_mbps) + " Mbit/s").c_str() : "");
+        if (so.tls)
+            std::printf("serve: TLS certificate: %s\n", so.tls->certificate_summary().c_str());
+        if (http)
+            std::printf("serve: page at %s://%s/ (WebSocket /ws)\n", so.tls ? "https" : "http",
+                        remote::host_port(at.host, http->port()).c_str());
+        std::fflush(stdout);
+        server.serve(g_stop);
+        std::printf("serve: stopped after %d connection(s)\n", server.accepted());
+        std::fflush(stdout);
+    }
+    // A signal stopped it: the server has closed every connection; the signal itself ends the
+    // process, as it ends every other command (exit 128 + signal).
+    if (const int sig = g_stop_signal.load(); sig != 0) {
+        std::signal(sig, SIG_DFL);
+        std::raise(sig);
+    }
     return 0;
 }
 

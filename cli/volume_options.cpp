@@ -46,7 +46,11 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
     app.add_option("--memory-limit", o.memory_limit,
                    "A store's voxels in memory at most (e.g. 512M, 8G); the rest stays on disk "
                    "and is read when a ray or the surface first needs it. Default: half the "
-                   "available memory, shared by the processes of this host");
+                   "available memory, shared by the processes of this host")
+        ->check([](const std::string& text) -> std::string {
+            if (parse_byte_size(text)) return "";
+            return "expected a size such as 512M or 8G, got " + quote(text);
+        });
 }
 
 namespace {

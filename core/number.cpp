@@ -81,15 +81,19 @@ double checked_number(std::string_view text, const NumberRange& range, const std
 }
 
 std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
-    std::string s(text);
-    std::size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(s, &used);
-    } catch (const std::exception&) {
-        return std::nullopt;
+    // Digits, an optional fraction, then the unit: no sign, space, exponent or hexadecimal.
+    std::size_t digits = 0;
+    while (digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits]))) ++digits;
+    std::size_t used = digits;
+    if (used < text.size() && text[used] == '.') {
+        ++used;
+        while (used < text.size() && std::isdigit(static_cast<unsigned char>(text[used]))) ++used;
+        if (used == digits + 1) return std::nullopt;  // "5." or "5.G"
     }
-    std::string unit = s.substr(used);
+    if (digits == 0) return std::nullopt;
+    const std::optional<double> v = parse_number(text.substr(0, used));
+    if (!v) return std::nullopt;
+    std::string unit(text.substr(used));
     std::transform(unit.begin(), unit.end(), unit.begin(),
                    [](unsigned char c) { return char(std::toupper(c)); });
     double scale = 1;
@@ -105,7 +109,7 @@ std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
         scale = 1024.0 * 1024 * 1024 * 1024;
     else
         return std::nullopt;
-    const double bytes = v * scale;
+    const double bytes = *v * scale;
     if (!std::isfinite(bytes) || bytes < 1 || bytes > 1.8e19) return std::nullopt;
     return static_cast<std::uint64_t>(bytes);
 }

@@ -74,8 +74,13 @@ TEST(CliStore, BadStoresAndOptionsAreOneLineEach) {
                                    " --out ph.zarr --no-cache -q")
                   .exit_code,
               0);
-    expect_one_line_error(run_isowall(dir, "info --volume ph.zarr --memory-limit 12X"),
-                          {"--memory-limit", "12X"});
+    // A malformed size is a bad command line (exit 2), whatever its spelling.
+    for (const char* bad : {"12X", "0x100000000", "' 512M'", "''", "-1G", "1e3M"}) {
+        const test::RunResult r =
+            run_isowall(dir, std::string("info --volume ph.zarr --memory-limit ") + bad);
+        expect_one_line_error(r, {"--memory-limit"});
+        EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    }
     expect_one_line_error(
         run_isowall(dir, std::string("info --volume phantom.raw --memory-limit 1G") + kRawOptions),
         {"--memory-limit", "store"});

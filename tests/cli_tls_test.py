@@ -10,6 +10,7 @@ Usage: cli_tls_test.py ISOWALL [DIR]   (DIR, emptied first: where its files go; 
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -119,6 +120,15 @@ def main():
         tls.stop()
         plain.stop()
     check("spoke plain text" in open(tls.log).read(), "the TLS server logs the plain client")
+
+    # A signal ends serve as it ends every command: the server closes its connections, says so,
+    # and the signal ends the process (128 + signal in a shell).
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        s = Serve(isowall, [], os.path.join(d, f"signal{int(sig)}.log"))
+        s.proc.send_signal(sig)
+        rc = s.proc.wait(timeout=60)
+        check(rc == -int(sig), f"serve ends by {sig.name} (got exit {rc})")
+        check("stopped after" in open(s.log).read(), f"serve says it stopped on {sig.name}")
 
     def serve_error(args, words, what):
         expect_one_line(run(isowall, ["serve", "--port", "0", *args]), words, what)

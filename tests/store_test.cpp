@@ -41,7 +41,8 @@ TEST(ByteSize, ByteSizesParseAndNonsenseDoesNot) {
     EXPECT_EQ(parse_byte_size("1.5GiB"), 3ull << 29);
     EXPECT_EQ(parse_byte_size("4096"), 4096u);
     EXPECT_EQ(parse_byte_size("64kb"), 64u << 10);
-    for (const char* bad : {"", "M", "0", "-1G", "12X", "nan", "inf", "1e30T", "5 M"})
+    for (const char* bad : {"", "M", "0", "-1G", "12X", "nan", "inf", "1e30T", "5 M", "0x100000000",
+                            " 512M", "512M ", "+5G", "1e3M", "5.", "5.G", ".5G"})
         EXPECT_FALSE(parse_byte_size(bad)) << bad;
 }
 
