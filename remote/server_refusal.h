@@ -1,7 +1,6 @@
 #pragma once
-// Pieces of the server's connections (view_server.cpp): a bounded wait on a channel, the error
-// code a broken stream is refused with, and a connection turned away (max_clients) that still
-// hears why.
+// Pieces of the server's connections (view_server.cpp): a bounded wait on a channel and the
+// error code a broken stream is refused with.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -38,18 +37,5 @@ inline void within(MessageChannel& conn, double timeout_s, F&& f) {
 
 // The error code of a broken stream: the framing's and decoders' WireError texts name the field.
 ErrorCode code_of(const WireError& e);
-
-// How long a connection turned away may take to open and hear why.
-inline constexpr double kRefusalTimeoutS = 2;
-
-// A connection turned away (max_clients): its own thread opens the channel (a TLS handshake,
-// bounded), sends the busy error and closes, so the client reads why, in TLS on a TLS port.
-struct ViewServer::Refusal {
-    Refusal(std::unique_ptr<MessageChannel> c, std::string text);
-    ~Refusal();
-    std::unique_ptr<MessageChannel> channel;
-    std::thread thread;
-    std::atomic<bool> done{false};
-};
 
 }  // namespace isowall::remote

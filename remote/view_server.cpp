@@ -25,9 +25,9 @@ using Clock = std::chrono::steady_clock;
 // How long an error may take to go out, and a worker to stop, before the connection is shut
 // down: a send to a client that does not read waits for room in its buffers for ever.
 constexpr double kErrorSendTimeoutS = 2;
-// Connections turned away at once (a thread each, about 3 s at most; past it one is closed
-// without a word).
-constexpr std::size_t kMaxRefusals = 16;
+
+constexpr const char* kDroppedText =
+    "too many connections had not said their hello; the oldest was closed";
 
 std::string seconds_text(double s) {
     char buf[32];
@@ -41,8 +41,8 @@ struct ViewServer::Impl {
     explicit Impl(Listener l) : listener(std::move(l)) {}
     Listener listener;
     std::mutex mutex;
-    std::list<std::unique_ptr<Client>> clients;
-    std::list<std::unique_ptr<Refusal>> refusals;  // at most kMaxRefusals
+    std::list<std::unique_ptr<Client>> clients;  // in the order they came
+    int seated = 0;                              // clients past their hello (max_clients)
 };
 
 // One connection: this reader thread, and the worker it starts once the hello is accepted.
@@ -57,6 +57,26 @@ class ViewServer::Client {
         if (thread_.joinable()) thread_.join();
     }
     bool done() const { return done_.load(); }
+
+    // The connection has not said its hello yet (under the server's mutex).
+    bool before_hello() const { return !seated_ && !yielding_ && !done_.load(); }
+    // Closes a connection that has not said its hello: another needs its place.
+    void drop_before_hello() {
+        dropped_ = true;
+        conn_.shutdown();
+    }
+    // Whether this client may give its seat to a newcomer, and how long it has been idle: a plain
+    // client (not in a shared session) between frames. Under the server's mutex.
+    std::optional<double> idle_for_yield() const {
+        if (!seated_ || yielding_ || seat_ || computing_.load()) return std::nullopt;
+        return idle_s();
+    }
+    // Gives its seat away: the reader tells the client why and closes. Under the server's mutex.
+    void yield_seat(std::string why) {
+        yield_why_ = std::move(why);
+        seated_ = false;
+        yielding_ = true;
+    }
 
   private:
     void say(const char* fmt, const std::string& a, const std::string& b = {}) const {
@@ -131,7 +151,13 @@ class ViewServer::Client {
     void run() {
         try {
             conn_.open(server_.options_.hello_timeout_s);
-            if (const Dataset* d = hello()) serve(*d);
+            if (const Dataset* d = hello()) {
+                touch();  // idle from the hello on, for choosing who yields a seat
+                if (const std::string busy = server_.take_seat(*this); !busy.empty())
+                    refuse(ErrorCode::internal, busy);
+                else
+                    serve(*d);
+            }
         } catch (const WireError& e) {
             refuse(code_of(e), e.what());
         } catch (const TlsHandshakeError& e) {
@@ -139,11 +165,16 @@ class ViewServer::Client {
             std::string_view text = e.what();
             if (text.rfind(conn_.peer() + ": ", 0) == 0)
                 text.remove_prefix(conn_.peer().size() + 2);
-            say("serve: %s: error: %s\n", std::string(text));
+            if (dropped_)
+                say("serve: %s: closed before its hello: %s\n", kDroppedText);
+            else
+                say("serve: %s: error: %s\n", std::string(text));
         } catch (const PeerClosed& e) {
             // A client that stops sending inside a message may still read the reply.
-            if (std::string_view(e.what()).find("inside a message") != std::string_view::npos)
+            if (std::string_view(e.what()).find("inside a message") != std::string_view::npos &&
+                !dropped_)
                 refuse(ErrorCode::malformed, e.what());
+            if (dropped_) say("serve: %s: closed before its hello: %s\n", kDroppedText);
         } catch (const std::exception& e) {
             refuse(ErrorCode::internal, e.what());
         }
@@ -151,7 +182,7 @@ class ViewServer::Client {
         if (seat_) say("serve: %s: left session %s\n", seat_->session().name());
         seat_.reset();
         conn_.close_gracefully();
-        --server_.open_;
+        server_.leave(*this);
         done_ = true;
     }
 
@@ -163,6 +194,9 @@ class ViewServer::Client {
         ready.dims = d.volume->dims();
         ready.spacing = d.volume->spacing();
         ready.axes = frame_rotation(d.volume->orientation().axes);
+        // Idle from here: before the ready goes out, so a client that connects once it has
+        // read its ready is idle for less time than this one (who yields a seat is decided by it).
+        touch();
         conn_.send(ready);
         if (server_.options_.rate_bits_per_s > 0) conn_.set_rate(server_.options_.rate_bits_per_s);
         say("serve: %s: dataset %s%s\n", d.name);
@@ -182,8 +216,11 @@ class ViewServer::Client {
         if (seat_) say("serve: %s: presents session %s\n", seat_->session().name());
         worker_ = std::thread([this] { work(); });
         const double limit = server_.options_.idle_timeout_s;
-        touch();
         for (;;) {
+            if (yielding_) {
+                refuse(ErrorCode::internal, yield_why_);
+                return;
+            }
             tell_status();
             // The server's own work on a request is not the client's silence (a frame may
             // take longer than the limit: a large view, a slow build).
@@ -329,6 +366,14 @@ class ViewServer::Client {
     std::atomic<Clock::rep> last_active_{0};  // see touch()
     std::atomic<bool> computing_{false};      // the worker runs a request, not in a send
     std::atomic<bool> done_{false};
+    // The seat (ViewServer::take_seat), under the server's mutex; yielding_ and yield_why_ are
+    // written there once, and the reader reads yield_why_ after it sees yielding_.
+    bool seated_ = false;
+    std::atomic<bool> yielding_{false};
+    std::string yield_why_;
+    std::atomic<bool> dropped_{false};  // closed before its hello (drop_before_hello)
+
+    friend class ViewServer;
 };
 
 ViewServer::ViewServer(std::vector<Dataset> datasets, ServerOptions options)
@@ -347,14 +392,19 @@ int ViewServer::port() const {
 }
 
 void ViewServer::reap(bool all) {
-    std::size_t gone = 0;
+    // Taken out under the lock, ended outside it: a client's thread that is still running takes
+    // the lock to give its seat back (leave) before its destructor's join can return.
+    std::list<std::unique_ptr<Client>> ending;
     {
         std::lock_guard lock(impl_->mutex);
-        gone = impl_->clients.remove_if(
-            [all](const std::unique_ptr<Client>& c) { return all || c->done(); });
-        impl_->refusals.remove_if(
-            [all](const std::unique_ptr<Refusal>& r) { return all || r->done.load(); });
+        for (auto it = impl_->clients.begin(); it != impl_->clients.end();) {
+            const auto next = std::next(it);
+            if (all || (*it)->done()) ending.splice(ending.end(), impl_->clients, it);
+            it = next;
+        }
     }
+    const std::size_t gone = ending.size();
+    ending.clear();
     // What a client that left had the server hold goes back to the system: `isowall` keeps
     // freed memory for the next frame (keep_freed_memory, core/util.h), which would keep
     // it for as long as the server runs.
@@ -372,23 +422,57 @@ void ViewServer::serve(const std::atomic<bool>& stop) {
     }
 }
 
-bool ViewServer::adopt(std::unique_ptr<MessageChannel> channel) {
-    {
-        std::lock_guard lock(impl_->mutex);
-        ++accepted_;
-        if (open_.load() < options_.max_clients) {
-            ++open_;  // here, under the lock, not in the thread: the next adopt already counts it
-            impl_->clients.push_back(std::make_unique<Client>(*this, std::move(channel)));
-            return true;
-        }
-    }
+void ViewServer::adopt(std::unique_ptr<MessageChannel> channel) {
     std::lock_guard lock(impl_->mutex);
-    impl_->refusals.remove_if([](const std::unique_ptr<Refusal>& r) { return r->done.load(); });
-    if (impl_->refusals.size() < kMaxRefusals)  // else the channel closes as it goes out of scope
-        impl_->refusals.push_back(std::make_unique<Refusal>(
-            std::move(channel), "server busy: " + std::to_string(options_.max_clients) +
-                                    " clients connected (--max-clients)"));
-    return false;
+    ++accepted_;
+    ++open_;  // here, under the lock, not in the thread: the next adopt already counts it
+    // Connections that have not said their hello hold no seat, and the oldest of them makes
+    // way: half-open handshakes cannot lock out a client that has the token.
+    std::size_t waiting = 0;
+    Client* oldest = nullptr;
+    for (const std::unique_ptr<Client>& c : impl_->clients)
+        if (c->before_hello() && !c->dropped_) {
+            ++waiting;
+            if (!oldest) oldest = c.get();
+        }
+    if (oldest && waiting >= static_cast<std::size_t>(options_.max_before_hello))
+        oldest->drop_before_hello();
+    impl_->clients.push_back(std::make_unique<Client>(*this, std::move(channel)));
+}
+
+std::string ViewServer::take_seat(Client& c) {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->seated < options_.max_clients) {
+        ++impl_->seated;
+        c.seated_ = true;
+        return "";
+    }
+    // Every seat is taken: the client idle the longest between frames gives its seat up.
+    Client* idlest = nullptr;
+    double longest = -1;
+    for (const std::unique_ptr<Client>& other : impl_->clients)
+        if (const std::optional<double> idle = other->idle_for_yield(); idle && *idle > longest) {
+            longest = *idle;
+            idlest = other.get();
+        }
+    const std::string count = std::to_string(options_.max_clients);
+    if (!idlest)
+        return "server busy: " + count +
+               " clients connected, each in a frame or a shared session (--max-clients)";
+    char idle[32];
+    std::snprintf(idle, sizeof idle, "%.1f", longest);
+    idlest->yield_seat("seat given to a newer client: all " + count +
+                       " seats were taken (--max-clients) and this one was idle the longest (" +
+                       idle + " s)");
+    c.seated_ = true;
+    return "";
+}
+
+void ViewServer::leave(Client& c) {
+    std::lock_guard lock(impl_->mutex);
+    if (c.seated_) --impl_->seated;
+    c.seated_ = false;
+    --open_;
 }
 
 std::vector<std::string> ViewServer::dataset_names() const {

@@ -60,7 +60,10 @@ struct ServerOptions {
     // a name the machine is reached by that it does not know, e.g. behind a proxy).
     std::vector<std::string> allowed_hosts;
     double rate_bits_per_s = 0;  // 0: as fast as the link goes; else paced (token bucket)
-    int max_clients = 8;
+    int max_clients = 8;         // seated clients (past their hello), both kinds
+    // Connections that have not said their hello yet (a TLS handshake, the hello itself); past
+    // it the oldest is closed. Each waits at most hello_timeout_s anyway.
+    int max_before_hello = 16;
     double hello_timeout_s = 10;
     // After the hello: nothing received and nothing sent for this long closes the connection.
     // A message that takes longer than this to go out (a 32 MiB group on a link under 1 Mbit/s
@@ -95,9 +98,13 @@ class ViewServer {
     // Accepts connections until `stop` reads true (checked every 100 ms).
     void serve(const std::atomic<bool>& stop);
     // Serves a connection that arrived another way (a WebSocket) with its own reader and worker
-    // threads, as serve() does each TCP one; max_clients counts both kinds. When that many are
-    // open, sends the busy error, drops the channel and returns false. Any thread may call it.
-    bool adopt(std::unique_ptr<MessageChannel> channel);
+    // threads, as serve() does each TCP one; max_clients counts both kinds. Any thread may call
+    // it. Seats (max_clients) are taken at the hello: when every seat is taken, the plain client
+    // idle the longest between frames yields its seat and is told why; only when none can (all
+    // in a frame or in a shared session) is the newcomer told the server is busy. Of the
+    // connections that have not said their hello, at most max_before_hello stay: past it the
+    // oldest is closed.
+    void adopt(std::unique_ptr<MessageChannel> channel);
     // The datasets' names, in the order they were loaded.
     std::vector<std::string> dataset_names() const;
     const ServerOptions& options() const { return options_; }
@@ -108,8 +115,11 @@ class ViewServer {
 
   private:
     class Client;
-    struct Refusal;
     void reap(bool all);
+    // The seat of a client whose hello was accepted: "" when it has one (given up by the idlest
+    // other client if need be), else why not.
+    std::string take_seat(Client& c);
+    void leave(Client& c);  // a client's end: its seat and its count go back
 
     std::vector<Dataset> datasets_;
     ServerOptions options_;
