@@ -199,7 +199,8 @@ bool page_info(void* file, int page, PageInfo& out) {
 bool read_page(void* file, int page, Sample sample, void* out, std::string& error) {
     return guarded(error, [&] {
         auto& in = *static_cast<OIIO::ImageInput*>(file);
-        if (!in.read_image(page, 0, 0, 1, type_of(sample), out))
+        // A page libtiff cannot decode may still "succeed" with its error only recorded.
+        if (!in.read_image(page, 0, 0, 1, type_of(sample), out) || in.has_error())
             return error = in.geterror(), false;
         return true;
     });

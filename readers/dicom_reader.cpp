@@ -32,12 +32,8 @@ namespace {
 const gdcm::Tag kSeriesUid(0x0020, 0x000e), kPosition(0x0020, 0x0032), kOrientation(0x0020, 0x0037),
     kRows(0x0028, 0x0010), kColumns(0x0028, 0x0011), kPixelSpacing(0x0028, 0x0030),
     kModality(0x0008, 0x0060), kDescription(0x0008, 0x103e), kSeriesNumber(0x0020, 0x0011),
-    kPixelData(0x7fe0, 0x0010), kBitsAllocated(0x0028, 0x0100), kFrames(0x0028, 0x0008);
-
-// The most bytes one slice may hold: 512 MiB (16384 x 16384 at 16 bits). Checked on the header
-// before GDCM decodes, since GDCM sizes its buffers from the header; a volume of slices past it
-// could not be held in memory anyway.
-constexpr std::uint64_t kMaxSliceBytes = std::uint64_t(1) << 29;
+    kPixelData(0x7fe0, 0x0010), kBitsAllocated(0x0028, 0x0100), kFrames(0x0028, 0x0008),
+    kRescaleIntercept(0x0028, 0x1052), kRescaleSlope(0x0028, 0x1053);
 
 std::string trimmed(const char* v) {
     std::string s = v ? v : "";
@@ -66,15 +62,22 @@ struct Series {
 };
 
 // The DICOM Part 10 files among `files`, each checked (dicom_lengths.h) before GDCM reads it;
-// other files (notes, a DICOMDIR is Part 10 too and has no series) are passed over.
+// other files (notes, a DICOMDIR is Part 10 too and has no series) are passed over after their
+// first 132 bytes, so a large file beside the series costs nothing. A FIFO or device in the folder
+// is named: opening one could block, and a series with one in it is not what it seems.
 gdcm::Directory::FilenamesType part10_files(const gdcm::Directory::FilenamesType& files) {
+    constexpr std::size_t kMagicEnd = 132;  // a 128-byte preamble, then "DICM"
     gdcm::Directory::FilenamesType out;
     for (const std::string& f : files) {
+        check_regular_file(f, f, "DICOM");
         std::ifstream in(f, std::ios::binary);
-        const std::vector<char> text((std::istreambuf_iterator<char>(in)),
-                                     std::istreambuf_iterator<char>());
+        std::vector<char> text(kMagicEnd);
+        in.read(text.data(), std::streamsize(text.size()));
+        text.resize(std::size_t(in.gcount()));
+        if (!has_part10_magic(std::as_bytes(std::span(text)))) continue;
+        text.insert(text.end(), std::istreambuf_iterator<char>(in),
+                    std::istreambuf_iterator<char>());
         const auto bytes = std::as_bytes(std::span(text));
-        if (!has_part10_magic(bytes)) continue;
         if (std::string problem = dicom_length_problem(bytes); !problem.empty())
             throw InputError(f, "DICOM", problem + " (a damaged file)");
         out.push_back(f);
@@ -265,6 +268,23 @@ Scaling gdcm_scaling(const std::string& f) {
     reader.SetFileName(f.c_str());
     if (!reader.ReadUpToTag(kPixelData))
         throw InputError(f, "DICOM", "GDCM cannot read its header (a damaged file)");
+    // GDCM reads an unparsable or non-finite RescaleSlope as some number and a slope of 0 as 1:
+    // the header's own text is checked first, so a damaged one is named, not guessed.
+    const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
+    for (const auto& [tag, field] : {std::pair{kRescaleSlope, "RescaleSlope"},
+                                     std::pair{kRescaleIntercept, "RescaleIntercept"}}) {
+        if (!ds.FindDataElement(tag)) continue;
+        const gdcm::ByteValue* v = ds.GetDataElement(tag).GetByteValue();
+        if (!v) continue;
+        const std::string text = trimmed(std::string(v->GetPointer(), v->GetLength()).c_str());
+        if (text.empty()) continue;
+        const std::vector<double> n = numbers(text);
+        if (n.size() != 1)
+            throw InputError(f, field,
+                             "expected one finite decimal number, got " + quote_bounded(text));
+        if (tag == kRescaleSlope && n[0] == 0)
+            throw InputError(f, field, "a slope of 0 makes every voxel the same value");
+    }
     const std::vector<double> is =
         gdcm::ImageHelper::GetRescaleInterceptSlopeValue(reader.GetFile());
     return is.size() == 2 ? Scaling{is[1], is[0]} : Scaling{};
@@ -326,9 +346,14 @@ PlaneStack dicom_planes(const fs::path& path) {
         std::vector<std::uint64_t>{std::uint64_t(first.columns), std::uint64_t(first.rows),
                                    std::uint64_t(headers.size())},
         d.type);
-    if (slices->per_slice)
+    if (slices->per_slice) {
         d.facts.push_back({"scaling", "RescaleSlope/Intercept per slice (applied: float32)"});
-    else
+        // Each slice's scaling, against the stored values its header allows, lands in float32.
+        const auto [lo, hi] = slices->first->stored_range;
+        for (std::size_t k = 0; k < sc.size(); ++k)
+            if (std::string p = scaling_problem(sc[k], lo, hi, VoxelType::f32); !p.empty())
+                throw InputError(slices->headers[k].file, "RescaleSlope", p);
+    } else
         d.scaling = slices->first->scaling;
     stack.declared_range = slices->first->stored_range;
     d.orientation.axes =

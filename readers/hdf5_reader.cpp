@@ -212,6 +212,41 @@ void check_filters(hid_t ds, const std::string& where) {
     }
 }
 
+// The most a filter in libhdf5's reach inflates data: deflate tops out near 1032:1 (a run of
+// zeros), the others (shuffle, fletcher32, nbit, scaleoffset) less.
+constexpr std::uint64_t kMaxInflation = 1100;
+
+// The voxels the dataset declares must be stored in the file (compressed: within what deflate
+// could inflate them from), before a byte of memory or disk is spent on them: libhdf5 gives the
+// fill value for every chunk never written, so 2 KB declaring 100000^3 float64 would read as 8 PB
+// of zeros. Stored bytes past the file's size mean a file cut short.
+void check_storage(hid_t ds, glm::ivec3 dims, const std::string& where, const std::string& name,
+                   const fs::path& file) {
+    const Handle dtype(H5Dget_type(ds), H5Tclose);
+    const Handle dcpl(H5Dget_create_plist(ds), H5Pclose);
+    if (!dtype.valid() || !dcpl.valid()) return;
+    const std::uint64_t declared =
+        *checked_product({std::uint64_t(dims.x), std::uint64_t(dims.y), std::uint64_t(dims.z),
+                          H5Tget_size(dtype.get())});
+    const std::uint64_t stored = H5Dget_storage_size(ds);
+    const bool filtered = H5Pget_nfilters(dcpl.get()) > 0;
+    const std::uint64_t least = filtered ? declared / kMaxInflation : declared;
+    if (stored < least)
+        throw InputError(
+            where, "data",
+            name + " declares " + std::to_string(declared) +
+                " bytes of voxels and the file stores " + std::to_string(stored) +
+                (filtered ? " compressed (more than " + std::to_string(kMaxInflation) + ":1)"
+                          : "") +
+                ": data never written, or a damaged file");
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(file, ec);
+    if (!ec && stored > size)
+        throw InputError(where, "data",
+                         name + " stores " + std::to_string(stored) + " bytes, the file holds " +
+                             std::to_string(size) + " (a file cut short)");
+}
+
 // Three numbers of attribute `attr` of the dataset, z y x, or nullopt when it has none.
 std::optional<std::array<double, 3>> zyx_attribute(hid_t ds, const char* attr,
                                                    const std::string& where) {
@@ -264,6 +299,7 @@ PlaneStack hdf5_planes(const fs::path& file, const std::string& dataset) {
     check_filters(ds, where);
     d.facts.push_back({"dataset", name});
     d.spacing = dataset_spacing(ds, where, d.facts);
+    check_storage(ds, d.dims, where, name, file);
     d.format = "HDF5";
     d.files = {file};
     stack.size_field = "dims";

@@ -5,12 +5,14 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <sstream>
 
 #include <nifti2_io.h>
 
@@ -51,31 +53,31 @@ class QuietStderr {
     int saved_;
 };
 
-// The voxels must be in the file before they are read: niftilib allocates what the header says
-// first, so a short file claiming gigabytes would cost gigabytes. Uncompressed: the file's size;
-// gzip: its trailer's length (modulo 2^32), checked for volumes past 64 MiB.
-void check_data_present(const nifti_image& n, std::uint64_t data_bytes, const std::string& where) {
-    const std::string image = n.iname ? n.iname : "";
+// An uncompressed image file must hold the voxels before they are read: niftilib allocates what
+// the header says first, so a short file claiming gigabytes would cost gigabytes. A gzip stream
+// proves its length only as it is inflated (its trailer holds the length modulo 2^32, which any
+// writer may set): read_whole grows its buffer as the stream delivers (PlaneStack::read_unproven).
+void check_data_present(const std::string& image, std::uint64_t offset, glm::ivec3 dims,
+                        VoxelType type, const std::string& where) {
+    if (nifti_is_gzfile(image.c_str())) return;
     std::error_code ec;
     const std::uint64_t size = std::filesystem::file_size(image, ec);
     if (ec) throw InputError(where, "data", "cannot read the image file " + quote_bounded(image));
-    const std::uint64_t need = std::uint64_t(std::max<int64_t>(n.iname_offset, 0)) + data_bytes;
-    const bool gz = image.size() > 3 && image.compare(image.size() - 3, 3, ".gz") == 0;
-    if (!gz && size < need)
+    const std::string holder =
+        image == where ? "the file" : "the image file " + quote_bounded(image);
+    if (offset > size)
+        throw InputError(where, "vox_offset",
+                         "the voxels start at byte " + std::to_string(offset) +
+                             ", past the end of " + holder + " (" + std::to_string(size) +
+                             " bytes)");
+    const std::uint64_t need = offset + voxel_bytes(dims, type);  // both below 2^63
+    if (size < need)
         throw InputError(where, "dim",
-                         "the header's voxels end at byte " + std::to_string(need) +
-                             ", the file holds " + std::to_string(size));
-    if (!gz || data_bytes <= (64u << 20)) return;
-    std::ifstream in(image, std::ios::binary);
-    std::uint8_t tail[4] = {};
-    in.seekg(-4, std::ios::end);
-    in.read(reinterpret_cast<char*>(tail), 4);
-    const std::uint32_t isize = std::uint32_t(tail[0]) | std::uint32_t(tail[1]) << 8 |
-                                std::uint32_t(tail[2]) << 16 | std::uint32_t(tail[3]) << 24;
-    if (!in || isize != std::uint32_t(need))
-        throw InputError(where, "dim",
-                         "the header's voxels end at byte " + std::to_string(need) +
-                             " of the uncompressed file, which gzip says is not its length");
+                         std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
+                             std::to_string(dims.z) + " " + std::string(type_name(type)) +
+                             " voxels from vox_offset " + std::to_string(offset) + " end at byte " +
+                             std::to_string(need) + ", " + holder + " holds " +
+                             std::to_string(size) + " (a truncated file)");
 }
 
 struct NiftiDeleter {
@@ -106,22 +108,62 @@ std::optional<VoxelType> voxel_type_of_nifti(int datatype) {
     }
 }
 
-// scl_slope and scl_inter as the header holds them.
-Scaling header_scaling(const fs::path& path, const std::string& where) {
+// What the header holds before niftilib adjusts it: niftilib turns a NaN or infinite scl_slope
+// into 0 (the standard's "not scaled"), and casts vox_offset to an integer, so a NaN, 1e10 or 352.5
+// becomes some other offset (a negative one it counts from the end of the file).
+struct RawHeader {
+    Scaling scaling;
+    double vox_offset = 0;
+    bool one_file = false;           // .nii: the voxels follow the header in the same file
+    std::uint64_t header_bytes = 0;  // of a .nii: 348 + 4 (extension flags), 540 for NIfTI-2
+    std::string version;             // "NIfTI-1", "NIfTI-2" (ANALYZE 7.5 reads as NIfTI-1)
+};
+
+RawHeader raw_header(const fs::path& path, const std::string& where) {
     int version = 0;
     void* raw = nifti_read_header(path.c_str(), &version, 1);
     if (!raw) throw InputError(where, "header", "not a NIfTI-1 or NIfTI-2 header niftilib reads");
-    Scaling s;
+    RawHeader r;
     if (version == 2) {
         const auto* h = static_cast<const nifti_2_header*>(raw);
-        s = {h->scl_slope, h->scl_inter};
+        r = {{h->scl_slope, h->scl_inter},
+             double(h->vox_offset),
+             h->magic[1] == '+',
+             540,
+             "NIfTI-2"};
     } else {
         const auto* h = static_cast<const nifti_1_header*>(raw);
-        s = {h->scl_slope, h->scl_inter};
+        r = {{h->scl_slope, h->scl_inter},
+             h->vox_offset,
+             std::memcmp(h->magic, "n+1", 4) == 0,
+             352,
+             "NIfTI-1"};
     }
     std::free(raw);
-    if (std::isfinite(s.slope) && s.slope == 0) return {};  // the standard's "not scaled"
-    return s;
+    // The standard's "not scaled"; a non-finite intercept beside it is still a damaged header.
+    if (std::isfinite(r.scaling.slope) && r.scaling.slope == 0 &&
+        std::isfinite(r.scaling.intercept))
+        r.scaling = {};
+    return r;
+}
+
+// vox_offset as a byte offset: a whole number of bytes, past the header in a .nii; from the
+// start of the .img in a .hdr/.img pair, where 0 is the usual value.
+std::uint64_t checked_offset(const RawHeader& h, const std::string& where) {
+    const double v = h.vox_offset;
+    std::ostringstream text;
+    text.precision(17);
+    text << v;
+    if (!std::isfinite(v) || std::trunc(v) != v || v < 0 || v >= 0x1p62)
+        throw InputError(where, "vox_offset",
+                         "expected a whole number of bytes from 0 to 2^62, got " + text.str());
+    if (h.one_file && v < double(h.header_bytes))
+        throw InputError(where, "vox_offset",
+                         text.str() + " lies inside the " + std::to_string(h.header_bytes) +
+                             "-byte header of a single-file " + h.version +
+                             " (.nii); its voxels start at byte " + std::to_string(h.header_bytes) +
+                             " or later");
+    return std::uint64_t(v);
 }
 
 // The file's index-to-patient matrix: the sform when it has one, else the qform; RAS columns
@@ -166,6 +208,7 @@ void take_geometry(const nifti_image& n, const std::string& where, Decoded& d) {
 struct OpenImage {
     NiftiPtr n;
     znzFile fp = nullptr;
+    std::uint64_t delivered = 0, total = 0;  // bytes of voxels read, and the header's
     ~OpenImage() {
         if (fp) znzclose(fp);
     }
@@ -177,11 +220,13 @@ PlaneStack nifti_planes(const fs::path& path) {
     const std::string where = path.string();
     nifti_set_debug_level(0);
     const QuietStderr quiet;
-    const Scaling scaling = header_scaling(path, where);
+    const RawHeader header = raw_header(path, where);
+    const std::uint64_t offset = checked_offset(header, where);
     auto image = std::make_shared<OpenImage>();
     image->n.reset(nifti_image_read(path.c_str(), 0));
-    const nifti_image* n = image->n.get();
+    nifti_image* n = image->n.get();
     if (!n) throw InputError(where, "header", "not a NIfTI file niftilib reads");
+    n->iname_offset = int64_t(offset);  // the header's, not niftilib's reading of it
     for (int a = 4; a <= n->dim[0] && a < 8; ++a)
         if (n->dim[a] > 1)
             throw InputError(where, "dim",
@@ -202,9 +247,9 @@ PlaneStack nifti_planes(const fs::path& path) {
     Decoded& d = stack.head;
     d.dims = checked_dims(where, "dim", sizes, *type);
     d.type = *type;
-    check_data_present(*n, voxel_bytes(d.dims, d.type), where);
+    check_data_present(n->iname, offset, d.dims, d.type, where);
     take_geometry(*n, where, d);
-    d.scaling = scaling;
+    d.scaling = header.scaling;
     d.format = n->nifti_type >= NIFTI_FTYPE_NIFTI2_1  ? "NIfTI-2"
                : n->nifti_type == NIFTI_FTYPE_ANALYZE ? "ANALYZE 7.5"
                                                       : "NIfTI-1";
@@ -219,25 +264,34 @@ PlaneStack nifti_planes(const fs::path& path) {
     stack.read_ahead = false;
     // The image file is streamed once, in order (a gzip stream cannot seek back cheaply);
     // niftilib's buffer read swaps the bytes of a file of the other byte order.
-    const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
-    stack.read = [image, plane, where](int z0, int z1, std::byte* to) {
+    image->total = voxel_bytes(d.dims, d.type);
+    const auto read_bytes = [image, where](std::size_t count, std::byte* to) {
         const QuietStderr quiet;
         nifti_image* n = image->n.get();
         if (!image->fp) {
             image->fp = znzopen(n->iname, "rb", nifti_is_gzfile(n->iname));
-            if (znz_isnull(image->fp) ||
-                znzseek(image->fp, std::max<int64_t>(n->iname_offset, 0), SEEK_SET) < 0)
+            if (znz_isnull(image->fp) || znzseek(image->fp, n->iname_offset, SEEK_SET) < 0)
                 throw InputError(where, "data",
                                  "cannot open the image file " + quote_bounded(n->iname));
         }
-        const auto want = static_cast<int64_t>(plane * std::size_t(z1 - z0));
-        if (nifti_read_buffer(image->fp, to, want, n) != want)
-            throw InputError(where, "data",
-                             "the voxels of slices " + std::to_string(z0) + " to " +
-                                 std::to_string(z1 - 1) +
-                                 " could not be read (the file is shorter than its header "
-                                 "says, or its compression is damaged)");
+        const auto want = static_cast<int64_t>(count);
+        if (nifti_read_buffer(image->fp, to, want, n) != want) {
+            // Where the stream stopped: the uncompressed position, past the offset.
+            const int64_t at = znztell(image->fp) - n->iname_offset;
+            const auto got = std::clamp<int64_t>(at, int64_t(image->delivered),
+                                                 int64_t(image->delivered + count));
+            throw InputError(where, "dim",
+                             "the file ends after " + std::to_string(got) + " of " +
+                                 std::to_string(image->total) +
+                                 " bytes of voxels (a truncated or damaged file)");
+        }
+        image->delivered += count;
     };
+    const std::size_t plane = std::size_t(d.dims.x) * d.dims.y * voxel_size(d.type);
+    stack.read = [read_bytes, plane](int z0, int z1, std::byte* to) {
+        read_bytes(plane * std::size_t(z1 - z0), to);
+    };
+    if (nifti_is_gzfile(n->iname)) stack.read_unproven = read_bytes;
     return stack;
 }
 

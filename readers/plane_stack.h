@@ -4,6 +4,8 @@
 // it is the reader's volume (read_whole); streamed, it is the planes of that volume a slab at a
 // time (stream_planes), so `isowall import` brings a TIFF stack, a DICOM series, an HDF5 dataset,
 // a NIfTI or MetaImage file past memory into a store without holding it.
+#include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -14,6 +16,11 @@
 #include "volume/plane_source.h"
 
 namespace isowall::formats {
+
+// The most bytes one slice of a stack may hold: 512 MiB (16384 x 16384 at 16 bits). Checked on
+// a header before a library decodes it (GDCM and OpenImageIO size their buffers from the header);
+// a volume of slices past it could not be held in memory anyway.
+inline constexpr std::uint64_t kMaxSliceBytes = std::uint64_t(1) << 29;
 
 struct PlaneStack {
     Decoded head;  // everything but the bytes (head.type: the stored type)
@@ -28,6 +35,11 @@ struct PlaneStack {
     // Whether the stream may decode the next slab on a thread of its own while the last one is
     // written (DecodedPlanes); off for a decoder that must run where it was opened.
     bool read_ahead = true;
+    // Set when the file cannot prove the header's size before it is read (a gzip stream):
+    // reads the next `count` bytes of stored voxels (a multiple of the voxel size), from the
+    // first on, and throws when the file ends first. read_whole then grows its buffer as the
+    // bytes arrive instead of allocating what the header claims before a byte is read.
+    std::function<void(std::size_t count, std::byte* to)> read_unproven = nullptr;
 };
 
 // Every plane, then the reader's usual end (finish_volume): the volume read_volume gives.

@@ -5,6 +5,7 @@
 // the spacing ImageJ writes (its description's spacing= for z, the resolution tags for x and y).
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 #include "files/oiio_module.h"
 #include "readers/plane_stack.h"
 #include "readers/readers.h"
+#include "readers/tiff_directories.h"
 #include "readers/voxel_ops.h"
 #include "volume/load_checks.h"
 
@@ -31,6 +33,7 @@ class Input {
     Input& operator=(const Input&) = delete;
     ~Input() { oiio::api().close_file(file_); }
     int page_count() const { return oiio::api().page_count(file_); }
+    int directories = 0;  // whole ones in the file's chain (tiff_directories)
     oiio::PageInfo spec(int page) const {
         oiio::PageInfo info;
         oiio::api().page_info(file_, page, info);
@@ -90,6 +93,14 @@ Slice slice_of(const oiio::PageInfo& spec, const std::string& where, const std::
         throw InputError(
             where, field,
             spec.format + " samples; isowall reads 8, 16 and 32-bit integers and floats");
+    const std::uint64_t bytes = std::uint64_t(std::max(spec.width, 0)) *
+                                std::uint64_t(std::max(spec.height, 0)) * voxel_size(*type);
+    if (bytes > kMaxSliceBytes)
+        throw InputError(where, field,
+                         std::to_string(spec.width) + "x" + std::to_string(spec.height) + " " +
+                             std::string(type_name(*type)) + " is " + std::to_string(bytes) +
+                             " bytes; isowall reads slices of at most " +
+                             std::to_string(kMaxSliceBytes >> 20) + " MiB");
     return {spec.width, spec.height, *type};
 }
 
@@ -101,6 +112,12 @@ std::unique_ptr<Input> open_tiff(const fs::path& file, const std::string& where)
     auto in = std::make_unique<Input>(handle);
     if (format != "tiff")
         throw InputError(where, "file", "not a TIFF (OpenImageIO reads it as " + format + ")");
+    std::ifstream raw(file, std::ios::binary);
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(file, ec);
+    const TiffDirectories dirs = tiff_directories(raw, ec ? 0 : size);
+    if (!dirs.problem.empty()) throw InputError(where, "directories", dirs.problem);
+    in->directories = dirs.pages;
     return in;
 }
 
@@ -237,6 +254,10 @@ std::size_t slice_bytes(const Decoded& d) {
 PlaneStack read_pages(const fs::path& file, const std::string& where) {
     std::shared_ptr<const Input> in = open_tiff(file, where);
     const int pages = in->page_count();
+    if (pages != in->directories)
+        throw InputError(where, "pages",
+                         "OpenImageIO reads " + std::to_string(pages) + " of the file's " +
+                             std::to_string(in->directories) + " pages");
     const oiio::PageInfo spec0 = in->spec(0);
     check_imagej_stack(spec0, pages, where);
     check_count(std::size_t(pages), where, "pages");

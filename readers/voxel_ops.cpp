@@ -76,14 +76,47 @@ std::string number_text(double v) {
 
 }  // namespace
 
+std::string scaling_problem(Scaling s, double lo, double hi, VoxelType out) {
+    if (!std::isfinite(s.slope) || !std::isfinite(s.intercept))
+        return "the value scaling is not a finite number (slope " + number_text(s.slope) +
+               ", intercept " + number_text(s.intercept) + ")";
+    if (s.slope == 0) return "a scaling slope of 0 makes every voxel the same value";
+    const double top = out == VoxelType::f32 ? double(std::numeric_limits<float>::max())
+                                             : std::numeric_limits<double>::max();
+    for (const double stored : {lo, hi}) {
+        const double v = s.slope * stored + s.intercept;
+        if (!(std::abs(v) <= top))
+            return "value = " + number_text(s.slope) + " * stored + " + number_text(s.intercept) +
+                   " overflows " + std::string(type_name(out)) + " for stored values in [" +
+                   number_text(lo) + ", " + number_text(hi) + "] (" + number_text(stored) +
+                   " gives " + number_text(v) + ")";
+    }
+    return {};
+}
+
+std::optional<std::pair<double, double>> finite_range(std::span<const std::byte> bytes,
+                                                      VoxelType type) {
+    return dispatch_voxel_type(type, [&](auto zero) -> std::optional<std::pair<double, double>> {
+        using T = decltype(zero);
+        const std::size_t n = bytes.size() / sizeof(T);
+        std::optional<std::pair<double, double>> range;
+        for (std::size_t i = 0; i < n; ++i) {
+            T v;
+            std::memcpy(&v, bytes.data() + i * sizeof(T), sizeof(T));
+            const double d = double(v);
+            if (!std::isfinite(d)) continue;
+            if (!range) range = {d, d};
+            range->first = std::min(range->first, d);
+            range->second = std::max(range->second, d);
+        }
+        return range;
+    });
+}
+
 ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling s,
                            const std::string& where, const std::string& field) {
-    if (!std::isfinite(s.slope) || !std::isfinite(s.intercept))
-        throw InputError(where, field,
-                         "the value scaling is not a finite number (slope " + number_text(s.slope) +
-                             ", intercept " + number_text(s.intercept) + ")");
-    if (s.slope == 0)
-        throw InputError(where, field, "a scaling slope of 0 makes every voxel the same value");
+    if (std::string p = scaling_problem(s, 0, 0, VoxelType::f64); !p.empty())
+        throw InputError(where, field, p);
     if (s.identity()) return {std::move(bytes), type};
     const bool integral = std::trunc(s.slope) == s.slope && std::trunc(s.intercept) == s.intercept;
     const auto [lo, hi] =
@@ -91,6 +124,10 @@ ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling
             ? dispatch_voxel_type(type, [&](auto t) { return value_range<decltype(t)>(bytes); })
             : std::pair<double, double>{0, 0};
     const VoxelType out = scaled_type(type, s, lo, hi);
+    // The values the file holds, scaled, must be numbers in the type they land in.
+    if (const auto range = finite_range(bytes, type))
+        if (std::string p = scaling_problem(s, range->first, range->second, out); !p.empty())
+            throw InputError(where, field, p);
     std::vector<std::byte> result = dispatch_voxel_type(type, [&](auto in) {
         return dispatch_voxel_type(
             out, [&](auto o) { return scaled<decltype(in), decltype(o)>(bytes, s); });

@@ -4,8 +4,10 @@
 // that is a rotation (a mirrored file has its x reversed). Pure functions over bytes, so each is
 // tested without a file.
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -24,13 +26,24 @@ struct Scaling {
 // scaling is the identity; otherwise widened only as far as needed: the smallest integer type
 // that holds every scaled value when slope and intercept are integers and the type is an integer
 // one (a CT's uint16 with intercept -1024 becomes int16), else float32 (float64 stays float64).
-// InputError naming `where` and `field` when slope or intercept is not finite or slope is 0.
+// InputError naming `where` and `field` when slope or intercept is not finite, slope is 0, or a
+// stored value's scaled value is not finite in the type it gives (scaling_problem).
 struct ScaledVoxels {
     std::vector<std::byte> bytes;
     VoxelType type;
 };
 ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling s,
                            const std::string& where, const std::string& field);
+
+// Why `s` cannot scale stored values in [lo, hi] into `out`, or empty: the slope or intercept is
+// not finite, the slope is 0, or a scaled end of the range is not finite in `out` (1e38 * 255 is
+// past float32's 3.4e38: every such voxel would be inf).
+std::string scaling_problem(Scaling s, double lo, double hi, VoxelType out);
+
+// The least and greatest finite value among stored voxels of `type` (NaN and infinities passed
+// over: scaling cannot make those worse), or nullopt when there is none.
+std::optional<std::pair<double, double>> finite_range(std::span<const std::byte> bytes,
+                                                      VoxelType type);
 
 // The type apply_scaling gives stored voxels of `type` whose values lie in [lo, hi] (a streamed
 // read decides it before any voxel is read, from the range the file declares or the type's).

@@ -211,6 +211,24 @@ TEST(FormatsHdf5, RankTypeAndSizeProblemsNameTheField) {
     EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0);
 }
 
+// Voxels the dataset declares but the file does not store (chunks never written read as the
+// fill value) are refused before anything is allocated: a 2 KB file declaring 100000^3 float64.
+TEST(FormatsHdf5, DeclaredVoxelsTheFileDoesNotStoreAreRefused) {
+    const fs::path dir = test::scratch_dir("formats_hdf5_unstored");
+    const fs::path plain = write_h5(dir / "plain.h5", {empty_dataset("/v", {40, 40, 40})});
+    expect_input_error([&] { formats::read_hdf5(plain, ""); }, plain.string(), "data",
+                       "/v declares 64000 bytes of voxels and the file stores 0: data never "
+                       "written");
+    Dataset huge = empty_dataset("/v", {100000, 100000, 100000}, H5T_IEEE_F64LE);
+    huge.layout = Layout::chunked_deflate;
+    const fs::path claim = write_h5(dir / "claim.h5", {huge});
+    EXPECT_LT(fs::file_size(claim), 8192u);
+    expect_input_error([&] { formats::read_hdf5(claim, ""); }, claim.string(), "data",
+                       "declares 8000000000000000 bytes of voxels and the file stores 0 "
+                       "compressed (more than 1100:1)");
+    EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0) << "a handle left open";
+}
+
 TEST(FormatsHdf5, AMalformedSpacingAttributeIsAnError) {
     const fs::path dir = test::scratch_dir("formats_hdf5_bad_spacing");
     const fs::path file = write_h5(dir / "v.h5", {Dataset{}}, [](hid_t f) {

@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <span>
+#include <tuple>
 
 #include <gdcmImageChangeTransferSyntax.h>
 #include <gdcmImageReader.h>
@@ -181,7 +182,7 @@ TEST(FormatsDicom, BadSeriesGetOneLineNamingTheFileAndTheField) {
         ASSERT_TRUE(v);
         position_of_10.assign(v->GetPointer(), v->GetLength());
     }
-    const std::vector<BadSeries> cases = {
+    std::vector<BadSeries> cases = {
         {"missing_slice", {}, {60}, {"1-062.dcm: ImagePositionPatient", "slices are missing"}},
         {"two_series",
          {{0, other_series}, {1, other_series}},
@@ -206,8 +207,23 @@ TEST(FormatsDicom, BadSeriesGetOneLineNamingTheFileAndTheField) {
          {},
          {"ImagePositionPatient", "the same position as"}},
     };
-    for (const BadSeries& c : cases) {
-        const fs::path series = series_copy(*dir / "mrhead_t1_dicom", c.name, c.change, c.drop);
+    // A scaling GDCM would read as 1 (or some number) is named as the header holds it.
+    const gdcm::Tag slope(0x0028, 0x1053), intercept(0x0028, 0x1052);
+    for (const auto& [text, tag, words] :
+         {std::tuple{"NaN", slope, "1-005.dcm: RescaleSlope: expected one finite decimal number"},
+          std::tuple{"inf", slope, "1-005.dcm: RescaleSlope: expected one finite"},
+          std::tuple{"abc", slope, "1-005.dcm: RescaleSlope: expected one finite"},
+          std::tuple{"1e400", slope, "1-005.dcm: RescaleSlope: expected one finite"},
+          std::tuple{"0", slope, "1-005.dcm: RescaleSlope: a slope of 0"},
+          std::tuple{"-1e999", intercept, "1-005.dcm: RescaleIntercept: expected one finite"}})
+        cases.push_back({"bad_scaling",
+                         {{4, [tag, text](gdcm::DataSet& ds) { set_text(ds, tag, text); }}},
+                         {},
+                         {words}});
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+        const BadSeries& c = cases[k];
+        const fs::path series = series_copy(*dir / "mrhead_t1_dicom",
+                                            c.name + "_" + std::to_string(k), c.change, c.drop);
         const std::string e = error_of(series.string());
         for (const std::string& piece : c.expect)
             EXPECT_NE(e.find(piece), std::string::npos) << c.name << ": " << e;
@@ -310,6 +326,79 @@ TEST(FormatsNifti, ANanScaleIsNamed) {
     const std::string e = error_of(p.string());
     EXPECT_NE(e.find("nan.nii: scl_slope: "), std::string::npos) << e;
     EXPECT_NE(e.find("not a finite number"), std::string::npos) << e;
+}
+
+void put_float(const fs::path& p, int at, float v) {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(at);
+    f.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+// vox_offset (the float at byte 108 of a NIfTI-1 header) must be a whole byte count past the
+// header and inside the file: niftilib casts it to an integer, so NaN, 1e10 or 352.5 read the
+// voxels from some other place.
+TEST(FormatsNifti, AVoxOffsetThatIsNoPlaceInTheFileIsNamed) {
+    const fs::path dir = scratch_dir("nifti_offset");
+    const std::vector<std::pair<float, std::string>> cases = {
+        {std::nanf(""), "expected a whole number of bytes"},
+        {INFINITY, "expected a whole number of bytes"},
+        {-1, "expected a whole number of bytes"},
+        {352.5f, "expected a whole number of bytes"},
+        {1e10f, "the voxels start at byte 10000000000, past the end of the file"},
+        {100, "100 lies inside the 352-byte header"},
+        {400, "end at byte 14224, the file holds 14176 (a truncated file)"},
+    };
+    for (const auto& [offset, words] : cases) {
+        const fs::path p = write_nifti(dir / "offset.nii", 1, 0);
+        put_float(p, 108, offset);
+        const std::string e = error_of(p.string());
+        EXPECT_EQ(e.rfind(p.string() + ": ", 0), 0u) << offset << ": " << e;
+        EXPECT_NE(e.find(words), std::string::npos) << offset << ": " << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+}
+
+// A scaling whose values overflow the type they land in is named, whole or streamed: 200 *
+// 1e38 is past float32's 3.4e38.
+TEST(FormatsNifti, AScaleThatOverflowsIsNamed) {
+    const fs::path dir = scratch_dir("nifti_overflow");
+    const fs::path p = write_nifti(dir / "big.nii", 1e38f, 0.5f);
+    const std::string e = error_of(p.string());
+    EXPECT_NE(e.find("big.nii: scl_slope: "), std::string::npos) << e;
+    EXPECT_NE(e.find("overflows float32"), std::string::npos) << e;
+    try {
+        formats::open_planes(p.string(), std::nullopt);
+        ADD_FAILURE() << "a stream of big.nii opened";
+    } catch (const InputError& s) {
+        const std::string what = s.what();
+        EXPECT_NE(what.find("big.nii: scl_slope: value = "), std::string::npos) << what;
+        EXPECT_NE(what.find(" overflows float32 for stored values in [0, 255]"), std::string::npos)
+            << what;
+    }
+}
+
+// A gzip stream proves its length only as it is inflated, and its trailer holds the length
+// modulo 2^32: a header alone that claims 4096x4096x512 uint8 (8 GiB, 0 modulo 2^32) is read
+// until it ends, not zero-filled to what it claims first.
+TEST(FormatsNifti, AGzipFileClaimingGigabytesEndsWhereItsBytesDo) {
+    const fs::path dir = scratch_dir("nifti_gzip_claim");
+    const fs::path plain = write_nifti(dir / "small.nii", 0, 0);
+    std::ifstream in(plain, std::ios::binary);
+    std::vector<char> header(352);
+    in.read(header.data(), 352);
+    for (const auto& [at, v] : {std::pair{42, 4096}, {44, 4096}, {46, 512}}) {
+        const std::int16_t d = std::int16_t(v);
+        std::memcpy(&header[std::size_t(at)], &d, 2);  // dim[1..3]
+    }
+    const fs::path gz = dir / "claim.nii.gz";
+    znzFile f = znzopen(gz.c_str(), "wb", 1);
+    ASSERT_FALSE(znz_isnull(f));
+    ASSERT_EQ(znzwrite(header.data(), 1, header.size(), f), header.size());
+    znzclose(f);
+    const std::string e = error_of(gz.string());
+    EXPECT_NE(e.find("claim.nii.gz: dim: the file ends after 0 of 8589934592 bytes of voxels"),
+              std::string::npos)
+        << e;
 }
 
 }  // namespace

@@ -4,9 +4,12 @@
 #include <OpenImageIO/imageio.h>
 
 #include <fstream>
+#include <iterator>
+#include <sstream>
 
 #include "readers/read_volume.h"
 #include "readers/readers.h"
+#include "readers/tiff_directories.h"
 #include "tests/formats_more_util.h"
 #include "tests/plane_stream_util.h"
 #include "tests/test_util.h"
@@ -185,6 +188,127 @@ TEST(FormatsTiff, AnImageJHyperstackOfChannelsIsRefused) {
     write_tiff(file, pages);
     expect_input_error([&] { formats::read_tiff_stack(file); }, file.string(), "ImageDescription",
                        "2 channels");
+}
+
+// The file's bytes, and the byte at which each directory entry of `tag` starts (classic
+// little-endian TIFF, as OpenImageIO writes here), in page order.
+std::vector<char> file_bytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::uint32_t le(const std::vector<char>& b, std::size_t at, int n) {
+    std::uint32_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = v << 8 | std::uint8_t(b[at + std::size_t(i)]);
+    return v;
+}
+
+std::vector<std::size_t> entries_of(const std::vector<char>& b, std::uint16_t tag) {
+    EXPECT_EQ(std::string(b.data(), 4), std::string("II*\0", 4));
+    std::vector<std::size_t> out;
+    for (std::size_t at = le(b, 4, 4); at != 0;) {
+        const std::uint32_t n = le(b, at, 2);
+        for (std::uint32_t i = 0; i < n; ++i)
+            if (le(b, at + 2 + 12 * i, 2) == tag) out.push_back(at + 2 + 12 * i);
+        at = le(b, at + 2 + 12 * n, 4);
+    }
+    return out;
+}
+
+void write_bytes(const fs::path& p, const std::vector<char>& b) {
+    std::ofstream(p, std::ios::binary).write(b.data(), std::streamsize(b.size()));
+}
+
+// A short value (its 2 bytes at byte 8 of the entry) set in every page.
+void set_short(std::vector<char>& b, std::uint16_t tag, std::uint16_t value) {
+    const std::vector<std::size_t> at = entries_of(b, tag);
+    ASSERT_FALSE(at.empty()) << "tag " << tag;
+    for (std::size_t e : at) {
+        ASSERT_EQ(le(b, e + 2, 2), 3u) << "tag " << tag << " is not a SHORT";
+        b[e + 8] = char(value & 0xff);
+        b[e + 9] = char(value >> 8);
+    }
+}
+
+// A file cut inside its last page's directory, or anywhere after its header, is named: libtiff
+// alone stops at the last directory it can read, and the stack read one slice fewer.
+TEST(FormatsTiff, AFileCutInsideAPageIsNamed) {
+    const fs::path dir = test::scratch_dir("formats_tiff_cut");
+    write_tiff(dir / "whole.tif", test_pages<std::uint8_t>({5, 4, 20}));
+    const std::vector<char> whole = file_bytes(dir / "whole.tif");
+    const std::vector<std::size_t> last = entries_of(whole, 256);
+    ASSERT_EQ(last.size(), 20u);
+    // Cut 4 entries into the last directory, and at every 97th byte past the header.
+    std::vector<std::size_t> cuts = {last.back() + 12 * 3};
+    for (std::size_t at = 8; at < whole.size(); at += 97) cuts.push_back(at);
+    for (std::size_t cut : cuts) {
+        const fs::path file = dir / "cut.tif";
+        write_bytes(file, {whole.begin(), whole.begin() + std::ptrdiff_t(cut)});
+        try {
+            const Volume v = formats::read_tiff_stack(file);
+            ADD_FAILURE() << "cut at " << cut << " of " << whole.size() << ": read " << v.dims().z
+                          << " slices";
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(file.string() + ": ", 0), 0u) << e.what();
+        }
+    }
+    write_bytes(dir / "cut.tif", {whole.begin(), whole.begin() + std::ptrdiff_t(cuts.front())});
+    expect_input_error([&] { formats::read_tiff_stack(dir / "cut.tif"); },
+                       (dir / "cut.tif").string(), "directories",
+                       "the directory of page 19 (at byte ");
+}
+
+// The walk itself, on chains written here: BigTIFF, big-endian, a loop, a link past the end.
+TEST(FormatsTiff, TheDirectoryWalkReadsEveryLayoutAndNamesLoops) {
+    const auto walk = [](const std::string& bytes) {
+        std::istringstream in(bytes);
+        return formats::tiff_directories(in, bytes.size());
+    };
+    using namespace std::string_literals;
+    // BigTIFF, little-endian: an empty directory at 16, then the end.
+    const auto big = walk("II+\0\x08\0\0\0\x10\0\0\0\0\0\0\0"s + std::string(16, '\0'));
+    EXPECT_EQ(big.pages, 1);
+    EXPECT_EQ(big.problem, "");
+    // Classic big-endian: one directory of one entry at 8, then the end.
+    const auto mm = walk("MM\0*\0\0\0\x08\0\x01"s + std::string(12, 'x') + std::string(4, '\0'));
+    EXPECT_EQ(mm.pages, 1);
+    EXPECT_EQ(mm.problem, "");
+    // A directory whose link leads back to itself.
+    const auto loop = walk("II*\0\x08\0\0\0\0\0\x08\0\0\0"s);
+    EXPECT_EQ(loop.pages, 1);
+    EXPECT_NE(loop.problem.find("the directory of page 1 (at byte 8) is one seen before"),
+              std::string::npos)
+        << loop.problem;
+    // A link past the end of the file.
+    const auto past = walk("II*\0\x08\0\0\0\0\0\xff\0\0\0"s);
+    EXPECT_NE(past.problem.find("page 1 (at byte 255) starts past the end of the file (14 bytes)"),
+              std::string::npos)
+        << past.problem;
+    EXPECT_NE(walk("II*\0"s).problem.find("shorter than a TIFF header"), std::string::npos);
+}
+
+// A compression libtiff cannot decode is named by the page, not read as zeros.
+TEST(FormatsTiff, ACompressionThatCannotBeDecodedIsNamed) {
+    const fs::path file = test::scratch_dir("formats_tiff_codec") / "stack.tif";
+    write_tiff(file, test_pages<std::uint8_t>({5, 4, 3}));
+    std::vector<char> b = file_bytes(file);
+    set_short(b, 259, 50000);  // Compression: no scheme has this number
+    write_bytes(file, b);
+    expect_input_error([&] { formats::read_tiff_stack(file); }, file.string(), "page 0",
+                       "OpenImageIO cannot decode it");
+}
+
+// A slice whose header claims more than memory could sensibly hold is refused from the header.
+TEST(FormatsTiff, AHugeSliceIsRefusedFromItsHeader) {
+    const fs::path file = test::scratch_dir("formats_tiff_huge") / "stack.tif";
+    write_tiff(file, test_pages<std::uint16_t>({5, 4, 3}));
+    std::vector<char> b = file_bytes(file);
+    set_short(b, 256, 60000);  // ImageWidth
+    set_short(b, 257, 60000);  // ImageLength
+    write_bytes(file, b);
+    expect_input_error([&] { formats::read_tiff_stack(file); }, file.string(), "page 0",
+                       "60000x60000 uint16 is 7200000000 bytes; isowall reads slices of at most "
+                       "512 MiB");
 }
 
 }  // namespace
