@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
+#include "app/stop_signals.h"
 #include "cli/cli_checks.h"
 #include "core/error.h"
 #include "core/util.h"
@@ -59,8 +61,14 @@ CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
     c->add_option("source", o.source,
                   "The volume to import: any file or folder --volume reads (or give --volume)");
     add_volume_options(*c, o.volume);
-    c->add_option("--out,-o", o.out, "The store folder to write")->required();
-    c->add_flag("--force", o.force, "Replace a store already at --out");
+    c->add_option("--out,-o", o.out, "The store folder to write")
+        ->required()
+        ->check(CLI::Validator(
+            [](const std::string& s) { return s.empty() ? "name the store folder to write" : ""; },
+            "FOLDER"));
+    c->add_flag("--force", o.force,
+                "Replace a store already at --out (only a store isowall wrote, holding no other "
+                "files)");
     c->add_option("--level", o.level,
                   "zstd level, 1 (fastest) to 19 (smallest). Default: 1 (3 makes the 4x CT head "
                   "6% smaller and its import 10% slower)")
@@ -105,9 +113,26 @@ int run_import(const ImportCommand& o) {
     opts.zstd_level = o.level;
     opts.levels = o.levels;
     opts.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    opts.progress = [&](const store::ImportProgress& p) { bar.update(p); };
-    const store::ImportResult r =
-        planes ? store::write_store(*planes, out, opts) : store::write_store(ov.volume, out, opts);
+    opts.progress = [&](const store::ImportProgress& p) {
+        bar.update(p);
+        if (o.fault.on(0)) raise_test_signal(o.fault, FaultMoment::slab);
+    };
+    // A stop signal ends the import at the next slab, its temporary folder removed; then the
+    // signal ends the process as it would have (128 + signal).
+    catch_stop_signals();
+    opts.stop = &stop_requested();
+    std::optional<store::ImportResult> written;
+    try {
+        written = planes ? store::write_store(*planes, out, opts)
+                         : store::write_store(ov.volume, out, opts);
+    } catch (const store::ImportStopped& e) {
+        bar.finish();
+        std::fprintf(stderr, "import: %s (signal %d)\n", e.what(), stop_signal());
+        std::fflush(stderr);
+        end_by_stop_signal();
+        throw;
+    }
+    const store::ImportResult& r = *written;
     bar.finish();
     const double write_s = sw.seconds();
 

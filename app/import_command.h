@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/volume_options.h"
+#include "core/test_fault.h"
 
 namespace isowall {
 
@@ -17,6 +18,7 @@ struct ImportCommand {
     int level = 1;
     int levels = 0;  // 0: down to one brick a side (store::levels_for)
     bool quiet = false;
+    TestFault fault;  // the fault tests' hook (core/test_fault.h): term@slab:0 stops it mid-way
 };
 
 CLI::App* add_import_command(CLI::App& app, ImportCommand& o);

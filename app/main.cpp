@@ -57,7 +57,10 @@ int main(int argc, char** argv) {
         if (cli.re_cmd->parsed()) return run_render(cli.re);
         if (cli.serve_cmd->parsed()) return run_serve(cli.serve);
         if (cli.view_cmd->parsed()) return run_view(cli.view);
-        if (cli.import_cmd->parsed()) return run_import(cli.import);
+        if (cli.import_cmd->parsed()) {
+            cli.import.fault = parse_test_fault(std::getenv("ISOWALL_TEST_FAULT"));
+            return run_import(cli.import);
+        }
         if (cli.wall_cmd->parsed() && cli.ranks_needed) {
             std::printf("%d\n", rank_count(load_wall(cli.wall.wall)));
             return 0;

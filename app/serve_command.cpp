@@ -1,9 +1,9 @@
 // `isowall serve`: options, the datasets it loads, and the accept loop until SIGINT or SIGTERM.
-#include <csignal>
 #include <cstdio>
 #include <optional>
 
 #include "app/remote_commands.h"
+#include "app/stop_signals.h"
 #include "cli/cli_checks.h"
 #include "cli/volume_options.h"
 #include "core/error.h"
@@ -15,13 +15,6 @@
 
 namespace isowall {
 namespace {
-
-std::atomic<bool> g_stop{false};
-std::atomic<int> g_stop_signal{0};
-extern "C" void on_stop_signal(int sig) {
-    g_stop_signal.store(sig);
-    g_stop.store(true);
-}
 
 remote::Dataset load_dataset(const std::string& name, const std::string& path,
                              const std::string& cache_dir) {
@@ -181,7 +174,7 @@ int run_serve(const ServeCommand& o) {
         // destroyed. A port in use throws here, and the TCP listener closes with `server`.
         std::optional<remote::HttpFrontEnd> http;
         if (o.http_port >= 0) http.emplace(server, o.http_port);
-        for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_stop_signal);
+        catch_stop_signals();
         std::printf(
             "serve: listening on %s%s%s%s\n", remote::host_port(at.host, server.port()).c_str(),
             so.tls ? " (TLS)" : "", o.token.empty() ? "" : " (token required)",
@@ -192,16 +185,13 @@ int run_serve(const ServeCommand& o) {
             std::printf("serve: page at %s://%s/ (WebSocket /ws)\n", so.tls ? "https" : "http",
                         remote::host_port(at.host, http->port()).c_str());
         std::fflush(stdout);
-        server.serve(g_stop);
+        server.serve(stop_requested());
         std::printf("serve: stopped after %d connection(s)\n", server.accepted());
         std::fflush(stdout);
     }
     // A signal stopped it: the server has closed every connection; the signal itself ends the
     // process, as it ends every other command (exit 128 + signal).
-    if (const int sig = g_stop_signal.load(); sig != 0) {
-        std::signal(sig, SIG_DFL);
-        std::raise(sig);
-    }
+    end_by_stop_signal();
     return 0;
 }
 

@@ -14,6 +14,7 @@ FaultMoment moment_of(std::string_view s) {
     if (s == "migration") return FaultMoment::migration;
     if (s == "gather") return FaultMoment::gather;
     if (s == "end") return FaultMoment::end;
+    if (s == "slab") return FaultMoment::slab;
     return FaultMoment::none;
 }
 
@@ -28,6 +29,7 @@ TestFault fault_of(std::string_view kind) {
     if (moment == FaultMoment::none) return {};
     if (kind.substr(0, at) == "stop") return {FaultAction::stop, moment};
     if (kind.substr(0, at) == "kill") return {FaultAction::kill, moment};
+    if (kind.substr(0, at) == "term") return {FaultAction::term, moment};
     return {};
 }
 
@@ -54,6 +56,7 @@ void raise_test_signal(const TestFault& fault, FaultMoment moment) {
     if (fault.moment != moment || moment == FaultMoment::none) return;
     if (fault.action == FaultAction::stop) ::raise(SIGSTOP);
     if (fault.action == FaultAction::kill) ::raise(SIGKILL);
+    if (fault.action == FaultAction::term) ::raise(SIGTERM);
 }
 
 }  // namespace isowall

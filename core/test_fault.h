@@ -8,15 +8,17 @@
 //                   frames last seconds whatever the machine (tests of what happens mid-frame)
 //   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
 //   kill@MOMENT     the same with SIGKILL
+//   term@MOMENT     the same with SIGTERM, which the process may catch (import: a stop mid-way)
 // MOMENT is init, load, frame, migration, gather or end (a tile released, the master after its
-// outputs). RANK is a rank, or "tiles" for every tile.
+// outputs), or slab (import: after its first slab of chunks). RANK is a rank, or "tiles" for
+// every tile; a command that is not the wall is rank 0.
 #include <cstdint>
 #include <string_view>
 
 namespace isowall {
 
-enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, slow, stop, kill };
-enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather, end };
+enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, slow, stop, kill, term };
+enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather, end, slab };
 
 struct TestFault {
     FaultAction action = FaultAction::none;
@@ -33,7 +35,8 @@ struct TestFault {
 // as without the variable.
 TestFault parse_test_fault(const char* spec);
 
-// When `fault` is a stop or kill at `moment`, this process sends itself SIGSTOP or SIGKILL.
+// When `fault` is a stop, kill or term at `moment`, this process sends itself SIGSTOP, SIGKILL
+// or SIGTERM.
 // Anything else does nothing.
 void raise_test_signal(const TestFault& fault, FaultMoment moment);
 

@@ -110,6 +110,11 @@ std::string zattrs_json(const StoreLayout& l);
 StoreLayout parse_layout(std::string_view zarray, std::string_view zattrs,
                          const std::string& store);
 
+// The whole of a store's small metadata file `file` (`name` in errors); an InputError naming
+// `store` and `name` when it cannot be read, is not a regular file, or passes 1 MiB.
+std::string read_metadata(const std::filesystem::path& file, const std::string& store,
+                          const std::string& name);
+
 // Level k's metadata (K/.zarray) checked against level 0's layout `l`: an InputError naming
 // the store, the file and the field when its shape, chunks or dtype are not l.level(k)'s.
 void check_level(std::string_view zarray, const StoreLayout& l, int k, const std::string& store);

@@ -20,10 +20,7 @@
 namespace isowall::store {
 namespace fs = std::filesystem;
 
-namespace {
-
-// The whole of a small metadata file; InputError when it cannot be read or is implausibly large.
-std::string read_text(const fs::path& file, const std::string& store, const std::string& name) {
+std::string read_metadata(const fs::path& file, const std::string& store, const std::string& name) {
     constexpr std::uintmax_t kMaxMeta = 1 << 20;
     std::error_code ec;
     const auto size = fs::file_size(file, ec);
@@ -35,6 +32,8 @@ std::string read_text(const fs::path& file, const std::string& store, const std:
     if (!in && !in.eof()) throw InputError(store, name, "cannot read");
     return s.str();
 }
+
+namespace {
 
 struct Fd {
     int fd = -1;
@@ -49,12 +48,12 @@ StoreReader::StoreReader(const fs::path& store) : path_(store) {
     const std::string where = store.string();
     if (!is_store(store))
         throw InputError(where, "store", "not a store (no .zattrs and 0/.zarray in the folder)");
-    zarray_ = read_text(store / "0" / ".zarray", where, "0/.zarray");
-    zattrs_ = read_text(store / ".zattrs", where, ".zattrs");
+    zarray_ = read_metadata(store / "0" / ".zarray", where, "0/.zarray");
+    zattrs_ = read_metadata(store / ".zattrs", where, ".zattrs");
     layout_ = parse_layout(zarray_, zattrs_, where);
     for (int k = 1; k < layout_.levels; ++k) {
         const std::string key = std::to_string(k) + "/.zarray";
-        check_level(read_text(store / key, where, key), layout_, k, where);
+        check_level(read_metadata(store / key, where, key), layout_, k, where);
     }
     check_chunks(store, where);
 }
@@ -110,7 +109,9 @@ std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b, int level) const {
     const std::string where = path_.string(), key = chunk_key(b, level);
     if (fetch_) throw InputError(where, key, "internal: the store is not read on this host");
     Fd f;
-    f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC);
+    // Without blocking: a FIFO put where a chunk belongs would wait for a writer for ever. The
+    // flag does nothing to a regular file's reads, and nothing else is read.
+    f.fd = ::open((path_ / key).c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (f.fd < 0) throw InputError(where, key, std::string("cannot open: ") + std::strerror(errno));
     struct stat st {};
     if (::fstat(f.fd, &st) != 0 || !S_ISREG(st.st_mode))
@@ -136,7 +137,7 @@ std::vector<std::byte> StoreReader::read_packed(glm::ivec3 b, int level) const {
 void StoreReader::prefetch(glm::ivec3 b) const {
     if (fetch_) return;
     Fd f;
-    f.fd = ::open((path_ / chunk_key(b)).c_str(), O_RDONLY | O_CLOEXEC);
+    f.fd = ::open((path_ / chunk_key(b)).c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (f.fd >= 0) ::posix_fadvise(f.fd, 0, 0, POSIX_FADV_WILLNEED);
 }
 

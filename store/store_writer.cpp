@@ -1,6 +1,7 @@
 #include "store/store_writer.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -20,6 +21,7 @@
 #include "store/pyramid.h"
 #include "store/slab_octree.h"
 #include "store/source_pages.h"
+#include "volume/load_checks.h"
 
 namespace isowall::store {
 namespace fs = std::filesystem;
@@ -79,15 +81,68 @@ void write_text(const fs::path& file, const std::string& text, const std::string
     write_file(file, std::as_bytes(std::span(text.data(), text.size())), store, key);
 }
 
+// The folder the store is built in, held for the whole import: made (or a stopped run's taken
+// over) and locked (flock), so that a second import into the same --out is refused rather than
+// writing its chunks among the first's. Removed at the end unless it became the store.
 struct TempDir {
     fs::path path;
-    bool keep = false;
+    int fd = -1;
+    bool keep = true;  // until it is ours
     ~TempDir() {
-        if (keep) return;
         std::error_code ec;
-        fs::remove_all(path, ec);
+        if (!keep) fs::remove_all(path, ec);
+        if (fd >= 0) ::close(fd);
     }
 };
+
+void hold(TempDir& tmp, const std::string& where) {
+    std::error_code ec;
+    fs::create_directory(tmp.path, ec);  // an existing one is a stopped run's, or another's
+    if (ec)
+        throw InputError(where, "--out", "cannot make " + tmp.path.string() + ": " + ec.message());
+    tmp.fd = ::open(tmp.path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (tmp.fd < 0)
+        throw InputError(where, "--out",
+                         "cannot open " + tmp.path.string() + ": " + std::strerror(errno));
+    if (::flock(tmp.fd, LOCK_EX | LOCK_NB) != 0)
+        throw InputError(where, "--out",
+                         "another import is writing this store now (" +
+                             tmp.path.filename().string() + " is locked)");
+    tmp.keep = false;
+    for (const fs::directory_entry& e : fs::directory_iterator(tmp.path, ec))
+        fs::remove_all(e.path(), ec);  // what a stopped run left
+}
+
+// Why `--force` may not replace the folder `out`, or empty: only a store isowall wrote is
+// replaced, holding nothing but a store's own files (its metadata, its levels' folders and its
+// octree), so that no file of the user's goes with it.
+std::string unreplaceable(const fs::path& out) {
+    std::error_code ec;
+    if (!fs::is_directory(out, ec)) return "exists and is not a folder";
+    for (const char* name : {".zattrs", "0/.zarray"})
+        if (!fs::is_regular_file(out / name, ec))
+            return std::string("is not a store isowall wrote (no ") + name + ")";
+    StoreLayout layout;
+    try {
+        const std::string at = out.string();
+        layout = parse_layout(read_metadata(out / "0" / ".zarray", at, "0/.zarray"),
+                              read_metadata(out / ".zattrs", at, ".zattrs"), at);
+    } catch (const InputError& e) {
+        std::string why = e.what();
+        if (why.rfind(out.string() + ": ", 0) == 0) why.erase(0, out.string().size() + 2);
+        return "is not a store isowall wrote (" + why + ")";
+    }
+    for (const fs::directory_entry& e : fs::directory_iterator(out, ec)) {
+        const std::string name = e.path().filename().string();
+        const bool level = name.find_first_not_of("0123456789") == std::string::npos &&
+                           name.size() <= 2 && std::stoi(name) < layout.levels &&
+                           e.is_directory(ec) && !e.is_symlink(ec);
+        const bool own =
+            name == ".zgroup" || name == ".zattrs" || e.path() == octree_file(out) || level;
+        if (!own) return "holds " + quote_bounded(name) + ", which is not part of a store";
+    }
+    return {};
+}
 
 // The metadata, then the store into place: an old store moves aside first and goes only once
 // the new one is in.
@@ -317,10 +372,15 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
 ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportOptions& options) {
     const std::string where = out.string();
     std::error_code ec;
-    if (fs::exists(out, ec) && !options.replace)
-        throw InputError(where, "--out", "exists; give --force to replace it");
-    if (fs::exists(out, ec) && !is_store(out))
-        throw InputError(where, "--out", "exists and is not a store; it is left alone");
+    TempDir tmp{temporary_for(out)};
+    hold(tmp, where);
+    // Under the lock: a store another import finished meanwhile counts as existing.
+    if (fs::symlink_status(out, ec).type() != fs::file_type::not_found) {
+        if (!options.replace)
+            throw InputError(where, "--out", "exists; give --force to replace it");
+        if (const std::string why = unreplaceable(out); !why.empty())
+            throw InputError(where, "--out", why + "; it is left alone");
+    }
 
     StoreLayout layout = layout_for(source.dims(), source.type(), source.spacing());
     layout.source = source.source();
@@ -330,8 +390,6 @@ ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportO
                         ? std::min(options.levels, levels_for(layout.dims, layout.brick_log2))
                         : levels_for(layout.dims, layout.brick_log2);
     const glm::ivec3 grid = layout.grid();
-    TempDir tmp{temporary_for(out)};
-    fs::remove_all(tmp.path, ec);  // what a stopped run left
     make_folders(layout, tmp.path, where);
 
     const int threads = std::max(1, std::min(options.threads, grid.y));
@@ -343,7 +401,11 @@ ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportO
     const std::unique_ptr<SlabOctree> octree =
         options.octree ? make_slab_octree(layout.dims, layout.type) : nullptr;
     FiniteRange finite;
+    const auto check_stop = [&] {
+        if (options.stop && options.stop->load()) throw ImportStopped(tmp.path);
+    };
     for (int bz = 0; bz < grid.z; ++bz) {
+        check_stop();
         const int z0 = bz * layout.brick(), z1 = std::min(z0 + layout.brick(), layout.dims.z);
         // The slab's planes and the next one's first, which the octree's last leaves reach.
         const std::span<const std::byte> planes =
@@ -363,6 +425,7 @@ ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportO
         if (r.any) tally.range.merge(r.min), tally.range.merge(r.max);
     }
     if (options.before_commit) options.before_commit(layout, tmp.path);
+    check_stop();
     layout.bytes = tally.level0_bytes;
     commit(layout, tally.range, tmp, out, where);
     result.layout = layout;

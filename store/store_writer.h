@@ -1,8 +1,10 @@
 #pragma once
 // Writing a store (store_format.h) from a volume, one slab of chunks at a time.
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 
 #include "store/store_format.h"
 #include "volume/plane_source.h"
@@ -36,14 +38,25 @@ struct ImportOptions {
     // Called with the layout and the temporary folder once every chunk is written, before the
     // store moves into place (tests: a stop at that moment).
     std::function<void(const StoreLayout&, const std::filesystem::path&)> before_commit;
+    // Read before each slab and before the store moves into place: true ends the import with
+    // ImportStopped, the temporary removed (a stop signal: app/stop_signals.h).
+    const std::atomic<bool>* stop = nullptr;
+};
+
+// An import ended by ImportOptions::stop; its temporary folder is gone when this is caught.
+struct ImportStopped : std::runtime_error {
+    explicit ImportStopped(const std::filesystem::path& temporary)
+        : std::runtime_error("stopped; " + temporary.string() + " removed, no store written") {}
 };
 
 // Writes `volume` as a store at `out`. The store is built under a temporary name beside `out`
 // and renamed into place only when whole, so a run that is stopped leaves no store (and the next
-// run starts over); a store is never half old, half new. Memory stays bounded by a slab of chunks
-// per thread: a memory-mapped source lets go of each slab's pages once it is written. Errors
-// (a full or read-only disk, an existing `out`) are InputErrors naming `out`; the temporary is
-// removed.
+// run starts over); a store is never half old, half new. The temporary is locked while it is
+// written: a second import into the same `out` at once is refused. `replace` replaces only a
+// store isowall wrote that holds nothing else (a folder with other files in it is left alone).
+// Memory stays bounded by a slab of chunks per thread: a memory-mapped source lets go of each
+// slab's pages once it is written. Errors (a full or read-only disk, an existing `out`) are
+// InputErrors naming `out`; the temporary is removed.
 ImportResult write_store(const Volume& volume, const std::filesystem::path& out,
                          const ImportOptions& options);
 // The same from planes read in z order (volume/plane_source.h): a slab of them, and one

@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <vector>
@@ -179,6 +180,30 @@ TEST(CliStore, ASourceThatFailsMidStreamLeavesNoStore) {
     expect_one_line_error(r, {"cut.nrrd", "data", "ends early"});
     EXPECT_FALSE(fs::exists(dir / "cut.zarr"));
     EXPECT_FALSE(fs::exists(dir / ".cut.zarr.importing"));
+}
+
+// A stop signal mid-import (SIGTERM, which the import raises itself after its first slab, as an
+// operator's kill would arrive) ends it by that signal: its temporary folder removed, no store.
+TEST(CliStore, ASignalMidImportEndsItByThatSignalLeavingNothing) {
+    const fs::path dir = test::scratch_dir("cli_store_signal");
+    phantom_raw(dir);
+    const auto r =
+        run_isowall(dir, std::string("import phantom.raw") + kRawOptions + " --out ph.zarr -q",
+                    "env ISOWALL_TEST_FAULT=term@slab:0 ");
+    EXPECT_EQ(r.exit_code, 128 + SIGTERM) << r.err;
+    EXPECT_NE(r.err.find("import: stopped; "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(".ph.zarr.importing removed, no store written (signal 15)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(test::files_in(dir), std::vector<std::string>{"phantom.raw"});
+}
+
+TEST(CliStore, AnEmptyOutIsABadCommandLine) {
+    const fs::path dir = test::scratch_dir("cli_store_empty_out");
+    phantom_raw(dir);
+    const auto r = run_isowall(dir, std::string("import phantom.raw") + kRawOptions + " --out ''");
+    expect_one_line_error(r, {"--out", "name the store folder to write"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // Volume stores (store/): the metadata, import, paging under a cap, and damaged stores.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -257,11 +259,98 @@ TEST(StoreImport, AnExistingStoreIsKeptUnlessReplacedAndNeverHalfWritten) {
     EXPECT_FALSE(fs::exists(temporary_for(store.parent_path() / "fresh")));
 }
 
+// Two imports into one store at once: the second is refused while the first holds its
+// temporary folder (here: at the moment the first is about to move its store into place), and the
+// store that lands is the first's alone.
+TEST(StoreImport, ASecondImportIntoTheSameStoreAtOnceIsRefused) {
+    const fs::path store = test::scratch_dir("store_two_imports") / "store";
+    const Volume a = pattern_volume({40, 30, 20});
+    const Volume b = make_phantom({{50, 40, 30}, glm::vec3(1.0f)});
+    ImportOptions first;
+    bool second_ran = false;
+    first.before_commit = [&](const StoreLayout&, const fs::path& tmp) {
+        EXPECT_TRUE(fs::exists(tmp));
+        expect_line([&] { write_store(b, store, {}); },
+                    {"store", "--out", "another import is writing this store now",
+                     ".store.importing is locked"});
+        EXPECT_TRUE(fs::exists(tmp)) << "the refused import removed the first one's folder";
+        second_ran = true;
+    };
+    write_store(a, store, first);
+    EXPECT_TRUE(second_ran);
+    EXPECT_EQ(StoreReader(store).layout().dims, glm::ivec3(40, 30, 20));
+    EXPECT_FALSE(fs::exists(temporary_for(store)));
+}
+
+// --force replaces a store isowall wrote, and nothing else: a folder that only looks like one, or
+// a store with the user's own files in it, is left alone, every file kept.
+TEST(StoreImport, ForceReplacesOnlyAStoreIsowallWroteAndNothingInIt) {
+    const Volume a = pattern_volume({40, 30, 20});
+    const fs::path store = import_to(a, "store_force");
+    const fs::path dir = store.parent_path();
+    ImportOptions force;
+    force.replace = true;
+    // Looks like a store to a glance (.zattrs and 0/.zarray), holds the user's work.
+    const fs::path lookalike = dir / "lookalike";
+    fs::create_directories(lookalike / "0");
+    std::ofstream(lookalike / ".zattrs") << "{}";
+    std::ofstream(lookalike / "0" / ".zarray") << "{}";
+    std::ofstream(lookalike / "thesis.tex") << "years of work";
+    expect_line([&] { write_store(a, lookalike, force); },
+                {"lookalike", "--out", "is not a store isowall wrote", "left alone"});
+    EXPECT_TRUE(fs::exists(lookalike / "thesis.tex"));
+    // A real store with a file of the user's beside its chunks.
+    std::ofstream(store / "notes.txt") << "mine";
+    expect_line([&] { write_store(a, store, force); },
+                {"store", "--out", "holds \"notes.txt\", which is not part of a store"});
+    EXPECT_TRUE(fs::exists(store / "notes.txt"));
+    fs::remove(store / "notes.txt");
+    write_store(make_phantom({{50, 40, 30}, glm::vec3(1.0f)}), store, force);
+    EXPECT_EQ(StoreReader(store).layout().dims, glm::ivec3(50, 40, 30));
+}
+
+// A stop (a signal, app/stop_signals.h) ends the import at the next slab: no store, no temporary.
+TEST(StoreImport, AStopEndsTheImportAndLeavesNothing) {
+    const fs::path store = test::scratch_dir("store_stop") / "store";
+    std::atomic<bool> stop{false};
+    ImportOptions o;
+    o.stop = &stop;
+    int slabs = 0;
+    o.progress = [&](const ImportProgress&) {
+        ++slabs;
+        stop = true;
+    };
+    try {
+        write_store(make_phantom({{64, 64, 200}, glm::vec3(1.0f)}), store, o);
+        ADD_FAILURE() << "the import was not stopped";
+    } catch (const ImportStopped& e) {
+        EXPECT_NE(std::string(e.what()).find("no store written"), std::string::npos);
+    }
+    EXPECT_EQ(slabs, 1);
+    EXPECT_FALSE(fs::exists(store));
+    EXPECT_FALSE(fs::exists(temporary_for(store)));
+}
+
 TEST(StoreDamage, AMissingChunkIsRefusedAtOpenNamingIt) {
     const fs::path store = import_to(pattern_volume({40, 300, 200}), "store_missing");
     const std::string key = chunk_key({1, 2, 0});
     fs::remove(store / key);
     expect_line([&] { StoreReader r(store); }, {store.string(), key, "missing"});
+}
+
+// A FIFO where a chunk belongs is named when the chunk is read (opening one to read would wait
+// for a writer for ever); so is one where the metadata belongs.
+TEST(StoreDamage, AFifoInPlaceOfAChunkOrItsMetadataIsNamedNotWaitedOn) {
+    const fs::path store = import_to(pattern_volume({40, 300, 200}), "store_fifo");
+    const std::string key = chunk_key({1, 2, 0});
+    fs::remove(store / key);
+    ASSERT_EQ(::mkfifo((store / key).c_str(), 0644), 0);
+    const StoreReader r(store);
+    std::vector<std::byte> out(r.layout().brick_bytes());
+    expect_line([&] { r.read_chunk({1, 2, 0}, out); }, {store.string(), key, "not a file"});
+    fs::remove(store / ".zattrs");
+    ASSERT_EQ(::mkfifo((store / ".zattrs").c_str(), 0644), 0);
+    expect_line([&] { StoreReader again(store); }, {store.string(), ".zattrs", "cannot read"});
 }
 
 TEST(StoreDamage, MetadataThatDisagreesWithTheChunksIsRefused) {
