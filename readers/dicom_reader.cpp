@@ -88,6 +88,12 @@ gdcm::Directory::FilenamesType part10_files(const gdcm::Directory::FilenamesType
 // The folder's DICOM files by series (files that are not DICOM, or have no series, are passed
 // over: a scanner's folder may hold a DICOMDIR or notes).
 std::map<std::string, Series> scan_series(const fs::path& dir, gdcm::Scanner& scanner) {
+    // GDCM passes over what is not a regular file; a FIFO or device where a slice may belong is
+    // named instead (the series would read as missing a slice, and opening one could block).
+    std::error_code ec;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+        if (!e.is_directory(ec) && !e.is_regular_file(ec))
+            check_regular_file(e.path(), e.path().string(), "DICOM");
     gdcm::Directory d;
     d.Load(dir.string(), false);
     for (const gdcm::Tag& t : {kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing,

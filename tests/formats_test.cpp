@@ -19,6 +19,8 @@
 #include <gdcmWriter.h>
 #include <gtest/gtest.h>
 #include <nifti2_io.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
 #include "extract/surface_extractor.h"
@@ -157,6 +159,30 @@ void set_text(gdcm::DataSet& ds, gdcm::Tag tag, std::string value) {
     gdcm::DataElement e(tag);
     e.SetByteValue(value.data(), gdcm::VL(std::uint32_t(value.size())));
     ds.Replace(e);
+}
+
+// Other files beside a series are judged by their first 132 bytes: a 3 GiB file (sparse, so it
+// costs no disk) is not read whole to find it is not DICOM. A FIFO where a slice belongs is
+// named; opening it to read would wait for a writer for ever.
+TEST(FormatsDicom, OtherFilesBesideASeriesCostNothingAndAFifoIsNamed) {
+    NEED_FORMATS(dir);
+    const fs::path big = series_copy(*dir / "mrhead_t1_dicom", "dicom_big_neighbour", {});
+    {
+        std::ofstream(big / "scan_notes.bin") << "not DICOM";
+        fs::resize_file(big / "scan_notes.bin", std::uintmax_t(3) << 30);
+    }
+    EXPECT_EQ(read_volume(big.string(), std::nullopt).dims(), glm::ivec3(512, 512, 120));
+    rusage self{}, children{};
+    getrusage(RUSAGE_SELF, &self);
+    getrusage(RUSAGE_CHILDREN, &children);
+    EXPECT_LT(std::max(self.ru_maxrss, children.ru_maxrss), 1L << 20)
+        << "KiB: the 3 GiB neighbour was read";
+    fs::remove(big / "scan_notes.bin");
+    const fs::path fifo = series_copy(*dir / "mrhead_t1_dicom", "dicom_fifo", {}, {60});
+    ASSERT_EQ(::mkfifo((fifo / "1-061.dcm").c_str(), 0644), 0);
+    const std::string e = error_of(fifo.string());
+    EXPECT_NE(e.find("1-061.dcm: DICOM: "), std::string::npos) << e;
+    EXPECT_NE(e.find("is a FIFO, not a regular file"), std::string::npos) << e;
 }
 
 struct BadSeries {
