@@ -16,6 +16,7 @@
 #include "app/wall_outputs.h"
 #include "cli/iso_option.h"
 #include "core/error.h"
+#include "core/fatal.h"
 #include "core/util.h"
 #include "extract/surface_extractor.h"
 #include "master/console.h"
@@ -284,6 +285,11 @@ int run_wall(const WallOptions& o, Comm& comm) {
             o.wall.c_str(), rank_count(spec) - 1, rank_count(spec), comm.size(), comm.rank());
         return 1;
     }
+    // An error where nothing can be thrown (a damaged chunk met by the pager mid-frame) ends the
+    // job as any other error on a rank after start-up: named by the rank, exit 2, every rank ended.
+    set_fatal_handler([&comm, &spec](const std::string& what) {
+        fail(comm, spec, std::runtime_error(what), false);
+    });
     try {
         // The master loads first and writes the octree cache; the tile ranks then map the same
         // files, so the machine holds one copy of the volume and the octree.

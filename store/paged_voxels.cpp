@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/fatal.h"
 
 namespace isowall::store {
 
@@ -32,11 +33,9 @@ std::string errno_text(const char* call) {
     return std::string(call) + ": " + std::strerror(errno);
 }
 
-// The pager's thread cannot throw into the thread stopped in a fault: one line, then exit.
+// The pager's thread cannot throw into the thread stopped in a fault (core/fatal.h).
 [[noreturn]] void die(const std::string& what) {
-    const std::string line = "isowall: error: " + clip(what, 800) + "\n";
-    [[maybe_unused]] const ssize_t n = ::write(2, line.data(), line.size());
-    ::_exit(1);
+    end_with_error(what);
 }
 
 double thread_cpu_s() {

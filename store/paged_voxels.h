@@ -22,8 +22,9 @@
 // still in use when dropped is read again (counted as a refault).
 //
 // A chunk that cannot be read or fails its checksum while a frame runs cannot be reported to the
-// thread that touched it (it is stopped inside a memory read), so the pager prints the chunk's
-// error line and ends the process with exit status 1: a picture is never drawn from garbage.
+// thread that touched it (it is stopped inside a memory read), so the pager ends the process with
+// the chunk's error line (core/fatal.h: exit status 1, or the wall's failure path on a rank): a
+// picture is never drawn from garbage.
 #include <atomic>
 #include <cstdint>
 #include <memory>

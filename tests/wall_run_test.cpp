@@ -115,6 +115,52 @@ TEST(WallRun, AStoreUnderAMemoryLimitGivesTheMosaicOfItsFile) {
     EXPECT_GE(m.equal_share, 0.999) << m;
 }
 
+// A chunk damaged on disk, met by a tile's pager in the middle of a frame, ends the job as any
+// error on a rank after start-up: the line names the rank, the store and the chunk, the exit
+// status is 2, no rank outlives mpirun and no mosaic is written.
+TEST(WallRun, ADamagedChunkMetMidFrameEndsTheJobNamingTheRank) {
+    const auto dir = test::scratch_dir("wall_damaged_chunk");
+    std::ofstream(dir / "2x1.toml") << "tiles = [2, 1]\ntile_size_px = [160, 240]\n";
+    {
+        const Volume v = make_phantom();
+        std::ofstream(dir / "phantom.raw", std::ios::binary)
+            .write(reinterpret_cast<const char*>(v.bytes().data()),
+                   static_cast<std::streamsize>(v.bytes().size()));
+    }
+    const std::string store = (dir / "phantom.zarr").string();
+    ASSERT_EQ(run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() +
+                      "' --dims 200 184 168 --type uint8 -q --no-cache --out '" + store + "'",
+                  dir / "import.log"),
+              0)
+        << slurp(dir / "import.log");
+    {
+        std::fstream f(dir / "phantom.zarr/0/1/1/0",
+                       std::ios::in | std::ios::out | std::ios::binary);
+        ASSERT_TRUE(f.good());
+        f.seekp(60);
+        f.write("garbage!", 8);
+    }
+    const int rc = run(mpirun(3) + "wall --wall '" + (dir / "2x1.toml").string() + "' --volume '" +
+                           store + "' --memory-limit 16M --no-cache --iso 50 --out '" +
+                           (dir / "mosaic.png").string() + "'",
+                       dir / "wall.log", 60);
+    const std::string log = slurp(dir / "wall.log");
+    EXPECT_EQ(rc, 2) << log;
+    const std::size_t at = log.find("isowall: error: rank ");
+    ASSERT_NE(at, std::string::npos) << log;
+    const std::string line = log.substr(at, log.find('\n', at) - at);
+    EXPECT_NE(line.find(store + ": 0/1/1/0: "), std::string::npos) << line;
+    EXPECT_NE(line.find("(tile "), std::string::npos) << line;
+    EXPECT_EQ(test::count_of(log, "isowall: error:"), test::count_of(log, "isowall: error: rank "))
+        << "a line that names no rank: " << log;
+    EXPECT_NE(
+        std::system(
+            ("pgrep -f '[w]all --wall " + (dir / "2x1.toml").string() + "' > /dev/null").c_str()),
+        0)
+        << "a rank is still running";
+    EXPECT_FALSE(std::filesystem::exists(dir / "mosaic.png"));
+}
+
 TEST(WallRun, WithBezelsEachTileIsItsRectangleOfTheVirtualScreen) {
     // 2x2 tiles of 120x90 with 8-pixel mullions (4 px on each tile's side): the virtual screen is
     // 248x188 (outer bezels are not part of it), and tile (c, r) sits at (c * 128, r * 98).

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/fatal.h"
 #include "files/output_files.h"
 
 namespace isowall {
@@ -189,11 +190,9 @@ void check_content(const MappedFile& file, const std::filesystem::path& path,
         have.content_checksum)
         return;
     // A damaged octree would hide surface: the program ends here, as on a damaged chunk.
-    const std::string line = "isowall: error: " + path.string() +
-                             ": the octree is damaged (checksum mismatch); delete it and open "
-                             "the volume again to rebuild it\n";
-    [[maybe_unused]] const ssize_t n = ::write(2, line.data(), line.size());
-    ::_exit(1);
+    end_with_error(path.string() +
+                   ": the octree is damaged (checksum mismatch); delete it and open the volume "
+                   "again to rebuild it");
 }
 
 }  // namespace
