@@ -1,6 +1,6 @@
 // Connection's emulated link (set_rate): on a fake clock the waits add up to exactly what the rate
-// asks; on the real clock a paced send takes about as long (a loose check only: speed targets
-// live in benchmarks); shutdown() cuts a paced wait short.
+// asks; on the real clock a paced send takes at least as long (speed targets live in benchmarks);
+// shutdown() cuts a paced wait short.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -99,7 +99,7 @@ TEST(RemoteNetPace, UnlimitedByDefaultAndAfterRateZero) {
     EXPECT_THROW(pair.sender->set_rate(-1), std::invalid_argument);
 }
 
-TEST(RemoteNetPace, RealClockTakesAboutAsLongAsTheRateSays) {
+TEST(RemoteNetPace, RealClockTakesAtLeastWhatTheRateAsks) {
     Pair pair = connected_pair();
     pair.sender->set_rate(8e6);
     std::size_t sent = 0;
@@ -109,15 +109,15 @@ TEST(RemoteNetPace, RealClockTakesAboutAsLongAsTheRateSays) {
     const double took =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double expected_s = static_cast<double>(sent - kPaceChunkBytes) / 1e6;  // ~0.25 s
+    // The pacing waited on the real clock at least as the rate asks (a busy machine can only make
+    // it slower; how exactly it waits is FakeClockWaitsExactlyWhatTheRateAsks's).
     EXPECT_GT(took, 0.7 * expected_s);
-    EXPECT_LT(took, 3 * expected_s) << "a loose sanity check, not a speed target";
 }
 
 TEST(RemoteNetPace, ShutdownCutsAPacedWaitShort) {
     Pair pair = connected_pair();
     pair.sender->set_rate(8000);  // 1000 bytes/s: 256 KiB would take over four minutes
     std::string error;
-    const auto start = std::chrono::steady_clock::now();
     std::thread sender([&] {
         try {
             pair.sender->send(group_of(256 * 1024));
@@ -126,11 +126,12 @@ TEST(RemoteNetPace, ShutdownCutsAPacedWaitShort) {
             error = e.what();
         }
     });
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // The first chunk arrives (the bucket's burst); the rest waits on the rate, and the shutdown
+    // must end that wait with an error, not let the send finish minutes later.
+    ASSERT_TRUE(pair.receiver->socket().peek(kPaceTimeoutS, "sender").has_value())
+        << "nothing was sent";
     pair.sender->shutdown();
     sender.join();
-    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-              kPaceTimeoutS / 2);
     EXPECT_NE(error.find("shut down"), std::string::npos) << error;
 }
 
