@@ -203,7 +203,10 @@ std::unique_ptr<SessionSeat> SessionHub::join(const HelloMsg& h, const std::stri
 void SessionHub::leave(const std::shared_ptr<SharedSession>& s, const std::string& peer,
                        const FollowerQueue* queue) {
     std::lock_guard lock(mutex_);
-    if (queue && !queue->why().empty()) ++dropped_;
+    if (queue && !queue->why().empty()) {
+        ++dropped_;
+        dropped_changed_.notify_all();
+    }
     {
         std::lock_guard session_lock(s->mutex_);
         if (queue) {
@@ -233,6 +236,21 @@ std::size_t SessionHub::sessions() const {
 std::size_t SessionHub::dropped() const {
     std::lock_guard lock(mutex_);
     return dropped_;
+}
+
+std::size_t SessionHub::overflowed() const {
+    std::lock_guard lock(mutex_);
+    std::size_t n = dropped_;
+    for (const auto& [name, s] : sessions_) {
+        std::lock_guard session_lock(s->mutex_);
+        for (const SharedSession::Follower& f : s->followers_) n += !f.queue->why().empty();
+    }
+    return n;
+}
+
+void SessionHub::wait_dropped(std::size_t n) const {
+    std::unique_lock lock(mutex_);
+    dropped_changed_.wait(lock, [&] { return dropped_ >= n; });
 }
 
 std::size_t SessionHub::peak_queue_bytes() const {

@@ -143,6 +143,10 @@ class SessionHub {
     std::size_t sessions() const;
     std::size_t peak_queue_bytes() const;  // over every session, past and present
     std::size_t dropped() const;           // followers dropped as too slow, so far
+    // dropped(), and the followers whose queue overflowed and who are on their way out: a
+    // presenter's send that overflows a queue counts here before its send returns.
+    std::size_t overflowed() const;
+    void wait_dropped(std::size_t n) const;  // returns once dropped() reaches n
     const SessionLimits& limits() const { return limits_; }
 
   private:
@@ -154,6 +158,7 @@ class SessionHub {
     mutable std::mutex mutex_;
     std::map<std::string, std::shared_ptr<SharedSession>> sessions_;
     std::size_t peak_ = 0, dropped_ = 0;
+    mutable std::condition_variable dropped_changed_;
 };
 
 }  // namespace isowall::remote

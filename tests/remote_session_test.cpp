@@ -10,7 +10,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <condition_variable>
 #include <cstdio>
+#include <mutex>
 #include <thread>
 
 #include "core/util.h"
@@ -42,7 +44,7 @@ struct Follower {
             try {
                 auto renderer = make_renderer("osmesa");
                 ViewClient c(*renderer, session_hello(port, SessionRole::follower));
-                joined = true;
+                mark_joined();
                 for (bool more = true; more;) {
                     const ClientFrameResult* r = c.next_frame(kTimeoutS);
                     if (!r) throw std::runtime_error("no frame within the limit");
@@ -55,14 +57,25 @@ struct Follower {
             } catch (const std::exception& e) {
                 error = e.what();
             }
-            joined = true;
+            mark_joined();
         });
     }
-    void wait_joined() const {
-        while (!joined.load()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    void mark_joined() {
+        {
+            std::lock_guard lock(joined_mutex);
+            joined = true;
+        }
+        joined_changed.notify_all();
+    }
+    // Returns once the follower is in the session (its ready came), or has failed.
+    void wait_joined() {
+        std::unique_lock lock(joined_mutex);
+        joined_changed.wait(lock, [&] { return joined; });
     }
     std::thread thread;
-    std::atomic<bool> joined{false};
+    std::mutex joined_mutex;
+    std::condition_variable joined_changed;
+    bool joined = false;
     static bool same_view(const FrameView& a, const FrameView& b) {
         return a.iso == b.iso && a.camera.eye == b.camera.eye && a.width == b.width;
     }
@@ -87,6 +100,9 @@ int stalled_follower(int port) {
     h.session = "class";
     const std::vector<std::byte> frame = encode_frame(h);
     EXPECT_EQ(::send(fd, frame.data(), frame.size(), 0), static_cast<ssize_t>(frame.size()));
+    // The server's answer begins: its hello was taken (a peek: the buffer stays as full).
+    char first = 0;
+    EXPECT_EQ(::recv(fd, &first, 1, MSG_PEEK), 1) << "no answer to the stalled follower's hello";
     return fd;
 }
 
@@ -102,7 +118,6 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     Follower early(server.port(), views[2]);
     early.wait_joined();
     const int stalled = stalled_follower(server.port());
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // its hello is taken
     std::vector<Image> shown;
     std::unique_ptr<Follower> late;
     for (const FrameView& v : views) {
@@ -111,7 +126,6 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
         if (!late) {  // joins after the first view: catches up with it, then follows
             late = std::make_unique<Follower>(server.port(), views[2]);
             late->wait_joined();
-            std::this_thread::sleep_for(std::chrono::milliseconds(300));
         }
     }
     early.thread.join();
@@ -138,14 +152,13 @@ TEST(RemoteSession, FollowersSeeEveryViewAndASlowOneIsDropped) {
     // The stalled follower is dropped once its queue would pass the bound: more views, each
     // sent whole (no cache), until it is (its connection closes within the error's 2 s).
     int more = 0;
-    for (; more < 12 && server.server().sessions().dropped() == 0; ++more) {
+    for (; more < 12 && server.server().sessions().overflowed() == 0; ++more) {
         presenter.request(test::phantom_view(640, 480, 10.0 * more, 60 + more), LodSchedule::off,
                           false);
         presenter.wait_done(kTimeoutS);
-        Stopwatch waited;
-        while (server.server().sessions().dropped() == 0 && waited.seconds() < 3)
-            std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
+    ASSERT_GT(server.server().sessions().overflowed(), 0u) << "no queue overflowed in 12 views";
+    server.server().sessions().wait_dropped(1);  // its connection ends within the error's 2 s
     std::printf("the stalled follower was dropped after %d more view(s)\n", more);
     const std::size_t peak = server.server().sessions().peak_queue_bytes();
     std::printf("session: followers' queues peaked at %zu KiB (bound %zu KiB), %zu dropped\n",
