@@ -11,6 +11,7 @@
 #include "core/pixel_rect_ops.h"
 #include "core/ray.h"
 #include "engine/progressive_engine.h"
+#include "render/renderer_sink.h"
 #include "tests/engine_util.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
@@ -216,26 +217,45 @@ TEST(Propagation, InterpolantCacheGivesTheSameTriangles) {
     EXPECT_EQ(b.mesh.vertex_count(), 3 * b.mesh.triangle_count());
 }
 
+// Presents as the renderer's sink does, but in the caller's time (no present in flight): each
+// timeline sample then reaches `progress` on the casting thread, before its next ray.
+class PresentNow final : public GroupSink {
+  public:
+    explicit PresentNow(RendererSink& s) : s_(s) {}
+    void begin(const FrameView& view) override { s_.begin(view); }
+    void add(const Group& group) override { s_.add(group); }
+    double present() override { return s_.present(); }
+
+  private:
+    RendererSink& s_;
+};
+
 TEST(Engine, InterruptStopsTheFrameAndTheNextFrameIsTheNewViewOnly) {
     const Volume p = make_phantom();
     auto ex = make_surface_extractor(p);
     auto renderer = make_renderer("osmesa");
     EngineOptions opt;
     opt.progress_interval_s = 0;  // progress at every sample
+    opt.threads = 1;              // stop is read before each ray of the one casting thread
     ProgressiveEngine engine(*ex, opt);
     const FrameView first = make_view(p, 200, 150, kPhantomSkinIso);
-    // The stop flag is set as a communication thread would, here from the first sample at 300 rays
-    // or more (samples grow by 1.25x, so that sample is at most 375 rays). A sample that waits for
-    // its present (GroupSink::present_async) reaches the callback once the renderer has drawn its
-    // groups, while rays go on: a few dozen on a quiet machine, a few hundred when other tests
-    // hold the cores (713 seen under ctest -j2), so the bound is a fifteenth of the screen's
-    // 30,000 pixels: the frame stops long before its end, whatever the load.
+    // The stop flag is set as a communication thread would, here from the first sample at 300
+    // rays or more; the sample reaches the callback on the casting thread, which reads the flag
+    // before its next ray: the frame ends at exactly that sample's rays, whatever the load.
     std::atomic<bool> stop{false};
-    FrameResult a = draw_frame(engine, first, *renderer, &stop, [&](const TimelineSample& s) {
-        if (s.rays >= 300) stop = true;
-    });
+    std::size_t rays_at_stop = 0;
+    RendererSink draw(*renderer);
+    PresentNow now(draw);
+    FrameResult a = engine.run(first, first.screen(), FrameOutput(now, &draw, nullptr), stop,
+                               [&](const TimelineSample& s) {
+                                   if (s.rays >= 300 && !stop) {
+                                       rays_at_stop = s.rays;
+                                       stop = true;
+                                   }
+                               });
     EXPECT_FALSE(a.completed);
-    EXPECT_LE(a.rays_cast, std::size_t(first.width) * std::size_t(first.height) / 15);
+    ASSERT_GE(rays_at_stop, 300u);
+    EXPECT_EQ(a.rays_cast, rays_at_stop);
     EXPECT_EQ(a.final_image.pixel_count(), 0u);
 
     // New view and new isovalue: nothing of the first frame may remain.
