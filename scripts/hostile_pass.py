@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""A hostile pass over isowall's inputs, counted by area (issue "Nothing lies, nothing hangs,
-round two"): damaged volume files of every format, hostile option values, damaged wall files,
-raw bytes at the server, and signals while `render` writes its image.
+"""A hostile pass over isowall's inputs, counted by area: damaged volume files of every format,
+headers that lie (offsets, scalings, declared sizes), damaged stores, imports raced, signalled and
+forced, hostile option values, damaged wall files, raw bytes at the server, pages that reach the
+server by a foreign name, and signals while `render` writes its image.
 
 Each run is judged by the one failure path: either it succeeds (exit 0, and what it writes is
 whole), or it exits non-zero with exactly one line on stderr, `isowall: error: ...`, leaves no
@@ -51,15 +52,21 @@ def run(cmd, cwd, timeout=LIMIT_S, stdin=subprocess.DEVNULL):
         return None, "", ""
 
 
+def whole_png(path):
+    data = Path(path).read_bytes() if Path(path).exists() else b""
+    return data[:8] == b"\x89PNG\r\n\x1a\n" and data[-8:-4] == b"IEND"
+
+
 def judge(rc, err, outputs):
-    """(ok, why) by the one failure path."""
+    """(ok, why) by the one failure path; on exit 0 every PNG among `outputs` must be whole."""
     if rc is None:
         return False, "still running after the limit"
     if rc < 0:
         return False, f"ended by signal {-rc}"
     lines = [l for l in err.splitlines() if l.strip()]
     if rc == 0:
-        return True, ""
+        broken = [o for o in outputs if str(o).endswith(".png") and not whole_png(o)]
+        return (False, f"exit 0 but {broken} not a whole PNG") if broken else (True, "")
     if len(lines) != 1 or not lines[0].startswith("isowall: error: "):
         return False, f"exit {rc} with stderr {lines[:3]!r}"
     left = [o for o in outputs if Path(o).exists()]
@@ -121,14 +128,246 @@ def volume_area(a, tally, tmp):
             out = d / "out.png"
             rc, _, err = run([a.isowall, "render", "--no-cache", "-v", str(path), "--size",
                               "32x24", "--no-measure", "--out", str(out)], d)
-            if rc != 0 or err:
-                ok, why = judge(rc, err, [out])
-            else:
-                ok, why = out.exists() and out.stat().st_size > 0, "exit 0 without an image"
-            # An iso outside the range is an option error, not a fault of the file.
-            if rc == 2 and "--iso" in err:
-                ok, why = True, ""
+            ok, why = judge(rc, err, [out])
+            if rc == 0 and err.strip():
+                ok, why = False, f"exit 0 with stderr {err.splitlines()[:2]!r}"
             tally.add(f"volume: {fmt}", ok, f"{why}: variant {k} in {d}")
+
+
+def nifti_bytes(offset=352.0, slope=0.0, inter=0.0, dims=(16, 16, 16), voxels=True):
+    """A NIfTI-1 single file of uint8 voxels with the header fields given."""
+    h = bytearray(348)
+    struct.pack_into("<i", h, 0, 348)
+    struct.pack_into("<8h", h, 40, 3, *dims, 1, 1, 1, 1)
+    struct.pack_into("<hh", h, 70, 2, 8)  # DT_UINT8, 8 bits
+    struct.pack_into("<8f", h, 76, 1, 1, 1, 1, 1, 1, 1, 1)
+    struct.pack_into("<f", h, 108, offset)
+    struct.pack_into("<ff", h, 112, slope, inter)
+    h[344:348] = b"n+1\0"
+    n = dims[0] * dims[1] * dims[2] if voxels else 0
+    return bytes(h) + b"\0\0\0\0" + bytes((i * 7) % 251 for i in range(n))
+
+
+def headers_area(a, tally, tmp):
+    """Headers that lie: NIfTI offsets and scalings, declared sizes past the bytes (plain and
+    gzip), TIFF stacks cut at every few bytes. Each must read or be refused in one line."""
+    import gzip
+    cases = []
+    for off in (float("nan"), float("inf"), -1.0, 1e10, 100.0, 352.5, 353.0, 1e30):
+        cases.append((f"vox_offset {off}", "in.nii", nifti_bytes(offset=off)))
+    for slope, inter in ((float("nan"), 0), (float("inf"), 0), (1e38, 0), (-1e38, 5), (1, 3e38),
+                         (1e-45, 0), (0, float("nan")), (1e38, 1e38)):
+        cases.append((f"scl {slope} {inter}", "in.nii", nifti_bytes(slope=slope, inter=inter)))
+    cases.append(("claims 4096^3, holds none", "in.nii",
+                  nifti_bytes(dims=(4096, 4096, 4096), voxels=False)))
+    cases.append(("gzip claims 4096x4096x512", "in.nii.gz",
+                  gzip.compress(nifti_bytes(dims=(4096, 4096, 512), voxels=False))))
+    tiff = (ROOT / "fuzz" / "corpus" / "tiff" / "u16_stack.tif").read_bytes()
+    for cut in range(8, len(tiff), max(1, len(tiff) // 40)):
+        cases.append((f"tiff cut at {cut} of {len(tiff)}", "in.tif", tiff[:cut]))
+    for k, (what, name, data) in enumerate(cases):
+        d = tmp / f"header{k}"
+        d.mkdir()
+        (d / name).write_bytes(data)
+        out = d / "o.png"
+        rc, _, err = run([a.isowall, "render", "--no-cache", "-v", str(d / name), "--size",
+                          "32x24", "--no-measure", "--out", str(out)], d)
+        ok, why = judge(rc, err, [out])
+        tally.add("readers: lying headers", ok, f"{why}: {what} in {d}")
+
+
+def raw_volume(d, n=48, ball=True):
+    """A uint8 raw volume (a ball, or for large ones a repeating ramp) and the options that read
+    it."""
+    c = (n - 1) / 2
+    data = bytes(min(255, int(4 * ((x - c) ** 2 + (y - c) ** 2 + (z - c) ** 2) ** 0.5))
+                 for z in range(n) for y in range(n) for x in range(n)) if ball else \
+        (bytes(range(251)) * (n ** 3 // 251 + 1))[: n ** 3]
+    (d / "ball.raw").write_bytes(data)
+    return ["ball.raw", "--dims", str(n), str(n), str(n), "--type", "uint8"]
+
+
+def stores_area(a, tally, tmp):
+    """A store damaged every way a disk or a hand can: chunks cut, flipped, swapped for a FIFO or
+    a folder, removed; metadata cut or made nonsense. `render` of it must end in one line."""
+    base = tmp / "store_base"
+    base.mkdir()
+    src = raw_volume(base, 96)
+    rc, _, err = run([a.isowall, "import", *src, "--out", "s.zarr", "-q", "--levels", "1"], base)
+    if rc != 0:
+        tally.add("stores: damaged", False, f"the import failed: {err[-200:]}")
+        return
+    rng = random.Random(a.seed)
+    chunks = sorted(p for p in (base / "s.zarr" / "0").rglob("*") if p.is_file()
+                    and p.name != ".zarray")
+    damages = ["cut", "flip", "fifo", "folder", "remove", "empty"] * 3
+    metas = [".zattrs", ".zgroup", "0/.zarray"]
+    for k, dmg in enumerate(damages + [f"meta:{m}" for m in metas] * 2):
+        d = tmp / f"store{k}"
+        shutil.copytree(base, d, symlinks=True)
+        s = d / "s.zarr"
+        if dmg.startswith("meta:"):
+            f = s / dmg[5:]
+            text = f.read_bytes()
+            f.write_bytes(text[: rng.randrange(len(text))] if k % 2 else
+                          text.replace(b"3", b"9").replace(b"]", b""))
+        else:
+            f = d / "s.zarr" / rng.choice(chunks).relative_to(base / "s.zarr")
+            if dmg == "cut":
+                f.write_bytes(f.read_bytes()[: rng.randrange(max(1, f.stat().st_size))])
+            elif dmg == "flip":
+                b = bytearray(f.read_bytes())
+                b[rng.randrange(len(b))] ^= 0xFF
+                f.write_bytes(bytes(b))
+            elif dmg == "fifo":
+                f.unlink()
+                os.mkfifo(f)
+            elif dmg == "folder":
+                f.unlink()
+                f.mkdir()
+            elif dmg == "remove":
+                f.unlink()
+            else:
+                f.write_bytes(b"")
+        out = d / "o.png"
+        rc, _, err = run([a.isowall, "render", "--volume", "s.zarr", "--no-cache", "--iso", "100",
+                          "--size", "48x36", "--no-measure", "--memory-limit", "64M", "--out",
+                          str(out)], d)
+        ok, why = judge(rc, err, [out])
+        # A missing chunk is refused at open; other damage only where a frame reads it.
+        if rc == 0 and dmg == "remove":
+            ok, why = False, "a store missing a chunk drew a picture"
+        tally.add("stores: damaged", ok, f"{why}: {dmg} in {d}")
+
+
+def imports_area(a, tally, tmp):
+    """Imports raced, signalled and forced: two into one store at once (one lands, whole, the other
+    refused or after it), SIGTERM at a random moment (no temporary left), --force onto folders
+    that are not isowall's stores (every file kept)."""
+    rng = random.Random(a.seed)
+    for k in range(max(2, a.per_file // 3)):
+        d = Path(tempfile.mkdtemp(dir=tmp))
+        src = raw_volume(d, 160)
+        cmd = [a.isowall, "import", *src, "--out", "s.zarr", "-q"]
+        procs = [subprocess.Popen(cmd, cwd=d, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                  text=True) for _ in range(2)]
+        results = []
+        for p in procs:
+            try:
+                _, err = p.communicate(timeout=LIMIT_S)
+                results.append((p.returncode, err))
+            except subprocess.TimeoutExpired:
+                p.kill()
+                results.append((None, ""))
+        judged = [judge(rc, err, []) for rc, err in results]
+        landed = [rc for rc, _ in results if rc == 0]
+        info_rc, info, _ = run([a.isowall, "info", "--volume", "s.zarr"], d)
+        left = sorted(x.name for x in d.iterdir() if x.name.startswith("."))
+        ok = all(j[0] for j in judged) and landed and info_rc == 0 and "160x160x160" in info \
+            and not left
+        tally.add("imports: two at once", ok, f"exits {[r for r, _ in results]}, "
+                  f"info exit {info_rc}, left {left}: {[j[1] for j in judged if not j[0]]} in {d}")
+    for k in range(a.per_file):
+        d = Path(tempfile.mkdtemp(dir=tmp))
+        src = raw_volume(d, 512, ball=False)  # 128 MiB: an import of a second or so
+        p = subprocess.Popen([a.isowall, "import", *src, "--out", "s.zarr", "-q"], cwd=d,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        time.sleep(rng.uniform(0.0, 1.0))
+        sig = rng.choice([signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+        p.send_signal(sig)
+        try:
+            _, err = p.communicate(timeout=LIMIT_S)
+            rc = p.returncode
+        except subprocess.TimeoutExpired:
+            p.kill()
+            rc, err = None, ""
+        left = sorted(x.name for x in d.iterdir() if x.name != "ball.raw")
+        if rc == 0:  # it finished first: the store must be whole
+            ok = left == ["s.zarr"] and run([a.isowall, "info", "--volume", "s.zarr"], d)[0] == 0
+        else:
+            ok = rc == -sig and left == []
+        tally.add("imports: signals", ok, f"{sig.name}: exit {rc}, left {left} in {d}")
+    lookalikes = {
+        "empty json": {".zattrs": "{}", "0/.zarray": "{}", "thesis.tex": "mine"},
+        "not json": {".zattrs": "\x00\xff", "0/.zarray": "[", "notes.txt": "mine"},
+        "a file": None,
+    }
+    for what, files in lookalikes.items():
+        d = Path(tempfile.mkdtemp(dir=tmp))
+        src = raw_volume(d, 32)
+        target = d / "s.zarr"
+        if files is None:
+            target.write_text("mine")
+        else:
+            for name, text in files.items():
+                (target / name).parent.mkdir(parents=True, exist_ok=True)
+                (target / name).write_text(text, errors="surrogateescape")
+        before = sorted(str(x.relative_to(d)) for x in target.rglob("*")) if files else ["s.zarr"]
+        rc, _, err = run([a.isowall, "import", *src, "--out", "s.zarr", "--force", "-q"], d)
+        after = sorted(str(x.relative_to(d)) for x in target.rglob("*")) if files else \
+            (["s.zarr"] if target.is_file() else [])
+        ok, why = judge(rc, err, [])
+        ok = ok and rc != 0 and before == after
+        tally.add("imports: --force", ok, f"{why}: {what}: exit {rc}, files {after} in {d}")
+    for out in ["", "/", "/proc/s.zarr", "no_such_dir/s.zarr", "ball.raw"]:
+        d = Path(tempfile.mkdtemp(dir=tmp))
+        src = raw_volume(d, 32)
+        rc, _, err = run([a.isowall, "import", *src, "--out", out, "-q"], d)
+        ok, why = judge(rc, err, [])
+        ok = ok and rc != 0 and (d / "ball.raw").stat().st_size == 32 ** 3
+        tally.add("imports: --out", ok, f"{why}: --out {out!r}: exit {rc}")
+
+
+def page_area(a, tally, tmp):
+    """The page and its WebSocket reached by a name the server does not serve (DNS rebinding):
+    refused with 403; by its address, localhost or --allow-host: served."""
+    d = Path(tempfile.mkdtemp(dir=tmp))
+    srv = subprocess.Popen([a.isowall, "serve", "--port", "0", "--http", "0", "--allow-host",
+                            "wall.example"], cwd=d, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    http = None
+    for _ in range(200):
+        line = srv.stdout.readline()
+        if not line:
+            break
+        if "page at" in line:
+            http = int(line.split("://", 1)[1].split("/", 1)[0].rsplit(":", 1)[1])
+            break
+    if http is None:
+        tally.add("page: Host", False, "serve --http did not start")
+        srv.kill()
+        return
+    ws = ("Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n"
+          "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n")
+    cases = []
+    for host in ["evil.example", "evil.example:%d" % http, "127.0.0.1.evil.example",
+                 "localhost.evil.example", "", "[::1]evil", "x" * 300]:
+        for path, extra in (("/", ""), ("/ws", ws)):
+            cases.append((host, path, extra, False))
+            cases.append((host, path, extra + f"Origin: http://{host}\r\n", False))
+    for host in ["127.0.0.1:%d" % http, "localhost:%d" % http, "wall.example:%d" % http,
+                 "app.localhost"]:
+        cases.append((host, "/", "", True))
+    for host, path, extra, served in cases:
+        req = f"GET {path} HTTP/1.1\r\nHost: {host}\r\n{extra}\r\n".encode()
+        status = None
+        try:
+            with socket.create_connection(("127.0.0.1", http), timeout=10) as s:
+                s.sendall(req)
+                head = s.recv(64).decode(errors="replace")
+                status = int(head.split()[1]) if head.startswith("HTTP/") else None
+        except (OSError, ValueError, IndexError):
+            status = None
+        ok = (status in (200, 101)) if served else status in (400, 403)
+        tally.add("page: Host", ok, f"Host {host[:40]!r} {path}: status {status}")
+    srv.send_signal(signal.SIGTERM)
+    try:
+        srv.wait(10)
+        tally.add("page: Host", srv.returncode == -signal.SIGTERM,
+                  f"serve ended with {srv.returncode} on SIGTERM, not by the signal")
+    except subprocess.TimeoutExpired:
+        srv.kill()
+        tally.add("page: Host", False, "serve did not end on SIGTERM")
 
 
 def options_area(a, tally, tmp):
@@ -176,7 +415,7 @@ def wall_area(a, tally, tmp):
         except subprocess.TimeoutExpired:
             rc, err = None, ""
         errors = [l for l in err.splitlines() if l.startswith("isowall: error: ")]
-        ok = rc not in (None, 0) and len(errors) >= 1 and not (d / "m.png").exists()
+        ok = rc not in (None, 0) and len(errors) == 1 and not (d / "m.png").exists()
         tally.add("wall files", ok, f"exit {rc}, {len(errors)} error lines: {text[:40]!r}")
 
 
@@ -254,13 +493,15 @@ def main(argv):
     ap.add_argument("--isowall", default=str(ROOT / "build" / "bin" / "isowall"))
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--per-file", type=int, default=12)
-    ap.add_argument("--areas", default="volume,options,wall,server,signals")
+    ap.add_argument("--areas",
+                    default="volume,headers,stores,imports,options,wall,server,page,signals")
     a = ap.parse_args(argv)
     tally = Tally()
     with tempfile.TemporaryDirectory(prefix="isowall-hostile-") as t:
         tmp = Path(t)
-        areas = {"volume": volume_area, "options": options_area, "wall": wall_area,
-                 "server": server_area, "signals": signal_area}
+        areas = {"volume": volume_area, "headers": headers_area, "stores": stores_area,
+                 "imports": imports_area, "options": options_area, "wall": wall_area,
+                 "server": server_area, "page": page_area, "signals": signal_area}
         for name in a.areas.split(","):
             areas[name](a, tally, tmp)
     print(f"{'area':24} {'tried':>6} {'clean':>6} {'failed':>7}")

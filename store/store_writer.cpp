@@ -372,10 +372,15 @@ ImportResult write_store(const Volume& volume, const fs::path& out, const Import
 ImportResult write_store(PlaneSource& source, const fs::path& out, const ImportOptions& options) {
     const std::string where = out.string();
     std::error_code ec;
+    const auto exists = [&] {
+        return fs::symlink_status(out, ec).type() != fs::file_type::not_found;
+    };
+    if (exists() && !options.replace)  // before any folder is made; again under the lock
+        throw InputError(where, "--out", "exists; give --force to replace it");
     TempDir tmp{temporary_for(out)};
     hold(tmp, where);
     // Under the lock: a store another import finished meanwhile counts as existing.
-    if (fs::symlink_status(out, ec).type() != fs::file_type::not_found) {
+    if (exists()) {
         if (!options.replace)
             throw InputError(where, "--out", "exists; give --force to replace it");
         if (const std::string why = unreplaceable(out); !why.empty())
