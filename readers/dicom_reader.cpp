@@ -305,6 +305,31 @@ struct SeriesSlices {
     std::optional<SlicePixels> first;
 };
 
+// The slices in order, each one's scaling from its header, and the first one's pixels.
+std::shared_ptr<SeriesSlices> series_slices(const std::vector<SliceHeader>& headers,
+                                            const SliceOrder& order) {
+    auto slices = std::make_shared<SeriesSlices>();
+    for (const std::size_t k : order.order) {
+        slices->headers.push_back(headers[k]);
+        slices->scalings.push_back(gdcm_scaling(headers[k].file));
+    }
+    slices->first = read_slice(slices->headers.front(), std::nullopt);
+    const std::vector<Scaling>& sc = slices->scalings;
+    slices->per_slice = !std::all_of(sc.begin(), sc.end(), [&](const Scaling& s) {
+        return s.slope == sc[0].slope && s.intercept == sc[0].intercept;
+    });
+    return slices;
+}
+
+// A series scaled slice by slice lands in float32: each slice's scaling, against the stored
+// values its header allows, must keep every value finite there.
+void check_slice_scalings(const SeriesSlices& slices) {
+    const auto [lo, hi] = slices.first->stored_range;
+    for (std::size_t k = 0; k < slices.scalings.size(); ++k)
+        if (std::string p = scaling_problem(slices.scalings[k], lo, hi, VoxelType::f32); !p.empty())
+            throw InputError(slices.headers[k].file, "RescaleSlope", p);
+}
+
 }  // namespace
 
 // The series' name in errors: the folder, or the folder of the file named.
@@ -331,17 +356,8 @@ PlaneStack dicom_planes(const fs::path& path) {
         numbers(trimmed(scanner.GetValue(series.files.front().c_str(), kPixelSpacing)));
     if (ps.size() != 2)
         throw InputError(series.files.front(), "PixelSpacing", "missing or not two numbers");
-    auto slices = std::make_shared<SeriesSlices>();
-    for (const std::size_t k : order.order) {
-        slices->headers.push_back(headers[k]);
-        slices->scalings.push_back(gdcm_scaling(headers[k].file));
-    }
+    const std::shared_ptr<SeriesSlices> slices = series_slices(headers, order);
     const SliceHeader& first = slices->headers.front();
-    slices->first = read_slice(first, std::nullopt);
-    const std::vector<Scaling>& sc = slices->scalings;
-    slices->per_slice = !std::all_of(sc.begin(), sc.end(), [&](const Scaling& s) {
-        return s.slope == sc[0].slope && s.intercept == sc[0].intercept;
-    });
 
     PlaneStack stack;
     Decoded& d = stack.head;
@@ -354,13 +370,10 @@ PlaneStack dicom_planes(const fs::path& path) {
         d.type);
     if (slices->per_slice) {
         d.facts.push_back({"scaling", "RescaleSlope/Intercept per slice (applied: float32)"});
-        // Each slice's scaling, against the stored values its header allows, lands in float32.
-        const auto [lo, hi] = slices->first->stored_range;
-        for (std::size_t k = 0; k < sc.size(); ++k)
-            if (std::string p = scaling_problem(sc[k], lo, hi, VoxelType::f32); !p.empty())
-                throw InputError(slices->headers[k].file, "RescaleSlope", p);
-    } else
+        check_slice_scalings(*slices);
+    } else {
         d.scaling = slices->first->scaling;
+    }
     stack.declared_range = slices->first->stored_range;
     d.orientation.axes =
         glm::mat3(glm::vec3(first.row), glm::vec3(first.column), glm::vec3(order.normal));

@@ -52,6 +52,23 @@ def run(cmd, cwd, timeout=LIMIT_S, stdin=subprocess.DEVNULL):
         return None, "", ""
 
 
+def run_and_signal(cmd, cwd, rng, lo, hi):
+    """Starts `cmd`, sends it SIGINT, SIGTERM or SIGHUP after a random lo..hi s; (signal, exit
+    status, None past the limit)."""
+    p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         text=True)
+    time.sleep(rng.uniform(lo, hi))
+    sig = rng.choice([signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+    p.send_signal(sig)
+    try:
+        p.communicate(timeout=LIMIT_S)
+        return sig, p.returncode
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.communicate()
+        return sig, None
+
+
 def whole_png(path):
     data = Path(path).read_bytes() if Path(path).exists() else b""
     return data[:8] == b"\x89PNG\r\n\x1a\n" and data[-8:-4] == b"IEND"
@@ -270,17 +287,8 @@ def imports_area(a, tally, tmp):
     for k in range(a.per_file):
         d = Path(tempfile.mkdtemp(dir=tmp))
         src = raw_volume(d, 512, ball=False)  # 128 MiB: an import of a second or so
-        p = subprocess.Popen([a.isowall, "import", *src, "--out", "s.zarr", "-q"], cwd=d,
-                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        time.sleep(rng.uniform(0.0, 1.0))
-        sig = rng.choice([signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-        p.send_signal(sig)
-        try:
-            _, err = p.communicate(timeout=LIMIT_S)
-            rc = p.returncode
-        except subprocess.TimeoutExpired:
-            p.kill()
-            rc, err = None, ""
+        sig, rc = run_and_signal([a.isowall, "import", *src, "--out", "s.zarr", "-q"], d, rng,
+                                 0.0, 1.0)
         left = sorted(x.name for x in d.iterdir() if x.name != "ball.raw")
         if rc == 0:  # it finished first: the store must be whole
             ok = left == ["s.zarr"] and run([a.isowall, "info", "--volume", "s.zarr"], d)[0] == 0
@@ -469,17 +477,8 @@ def signal_area(a, tally, tmp):
     for k in range(a.per_file):
         d = Path(tempfile.mkdtemp(dir=tmp))
         out = d / "o.png"
-        p = subprocess.Popen([a.isowall, "render", "--size", "1600x1200", "--out", str(out)],
-                             cwd=d, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        time.sleep(rng.uniform(0.2, 3.0))
-        sig = rng.choice([signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-        p.send_signal(sig)
-        try:
-            _, err = p.communicate(timeout=LIMIT_S)
-            rc = p.returncode
-        except subprocess.TimeoutExpired:
-            p.kill()
-            rc, err = None, ""
+        sig, rc = run_and_signal([a.isowall, "render", "--size", "1600x1200", "--out", str(out)],
+                                 d, rng, 0.2, 3.0)
         left = sorted(x.name for x in d.iterdir())
         if rc == 0:  # it finished before the signal: the image must be whole
             ok = out.exists() and out.read_bytes()[-8:-4] == b"IEND" and left == ["o.png"]

@@ -69,22 +69,27 @@ TEST(WallRun, MosaicOfA2x2WallEqualsOneViewOfTheVirtualScreen) {
 
 // A store under a memory limit: every rank pages its own bricks in; the mosaic is the
 // picture of the file the store was imported from.
+// The phantom as raw bytes (dir/phantom.raw) imported as a store (dir/phantom.zarr): the store's
+// path, or empty (with a failure) when the import failed.
+std::string phantom_store(const std::filesystem::path& dir) {
+    const Volume v = make_phantom();
+    std::ofstream(dir / "phantom.raw", std::ios::binary)
+        .write(reinterpret_cast<const char*>(v.bytes().data()),
+               static_cast<std::streamsize>(v.bytes().size()));
+    const std::string store = (dir / "phantom.zarr").string();
+    const int rc = run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() +
+                           "' --dims 200 184 168 --type uint8 -q --no-cache --out '" + store + "'",
+                       dir / "import.log");
+    EXPECT_EQ(rc, 0) << slurp(dir / "import.log");
+    return rc == 0 ? store : std::string();
+}
+
 TEST(WallRun, AStoreUnderAMemoryLimitGivesTheMosaicOfItsFile) {
     const auto dir = test::scratch_dir("wall_store");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [160, 120]\n";
-    {
-        const Volume v = make_phantom();
-        std::ofstream(dir / "phantom.raw", std::ios::binary)
-            .write(reinterpret_cast<const char*>(v.bytes().data()),
-                   static_cast<std::streamsize>(v.bytes().size()));
-    }
     const std::string raw = " --dims 200 184 168 --type uint8";
-    const std::string store = (dir / "phantom.zarr").string();
-    ASSERT_EQ(run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() + "'" + raw +
-                      " -q --no-cache --out '" + store + "'",
-                  dir / "import.log"),
-              0)
-        << slurp(dir / "import.log");
+    const std::string store = phantom_store(dir);
+    ASSERT_FALSE(store.empty());
     ASSERT_EQ(
         run(mpirun(5) + "wall --wall '" + (dir / "2x2.toml").string() + "' --volume '" + store +
                 "' --memory-limit 16M --iso 50 --out '" + (dir / "mosaic.png").string() + "'",
@@ -121,18 +126,8 @@ TEST(WallRun, AStoreUnderAMemoryLimitGivesTheMosaicOfItsFile) {
 TEST(WallRun, ADamagedChunkMetMidFrameEndsTheJobNamingTheRank) {
     const auto dir = test::scratch_dir("wall_damaged_chunk");
     std::ofstream(dir / "2x1.toml") << "tiles = [2, 1]\ntile_size_px = [160, 240]\n";
-    {
-        const Volume v = make_phantom();
-        std::ofstream(dir / "phantom.raw", std::ios::binary)
-            .write(reinterpret_cast<const char*>(v.bytes().data()),
-                   static_cast<std::streamsize>(v.bytes().size()));
-    }
-    const std::string store = (dir / "phantom.zarr").string();
-    ASSERT_EQ(run(isowall_cmd() + "import '" + (dir / "phantom.raw").string() +
-                      "' --dims 200 184 168 --type uint8 -q --no-cache --out '" + store + "'",
-                  dir / "import.log"),
-              0)
-        << slurp(dir / "import.log");
+    const std::string store = phantom_store(dir);
+    ASSERT_FALSE(store.empty());
     {
         std::fstream f(dir / "phantom.zarr/0/1/1/0",
                        std::ios::in | std::ios::out | std::ios::binary);
