@@ -27,8 +27,8 @@ inline std::string isowall_cmd() {
     return s;
 }
 
-inline std::string mpirun(int np) {
-    std::string s = "mpirun --oversubscribe -np ";
+inline std::string mpirun(int np, const std::string& options = "") {
+    std::string s = "mpirun " + options + "--oversubscribe -np ";
     s += std::to_string(np);
     s += ' ';
     return s + isowall_cmd();
