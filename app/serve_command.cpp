@@ -105,7 +105,10 @@ CLI::App* add_serve_command(CLI::App& app, ServeCommand& o) {
                   "Emulate a link of this many Mbit/s (token bucket on every send); 0: no limit")
         ->transform(number_in({0, 1e6}))
         ->capture_default_str();
-    c->add_option("--max-clients", o.max_clients, "Connections served at once")
+    c->add_option("--max-clients", o.max_clients,
+                  "Clients served at once (seats, taken at the hello). When every seat is "
+                  "taken, the client idle the longest between frames gives its seat to the "
+                  "newcomer and is told why")
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();
     c->add_option("--max-sessions", o.max_sessions,
