@@ -54,19 +54,6 @@ std::vector<std::byte> scaled(std::span<const std::byte> bytes, Scaling s) {
     return out;
 }
 
-template <class In>
-std::pair<double, double> value_range(const std::vector<std::byte>& bytes) {
-    const std::size_t n = bytes.size() / sizeof(In);
-    double lo = 0, hi = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        In v;
-        std::memcpy(&v, bytes.data() + i * sizeof(In), sizeof(In));
-        if (i == 0 || double(v) < lo) lo = double(v);
-        if (i == 0 || double(v) > hi) hi = double(v);
-    }
-    return {lo, hi};
-}
-
 std::string number_text(double v) {
     std::ostringstream s;
     s.precision(9);
@@ -118,15 +105,13 @@ ScaledVoxels apply_scaling(std::vector<std::byte> bytes, VoxelType type, Scaling
     if (std::string p = scaling_problem(s, 0, 0, VoxelType::f64); !p.empty())
         throw InputError(where, field, p);
     if (s.identity()) return {std::move(bytes), type};
-    const bool integral = std::trunc(s.slope) == s.slope && std::trunc(s.intercept) == s.intercept;
-    const auto [lo, hi] =
-        integral && is_integer_type(type)
-            ? dispatch_voxel_type(type, [&](auto t) { return value_range<decltype(t)>(bytes); })
-            : std::pair<double, double>{0, 0};
+    // One pass for the values the file holds: an integer type's range chooses the type the
+    // scaled values need, and every type's, scaled, must be numbers in that type.
+    const auto range = finite_range(bytes, type);
+    const auto [lo, hi] = range.value_or(std::pair<double, double>{0, 0});
     const VoxelType out = scaled_type(type, s, lo, hi);
-    // The values the file holds, scaled, must be numbers in the type they land in.
-    if (const auto range = finite_range(bytes, type))
-        if (std::string p = scaling_problem(s, range->first, range->second, out); !p.empty())
+    if (range)
+        if (std::string p = scaling_problem(s, lo, hi, out); !p.empty())
             throw InputError(where, field, p);
     std::vector<std::byte> result = dispatch_voxel_type(type, [&](auto in) {
         return dispatch_voxel_type(
