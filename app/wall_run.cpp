@@ -231,7 +231,7 @@ void await_start(Comm& comm, double timeout_s) {
                   "the master (rank 0) has not started the wall within %g s (--startup-timeout): "
                   "it is still loading the volume, has stopped, or cannot be reached",
                   timeout_s);
-    throw std::runtime_error(msg);
+    throw MasterUnreachable(msg);
 }
 
 std::string role(const WallSpec& spec, int rank) {
@@ -239,19 +239,47 @@ std::string role(const WallSpec& spec, int rank) {
                                : "tile " + std::to_string(tile_of_rank(spec, rank));
 }
 
-// The single failure path: whatever a rank throws is printed once, as one line, and ends the job.
-// Bad input names its source and field already; any other error is prefixed with the rank.
-[[noreturn]] void fail(Comm& comm, const WallSpec& spec, const std::exception& e, bool input) {
+// The job's one error line, then every rank ended. Bad input names its source and field already;
+// any other error is prefixed with the rank that met it.
+[[noreturn]] void print_and_end(Comm& comm, const WallSpec& spec, int rank, bool input,
+                                const std::string& what) {
     std::fflush(stdout);
     // clip: one bounded line, every byte a terminal could act on escaped.
     if (input)
-        std::fprintf(stderr, "isowall: error: %s\n", clip(e.what(), 800).c_str());
+        std::fprintf(stderr, "isowall: error: %s\n", clip(what, 800).c_str());
     else
-        std::fprintf(stderr, "isowall: error: rank %d (%s): %s\n", comm.rank(),
-                     role(spec, comm.rank()).c_str(), clip(e.what(), 800).c_str());
+        std::fprintf(stderr, "isowall: error: rank %d (%s): %s\n", rank, role(spec, rank).c_str(),
+                     clip(what, 800).c_str());
     std::fflush(stderr);
     comm.abort(input ? 1 : 2);
     throw CommAborted(input ? 1 : 2);  // not reached: abort() ends the rank
+}
+
+// How long a failed tile waits for the master to end the job before it says why itself: the
+// master answers within a receive slice unless it is stopped or busy outside its loop.
+constexpr double kMasterEndsJobS = 10;
+
+// The single failure path: whatever a rank throws is printed once, as one line, and ends the job.
+// A tile does not print: it tells the master, which prints the first failure it hears of (tiles
+// that fail together, as on a damaged chunk each of them meets, give one line, not one per tile)
+// and ends every rank. Only when the master cannot be told, or does not end the job in time,
+// does the tile print its own line and end the job itself.
+[[noreturn]] void fail(Comm& comm, const WallSpec& spec, const std::exception& e, bool input,
+                       double timeout_s) {
+    if (comm.rank() != kMasterRank && !dynamic_cast<const MasterUnreachable*>(&e)) {
+        try {
+            send_message(comm, kMasterRank, FailedMsg{input, e.what()});
+            const Stopwatch waited;
+            const double limit = std::min(timeout_s, kMasterEndsJobS);
+            // Whatever comes meanwhile is for a rank that is ending; the in-process transport
+            // throws CommAborted here once the master has ended the job.
+            while (waited.seconds() < limit) comm.receive(kMasterRank, limit - waited.seconds());
+        } catch (const CommAborted&) {
+            throw;
+        } catch (const std::exception&) {  // the master cannot be told: say it here
+        }
+    }
+    print_and_end(comm, spec, comm.rank(), input, e.what());
 }
 
 }  // namespace
@@ -287,8 +315,8 @@ int run_wall(const WallOptions& o, Comm& comm) {
     }
     // An error where nothing can be thrown (a damaged chunk met by the pager mid-frame) ends the
     // job as any other error on a rank after start-up: named by the rank, exit 2, every rank ended.
-    set_fatal_handler([&comm, &spec](const std::string& what) {
-        fail(comm, spec, std::runtime_error(what), false);
+    set_fatal_handler([&comm, &spec, &o](const std::string& what) {
+        fail(comm, spec, std::runtime_error(what), false, o.timeout_s);
     });
     try {
         // The master loads first and writes the octree cache; the tile ranks then map the same
@@ -307,15 +335,17 @@ int run_wall(const WallOptions& o, Comm& comm) {
         try {
             input.emplace(check_master_input(o, rank_budget(o, comm)));
         } catch (const InputError& e) {
-            fail(comm, spec, e, true);
+            fail(comm, spec, e, true, o.timeout_s);
         }
         return run_master(o, comm, spec, *input);
     } catch (const CommAborted&) {
-        throw;  // another rank failed and has said why
+        throw;                       // another rank failed and has said why
+    } catch (const TileFailed& e) {  // the master, told by a tile
+        print_and_end(comm, spec, e.rank(), e.input(), e.what());
     } catch (const InputError& e) {
-        fail(comm, spec, e, true);
+        fail(comm, spec, e, true, o.timeout_s);
     } catch (const std::exception& e) {
-        fail(comm, spec, e, false);
+        fail(comm, spec, e, false, o.timeout_s);
     }
 }
 

@@ -60,7 +60,8 @@ std::vector<Message> samples() {
             StoreMetaMsg{true, R"({"zarr_format": 2})", R"({"isowall": {}})", 4096, 100},
             StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}},
             CurveAskMsg{9},
-            CurveMsg{{9, 100, {{0.5, 40, 1.25}, {0.75, 100, 0}}}}};  // new last
+            CurveMsg{{9, 100, {{0.5, 40, 1.25}, {0.75, 100, 0}}}},
+            FailedMsg{false, "0/1/1/0: cannot decompress"}};  // new last
 }
 
 }  // namespace

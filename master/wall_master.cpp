@@ -60,6 +60,8 @@ void WallMaster::handle(const Envelope& e) {
         t.threads = h->threads;
         (h->loaded ? t.hello : t.joined) = true;
     } else if (std::holds_alternative<AliveMsg>(m)) {  // its loop runs: heard is all it tells
+    } else if (auto* f = std::get_if<FailedMsg>(&m)) {
+        throw TileFailed(e.from, f->input, f->what);
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
         if (p->generation == generation_ && board_) {  // older: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);

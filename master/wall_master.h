@@ -4,6 +4,7 @@
 // so no message is dropped unread and a silent wall is noticed wherever the master waits.
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,20 @@
 #include "wall_spec/wall.h"
 
 namespace isowall {
+
+// A tile rank's failure as its failed message told the master (handle() throws it): the wall's
+// failure path prints it as the job's one error line, under the tile's name.
+class TileFailed : public std::runtime_error {
+  public:
+    TileFailed(int rank, bool input, const std::string& what)
+        : std::runtime_error(what), rank_(rank), input_(input) {}
+    int rank() const { return rank_; }
+    bool input() const { return input_; }
+
+  private:
+    int rank_;
+    bool input_;
+};
 
 struct MasterOptions {
     std::string wall_name;  // for the start-up line

@@ -259,6 +259,20 @@ TEST(ProtocolMalformed, PreviewWithAHugeLengthThrowsWithoutAllocating) {
 
 // ---- tile result --------------------------------------------------------------------------------
 
+TEST(ProtocolMalformed, FailedFaultsThrowNamingTheField) {
+    Bytes bad_bool = encode(FailedMsg{true, "x"});
+    bad_bool[1] = std::byte{2};  // after the version byte
+    expect_wire_error(Tag::failed, bad_bool, "input");
+    // A what longer than the limit (the encoder cuts; a forged message is refused).
+    MessageWriter w(FailedMsg::kVersion);
+    w.put(std::uint8_t{0});
+    w.put_string(std::string(kMaxFailedBytes + 1, 'x'));
+    expect_wire_error(Tag::failed, w.take(), "what");
+    // The encoder cuts an over-long line to the limit instead of sending what would be refused.
+    const Bytes cut = encode(FailedMsg{false, std::string(kMaxFailedBytes + 100, 'y')});
+    EXPECT_EQ(decode_as<FailedMsg>(Tag::failed, cut).what.size(), kMaxFailedBytes);
+}
+
 TEST(ProtocolMalformed, TileResultWithABadStageThrows) {
     for (std::uint8_t stage :
          {static_cast<std::uint8_t>(std::size(kTraceStages)), std::uint8_t{255}}) {

@@ -108,6 +108,12 @@ TEST(Protocol, CurveAskAndCurveRoundTrip) {
     expect_round_trip(CurveMsg{{7, 123456, {{0.25, 100, 1.5}, {0.5, 123456, 0}}}});
 }
 
+TEST(Protocol, FailedRoundTrips) {
+    expect_round_trip(FailedMsg{});
+    expect_round_trip(FailedMsg{true, "volume.nrrd: sizes: expected 3 numbers"});
+    expect_round_trip(FailedMsg{false, std::string(kMaxFailedBytes, 'x')});
+}
+
 TEST(Protocol, PerspectiveProjectionRoundTrips) {
     ViewMsg m = sample_view();
     m.view.camera.projection = Projection::perspective;
@@ -157,7 +163,8 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(static_cast<Tag>(15)), "unknown");
     EXPECT_STREQ(to_string(Tag::curve_ask), "curve_ask");
     EXPECT_STREQ(to_string(Tag::curve), "curve");
-    EXPECT_STREQ(to_string(static_cast<Tag>(22)), "unknown");
+    EXPECT_STREQ(to_string(Tag::failed), "failed");
+    EXPECT_STREQ(to_string(static_cast<Tag>(23)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }
 

@@ -114,6 +114,9 @@ inline bool operator==(const CurveAskMsg& a, const CurveAskMsg& b) {
 inline bool operator==(const CurveMsg& a, const CurveMsg& b) {
     return a.curve == b.curve;
 }
+inline bool operator==(const FailedMsg& a, const FailedMsg& b) {
+    return a.input == b.input && a.what == b.what;
+}
 
 inline bool operator==(const StoreAskMsg& a, const StoreAskMsg& b) {
     return a.part == b.part && a.index == b.index;
@@ -346,7 +349,8 @@ inline std::vector<Sample> samples() {
             {"landed", Tag::landed, encode(LandedMsg{3, 4})},
             {"store_ask", Tag::store_ask, encode(StoreAskMsg{StorePart::chunk, 77})},
             {"store_meta", Tag::store_meta, encode(sample_store_meta())},
-            {"store_part", Tag::store_part, encode(sample_store_part())}};
+            {"store_part", Tag::store_part, encode(sample_store_part())},
+            {"failed", Tag::failed, encode(FailedMsg{true, "a.nrrd: sizes: bad"})}};
 }
 
 // decode_message must throw a WireError whose text names the message and `field`.

@@ -200,6 +200,19 @@ TEST(WallInProcess, ARankThatThrowsEndsEveryRankWithOneLine) {
     }
 }
 
+// Every tile throws at its first view: the tiles tell the master, which prints the first it hears
+// of, so the job still says why once, not once per tile.
+TEST(WallInProcess, TilesThatFailTogetherGiveOneLine) {
+    WallOptions o = small_wall(test::scratch_dir("inproc_tiles_throw"));
+    o.fault = {FaultAction::throw_error, FaultMoment::none, TestFault::kEveryTile};
+    const WallRun r = run_wall_in_process(o);
+    for (int code : r.codes) EXPECT_NE(code, 0) << r.err;
+    EXPECT_EQ(test::count_of(r.err, "isowall: error:"), 1u) << r.err;
+    EXPECT_EQ(test::count_of(r.err, " (tile "), 1u) << r.err;
+    EXPECT_NE(r.err.find("test fault: a tile throws"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(o.out));
+}
+
 // ---- the screen-region scheduler ------------------------------------------------------------
 
 // A 2x2 wall of 640x480 tiles cut into 160x120 regions (16 per tile; large enough that a cell

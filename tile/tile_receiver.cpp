@@ -42,13 +42,13 @@ double Receiver::limit_s() const {
     return timeout_s_ + tile_grace_s(comm_.rank());
 }
 
-std::runtime_error Receiver::silent_master() const {
+MasterUnreachable Receiver::silent_master() const {
     char msg[200];
     std::snprintf(msg, sizeof(msg),
                   "the master (rank 0) has sent nothing for %g s (--timeout): it has stopped, "
                   "or its host cannot be reached",
                   timeout_s_);
-    return std::runtime_error(msg);
+    return MasterUnreachable(msg);
 }
 
 void Receiver::loop() {

@@ -7,6 +7,7 @@
 
 #include "comm/comm.h"
 #include "tile/tile_inbox.h"
+#include "wall_protocol/protocol.h"
 
 namespace isowall {
 
@@ -28,7 +29,7 @@ class Receiver {
   private:
     void loop();
     double limit_s() const;
-    std::runtime_error silent_master() const;
+    MasterUnreachable silent_master() const;
 
     Comm& comm_;
     TileInbox& inbox_;

@@ -167,6 +167,27 @@ std::vector<std::byte> encode(const QuitMsg&) {
     return MessageWriter(QuitMsg::kVersion).take();
 }
 
+std::vector<std::byte> encode(const FailedMsg& m) {
+    MessageWriter w(FailedMsg::kVersion);
+    w.put(static_cast<std::uint8_t>(m.input ? 1 : 0));
+    w.put_string(m.what.substr(0, kMaxFailedBytes));
+    return w.take();
+}
+
+static FailedMsg decode_failed(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, FailedMsg::kVersion, "failed message");
+    FailedMsg m;
+    const auto input = r.get<std::uint8_t>();
+    if (input > 1) r.fail("input: expected 0 or 1, got " + std::to_string(input));
+    m.input = input == 1;
+    m.what = r.get_string();
+    if (m.what.size() > kMaxFailedBytes)
+        r.fail("what: " + std::to_string(m.what.size()) + " bytes, at most " +
+               std::to_string(kMaxFailedBytes));
+    r.finish();
+    return m;
+}
+
 static QuitMsg decode_quit(std::span<const std::byte> bytes) {
     MessageReader r(bytes, QuitMsg::kVersion, "quit message");
     r.finish();
@@ -308,6 +329,8 @@ const char* to_string(Tag tag) {
             return "curve_ask";
         case Tag::curve:
             return "curve";
+        case Tag::failed:
+            return "failed";
     }
     // A tag comes off the wire as any int32, so this is reachable.
     return "unknown";
@@ -355,9 +378,11 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_curve_ask(bytes);
         case Tag::curve:
             return job_wire::decode_curve(bytes);
+        case Tag::failed:
+            return decode_failed(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
-                    ": unknown tag, expected 1..14 or 16..21");
+                    ": unknown tag, expected 1..14 or 16..22");
 }
 
 }  // namespace isowall

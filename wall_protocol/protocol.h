@@ -5,6 +5,7 @@
 // malformed, truncated, of another version or with trailing bytes.
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -40,6 +41,7 @@ enum class Tag : std::int32_t {
     landed = 19,      // owner -> master: a helper's region result has been composited
     curve_ask = 20,   // master -> tile (--measure): the frame is complete; send its curve
     curve = 21,       // tile -> master: that frame's correctness curve (the page's C = 99%)
+    failed = 22,      // tile -> master: the rank has failed; the master says why, once, and ends
 };
 const char* to_string(Tag tag);
 
@@ -242,10 +244,28 @@ struct CurveMsg {
     FrameCurve curve;  // its generation is the frame's
 };
 
-using Message =
-    std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg, TileResultMsg,
-                 ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg, JobDoneMsg, RegionMsg,
-                 LandedMsg, StoreAskMsg, StoreMetaMsg, StorePartMsg, CurveAskMsg, CurveMsg>;
+// A tile rank's error, sent to the master instead of printed: the master prints the first it
+// hears of as the job's one error line and ends every rank, so tiles that fail together (a
+// damaged chunk that each of them meets) give one line, not one per tile.
+struct FailedMsg {
+    static constexpr Tag kTag = Tag::failed;
+    static constexpr std::uint8_t kVersion = 1;
+    bool input = false;  // bad input (it names its source), not an error of the rank itself
+    std::string what;    // at most kMaxFailedBytes
+};
+inline constexpr std::uint64_t kMaxFailedBytes = 4096;
+
+// A tile's error that says the master cannot hear it (silent, or not yet listening): the tile
+// says it itself rather than sending a failed message that nobody would read.
+class MasterUnreachable : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+using Message = std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
+                             TileResultMsg, ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg,
+                             JobDoneMsg, RegionMsg, LandedMsg, StoreAskMsg, StoreMetaMsg,
+                             StorePartMsg, CurveAskMsg, CurveMsg, FailedMsg>;
 
 std::vector<std::byte> encode(const TileHelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -267,6 +287,7 @@ std::vector<std::byte> encode(const StoreMetaMsg& m);
 std::vector<std::byte> encode(const StorePartMsg& m);
 std::vector<std::byte> encode(const CurveAskMsg& m);
 std::vector<std::byte> encode(const CurveMsg& m);
+std::vector<std::byte> encode(const FailedMsg& m);
 std::vector<std::byte> encode(const Message& m);
 Tag tag_of(const Message& m);
 
