@@ -259,6 +259,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
     Image full;
     if (o.against_full) full = print_against_full(ex, renderer, fv, fr.final_image);
+    if (o.against_truth) print_against_truth(ex, renderer, fv, fr.final_image);
 
     const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
                               !o.snapshots.empty() || !o.snapshot_rays.empty();

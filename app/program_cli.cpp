@@ -73,6 +73,13 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
                      "After the progressive frame, extract and draw the full surface (not timed) "
                      "and print both correctness measures of the final image against it: what "
                      "adaptive resolution and other shortcuts cost in the image");
+    re_cmd->add_flag(
+        "--against-truth", re.against_truth,
+        "After the frame (not timed), draw the full surface at 4x4 samples per pixel, "
+        "box-filtered (what a pixel can show), and print C_T and coverage IoU against it for "
+        "the final image and for the full surface at one sample per pixel, and whether the final "
+        "image passes the fidelity gate (C_T within 0.005 and IoU within 0.002 of the full "
+        "surface's, or better)");
     re_cmd->add_flag("--warm-up", re.warm_up,
                      "First draw one untimed frame (of the view turned 30 degrees; with --full, "
                      "the same full surface), so the timed frame finds the process warm as a "

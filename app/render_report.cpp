@@ -102,6 +102,34 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
     return full;
 }
 
+bool print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                         const Image& final_image) {
+    Stopwatch sw;
+    const Mesh mesh = ex.extract_full(fv.iso);
+    FrameView big = fv;
+    big.width *= kTruthSamples;
+    big.height *= kTruthSamples;
+    const Image truth = box_filtered_truth(draw_alone(renderer, mesh, big), kTruthSamples);
+    const Fidelity full = measure_fidelity(draw_alone(renderer, mesh, fv), truth);
+    const Fidelity own = measure_fidelity(final_image, truth);
+    const bool holds = passes_fidelity_gate(own, full);
+    std::printf(
+        "against the truth (the full surface, %zu triangles, at %dx%d samples a pixel, "
+        "box-filtered: %zu px covered; %.3f s, not part of the timings):\n",
+        mesh.triangle_count(), kTruthSamples, kTruthSamples, covered_pixels(truth), sw.seconds());
+    auto row = [](const char* what, const Fidelity& f) {
+        std::printf("  %-34s C_T = %.5f, coverage IoU %.5f, %.2f%% of px off by > 8/255\n", what,
+                    f.c, f.iou, 100.0 * f.off_share);
+    };
+    row("final image:", own);
+    row("full surface at 1 sample a pixel:", full);
+    const double c_bar = full.c - kFidelityC, iou_bar = full.iou - kFidelityIoU;
+    std::printf("  fidelity gate: %s (C_T %.5f %s %.5f, IoU %.5f %s %.5f)\n",
+                holds ? "holds" : "FAILS", own.c, own.c >= c_bar ? ">=" : "<", c_bar, own.iou,
+                own.iou >= iou_bar ? ">=" : "<", iou_bar);
+    return holds;
+}
+
 void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s) {
     const auto first = std::find_if(fr.timeline.begin(), fr.timeline.end(),
                                     [](const TimelineSample& s) { return s.triangles > 0; });

@@ -42,6 +42,13 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image);
 
+// The final image against the truth (progressive/correctness.h: the full surface at
+// kTruthSamples x kTruthSamples samples per pixel, box-filtered), beside the full surface at one
+// sample per pixel, and the fidelity gate; outside the timings. Returns whether the gate holds.
+inline constexpr int kTruthSamples = 4;
+bool print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+                         const Image& final_image);
+
 // When the frame's first group showed, counted from the command's start (the frame began
 // `frame_at` seconds after it; `load_s` and `octree_s` of that went to the volume and its octree):
 // what a user waits before a picture, a cold volume's read included.

@@ -1,5 +1,6 @@
 #include "progressive/correctness.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -140,6 +141,56 @@ double coverage_iou(const Image& a, const Image& b) {
         either += ca || cb;
     }
     return either == 0 ? 1.0 : double(both) / double(either);
+}
+
+Image box_filtered_truth(const Image& supersampled, int k) {
+    if (k < 1 || supersampled.width % k != 0 || supersampled.height % k != 0)
+        throw std::invalid_argument("box_filtered_truth: " + size_text(supersampled) +
+                                    " is not a whole number of " + std::to_string(k) + "x" +
+                                    std::to_string(k) + " boxes");
+    check_buffers(supersampled, "supersampled");
+    Image out;
+    out.resize(supersampled.width / k, supersampled.height / k);
+    const auto samples = static_cast<std::uint32_t>(k * k);
+    for (int oy = 0; oy < out.height; ++oy)
+        for (int ox = 0; ox < out.width; ++ox) {
+            std::uint32_t sum[4] = {0, 0, 0, 0}, hits = 0;
+            float nearest = 1.0f;
+            for (int y = oy * k; y < oy * k + k; ++y)
+                for (int x = ox * k; x < ox * k + k; ++x) {
+                    const std::size_t s = static_cast<std::size_t>(y) * supersampled.width + x;
+                    for (int c = 0; c < 4; ++c) sum[c] += supersampled.rgba[4 * s + c];
+                    const float d = supersampled.depth[s];
+                    hits += d < 1.0f;
+                    nearest = std::min(nearest, d);
+                }
+            const std::size_t o = static_cast<std::size_t>(oy) * out.width + ox;
+            for (int c = 0; c < 4; ++c)
+                out.rgba[4 * o + c] = static_cast<std::uint8_t>((sum[c] + samples / 2) / samples);
+            if (2 * hits >= samples) out.depth[o] = nearest;
+        }
+    return out;
+}
+
+Fidelity measure_fidelity(const Image& image, const Image& truth) {
+    Fidelity f;
+    f.c = measure_correctness(image, truth).c;
+    f.iou = coverage_iou(image, truth);
+    std::size_t covered = 0, off = 0;
+    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
+        if (truth.depth[p] >= 1.0f) continue;
+        ++covered;
+        bool far = image.depth[p] >= 1.0f;
+        for (int c = 0; c < 3 && !far; ++c)
+            far = std::abs(int(image.rgba[4 * p + c]) - int(truth.rgba[4 * p + c])) > 8;
+        off += far;
+    }
+    f.off_share = covered == 0 ? 0.0 : double(off) / double(covered);
+    return f;
+}
+
+bool passes_fidelity_gate(const Fidelity& image, const Fidelity& full) {
+    return image.c >= full.c - kFidelityC && image.iou >= full.iou - kFidelityIoU;
 }
 
 void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn) {

@@ -65,6 +65,30 @@ class CorrectnessTracker {
 // covers any. Throws std::invalid_argument as measure_correctness does.
 double coverage_iou(const Image& a, const Image& b);
 
+// What a pixel can show: the truth a final image is judged against. `supersampled` is the full
+// surface drawn at k x k samples per pixel (k times the screen's width and height, the same
+// camera); each pixel of the result is the mean colour of its k x k samples, background (black)
+// included, and is covered (depth: the nearest sample's) where at least half of its samples hit
+// the surface, else depth 1. A point-sampled picture of a surface whose normals turn within a
+// pixel is aliased; this one is not, so a coarser mesh whose shading stands for the fine one can
+// be as close to it as the full mesh drawn at one sample per pixel. Throws std::invalid_argument
+// when k < 1 or the image's sides are not multiples of k.
+Image box_filtered_truth(const Image& supersampled, int k);
+
+// A final image against the truth, beside the full surface drawn at one sample per pixel.
+struct Fidelity {
+    double c = 0;          // C = 1 - E against the truth (C_T)
+    double iou = 0;        // coverage IoU against the truth
+    double off_share = 0;  // of the truth's covered pixels, the share off by more than 8/255
+};
+Fidelity measure_fidelity(const Image& image, const Image& truth);
+
+// The fidelity gate: an image passes where it is at least as close to the truth as the full
+// surface at one sample per pixel, within kFidelityC in C_T and kFidelityIoU in coverage IoU.
+inline constexpr double kFidelityC = 0.005;
+inline constexpr double kFidelityIoU = 0.002;
+bool passes_fidelity_gate(const Fidelity& image, const Fidelity& full);
+
 // Marks in `drawn` (resized to one entry per pixel) every pixel of `frame` whose depth is below
 // 1; entries already set stay set.
 void mark_drawn(const Image& frame, std::vector<std::uint8_t>& drawn);

@@ -145,6 +145,24 @@ TEST_F(Cli, AgainstFullPrintsBothMeasures) {
     EXPECT_LT(c, c_of(full.out)) << coarse.out;
 }
 
+// --against-truth: the final image and the full surface at one sample a pixel, each against the
+// truth (4x4 samples a pixel, box-filtered), and the fidelity gate, which the defaults pass and a
+// level of detail far coarser than a pixel fails.
+TEST_F(Cli, AgainstTruthPrintsTheGate) {
+    auto fine =
+        run_isowall(dir_, "render --size 160x120 -q --no-measure --against-truth --out a.png");
+    ASSERT_EQ(fine.exit_code, 0) << fine.err;
+    EXPECT_NE(fine.out.find("at 4x4 samples a pixel, box-filtered"), std::string::npos) << fine.out;
+    EXPECT_NE(fine.out.find("full surface at 1 sample a pixel:  C_T = "), std::string::npos)
+        << fine.out;
+    EXPECT_NE(fine.out.find("fidelity gate: holds (C_T "), std::string::npos) << fine.out;
+    auto coarse = run_isowall(dir_,
+                              "render --size 160x120 -q --no-measure --against-truth --adaptive "
+                              "--adaptive-pixels 8 --no-adaptive-refine --out b.png");
+    ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
+    EXPECT_NE(coarse.out.find("fidelity gate: FAILS (C_T "), std::string::npos) << coarse.out;
+}
+
 // --against-full with the replay: a second table measures every replayed image against the full
 // surface. At full resolution the final image is the full surface's, so the two tables agree row
 // for row; a coarse level of detail never reaches 100% of the truth.

@@ -264,5 +264,65 @@ TEST(CorrectnessTracker, RefusesAFrameOfAnotherSizeAndAMalformedFinalImage) {
     EXPECT_THROW(CorrectnessTracker{short_depth}, std::invalid_argument);
 }
 
+// ---- the truth and the fidelity gate ---------------------------------------------------------
+
+TEST(Truth, EachPixelIsTheMeanOfItsSamplesBackgroundIncluded) {
+    // 4x2 samples, k = 2: the left pixel has 3 of 4 samples drawn, the right 1 of 4.
+    Image big = background(4, 2);
+    draw(big, 0, 0, 200, 100, 40);
+    draw(big, 1, 0, 200, 100, 40);
+    draw(big, 0, 1, 200, 100, 40);
+    draw(big, 3, 1, 100, 100, 100);
+    big.depth[0] = 0.25f;  // the nearest sample gives the pixel's depth
+    const Image t = box_filtered_truth(big, 2);
+    ASSERT_EQ(t.width, 2);
+    ASSERT_EQ(t.height, 1);
+    EXPECT_EQ(t.rgba[0], 150);  // (3 * 200 + 0) / 4
+    EXPECT_EQ(t.rgba[1], 75);
+    EXPECT_EQ(t.rgba[2], 30);
+    EXPECT_FLOAT_EQ(t.depth[0], 0.25f);
+    EXPECT_EQ(t.rgba[4], 25);  // 100 / 4: the colour counts, the coverage does not
+    EXPECT_FLOAT_EQ(t.depth[1], 1.0f);
+}
+
+TEST(Truth, HalfTheSamplesCoverAPixel) {
+    Image big = background(2, 2);
+    draw(big, 0, 0, 255, 255, 255);
+    EXPECT_FLOAT_EQ(box_filtered_truth(big, 2).depth[0], 1.0f);  // 1 of 4
+    draw(big, 1, 1, 255, 255, 255);
+    EXPECT_FLOAT_EQ(box_filtered_truth(big, 2).depth[0], 0.5f);  // 2 of 4
+}
+
+TEST(Truth, OneSampleIsACopyAndSidesMustDivide) {
+    const Image img = filled(3, 2, 9, 8, 7);
+    const Image t = box_filtered_truth(img, 1);
+    EXPECT_EQ(t.rgba, img.rgba);
+    EXPECT_EQ(t.depth, img.depth);
+    EXPECT_THROW(box_filtered_truth(background(5, 4), 2), std::invalid_argument);
+    EXPECT_THROW(box_filtered_truth(background(4, 4), 0), std::invalid_argument);
+}
+
+TEST(Fidelity, CountsTheTruthsPixelsOffByMoreThan8) {
+    const Image truth = filled(4, 1, 100, 100, 100);
+    Image img = truth;
+    img.rgba[0] = 108;    // 8: within
+    img.rgba[4] = 109;    // 9: off
+    img.depth[2] = 1.0f;  // not drawn: off
+    const Fidelity f = measure_fidelity(img, truth);
+    EXPECT_DOUBLE_EQ(f.off_share, 0.5);
+    EXPECT_DOUBLE_EQ(f.iou, 0.75);
+    EXPECT_LT(f.c, 1.0);
+    EXPECT_DOUBLE_EQ(measure_fidelity(truth, truth).c, 1.0);
+}
+
+TEST(Fidelity, TheGateHoldsAtItsBoundaryAndNotPastIt) {
+    const Fidelity full{0.9, 0.99, 0.1};
+    EXPECT_TRUE(passes_fidelity_gate(full, full));
+    EXPECT_TRUE(passes_fidelity_gate({0.95, 0.999, 0}, full));  // closer than the full surface
+    EXPECT_TRUE(passes_fidelity_gate({full.c - kFidelityC, full.iou - kFidelityIoU, 0}, full));
+    EXPECT_FALSE(passes_fidelity_gate({full.c - kFidelityC - 1e-6, full.iou, 0}, full));
+    EXPECT_FALSE(passes_fidelity_gate({full.c, full.iou - kFidelityIoU - 1e-6, 0}, full));
+}
+
 }  // namespace
 }  // namespace isowall
