@@ -203,6 +203,22 @@ def scaled_volume(a, scale):
     return path, out_sizes
 
 
+def truth_figures(out, what):
+    """The final image and the full surface at one sample a pixel against the truth (`render
+    --against-truth`): {"ct": C_T, "iou_t": IoU, "full_ct", "full_iou_t", "gate": bool}."""
+    res = {}
+    for key, label in (("", "final image:"), ("full_", "full surface at 1 sample a pixel:")):
+        m = re.search(r"^  " + re.escape(label) + r"\s+C_T = ([\d.]+), coverage IoU ([\d.]+)", out, re.M)
+        if not m:
+            raise BenchError(f"{what}: no '{label}' line against the truth in its output")
+        res[key + "ct"], res[key + "iou_t"] = float(m.group(1)), float(m.group(2))
+    m = re.search(r"^  fidelity gate: (holds|FAILS)", out, re.M)
+    if not m:
+        raise BenchError(f"{what}: no fidelity gate line in its output")
+    res["gate"] = m.group(1) == "holds"
+    return res
+
+
 def first_reaching(rows, th):
     return next((r for r in rows if r["final_pixels"] >= th), None)
 
@@ -211,7 +227,7 @@ def progressive(a, volume, tmp, engine):
     csv_path = os.path.join(tmp, "timeline.csv")
     out = run([a.isowall, "render", "-v", volume, "--iso", f"{a.iso:g}", "--size", a.size, "-q",
                "--out", os.path.join(tmp, "progressive.png"), "--timeline", csv_path, "--against-full",
-               *ENGINES[engine], *a.warm], f"isowall render --timeline ({engine})")
+               "--against-truth", *ENGINES[engine], *a.warm], f"isowall render --timeline ({engine})")
     with open(csv_path) as f:
         rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
     res = {}
@@ -227,6 +243,7 @@ def progressive(a, volume, tmp, engine):
                   out, re.M)
     res["c_vs_full"], res["final_px_vs_full"] = float(m.group(1)), float(m.group(2)) / 100
     res["iou_vs_full"] = float(m.group(3))
+    res.update(truth_figures(out, f"isowall render ({engine})"))
     res["engine"] = engine
     return res
 
@@ -270,11 +287,11 @@ def peer(a, volume, tmp, threads=None):
 
 
 def median_run(runs, key):
-    """The run whose `key` is the median of the runs that reached it (the lower middle one for an
-    even count), whole, with every run beside it: every contender gets the same statistic."""
-    done = sorted((r for r in runs if r.get(key) is not None), key=lambda r: r[key])
-    pick = done[(len(done) - 1) // 2] if done else runs[0]
-    return dict(pick, runs=runs)
+    """The run whose `key` is the median of every run (the lower middle one for an even count),
+    whole, with every run beside it: every contender gets the same statistic. A run that never
+    reached `key` counts as infinitely slow: it stays in the ranking, never dropped."""
+    ranked = sorted(runs, key=lambda r: math.inf if r.get(key) is None else r[key])
+    return dict(ranked[(len(ranked) - 1) // 2], runs=runs)
 
 
 def pair_rounds(a, volume, tmp, runs):
