@@ -218,7 +218,8 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         std::fflush(stdout);
     };
     if (o.warm_up) {
-        const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer);
+        const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer,
+                                         nullptr, {}, o.every_triangle);
         std::printf(
             "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
             "%.3f s\n",
@@ -226,7 +227,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     }
     const double frame_at = t.command.seconds();
     const double cpu0 = thread_cpu_seconds();
-    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress);
+    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress, o.every_triangle);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
     preload_image_io();  // OpenImageIO loads beside the report, not after it
     const TimelineSample& last = fr.timeline.back();
@@ -252,6 +253,10 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
             "past the drawing thread's levels)\n",
             caller_cpu, fr.workers.sum_s, fr.workers.beyond_s);
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
+    std::printf("drawn: %zu of the %zu triangles cover a pixel centre%s\n", fr.triangles_drawn,
+                last.triangles,
+                o.every_triangle ? " (all drawn: --draw-every-triangle)"
+                                 : "; the others change no pixel and are not drawn");
     print_first_picture(fr, frame_at, t.load, t.octree);
     if (fr.mask_level >= 0)
         std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",

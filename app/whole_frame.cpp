@@ -12,14 +12,16 @@
 namespace isowall {
 
 FrameResult draw_frame(ProgressiveEngine& engine, const FrameView& view, Renderer& renderer,
-                       const std::atomic<bool>* stop, const ProgressiveEngine::Progress& progress) {
+                       const std::atomic<bool>* stop, const ProgressiveEngine::Progress& progress,
+                       bool every_triangle) {
     static const std::atomic<bool> never{false};
-    RendererSink draw(renderer);
+    RendererSink draw(renderer, every_triangle);
     RecordingSink record;
     TeeSink both({&draw, &record});
     FrameResult frame = engine.run(view, view.screen(), FrameOutput(both, &draw, nullptr),
                                    stop ? *stop : never, progress);
     frame.groups = std::move(record.groups);
+    frame.triangles_drawn = draw.drawn_triangles();
     if (frame.completed) draw.read_back(frame.final_image);
     return frame;
 }

@@ -107,8 +107,11 @@ struct FrameResult {
     std::size_t group_count = 0;
     std::vector<Group> groups;  // every group in order (app/whole_frame.h's run only)
     std::vector<TimelineSample> timeline;
-    Image final_image;      // colour and depth after the last ray (app/whole_frame.h's run only;
-                            // empty when interrupted)
+    Image final_image;  // colour and depth after the last ray (app/whole_frame.h's run only;
+                        // empty when interrupted)
+    // Of the triangles drawn, those that cover a pixel centre (app/whole_frame.h's run only: its
+    // drawing leaves the others out, render/renderer_sink.h).
+    std::size_t triangles_drawn = 0;
     PixelRect screen_rect;  // the pixels cast: the region clipped to the volume's screen box
     std::size_t screen_pixels = 0;  // of them, the pixels to cast (the screen mask's, if on)
     // The screen mask's octree level and active nodes (-1 and 0 without the mask).

@@ -2,17 +2,30 @@
 
 #include <chrono>
 
+#include "core/sample_cull.h"
+
 namespace isowall {
 
 void RendererSink::begin(const FrameView& view) {
     view_m_ = view.camera.view();
     proj_m_ = view.frustum.matrix();
+    width_ = view.width;
+    height_ = view.height;
+    given_ = drawn_ = 0;
     renderer_.resize(view.width, view.height);
     renderer_.clear();
 }
 
 void RendererSink::add(const Group& group) {
-    renderer_.draw(group.mesh, view_m_, proj_m_);
+    given_ += group.mesh.triangle_count();
+    if (every_triangle_) {
+        drawn_ += group.mesh.triangle_count();
+        renderer_.draw(group.mesh, view_m_, proj_m_);
+        return;
+    }
+    drawn_ +=
+        keep_sampled_triangles(group.mesh, proj_m_ * view_m_, width_, height_, sampled_, remap_);
+    renderer_.draw(sampled_, view_m_, proj_m_);
 }
 
 double RendererSink::present() {

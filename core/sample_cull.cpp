@@ -1,0 +1,92 @@
+#include "core/sample_cull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace isowall {
+namespace {
+
+constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
+
+// The pixels (i, i in [0, n)) whose centres i + 0.5 lie in [lo, hi], widened by the margin:
+// first > last when none.
+struct Span {
+    float first, last;
+};
+Span centres_in(float lo, float hi, int n) {
+    return {std::max(std::ceil(lo - kSampleCullMarginPx - 0.5f), 0.0f),
+            std::min(std::floor(hi + kSampleCullMarginPx - 0.5f), float(n - 1))};
+}
+
+// A triangle whose box holds at most this many centres has each tested against its edges; a
+// larger one is kept (it covers one surely enough, and testing would cost more than drawing).
+constexpr float kCentresTested = 4;
+
+// Whether the point lies inside the triangle (a, b, c) or within the margin of it; `area2` is
+// twice its signed area (non-zero).
+bool near_inside(glm::vec2 p, glm::vec2 a, glm::vec2 b, glm::vec2 c, float area2) {
+    const glm::vec2 v[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+        const glm::vec2 e = v[(k + 1) % 3] - v[k], d = p - v[k];
+        // The point's distance inside the edge's line (positive inside), against the margin.
+        const float cross = (e.x * d.y - e.y * d.x) * (area2 > 0 ? 1.0f : -1.0f);
+        if (cross < -kSampleCullMarginPx * std::sqrt(e.x * e.x + e.y * e.y)) return false;
+    }
+    return true;
+}
+
+// Whether the triangle may cover the centre of a pixel of a width x height frame.
+bool covers_a_centre(glm::vec2 a, glm::vec2 b, glm::vec2 c, int width, int height) {
+    const Span x = centres_in(std::min({a.x, b.x, c.x}), std::max({a.x, b.x, c.x}), width);
+    const Span y = centres_in(std::min({a.y, b.y, c.y}), std::max({a.y, b.y, c.y}), height);
+    if (x.first > x.last || y.first > y.last) return false;
+    const float area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    if ((x.last - x.first + 1) * (y.last - y.first + 1) > kCentresTested || area2 == 0) return true;
+    for (float j = y.first; j <= y.last; ++j)
+        for (float i = x.first; i <= x.last; ++i)
+            if (near_inside({i + 0.5f, j + 0.5f}, a, b, c, area2)) return true;
+    return false;
+}
+
+}  // namespace
+
+std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
+                                   Mesh& out, std::vector<std::uint32_t>& remap) {
+    out.positions.clear();
+    out.normals.clear();
+    out.indices.clear();
+    // Window coordinates of every vertex; w <= 0 (at or behind the eye's plane) marks "keep".
+    std::vector<glm::vec3> window(mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const glm::vec4 c = clip * glm::vec4(mesh.positions[v], 1.0f);
+        window[v] = c.w > 0 ? glm::vec3((c.x / c.w + 1.0f) * 0.5f * float(width),
+                                        (c.y / c.w + 1.0f) * 0.5f * float(height), 1.0f)
+                            : glm::vec3(0.0f);
+    }
+    remap.assign(mesh.positions.size(), kUnused);
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        const glm::vec3 a = window[mesh.indices[t]], b = window[mesh.indices[t + 1]],
+                        c = window[mesh.indices[t + 2]];
+        const bool clipped = a.z == 0 || b.z == 0 || c.z == 0;
+        const bool finite = std::isfinite(a.x + a.y + b.x + b.y + c.x + c.y);
+        if (!clipped && finite &&
+            !covers_a_centre(glm::vec2(a), glm::vec2(b), glm::vec2(c), width, height))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = mesh.indices[t + std::size_t(k)];
+            if (remap[v] == kUnused) {
+                remap[v] = static_cast<std::uint32_t>(out.positions.size());
+                out.positions.push_back(mesh.positions[v]);
+                out.normals.push_back(mesh.normals[v]);
+            }
+            out.indices.push_back(remap[v]);
+        }
+    }
+    return out.triangle_count();
+}
+
+}  // namespace isowall

@@ -1,0 +1,29 @@
+#pragma once
+// Triangles that cannot show. Drawn at one sample a pixel, a triangle writes a fragment only where
+// it covers a pixel's centre; once cells project to less than a pixel most of a fine surface's
+// triangles cover none (at 4x a side on the CT head, about four in five), yet each is uploaded,
+// transformed and set up by the rasteriser. Leaving them out leaves the frame exactly as it was:
+// same colours, same depths.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+
+#include "core/mesh.h"
+
+namespace isowall {
+
+// Of `mesh`, the triangles that may cover the centre of a pixel of a width x height frame under
+// `clip` (the projection times the view): the centre inside the projected triangle or within
+// kSampleCullMarginPx of it (for the rasteriser's rounding), tested where the triangle's box holds
+// a few centres; a triangle whose box holds more is kept. Into `out` with only the vertices they
+// use
+// (`remap` is scratch space, kept between calls to save allocations). A triangle with a vertex at
+// or behind the eye's plane, or not finite, is kept: the rasteriser clips it. Returns the
+// triangles kept.
+inline constexpr float kSampleCullMarginPx = 1.0f / 64.0f;
+std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
+                                   Mesh& out, std::vector<std::uint32_t>& remap);
+
+}  // namespace isowall
