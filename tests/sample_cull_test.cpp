@@ -46,7 +46,8 @@ TEST(SampleCull, ATriangleBetweenCentresIsLeftOut) {
 TEST(SampleCull, ACentreInTheBoxButOutsideTheTriangleLeavesItOut) {
     // The box [2, 3] x [2, 2.6] holds the centre (2.5, 2.5); the triangle passes under it.
     EXPECT_EQ(kept(one_triangle({2.0f, 2.0f, 0}, {3.0f, 2.6f, 0}, {3.0f, 2.2f, 0})), 0u);
-    EXPECT_EQ(kept(one_triangle({2.0f, 2.0f, 0}, {3.0f, 2.2f, 0}, {3.0f, 2.6f, 0})), 0u);  // wound back
+    EXPECT_EQ(kept(one_triangle({2.0f, 2.0f, 0}, {3.0f, 2.2f, 0}, {3.0f, 2.6f, 0})),
+              0u);  // wound back
     // The same triangle a little higher covers it.
     EXPECT_EQ(kept(one_triangle({2.0f, 2.4f, 0}, {3.0f, 3.0f, 0}, {3.0f, 2.4f, 0})), 1u);
 }
