@@ -219,7 +219,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     };
     if (o.warm_up) {
         const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer,
-                                         nullptr, {}, o.every_triangle);
+                                         nullptr, {}, o.engine.every_triangle);
         std::printf(
             "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
             "%.3f s\n",
@@ -227,7 +227,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     }
     const double frame_at = t.command.seconds();
     const double cpu0 = thread_cpu_seconds();
-    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress, o.every_triangle);
+    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress, o.engine.every_triangle);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
     preload_image_io();  // OpenImageIO loads beside the report, not after it
     const TimelineSample& last = fr.timeline.back();
@@ -255,8 +255,8 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
     std::printf("drawn: %zu of the %zu triangles cover a pixel centre%s\n", fr.triangles_drawn,
                 last.triangles,
-                o.every_triangle ? " (all drawn: --draw-every-triangle)"
-                                 : "; the others change no pixel and are not drawn");
+                o.engine.every_triangle ? " (all made and drawn: --every-triangle)"
+                                        : "; the others change no pixel and are not drawn");
     print_first_picture(fr, frame_at, t.load, t.octree);
     if (fr.mask_level >= 0)
         std::printf("screen mask: %zu active nodes of octree level %d, %zu pixels to cast\n",

@@ -37,11 +37,10 @@ struct RenderOptions {
     std::string snapshot_measure = "final";  // "final" (share of final pixels) or "c" (1 - E)
     std::vector<std::size_t> snapshot_rays;
     bool no_measure = false;
-    bool against_full = false;    // also measure the final image against the full surface's
-    bool against_truth = false;   // and against the truth, with the fidelity gate (--against-truth)
-    bool warm_up = false;         // one untimed frame first (a running wall's steady state)
-    bool every_triangle = false;  // draw also the triangles that cover no pixel centre
-    int threads = 0;              // the engine's threads (and the octree build's); 0: every core
+    bool against_full = false;   // also measure the final image against the full surface's
+    bool against_truth = false;  // and against the truth, with the fidelity gate (--against-truth)
+    bool warm_up = false;        // one untimed frame first (a running wall's steady state)
+    int threads = 0;             // the engine's threads (and the octree build's); 0: every core
     bool quiet = false;
 };
 

@@ -80,9 +80,6 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
         "the final image and for the full surface at one sample per pixel, and whether the final "
         "image passes the fidelity gate (C_T within 0.005 and IoU within 0.002 of the full "
         "surface's, or better)");
-    re_cmd->add_flag("--draw-every-triangle", re.every_triangle,
-                     "Draw every triangle the engine extracts, also those that cover no pixel "
-                     "centre (which change no pixel): for studies of what leaving them out saves");
     re_cmd->add_flag("--warm-up", re.warm_up,
                      "First draw one untimed frame (of the view turned 30 degrees; with --full, "
                      "the same full surface), so the timed frame finds the process warm as a "

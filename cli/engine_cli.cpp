@@ -47,6 +47,10 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
     app.add_flag("--no-screen-mask", e.no_screen_mask,
                  "Cast every ray of the volume's projected box, also where no active octree node "
                  "projects (the box alone, to measure what the mask saves)");
+    app.add_flag("--every-triangle", e.every_triangle,
+                 "Make and draw every triangle of the surface the engine visits, also those that "
+                 "cover no pixel centre (which change no pixel; by default they are neither made "
+                 "nor drawn): for studies of what leaving them out saves");
     app.add_flag("--no-frontier-seeds", e.no_frontier_seeds,
                  "Do not seed, before the ray order's fill level, the units full propagation "
                  "passes left out and the cells beside missed hits whose pixels still show "
@@ -99,6 +103,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.screen_box = !c.no_screen_box;
     e.screen_mask = !c.no_screen_mask;
     e.frontier_seeds = !c.no_frontier_seeds;
+    e.sampled_triangles = !c.every_triangle;
     e.adaptive = c.adaptive;
     e.adaptive_max_level = c.adaptive_max_level;
     e.adaptive_pixels = c.adaptive_pixels;

@@ -28,6 +28,7 @@ struct EngineCli {
     bool no_adaptive_refine = false;
     std::optional<float> adaptive_error;  // the error rule's bound; none: the size rule alone
     bool facing_only = false;
+    bool every_triangle = !EngineOptions{}.sampled_triangles;
 };
 
 // `serve`'s max count: a default chosen, like the engine's, over several volumes by the smallest

@@ -54,6 +54,11 @@ bool covers_a_centre(glm::vec2 a, glm::vec2 b, glm::vec2 c, int width, int heigh
 
 }  // namespace
 
+bool box_holds_a_centre(float x0, float x1, float y0, float y1, int width, int height) {
+    const Span x = centres_in(x0, x1, width), y = centres_in(y0, y1, height);
+    return x.first <= x.last && y.first <= y.last;
+}
+
 std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
                                    Mesh& out, std::vector<std::uint32_t>& remap) {
     out.positions.clear();

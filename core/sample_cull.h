@@ -23,6 +23,11 @@ namespace isowall {
 // or behind the eye's plane, or not finite, is kept: the rasteriser clips it. Returns the
 // triangles kept.
 inline constexpr float kSampleCullMarginPx = 1.0f / 64.0f;
+
+// Whether the window-space box [x0, x1] x [y0, y1] holds the centre of a pixel of a width x height
+// frame (widened by kSampleCullMarginPx).
+bool box_holds_a_centre(float x0, float x1, float y0, float y1, int width, int height);
+
 std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
                                    Mesh& out, std::vector<std::uint32_t>& remap);
 

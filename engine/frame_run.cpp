@@ -38,6 +38,9 @@ bool FrameRun::cast(const FrameView& view, RegionCursor& c, const FrameOutput& o
     params_ = opt_.propagation;
     params_.keep_frontier = opt_.frontier_seeds && shown_ != nullptr;
     if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
+    refine_params_ = opt_.propagation;
+    if (opt_.sampled_triangles)
+        params_.samples = refine_params_.samples = sample_grid(view, ex_.volume().spacing());
     // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
     // c.rays, so a region's second band would cast nothing.
     const std::size_t limit = ray_limit > SIZE_MAX - c.rays ? SIZE_MAX : c.rays + ray_limit;
@@ -179,7 +182,7 @@ bool FrameRun::cast_level_parallel(int n, IntersectMode mode, bool second_pass, 
     const std::size_t rays_before = now_.rays;
     bool begun = false;
     LevelJob job{ex_,  pixels_, {rect_.x, rect_.y}, *view_,       view_inv_,
-                 mode, params_, opt_.propagation,   interrupted_, opt_.first_group_id + ids_used_,
+                 mode, params_, refine_params_,     interrupted_, opt_.first_group_id + ids_used_,
                  seeds};
     job.want_seen = seen_ != nullptr;
     const double own0 = thread_cpu_seconds();

@@ -120,10 +120,11 @@ class FrameRun {
     TimelineSample now_;
     Clock::time_point start_;
     glm::mat4 view_m_{1.0f}, view_inv_{1.0f};
-    ActiveBoxes active_;              // the screen mask's nodes at this frame's isovalue
-    PixelRect rect_;                  // the region being cast
-    RegionCursor* cursor_ = nullptr;  // its cursor
-    PropagationParams params_;        // the options, with the clip of the region being cast
+    ActiveBoxes active_;               // the screen mask's nodes at this frame's isovalue
+    PixelRect rect_;                   // the region being cast
+    RegionCursor* cursor_ = nullptr;   // its cursor
+    PropagationParams params_;         // the options, with the clip of the region being cast
+    PropagationParams refine_params_;  // the options, with the frame's sample grid
     std::vector<std::size_t> extra_;
     std::size_t next_extra_ = 0, next_sample_rays_ = 1;
     // The first progress report comes at the first ray: a wall master then knows the frame began.

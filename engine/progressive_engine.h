@@ -41,6 +41,11 @@ struct EngineOptions {
     // a wall tile or job extracts no surface its region cannot show. Off: passes run over the
     // whole surface within their limits, as in the text.
     bool region_clip = false;
+    // Triangles only where they may show: a unit whose projection holds no pixel centre of the
+    // frame is propagated through but not triangulated (extract/propagator.h SampleGrid), as no
+    // triangle of it would write a fragment. The frame is the same; off, groups hold every
+    // triangle, for a viewer that draws them in other views (a remote server's group cache).
+    bool sampled_triangles = true;
     // Frontier seeds: a propagation pass that fills its max count (count mode) stops short of
     // the surface beyond it, which then waits for the rays of its own pixels; at the screen's
     // fill level (the last, with most of the rays) those are the slivers between passes'

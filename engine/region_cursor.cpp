@@ -96,6 +96,16 @@ ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 s
     return clip;
 }
 
+SampleGrid sample_grid(const FrameView& view, glm::vec3 spacing) {
+    SampleGrid g;
+    g.active = view.width > 0 && view.height > 0;
+    g.clip_from_voxel =
+        view.frustum.matrix() * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
+    g.width = view.width;
+    g.height = view.height;
+    return g;
+}
+
 ActiveBoxes screen_mask_nodes(const SurfaceExtractor& ex, double iso,
                               const ResolutionLevels& levels) {
     // The screen mask's node budget: the finest octree level with at most this many active nodes.

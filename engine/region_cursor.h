@@ -28,6 +28,9 @@ struct EngineOptions;
 // The clip of `rect` of `view` for propagation (EngineOptions::region_clip): the region's own
 // frustum, from the voxel space of a volume of `spacing`; inactive for an empty rect.
 ScreenClip region_clip(const FrameView& view, const PixelRect& rect, glm::vec3 spacing);
+// The pixel centres of the whole frame of `view`, for propagation (EngineOptions::
+// sampled_triangles).
+SampleGrid sample_grid(const FrameView& view, glm::vec3 spacing);
 
 // A region's place in its progressive ray order, kept between the calls that cast it (the coarse
 // and the fine band of a wall job).

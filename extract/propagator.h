@@ -20,12 +20,14 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
+#include "core/sample_cull.h"
 #include "extract/adaptive.h"
 #include "extract/group.h"
 #include "extract/marching_cubes.h"
@@ -54,6 +56,46 @@ struct ScreenClip {
     }
 };
 
+// The pixel centres of the frame a pass's triangles are drawn into (the whole frame's, not a
+// region's). Drawn at one sample a pixel a triangle writes a fragment only where it covers a pixel
+// centre, and a unit's triangles lie inside the unit, so a unit whose projected box holds no centre
+// has no triangle that could show: it is visited and propagated through, but not triangulated.
+// Where cells are smaller than a pixel this is most of them. Only units wholly inside the frame
+// are judged: the visited cells of one frame also serve other frames of the same virtual screen
+// (a wall rank's jobs for other tiles), whose pixel centres continue this frame's grid outside it.
+// Inactive: every unit is triangulated (groups kept for other views, as a remote server's cache
+// keeps them).
+struct SampleGrid {
+    bool active = false;
+    glm::mat4 clip_from_voxel{1.0f};  // projection * view * voxel-to-object
+    int width = 0, height = 0;
+
+    bool may_cover_a_centre(glm::ivec3 base, int stride) const {
+        // The eight corners in clip space: the base corner plus the matrix's columns per axis.
+        const glm::vec4 c0 = clip_from_voxel * glm::vec4(glm::vec3(base), 1.0f);
+        const glm::vec4 step[3] = {clip_from_voxel[0] * float(stride),
+                                   clip_from_voxel[1] * float(stride),
+                                   clip_from_voxel[2] * float(stride)};
+        float x0 = std::numeric_limits<float>::max(), x1 = -x0, y0 = x0, y1 = -x0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::vec4 c = c0 + ((k & 1) ? step[0] : glm::vec4(0)) +
+                                ((k & 2) ? step[1] : glm::vec4(0)) +
+                                ((k & 4) ? step[2] : glm::vec4(0));
+            if (!(c.w > 1e-6f)) return true;  // at or behind the eye, or not finite: no bound
+            const float x = (c.x / c.w + 1.0f) * 0.5f * float(width);
+            const float y = (c.y / c.w + 1.0f) * 0.5f * float(height);
+            x0 = std::min(x0, x);
+            x1 = std::max(x1, x);
+            y0 = std::min(y0, y);
+            y1 = std::max(y1, y);
+        }
+        // A unit reaching past the frame may hold centres of a neighbouring frame (a wall's other
+        // tiles, which the same visited cells serve): only a unit wholly inside is judged.
+        if (x0 < 0 || y0 < 0 || x1 > float(width) || y1 > float(height)) return true;
+        return box_holds_a_centre(x0, x1, y0, y1, width, height);
+    }
+};
+
 inline constexpr float kRadiansPerDegree = 3.14159265358979f / 180.0f;
 
 struct PropagationParams {
@@ -77,7 +119,8 @@ struct PropagationParams {
     // (Group::frontier), so the engine can go on from those its picture still misses
     // (engine/beside_seeds.h).
     bool keep_frontier = false;
-    ScreenClip clip;  // inactive: no limit on screen
+    ScreenClip clip;     // inactive: no limit on screen
+    SampleGrid samples;  // inactive: every unit triangulated
 };
 
 // The most frontier units one pass lists: a pass of max_count units has a rim of a few times
@@ -189,7 +232,9 @@ class Propagator {
             const auto t0 =
                 timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
             double corner[8];
-            const int cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner);
+            const bool shows =
+                !p.samples.active || p.samples.may_cover_a_centre(item.cell, 1 << item.level);
+            const int cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner, shows);
             if (timed) {
                 timed_s +=
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -245,7 +290,9 @@ class Propagator {
         for (int z = 0; z < s; ++z)
             for (int y = 0; y < s; ++y)
                 for (int x = 0; x < s; ++x)
-                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh, corner);
+                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh, corner,
+                                !p.samples.active ||
+                                    p.samples.may_cover_a_centre(base + glm::ivec3(x, y, z), 1));
         extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return g;
     }
@@ -258,11 +305,13 @@ class Propagator {
   private:
     static constexpr std::size_t kTimedEvery = 16;
 
-    // Triangulates the unit of `level` at `c` (a cell at level 0) and returns its case.
+    // Triangulates the unit of `level` at `c` (a cell at level 0), unless not `emit`, and returns
+    // its case.
     int triangulate(glm::ivec3 c, int level, double iso, const PropagationParams& p, Mesh& mesh,
-                    double corner[8]) {
+                    double corner[8], bool emit = true) {
         meta_cell_corners(v_, c, level, corner);
         const int cs = cell_case(corner, iso);
+        if (!emit) return cs;
         if (p.interpolant_cache) {
             emit_meta_cell(v_, c, level, iso, cs, corner, cache_, mesh);
         } else {

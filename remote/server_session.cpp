@@ -244,6 +244,9 @@ bool ServerSession::cast_level(int l, const RequestMsg& r, bool keep, const std:
     EngineOptions eo = options_.engine;
     eo.uniform_level = l;
     eo.adaptive = false;
+    // The client keeps groups for later views (cached groups): they hold every triangle, not
+    // only those that cover a pixel centre of this view.
+    eo.sampled_triangles = false;
     eo.begin_extractor_frame = false;  // begin_cached began it, with the cached cells taken
     eo.first_group_id = static_cast<std::uint32_t>(lv.sent.size());
     eo.trace = nullptr;

@@ -245,8 +245,11 @@ void expect_groups_partition_the_visited_cells(SurfaceExtractor& ex, const Volum
     EXPECT_EQ(covered, ex.visited_count());
 }
 
-// One frame with `opt`, measured against the full surface at full resolution.
-Figures run_frame(const Volume& volume, const FrameView& fv, const EngineOptions& opt) {
+// One frame with `opt`, measured against the full surface at full resolution. The triangles are
+// counted as the level of detail makes them: every triangle (by default units whose projection
+// holds no pixel centre are not triangulated, at any level, which is not what these tests count).
+Figures run_frame(const Volume& volume, const FrameView& fv, EngineOptions opt) {
+    opt.sampled_triangles = false;
     auto ex = make_surface_extractor(volume);
     auto renderer = make_renderer("osmesa");
     const FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);

@@ -29,6 +29,7 @@ TEST(CliEngineDefaults, AreTheEnginesOwn) {
     EXPECT_EQ(cli.adaptive_max_level, engine.adaptive_max_level);
     EXPECT_EQ(cli.adaptive_pixels, engine.adaptive_pixels);
     EXPECT_EQ(cli.adaptive_refine, engine.adaptive_refine);
+    EXPECT_EQ(cli.sampled_triangles, engine.sampled_triangles);
     EXPECT_EQ(std::isinf(cli.adaptive_error_px), std::isinf(engine.adaptive_error_px));
 }
 

@@ -7,7 +7,10 @@
 #include <sstream>
 #include <unordered_set>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "extract/group.h"
+#include "extract/propagator.h"
 #include "extract/surface_extractor.h"
 #include "volume/phantom.h"
 
@@ -142,6 +145,23 @@ TEST(ThreadBudget, OctreeIsTheSameOnAnyNumberOfThreads) {
         EXPECT_TRUE(std::equal(one.nodes().begin(), one.nodes().end(), many.nodes().begin()))
             << ThreadBudget{t};
     }
+}
+
+// Which units a pass triangulates (SampleGrid): those whose projected box holds a pixel centre,
+// and every unit that reaches past the frame (another frame of the screen may need it).
+TEST(SampleGrid, JudgesOnlyUnitsInsideTheFrameByTheirCentres) {
+    SampleGrid g;
+    g.active = true;
+    g.width = g.height = 10;
+    // Voxel (x, y) maps to window (x, y) / 4: a cell is a quarter of a pixel.
+    g.clip_from_voxel = glm::ortho(0.0f, 40.0f, 0.0f, 40.0f, -100.0f, 100.0f);
+    EXPECT_TRUE(g.may_cover_a_centre({9, 9, 0}, 1));     // [2.25, 2.5]: holds 2.5
+    EXPECT_FALSE(g.may_cover_a_centre({11, 11, 0}, 1));  // [2.75, 3]: no centre
+    EXPECT_TRUE(g.may_cover_a_centre({8, 8, 0}, 4));     // a meta-cell of 4: [2, 3]
+    EXPECT_FALSE(g.may_cover_a_centre({39, 21, 0}, 1));  // [9.75, 10] x [5.25, 5.5]: judged
+    EXPECT_TRUE(g.may_cover_a_centre({39, 21, 0}, 2));   // [9.75, 10.25]: reaches past
+    EXPECT_TRUE(g.may_cover_a_centre({40, 20, 0}, 1));   // past the frame
+    EXPECT_TRUE(g.may_cover_a_centre({-1, 20, 0}, 1));
 }
 
 }  // namespace
