@@ -130,6 +130,8 @@ def render(a, volume, iso, tmp):
     res.update(full_triangles=int(m.group(1)), covered_px=int(m.group(2)), c_vs_full=float(m.group(3)),
                final_px_vs_full=float(m.group(4)) / 100, iou_vs_full=float(m.group(5)))
     res.update(bs.truth_figures(out, f"isowall render {volume}"))
+    m = re.search(r"^drawn: (\d+) of the (\d+) triangles", out, re.M)
+    res["drawn"] = int(m.group(1)) if m else None  # the whole frame's, hidden ones included
     m = re.search(r"^progressive: .* in ([\d.]+) s: \d+ groups, (\d+) triangles", out, re.M)
     res["every_ray_s"], res["triangles"] = float(m.group(1)), int(m.group(2))
     return res

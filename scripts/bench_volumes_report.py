@@ -39,6 +39,14 @@ def tris_per_px(case):
     return e["own"]["tris_c99"] / e["covered_px"]
 
 
+def drawn_per_px(case):
+    """Triangles drawn over the whole final frame per covered pixel (those that cover a centre)."""
+    e = case.get("engine")
+    if not e or e.get("drawn") is None or not e["covered_px"]:
+        return None
+    return e["drawn"] / e["covered_px"]
+
+
 def peer_ratio(case):
     t, p = c99(case), case.get("peer", {}).get("total_s")
     return t / p if t is not None and p else None
@@ -74,7 +82,10 @@ def verdicts(cases):
             a, b = c99(one), c99(top)
             growth = math.inf if math.inf in (a, b) else b / a
         at4 = top is not None and top["scale"] == 4
-        worst_tris = max((t for t in map(tris_per_px, ran) if t is not None), default=None)
+        # Drawn per pixel over the whole frame bounds those drawn by C = 99% from above; runs
+        # saved before it was printed are judged on the triangles made by then.
+        per_px = [drawn_per_px(c) if drawn_per_px(c) is not None else tris_per_px(c) for c in ran]
+        worst_tris = max((t for t in per_px if t is not None), default=None)
         margins = [(c["engine"]["ct"] - c["engine"]["full_ct"], c) for c in ran]
         r = {"volume": name, "iso": iso, "top_scale": top["scale"] if top else None,
              "gate_holds": gate_all, "growth": growth,
@@ -98,10 +109,10 @@ def word(holds):
 def volume_table(cs):
     lines = ["| scale | voxels | C=99% own s | every ray s | C=99% vs full s | C_T final / full | "
              "IoU_T final / full | gate | C vs full | triangles by C=99% | per covered px | "
-             "FE+Embree s | C=99% / peer |", "|" + "---|" * 13]
+             "drawn / px (frame) | FE+Embree s | C=99% / peer |", "|" + "---|" * 14]
     for c in cs:
         if "skipped" in c:
-            lines.append(f"| {c['scale']:g}x | {c['voxels'] / 1e6:.0f} M | skipped: {c['skipped']} |" + " |" * 10)
+            lines.append(f"| {c['scale']:g}x | {c['voxels'] / 1e6:.0f} M | skipped: {c['skipped']} |" + " |" * 11)
             continue
         e = c["engine"]
         lines.append(
@@ -109,7 +120,7 @@ def volume_table(cs):
             f"{fmt(e['truth']['c99'])} | {e['ct']:.5f} / {e['full_ct']:.5f} | "
             f"{e['iou_t']:.5f} / {e['full_iou_t']:.5f} | {'holds' if e['gate'] else 'FAILS'} | "
             f"{e['c_vs_full']:.5f} | {e['own'].get('tris_c99') or '-'} | {fmt(tris_per_px(c), 2)} | "
-            f"{fmt(c.get('peer', {}).get('total_s'))} | {fmt(peer_ratio(c))} |")
+            f"{fmt(drawn_per_px(c), 2)} | {fmt(c.get('peer', {}).get('total_s'))} | {fmt(peer_ratio(c))} |")
     return "\n".join(lines)
 
 
@@ -129,7 +140,7 @@ def report(meta, cases):
     out += ["## Targets", "",
             f"| volume | iso | fidelity gate, every scale | worst C_T - full C_T | growth of C=99%, 1x to "
             f"largest | {GROWTH_LIMIT}x ({GROWTH_RESOLVED}x to resolve) | C=99% / peer at 4x | 1/20 | "
-            f"worst triangles per px | <= {TRIS_PER_PX_LIMIT:g} | skipped |", "|" + "---|" * 11]
+            f"worst triangles drawn per px | <= {TRIS_PER_PX_LIMIT:g} | skipped |", "|" + "---|" * 11]
     for r in rows:
         g = "-" if r["growth"] is None else (
             "missed" if r["growth"] == math.inf else f"{r['growth']:.2f}x (to {r['top_scale']:g}x)")
@@ -147,7 +158,7 @@ def report(meta, cases):
     for key, pick, what in (("growth", max, "growth of C = 99% of the own final image"),
                             ("worst_ct_margin", min, "final C_T less the full surface's"),
                             ("peer_ratio_4x", max, "C = 99% over FE + Embree at 4x"),
-                            ("tris_per_px", max, "triangles by C = 99% per covered pixel")):
+                            ("tris_per_px", max, "triangles drawn per covered pixel (made, in older runs)")):
         r = worst(key, pick)
         out.append(f"- {what}: " + ("not measured" if r is None else
                                     f"{r[key]:.4g} ({r['volume']}, iso {r['iso']:g})"))

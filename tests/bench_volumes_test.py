@@ -96,6 +96,16 @@ class Verdicts(unittest.TestCase):
         runs = [{"own": {"c99": 0.3}}, {"own": {"c99": 0.1}}, {"own": {"c99": None}}]
         self.assertEqual(bench_volumes.median_by_own_c99(runs)["own"]["c99"], 0.3)
 
+    def test_triangles_are_judged_drawn_where_the_run_printed_them(self):
+        made_only = case(1, 0.1, tris=3000)
+        (v,) = report.verdicts([made_only])
+        self.assertFalse(v["tris_holds"])  # 3 made per pixel
+        drawn = case(1, 0.1, tris=3000)
+        drawn["engine"]["drawn"] = 1500
+        (w,) = report.verdicts([drawn])
+        self.assertAlmostEqual(w["tris_per_px"], 1.5)
+        self.assertTrue(w["tris_holds"])
+
     def test_without_4x_growth_is_printed_not_judged(self):
         (h,) = report.verdicts([case(1, 0.1), case(2, 0.3)])
         self.assertAlmostEqual(h["growth"], 3.0)
