@@ -218,8 +218,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
         std::fflush(stdout);
     };
     if (o.warm_up) {
-        const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer,
-                                         nullptr, {}, o.engine.every_triangle);
+        const FrameResult w = draw_frame(engine, warm_up_view(fv, ex.volume().bounds()), renderer);
         std::printf(
             "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
             "%.3f s\n",
@@ -227,7 +226,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     }
     const double frame_at = t.command.seconds();
     const double cpu0 = thread_cpu_seconds();
-    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress, o.engine.every_triangle);
+    FrameResult fr = draw_frame(engine, fv, renderer, nullptr, progress);
     const double caller_cpu = thread_cpu_seconds() - cpu0;
     preload_image_io();  // OpenImageIO loads beside the report, not after it
     const TimelineSample& last = fr.timeline.back();

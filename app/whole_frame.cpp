@@ -12,10 +12,9 @@
 namespace isowall {
 
 FrameResult draw_frame(ProgressiveEngine& engine, const FrameView& view, Renderer& renderer,
-                       const std::atomic<bool>* stop, const ProgressiveEngine::Progress& progress,
-                       bool every_triangle) {
+                       const std::atomic<bool>* stop, const ProgressiveEngine::Progress& progress) {
     static const std::atomic<bool> never{false};
-    RendererSink draw(renderer, every_triangle);
+    RendererSink draw(renderer, !engine.options().sampled_triangles);
     RecordingSink record;
     TeeSink both({&draw, &record});
     FrameResult frame = engine.run(view, view.screen(), FrameOutput(both, &draw, nullptr),

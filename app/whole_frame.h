@@ -15,18 +15,16 @@ namespace isowall {
 
 // The whole screen of `view` drawn into `renderer` (warmed up beforehand: render/renderer.h
 // warm_up), keeping every group and, when the frame completed, the final image in the result.
-// Triangles that cover no pixel centre are not drawn (they change no pixel) unless
-// `every_triangle`.
+// Triangles that cover no pixel centre are not drawn (they change no pixel) unless the engine
+// makes every triangle (EngineOptions::sampled_triangles off).
 FrameResult draw_frame(ProgressiveEngine& engine, const FrameView& view, Renderer& renderer,
                        const std::atomic<bool>* stop = nullptr,
-                       const ProgressiveEngine::Progress& progress = {},
-                       bool every_triangle = false);
+                       const ProgressiveEngine::Progress& progress = {});
 // The same with an engine made for this one frame.
 inline FrameResult draw_frame(ProgressiveEngine&& engine, const FrameView& view, Renderer& renderer,
                               const std::atomic<bool>* stop = nullptr,
-                              const ProgressiveEngine::Progress& progress = {},
-                              bool every_triangle = false) {
-    return draw_frame(engine, view, renderer, stop, progress, every_triangle);
+                              const ProgressiveEngine::Progress& progress = {}) {
+    return draw_frame(engine, view, renderer, stop, progress);
 }
 
 // Replays the frame's groups in order and measures both correctness measures of the image at

@@ -64,7 +64,10 @@ bool TileJobs::shows(const Box3& bounds, const FrameView& view) {
 }
 
 TileJobs::TileJobs(ProgressiveEngine& engine, Renderer& tile, Renderer& help, bool measure)
-    : engine_(engine), tile_sink_(tile), help_sink_(help), measure_(measure) {
+    : engine_(engine),
+      tile_sink_(tile, !engine.options().sampled_triangles),
+      help_sink_(help, !engine.options().sampled_triangles),
+      measure_(measure) {
     warm_up(tile);
     warm_up(help);
 }
