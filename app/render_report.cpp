@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "app/whole_frame.h"
 #include "core/util.h"
 #include "progressive/correctness.h"
 #include "progressive/timeline.h"
@@ -102,14 +103,11 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
     return full;
 }
 
-bool print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image) {
     Stopwatch sw;
     const Mesh mesh = ex.extract_full(fv.iso);
-    FrameView big = fv;
-    big.width *= kTruthSamples;
-    big.height *= kTruthSamples;
-    const Image truth = box_filtered_truth(draw_alone(renderer, mesh, big), kTruthSamples);
+    const Image truth = draw_truth(renderer, mesh, fv);
     const Fidelity full = measure_fidelity(draw_alone(renderer, mesh, fv), truth);
     const Fidelity own = measure_fidelity(final_image, truth);
     const bool holds = passes_fidelity_gate(own, full);
@@ -127,7 +125,6 @@ bool print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const F
     std::printf("  fidelity gate: %s (C_T %.5f %s %.5f, IoU %.5f %s %.5f)\n",
                 holds ? "holds" : "FAILS", own.c, own.c >= c_bar ? ">=" : "<", c_bar, own.iou,
                 own.iou >= iou_bar ? ">=" : "<", iou_bar);
-    return holds;
 }
 
 void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s) {

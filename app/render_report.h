@@ -42,11 +42,9 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image);
 
-// The final image against the truth (progressive/correctness.h: the full surface at
-// kTruthSamples x kTruthSamples samples per pixel, box-filtered), beside the full surface at one
-// sample per pixel, and the fidelity gate; outside the timings. Returns whether the gate holds.
-inline constexpr int kTruthSamples = 4;
-bool print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
+// The final image against the truth (app/whole_frame.h draw_truth), beside the full surface at one
+// sample per pixel, and the fidelity gate; outside the timings.
+void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image);
 
 // When the frame's first group showed, counted from the command's start (the frame began

@@ -25,6 +25,13 @@ FrameResult draw_frame(ProgressiveEngine& engine, const FrameView& view, Rendere
     return frame;
 }
 
+Image draw_truth(Renderer& renderer, const Mesh& mesh, const FrameView& view) {
+    FrameView big = view;
+    big.width *= kTruthSamples;
+    big.height *= kTruthSamples;
+    return box_filtered_truth(draw_alone(renderer, mesh, big), kTruthSamples);
+}
+
 void measure_frame(FrameResult& frame, const FrameView& view, Renderer& renderer,
                    const std::function<void(const TimelineSample&, const Image&)>& on_image) {
     if (frame.final_image.pixel_count() == 0) return;

@@ -27,6 +27,10 @@ inline FrameResult draw_frame(ProgressiveEngine&& engine, const FrameView& view,
     return draw_frame(engine, view, renderer, stop, progress);
 }
 
+// The truth a final image is judged against: `mesh` drawn alone at kTruthSamples x kTruthSamples
+// samples a pixel (progressive/correctness.h) and box-filtered to `view`'s size.
+Image draw_truth(Renderer& renderer, const Mesh& mesh, const FrameView& view);
+
 // Replays the frame's groups in order and measures both correctness measures of the image at
 // every timeline sample against the final image (not part of the timed run). `on_image` sees
 // each replayed image (the whole screen), e.g. to write snapshots; without it the replay reads

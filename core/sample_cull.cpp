@@ -7,6 +7,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "core/camera.h"
+
 namespace isowall {
 namespace {
 
@@ -60,35 +62,34 @@ bool box_holds_a_centre(float x0, float x1, float y0, float y1, int width, int h
 }
 
 std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
-                                   Mesh& out, std::vector<std::uint32_t>& remap) {
+                                   Mesh& out, SampleCullScratch& scratch) {
     out.positions.clear();
     out.normals.clear();
     out.indices.clear();
-    // Window coordinates of every vertex; w <= 0 (at or behind the eye's plane) marks "keep".
-    std::vector<glm::vec3> window(mesh.positions.size());
-    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const std::size_t n = mesh.positions.size();
+    scratch.window.resize(n);
+    scratch.kept_always.assign(n, 0);
+    for (std::size_t v = 0; v < n; ++v) {
         const glm::vec4 c = clip * glm::vec4(mesh.positions[v], 1.0f);
-        window[v] = c.w > 0 ? glm::vec3((c.x / c.w + 1.0f) * 0.5f * float(width),
-                                        (c.y / c.w + 1.0f) * 0.5f * float(height), 1.0f)
-                            : glm::vec3(0.0f);
+        scratch.window[v] = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
+        scratch.kept_always[v] =
+            !(c.w > 0) || !std::isfinite(scratch.window[v].x + scratch.window[v].y);
     }
-    remap.assign(mesh.positions.size(), kUnused);
+    scratch.remap.assign(n, kUnused);
     for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-        const glm::vec3 a = window[mesh.indices[t]], b = window[mesh.indices[t + 1]],
-                        c = window[mesh.indices[t + 2]];
-        const bool clipped = a.z == 0 || b.z == 0 || c.z == 0;
-        const bool finite = std::isfinite(a.x + a.y + b.x + b.y + c.x + c.y);
-        if (!clipped && finite &&
-            !covers_a_centre(glm::vec2(a), glm::vec2(b), glm::vec2(c), width, height))
+        const std::uint32_t i[3] = {mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]};
+        const bool always =
+            scratch.kept_always[i[0]] || scratch.kept_always[i[1]] || scratch.kept_always[i[2]];
+        if (!always && !covers_a_centre(scratch.window[i[0]], scratch.window[i[1]],
+                                        scratch.window[i[2]], width, height))
             continue;
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t v = mesh.indices[t + std::size_t(k)];
-            if (remap[v] == kUnused) {
-                remap[v] = static_cast<std::uint32_t>(out.positions.size());
+        for (const std::uint32_t v : i) {
+            if (scratch.remap[v] == kUnused) {
+                scratch.remap[v] = static_cast<std::uint32_t>(out.positions.size());
                 out.positions.push_back(mesh.positions[v]);
                 out.normals.push_back(mesh.normals[v]);
             }
-            out.indices.push_back(remap[v]);
+            out.indices.push_back(scratch.remap[v]);
         }
     }
     return out.triangle_count();

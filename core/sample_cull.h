@@ -9,26 +9,34 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 
 #include "core/mesh.h"
 
 namespace isowall {
 
-// Of `mesh`, the triangles that may cover the centre of a pixel of a width x height frame under
-// `clip` (the projection times the view): the centre inside the projected triangle or within
-// kSampleCullMarginPx of it (for the rasteriser's rounding), tested where the triangle's box holds
-// a few centres; a triangle whose box holds more is kept. Into `out` with only the vertices they
-// use
-// (`remap` is scratch space, kept between calls to save allocations). A triangle with a vertex at
-// or behind the eye's plane, or not finite, is kept: the rasteriser clips it. Returns the
-// triangles kept.
+// How far outside a triangle (or a box) a pixel centre may lie and still count as covered, for the
+// rasteriser's rounding of window coordinates.
 inline constexpr float kSampleCullMarginPx = 1.0f / 64.0f;
 
 // Whether the window-space box [x0, x1] x [y0, y1] holds the centre of a pixel of a width x height
 // frame (widened by kSampleCullMarginPx).
 bool box_holds_a_centre(float x0, float x1, float y0, float y1, int width, int height);
 
+// Space keep_sampled_triangles reuses from call to call (a frame draws thousands of groups).
+struct SampleCullScratch {
+    std::vector<glm::vec2> window;          // each vertex in window coordinates
+    std::vector<std::uint8_t> kept_always;  // the vertex is behind the eye or not finite
+    std::vector<std::uint32_t> remap;       // each vertex's index in the output, if used
+};
+
+// Of `mesh`, the triangles that may cover the centre of a pixel of a width x height frame under
+// `clip` (the projection times the view): the centre inside the projected triangle or within
+// kSampleCullMarginPx of it, tested where the triangle's box holds a few centres; a triangle whose
+// box holds more is kept. They go into `out` with only the vertices they use. A triangle with a
+// vertex at or behind the eye's plane, or not finite, is kept: the rasteriser clips it. Returns
+// the triangles kept.
 std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int width, int height,
-                                   Mesh& out, std::vector<std::uint32_t>& remap);
+                                   Mesh& out, SampleCullScratch& scratch);
 
 }  // namespace isowall

@@ -27,6 +27,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
+#include "core/camera.h"
 #include "core/sample_cull.h"
 #include "extract/adaptive.h"
 #include "extract/group.h"
@@ -82,12 +83,11 @@ struct SampleGrid {
                                 ((k & 2) ? step[1] : glm::vec4(0)) +
                                 ((k & 4) ? step[2] : glm::vec4(0));
             if (!(c.w > 1e-6f)) return true;  // at or behind the eye, or not finite: no bound
-            const float x = (c.x / c.w + 1.0f) * 0.5f * float(width);
-            const float y = (c.y / c.w + 1.0f) * 0.5f * float(height);
-            x0 = std::min(x0, x);
-            x1 = std::max(x1, x);
-            y0 = std::min(y0, y);
-            y1 = std::max(y1, y);
+            const glm::vec2 w = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
+            x0 = std::min(x0, w.x);
+            x1 = std::max(x1, w.x);
+            y0 = std::min(y0, w.y);
+            y1 = std::max(y1, w.y);
         }
         // A unit reaching past the frame may hold centres of a neighbouring frame (a wall's other
         // tiles, which the same visited cells serve): only a unit wholly inside is judged.

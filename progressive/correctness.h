@@ -74,6 +74,8 @@ double coverage_iou(const Image& a, const Image& b);
 // be as close to it as the full mesh drawn at one sample per pixel. Throws std::invalid_argument
 // when k < 1 or the image's sides are not multiples of k.
 Image box_filtered_truth(const Image& supersampled, int k);
+// The samples a side of a pixel of the truth the benchmarks and `render --against-truth` use.
+inline constexpr int kTruthSamples = 4;
 
 // A final image against the truth, beside the full surface drawn at one sample per pixel.
 struct Fidelity {

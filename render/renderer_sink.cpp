@@ -24,7 +24,7 @@ void RendererSink::add(const Group& group) {
         return;
     }
     drawn_ +=
-        keep_sampled_triangles(group.mesh, proj_m_ * view_m_, width_, height_, sampled_, remap_);
+        keep_sampled_triangles(group.mesh, proj_m_ * view_m_, width_, height_, sampled_, scratch_);
     renderer_.draw(sampled_, view_m_, proj_m_);
 }
 

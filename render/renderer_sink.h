@@ -11,6 +11,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "core/image.h"
+#include "core/sample_cull.h"
 #include "extract/group_sink.h"
 #include "render/renderer.h"
 
@@ -40,8 +41,8 @@ class RendererSink final : public GroupSink, public ShownPixels {
     glm::mat4 view_m_{1.0f}, proj_m_{1.0f};
     int width_ = 0, height_ = 0;
     std::size_t given_ = 0, drawn_ = 0;
-    Mesh sampled_;                      // the group's triangles that cover a pixel centre
-    std::vector<std::uint32_t> remap_;  // scratch of the cull
+    Mesh sampled_;               // the group's triangles that cover a pixel centre
+    SampleCullScratch scratch_;  // the cull's, kept between groups
 };
 
 }  // namespace isowall

@@ -6,6 +6,7 @@
 
 #include <iostream>
 
+#include "app/whole_frame.h"
 #include "engine/progressive_engine.h"
 #include "extract/surface_extractor.h"
 #include "progressive/correctness.h"
@@ -17,8 +18,6 @@
 namespace isowall {
 namespace {
 
-constexpr int kSamples = 4;
-
 struct GateFigures {
     Fidelity engine, full;
 };
@@ -29,10 +28,7 @@ GateFigures judge(const Volume& v, const FrameView& fv, const EngineOptions& opt
     const FrameResult fr = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
     EXPECT_TRUE(fr.completed);
     const Mesh mesh = ex->extract_full(fv.iso);
-    FrameView big = fv;
-    big.width *= kSamples;
-    big.height *= kSamples;
-    const Image truth = box_filtered_truth(draw_alone(*renderer, mesh, big), kSamples);
+    const Image truth = draw_truth(*renderer, mesh, fv);
     GateFigures g{measure_fidelity(fr.final_image, truth),
                   measure_fidelity(draw_alone(*renderer, mesh, fv), truth)};
     std::cout << "  " << to_string(opt.order) << ": engine C_T " << g.engine.c << " IoU "
@@ -72,10 +68,7 @@ TEST(FidelityGate, AnEmptyFinalImageFails) {
     auto ex = make_surface_extractor(v, {}, nullptr, ThreadBudget{1});
     auto renderer = make_renderer("osmesa");
     const Mesh mesh = ex->extract_full(fv.iso);
-    FrameView big = fv;
-    big.width *= kSamples;
-    big.height *= kSamples;
-    const Image truth = box_filtered_truth(draw_alone(*renderer, mesh, big), kSamples);
+    const Image truth = draw_truth(*renderer, mesh, fv);
     Image empty;
     empty.resize(fv.width, fv.height);
     EXPECT_FALSE(passes_fidelity_gate(measure_fidelity(empty, truth),

@@ -28,8 +28,8 @@ Mesh one_triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
 
 std::size_t kept(const Mesh& m, int w = 10, int h = 10, glm::mat4 clip = window_clip()) {
     Mesh out;
-    std::vector<std::uint32_t> remap;
-    return keep_sampled_triangles(m, clip, w, h, out, remap);
+    SampleCullScratch scratch;
+    return keep_sampled_triangles(m, clip, w, h, out, scratch);
 }
 
 TEST(SampleCull, ATriangleOverAPixelCentreIsKept) {
@@ -81,15 +81,15 @@ TEST(SampleCull, KeptTrianglesKeepTheirVerticesAndNormalsOnly) {
     for (int i = 0; i < 6; ++i) m.normals.push_back(glm::vec3(float(i), 0, 1));
     m.indices = {3, 4, 5, 0, 1, 2, 2, 1, 0};  // left out, kept, kept (the same vertices)
     Mesh out;
-    std::vector<std::uint32_t> remap;
-    EXPECT_EQ(keep_sampled_triangles(m, window_clip(), 10, 10, out, remap), 2u);
+    SampleCullScratch scratch;
+    EXPECT_EQ(keep_sampled_triangles(m, window_clip(), 10, 10, out, scratch), 2u);
     ASSERT_EQ(out.positions.size(), 3u);
     EXPECT_EQ(out.normals[0].x, 0.0f);
     EXPECT_EQ(out.indices, (std::vector<std::uint32_t>{0, 1, 2, 2, 1, 0}));
     // The output is rebuilt on every call.
     EXPECT_EQ(
         keep_sampled_triangles(one_triangle({0.1f, 0.1f, 0}, {0.2f, 0.1f, 0}, {0.1f, 0.2f, 0}),
-                               window_clip(), 10, 10, out, remap),
+                               window_clip(), 10, 10, out, scratch),
         0u);
     EXPECT_TRUE(out.positions.empty());
 }
