@@ -38,14 +38,16 @@ plain work at that time (bench/cores' isowall-cores: arithmetic, and random read
 2.0 is perfect), since on a shared machine that moves from hour to hour.
 
 Each progressive configuration (--engines; the first, by default `defaults`, is the one the
-targets judge) also prints its final image against the full surface (`render --against-full`,
-outside the clock): C and coverage IoU. A verdict on a speed holds only when the judged final
-image matches the full-resolution one (C >= 0.99 and coverage IoU >= 0.999, the thresholds of
-the issue "Resolution insensitivity on any volume"): a fast engine that draws another picture
-does not pass. Every figure is wall-clock seconds measured inside the programs (loading and the
+targets judge) also prints its final image against the full surface (`render --against-full`)
+and against the truth (`render --against-truth`: the full surface at 4x4 samples a pixel,
+box-filtered), outside the clock. A verdict on a speed holds only when the judged final image
+passes the fidelity gate of the same runs (C_T within 0.005 and coverage IoU within 0.002 of the
+full surface at one sample a pixel, or better; saved runs without the truth are judged by C >=
+0.99 and coverage IoU >= 0.999): a fast engine that draws another picture does not pass, and a
+run that never reaches a threshold counts as missed. Every figure is wall-clock seconds measured inside the programs (loading and the
 octree are outside them). Every contender (each engine, --full, FE + Embree) runs --runs times
 and keeps its median run (by time to C = 99%, extract + draw, and FE + BVH + rays; all runs are
-in the JSON), the engines' runs taking turns round by round. The peer's mesh goes from Python to C++ through a file in a temp folder,
+in the JSON; a missed run ranks last), the engines' runs taking turns round by round. The peer's mesh goes from Python to C++ through a file in a temp folder,
 outside the clock. Writes OUT/scaling.md, OUT/scaling.json and OUT/scaling.png (time against voxels,
 log-log). Errors: one line naming the option, exit 1.
 """
