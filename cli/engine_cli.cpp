@@ -51,6 +51,14 @@ void add_engine_options(CLI::App& app, EngineCli& e) {
                  "Make and draw every triangle of the surface the engine visits, also those that "
                  "cover no pixel centre (which change no pixel; by default they are neither made "
                  "nor drawn): for studies of what leaving them out saves");
+    app.add_option("--footprint-pixels", e.footprint_pixels,
+                   "Where cells project below a pixel, propagate over meta-cells that project "
+                   "below this many pixels and draw, for each pixel centre one covers, the "
+                   "full-resolution surface its ray meets there (the picture of every triangle, "
+                   "at a cost that follows the pixels); 0: every cell at full resolution. Not "
+                   "with --adaptive or --every-triangle")
+        ->transform(number_in(limits::kFootprintPixels))
+        ->capture_default_str();
     app.add_flag("--no-frontier-seeds", e.no_frontier_seeds,
                  "Do not seed, before the ray order's fill level, the units full propagation "
                  "passes left out and the cells beside missed hits whose pixels still show "
@@ -104,6 +112,7 @@ EngineOptions to_engine_options(const EngineCli& c) {
     e.screen_mask = !c.no_screen_mask;
     e.frontier_seeds = !c.no_frontier_seeds;
     e.sampled_triangles = !c.every_triangle;
+    e.footprint_pixels = c.footprint_pixels;
     e.adaptive = c.adaptive;
     e.adaptive_max_level = c.adaptive_max_level;
     e.adaptive_pixels = c.adaptive_pixels;

@@ -29,6 +29,7 @@ struct EngineCli {
     std::optional<float> adaptive_error;  // the error rule's bound; none: the size rule alone
     bool facing_only = false;
     bool every_triangle = !EngineOptions{}.sampled_triangles;
+    float footprint_pixels = EngineOptions{}.footprint_pixels;
 };
 
 // `serve`'s max count: a default chosen, like the engine's, over several volumes by the smallest

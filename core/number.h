@@ -39,6 +39,8 @@ inline constexpr NumberRange kCellCount{1, 2147483647.0, false, true};
 // --adaptive-pixels: a meta-cell's projected size target; past 64 px a meta-cell of 8 cells
 // would stand for a region the size of an icon.
 inline constexpr NumberRange kMetaCellPixels{0, 64, true};
+// --footprint-pixels: the same size target for footprint units; 0 turns them off.
+inline constexpr NumberRange kFootprintPixels{0, 64};
 }  // namespace limits
 
 // The finite number `text` spells, all of it (decimal or exponent form, an optional sign), or

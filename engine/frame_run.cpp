@@ -39,8 +39,18 @@ bool FrameRun::cast(const FrameView& view, RegionCursor& c, const FrameOutput& o
     params_.keep_frontier = opt_.frontier_seeds && shown_ != nullptr;
     if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
     refine_params_ = opt_.propagation;
-    if (opt_.sampled_triangles)
+    if (opt_.sampled_triangles) {
         params_.samples = refine_params_.samples = sample_grid(view, ex_.volume().spacing());
+        const SampleGrid& g = params_.samples;
+        if (g.clip_from_voxel != depths_clip_ || g.width != depths_width_ ||
+            g.height != depths_height_) {
+            depths_.reset(g.width, g.height);
+            depths_clip_ = g.clip_from_voxel;
+            depths_width_ = g.width;
+            depths_height_ = g.height;
+        }
+        params_.samples.depths = refine_params_.samples.depths = &depths_;
+    }
     // Saturating: a fine band's limit is SIZE_MAX, and c.rays + SIZE_MAX would wrap to below
     // c.rays, so a region's second band would cast nothing.
     const std::size_t limit = ray_limit > SIZE_MAX - c.rays ? SIZE_MAX : c.rays + ray_limit;
@@ -84,7 +94,8 @@ FrameResult FrameRun::finish(bool completed) {
 void FrameRun::begin(const FrameView& view) {
     stage(Stage::setup);
     start_ = Clock::now();
-    const ResolutionLevels levels = frame_levels(opt_, view, ex_.volume().spacing());
+    const ResolutionLevels levels =
+        frame_levels(opt_, view, ex_.volume().spacing(), ex_.volume().bounds());
     if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
     if (masked()) {
         active_ = screen_mask_nodes(ex_, view.iso, levels);

@@ -125,6 +125,11 @@ class FrameRun {
     RegionCursor* cursor_ = nullptr;   // its cursor
     PropagationParams params_;         // the options, with the clip of the region being cast
     PropagationParams refine_params_;  // the options, with the frame's sample grid
+    // The nearest footprint samples of the view whose sample grid is `depths_clip_` (reset when
+    // a cast brings another view: a wall rank's jobs for other tiles).
+    SampleDepths depths_;
+    glm::mat4 depths_clip_{0.0f};
+    int depths_width_ = 0, depths_height_ = 0;
     std::vector<std::size_t> extra_;
     std::size_t next_extra_ = 0, next_sample_rays_ = 1;
     // The first progress report comes at the first ray: a wall master then knows the frame began.

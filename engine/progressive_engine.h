@@ -68,6 +68,12 @@ struct EngineOptions {
     // surface lies within this many pixels of the full-resolution surface, projected. Infinite:
     // the distance rule alone.
     float adaptive_error_px = std::numeric_limits<float>::infinity();
+    // Footprint units (extract/footprint.h), with sampled_triangles and without adaptive or
+    // uniform levels: where a meta-cell of up to 2^kMaxMetaLevel cells a side projects below
+    // this many pixels, propagation walks it as one unit, which shows the full-resolution surface
+    // at the pixel centres it covers. The picture is that of every full-resolution triangle, and
+    // the work follows the pixels rather than the cells. 0: every cell at full resolution.
+    float footprint_pixels = 4.0f;
     // Threads casting rays and propagating side by side over each ray-order level: at most the
     // extractor's workers (its thread budget); 0: all of them. The calling thread is one of them
     // and alone draws (the renderer's context is its own), taking the groups in the order of

@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/matrix.hpp>
 
 #include "core/pixel_rect_ops.h"
 #include "core/ray.h"
@@ -14,10 +15,31 @@
 
 namespace isowall {
 
-ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing) {
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing,
+                              const Box3& volume_box) {
     ResolutionLevels levels;
     if (opt.uniform_level > 0) return uniform_levels(opt.uniform_level);
-    if (!opt.adaptive) return levels;
+    if (!opt.adaptive) {
+        if (!(opt.footprint_pixels > 0) || !opt.sampled_triangles) return levels;
+        levels = resolution_levels(view.camera, view.frustum, view.height, spacing, kMaxMetaLevel,
+                                   opt.footprint_pixels);
+        // Only the levels some unit of the volume is far enough for: a frame whose cells all
+        // project above the target walks cells alone and pays no level test per neighbour.
+        float farthest = 0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::vec3 corner((k & 1) ? volume_box.max.x : volume_box.min.x,
+                                   (k & 2) ? volume_box.max.y : volume_box.min.y,
+                                   (k & 4) ? volume_box.max.z : volume_box.min.z);
+            farthest = std::max(farthest, glm::length(corner - levels.eye));
+        }
+        while (levels.max_level > 0 &&
+               !(levels.d[static_cast<std::size_t>(levels.max_level)] < farthest))
+            --levels.max_level;
+        if (levels.max_level == 0) return ResolutionLevels{};
+        levels.refine = false;
+        levels.footprint = true;
+        return levels;
+    }
     // D[] depends on the eye, the frustum and the pixel size only: once per frame (every tile of
     // a wall has the same pixel size, so one frame serves all of them).
     levels = resolution_levels(view.camera, view.frustum, view.height, spacing,
@@ -101,6 +123,7 @@ SampleGrid sample_grid(const FrameView& view, glm::vec3 spacing) {
     g.active = view.width > 0 && view.height > 0;
     g.clip_from_voxel =
         view.frustum.matrix() * view.camera.view() * glm::scale(glm::mat4(1.0f), spacing);
+    g.voxel_from_clip = glm::inverse(g.clip_from_voxel);
     g.width = view.width;
     g.height = view.height;
     return g;

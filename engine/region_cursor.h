@@ -59,9 +59,11 @@ struct RegionCursor {
     std::size_t frontier_kept = 0;  // its size after the last drop of visited units
 };
 
-// The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive, or
-// every cell at full resolution; `spacing` is the volume's.
-ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing);
+// The resolution levels of a frame of `view` under `opt`: uniform (uniform_level), adaptive,
+// footprint units (footprint_pixels, up to the coarsest level a unit of `volume_box` is far
+// enough for), or every cell at full resolution; `spacing` is the volume's.
+ResolutionLevels frame_levels(const EngineOptions& opt, const FrameView& view, glm::vec3 spacing,
+                              const Box3& volume_box);
 
 // The screen mask's nodes for a frame at `iso` with resolution `levels`: the active octree nodes
 // of the finest level within its budget that still holds each meta-cell whole.

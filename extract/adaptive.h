@@ -73,6 +73,10 @@ struct ResolutionLevels {
     // sends is of its own level and the client, which switches to a finer level at the first
     // finer group, does not take a border sliver for the start of the next pass).
     bool finer_units = true;
+    // Footprint units (footprint.h): a meta-cell unit is entered where the full-resolution
+    // surface crosses its face and shows the full-resolution surface at the pixel centres it
+    // holds, instead of its own coarse triangles; rays walk cells, and nothing needs refining.
+    bool footprint = false;
 
     // The largest i in [1, max_level] with distance > d[i], else 0.
     int level_at(float distance) const {
@@ -140,7 +144,8 @@ class ResolutionMap {
           max_level_(levels.max_level),
           refine_(levels.refine),
           cross_levels_(levels.cross_levels),
-          finer_units_(levels.finer_units) {
+          finer_units_(levels.finer_units),
+          footprint_(levels.footprint) {
         for (std::size_t i = 0; i < levels.d.size(); ++i) d2_[i] = levels.d[i] * levels.d[i];
         if (errors && !errors->empty() && std::isfinite(levels.error_px)) {
             // error (cells) * s_max <= error_px * (pixel_slope * distance + pixel_size), the
@@ -158,6 +163,7 @@ class ResolutionMap {
     bool refine() const { return refine_; }
     bool cross_levels() const { return cross_levels_; }
     bool finer_units() const { return finer_units_; }
+    bool footprint() const { return footprint_; }
 
     // Whether the meta-cell of `level` >= 1 at `base` (a multiple of 2^level) may be a unit on its
     // own account: complete, and its centre beyond D[level]. A unit also needs no coarser unit
@@ -199,6 +205,7 @@ class ResolutionMap {
     bool refine_ = false;
     bool cross_levels_ = false;
     bool finer_units_ = true;
+    bool footprint_ = false;
     std::array<float, kMaxMetaLevel + 1> d2_{};  // D[i]^2
     const LodErrors* errors_ = nullptr;          // null: no error rule
     float err_k2_ = 0, err_c2_ = 0;              // the error rule's bound, squared (see above)

@@ -30,6 +30,7 @@
 #include "core/camera.h"
 #include "core/sample_cull.h"
 #include "extract/adaptive.h"
+#include "extract/footprint.h"
 #include "extract/group.h"
 #include "extract/marching_cubes.h"
 #include "extract/visited.h"
@@ -69,31 +70,53 @@ struct ScreenClip {
 struct SampleGrid {
     bool active = false;
     glm::mat4 clip_from_voxel{1.0f};  // projection * view * voxel-to-object
+    glm::mat4 voxel_from_clip{1.0f};  // its inverse, for the rays of pixel centres
     int width = 0, height = 0;
+    // The nearest footprint sample of the frame at each pixel so far (null: none kept), to skip
+    // the walks of units behind it.
+    SampleDepths* depths = nullptr;
 
-    bool may_cover_a_centre(glm::ivec3 base, int stride) const {
+    // Where the unit of `stride` cells at `base` projects.
+    enum class Reach { unbounded, past_frame, inside };
+    struct WindowBox {
+        Reach reach = Reach::unbounded;
+        float x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+    };
+    WindowBox window_box(glm::ivec3 base, int stride) const {
         // The eight corners in clip space: the base corner plus the matrix's columns per axis.
         const glm::vec4 c0 = clip_from_voxel * glm::vec4(glm::vec3(base), 1.0f);
         const glm::vec4 step[3] = {clip_from_voxel[0] * float(stride),
                                    clip_from_voxel[1] * float(stride),
                                    clip_from_voxel[2] * float(stride)};
-        float x0 = std::numeric_limits<float>::max(), x1 = -x0, y0 = x0, y1 = -x0;
+        WindowBox b;
+        b.x0 = b.y0 = std::numeric_limits<float>::max();
+        b.x1 = b.y1 = -b.x0;
         for (int k = 0; k < 8; ++k) {
             const glm::vec4 c = c0 + ((k & 1) ? step[0] : glm::vec4(0)) +
                                 ((k & 2) ? step[1] : glm::vec4(0)) +
                                 ((k & 4) ? step[2] : glm::vec4(0));
-            if (!(c.w > 1e-6f)) return true;  // at or behind the eye, or not finite: no bound
+            if (!(c.w > 1e-6f)) return b;  // at or behind the eye, or not finite: no bound
             const glm::vec2 w = ndc_to_window(c.x / c.w, c.y / c.w, width, height);
-            x0 = std::min(x0, w.x);
-            x1 = std::max(x1, w.x);
-            y0 = std::min(y0, w.y);
-            y1 = std::max(y1, w.y);
+            b.x0 = std::min(b.x0, w.x);
+            b.x1 = std::max(b.x1, w.x);
+            b.y0 = std::min(b.y0, w.y);
+            b.y1 = std::max(b.y1, w.y);
         }
         // A unit reaching past the frame may hold centres of a neighbouring frame (a wall's other
         // tiles, which the same visited cells serve): only a unit wholly inside is judged.
-        if (x0 < 0 || y0 < 0 || x1 > float(width) || y1 > float(height)) return true;
-        return box_holds_a_centre(x0, x1, y0, y1, width, height);
+        b.reach = b.x0 < 0 || b.y0 < 0 || b.x1 > float(width) || b.y1 > float(height)
+                      ? Reach::past_frame
+                      : Reach::inside;
+        return b;
     }
+
+    bool may_cover_a_centre(glm::ivec3 base, int stride) const {
+        const WindowBox b = window_box(base, stride);
+        if (b.reach != Reach::inside) return true;
+        return box_holds_a_centre(b.x0, b.x1, b.y0, b.y1, width, height);
+    }
+
+    FootprintGrid footprint() const { return {clip_from_voxel, voxel_from_clip, width, height}; }
 };
 
 inline constexpr float kRadiansPerDegree = 3.14159265358979f / 180.0f;
@@ -190,6 +213,7 @@ class Propagator {
         int taken = 1;
         std::size_t taken_cells = std::size_t{1} << (3 * level);
         const glm::ivec3 cells = visited.dims();
+        const InsideTest<T> inside(iso);
         // Takes the unit of `l` at `u` into this pass when the criteria allow; false when the
         // pass is full (count mode).
         auto take = [&](glm::ivec3 u, int l, float from_angle) {
@@ -232,9 +256,19 @@ class Propagator {
             const auto t0 =
                 timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
             double corner[8];
-            const bool shows =
-                !p.samples.active || p.samples.may_cover_a_centre(item.cell, 1 << item.level);
-            const int cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner, shows);
+            // A footprint unit: its crossed faces by its voxels, its picture by its pixels.
+            const bool footprint = item.level > 0 && resolution_.footprint();
+            int cs = 0, faces = 0;
+            if (footprint) {
+                const UnitBlock<T> block(v_, item.cell, item.level, inside);
+                faces = block.crossed_faces();
+                emit_footprint(block, iso, p, g.mesh);
+                if (p.facing_only) meta_cell_corners(v_, item.cell, item.level, corner);
+            } else {
+                const bool shows =
+                    !p.samples.active || p.samples.may_cover_a_centre(item.cell, 1 << item.level);
+                cs = triangulate(item.cell, item.level, iso, p, g.mesh, corner, shows);
+            }
             if (timed) {
                 timed_s +=
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -249,11 +283,15 @@ class Propagator {
             }
             for (int f = 0; f < 6; ++f) {
                 const int axis = f >> 1, side = f & 1;
-                // The face's four corners: those with bit `axis` equal to `side`.
-                int on_face = 0;
-                for (int k = 0; k < 8; ++k)
-                    if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
-                if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
+                if (footprint) {
+                    if (!((faces >> f) & 1)) continue;
+                } else {
+                    // The face's four corners: those with bit `axis` equal to `side`.
+                    int on_face = 0;
+                    for (int k = 0; k < 8; ++k)
+                        if (((k >> axis) & 1) == side) on_face += (cs >> k) & 1;
+                    if (on_face == 0 || on_face == 4) continue;  // the surface does not cross it
+                }
                 // The cell just across the face, at the unit's first corner.
                 glm::ivec3 nb = item.cell;
                 nb[axis] = side ? nb[axis] + stride : nb[axis] - 1;
@@ -263,7 +301,7 @@ class Propagator {
                 if (nl >= item.level)  // one unit across the face, as large or larger
                     take(nb & ~((1 << nl) - 1), nl, item.max_angle);
                 else  // finer units (a resolution boundary): the pass goes on into them
-                    take_finer_across(nb, axis, stride, iso, take, item.max_angle);
+                    take_finer_across(nb, axis, f ^ 1, stride, iso, inside, take, item.max_angle);
             }
         }
         visited.add_count(taken_cells);
@@ -321,6 +359,48 @@ class Propagator {
         return cs;
     }
 
+    // A footprint unit's picture: inside the frame, a sample triangle for each pixel centre whose
+    // ray meets the full-resolution surface in it; reaching past the frame (whose neighbouring
+    // frames' centres are not known here) or with no sample grid, its cells' full-resolution
+    // triangles.
+    void emit_footprint(const UnitBlock<T>& block, double iso, const PropagationParams& p,
+                        Mesh& mesh) {
+        const int s = block.side();
+        const glm::ivec3 base = block.base();
+        const SampleGrid::WindowBox box =
+            p.samples.active ? p.samples.window_box(base, s) : SampleGrid::WindowBox{};
+        if (box.reach != SampleGrid::Reach::inside) {
+            double corner[8];
+            for (int z = 0; z < s; ++z)
+                for (int y = 0; y < s; ++y)
+                    for (int x = 0; x < s; ++x) {
+                        const glm::ivec3 c = base + glm::ivec3(x, y, z);
+                        triangulate(c, 0, iso, p, mesh, corner,
+                                    !p.samples.active || p.samples.may_cover_a_centre(c, 1));
+                    }
+            return;
+        }
+        const FootprintGrid grid = p.samples.footprint();
+        SampleDepths* depths = p.samples.depths;
+        const glm::vec3 centre = glm::vec3(base) + 0.5f * static_cast<float>(s);
+        const SampleShape shape =
+            SampleShape::at(grid, centre, grid.ray_through(grid.window(centre)).d);
+        if (!shape.usable) return;
+        // Pixel (x, y) has its centre at (x + 0.5, y + 0.5).
+        const int x0 = static_cast<int>(std::ceil(box.x0 - 0.5f));
+        const int x1 = static_cast<int>(std::floor(box.x1 - 0.5f));
+        const int y0 = static_cast<int>(std::ceil(box.y0 - 0.5f));
+        const int y1 = static_cast<int>(std::floor(box.y1 - 0.5f));
+        for (int y = std::max(y0, 0); y <= std::min(y1, grid.height - 1); ++y)
+            for (int x = std::max(x0, 0); x <= std::min(x1, grid.width - 1); ++x) {
+                const Ray ray = grid.centre_ray(x, y);
+                const FootprintHit hit = first_hit_in_unit(v_, block, iso, ray, depths, x, y);
+                if (!hit.found) continue;
+                append_sample_triangle(hit, shape, v_.spacing, mesh);
+                if (depths) depths->take(x, y, hit.t);
+            }
+    }
+
     const VolumeView<T>& v_;
     HashEdgeCache cache_;
     ResolutionMap resolution_;
@@ -334,9 +414,10 @@ class Propagator {
     // The units finer than a unit of `stride` cells that touch its face, in the slab of cells
     // at nb[axis] (nb: the cell across the face at the unit's first corner), handed to `take`
     // when their own corners cross the isovalue. Each unit once: at its first cell on the face.
+    // `toward`: the face of those units that lies on the shared face.
     template <class Take>
-    bool take_finer_across(glm::ivec3 nb, int axis, int stride, double iso, Take& take,
-                           float from_angle) {
+    bool take_finer_across(glm::ivec3 nb, int axis, int toward, int stride, double iso,
+                           const InsideTest<T>& inside, Take& take, float from_angle) {
         const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
         const glm::ivec3 cells = v_.cell_dims();
         for (int j = 0; j < stride && nb[a2] + j < cells[a2]; ++j)
@@ -347,10 +428,15 @@ class Propagator {
                 const int l = resolution_.level_of(q);
                 const glm::ivec3 u = q & ~((1 << l) - 1);
                 if (u[a1] != q[a1] || u[a2] != q[a2]) continue;  // met at its first cell already
-                double corner[8];
-                meta_cell_corners(v_, u, l, corner);
-                const int cs = cell_case(corner, iso);
-                if (cs == 0 || cs == 255) continue;
+                if (l > 0 && resolution_.footprint()) {
+                    // A footprint unit, entered where the fine surface crosses into it.
+                    if (!face_straddles(v_, u, l, toward, inside)) continue;
+                } else {
+                    double corner[8];
+                    meta_cell_corners(v_, u, l, corner);
+                    const int cs = cell_case(corner, iso);
+                    if (cs == 0 || cs == 255) continue;
+                }
                 if (!take(u, l, from_angle)) return false;
             }
         return true;

@@ -133,7 +133,8 @@ class alignas(64) ExtractWorker {  // cache lines of its own: a worker's state i
 
     // Takes the frame's resolution; a copy per worker, so the hot paths read no shared state.
     void begin_frame(const FrameState& frame) {
-        caster_.set_resolution(frame.resolution);
+        // Footprint units show the full-resolution surface, which rays then find cell by cell.
+        caster_.set_resolution(frame.resolution.footprint() ? ResolutionMap{} : frame.resolution);
         propagator_.set_resolution(frame.resolution);
     }
 

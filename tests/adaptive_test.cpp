@@ -383,7 +383,9 @@ TEST(Adaptive, MaxLevelZeroIsFullResolution) {
     EngineOptions opt = adaptive_options();
     opt.adaptive_max_level = 0;
     const FrameResult a = draw_frame(ProgressiveEngine(*ex, opt), fv, *renderer);
-    const FrameResult b = draw_frame(ProgressiveEngine(*ex, EngineOptions{}), fv, *renderer);
+    EngineOptions cells;
+    cells.footprint_pixels = 0;  // every cell a unit
+    const FrameResult b = draw_frame(ProgressiveEngine(*ex, cells), fv, *renderer);
     ASSERT_EQ(a.groups.size(), b.groups.size());
     for (std::size_t i = 0; i < a.groups.size(); ++i) {
         EXPECT_EQ(a.groups[i].level, 0);

@@ -130,6 +130,7 @@ FrameRunOutcome run_frame(SurfaceExtractor& ex, Renderer& r, const FrameView& fv
     EngineOptions opt;
     opt.frontier_seeds = frontier;
     opt.propagation.max_count = 40;  // small passes: many slivers between them
+    opt.footprint_pixels = 0;        // passes of cells (a footprint unit holds up to 512)
     opt.threads = threads;
     // A sample every 16 rays, each waiting for its groups to show: a sample that a present
     // still in flight would hold back (and so the ray count read here) no longer depends on

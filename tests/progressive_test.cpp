@@ -158,6 +158,7 @@ TEST(Propagation, VisitsOnlyActiveCellsEachInOneGroup) {
         EngineOptions opt;
         opt.propagation.mode = mode;
         opt.propagation.max_count = 500;  // many small groups
+        opt.footprint_pixels = 0;         // cells alone (footprint units: footprint_engine_test)
         ProgressiveEngine engine(*ex, opt);
         const FrameView fv = make_view(p, 160, 120, kPhantomBoneIso, 30, 20);
         FrameResult fr = draw_frame(engine, fv, *renderer);
