@@ -28,6 +28,7 @@ const std::vector<CliSlot> kCliSlots = {
     {"render --foldback-tolerance {}", "--foldback-tolerance", {"-5", "181", "1e300"}},
     {"render --adaptive-max-level {}", "--adaptive-max-level", {"0", "4", "-5", "2.5"}},
     {"render --adaptive-pixels {}", "--adaptive-pixels", {"0", "-5", "64.5", "1e300"}},
+    {"render --footprint-pixels {}", "--footprint-pixels", {"-0.5", "-5", "64.5", "1e300"}},
     {"render --snapshots 90,{}", "--snapshots", {"0", "-5", "100.5", "1e300"}},
     {"render --snapshot-rays 100,{}", "--snapshot-rays", {"-5", "2.5", "1e16", "1e300"}},
     {"render --spacing 1 {} 1", "--spacing", {"0", "-5", "1e300", "1e-300"}},
