@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
@@ -227,39 +228,79 @@ glm::vec3 edge_normal(const VolumeView<T>& v, glm::ivec3 pa, int axis, float fra
     return len2 > 0 && std::isfinite(len2) ? g * (-1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
 }
 
+// What the rays of one unit's pixel centres share: each cell's case, and the crossings and vertex
+// normals of its edges, worked out the first time a ray needs them (neighbouring centres' rays
+// cross the same cells, and often hit the same triangle). Scratch reused from unit to unit.
+class UnitCells {
+  public:
+    struct Cell {
+        int cs = -1;                 // -1: not classified yet
+        std::uint16_t placed = 0;    // edges whose crossing is in `at`, `start`, `frac`
+        std::uint16_t normaled = 0;  // edges whose normal is in `normal`
+        std::uint32_t unit = 0;      // the unit these are of (UnitCells::unit_)
+        std::array<glm::vec3, 12> at;
+        std::array<glm::ivec3, 12> start;
+        std::array<float, 12> frac;
+        std::array<glm::vec3, 12> normal;
+    };
+
+    // Forgets every cell (by a new unit number: no cell is written until a ray needs it); the
+    // next unit has `side` cells a side.
+    void reset(int side) {
+        side_ = side;
+        const auto n = static_cast<std::size_t>(side * side * side);
+        if (cells_.size() < n) cells_.resize(n);
+        if (++unit_ == 0) {  // wrapped: make every cell stale by hand, once in 2^32 units
+            for (Cell& c : cells_) c.unit = 0;
+            unit_ = 1;
+        }
+    }
+    Cell& at(glm::ivec3 c) {
+        Cell& cell = cells_[static_cast<std::size_t>((c.z * side_ + c.y) * side_ + c.x)];
+        if (cell.unit != unit_) {
+            cell.unit = unit_;
+            cell.cs = -1;
+            cell.placed = cell.normaled = 0;
+        }
+        return cell;
+    }
+
+  private:
+    int side_ = 0;
+    std::uint32_t unit_ = 0;
+    std::vector<Cell> cells_;
+};
+
 // Whether `ray` meets a marching-cubes triangle of cell `c` (within the unit `block`); the
 // nearest such hit goes into `hit`, its normal worked out for that triangle alone.
 template <class T>
 bool hit_in_cell(const VolumeView<T>& v, const UnitBlock<T>& block, glm::ivec3 c, double iso,
-                 const Ray& ray, FootprintHit& hit) {
-    const int cs = block.cell_case(c.x, c.y, c.z);
+                 const Ray& ray, FootprintHit& hit, UnitCells& cells) {
+    UnitCells::Cell& cell = cells.at(c);
+    if (cell.cs < 0) cell.cs = block.cell_case(c.x, c.y, c.z);
+    const int cs = cell.cs;
     if (cs == 0 || cs == 255) return false;
     const int count = mc::kTriangleCount[static_cast<std::size_t>(cs)];
     const auto& edges = mc::kTriangleEdges[static_cast<std::size_t>(cs)];
     const glm::ivec3 base = block.base();
-    // Each crossed edge's first voxel, axis and crossing, as emit_meta_cell() places them, worked
-    // out once for the cell; filled as `have` says (no zeroing: it cost a fifth of the walk).
-    std::array<glm::vec3, 12> at;
-    std::array<glm::ivec3, 12> start;
-    std::array<float, 12> frac;
-    unsigned have = 0;
+    // Each crossed edge's first voxel, axis and crossing, as emit_meta_cell() places them.
     auto vertex = [&](int e) -> const glm::vec3& {
         const auto ue = static_cast<std::size_t>(e);
-        if (!((have >> e) & 1u)) {
-            have |= 1u << e;
+        if (!((cell.placed >> e) & 1u)) {
+            cell.placed = static_cast<std::uint16_t>(cell.placed | (1u << e));
             const auto& oa = mc::kCornerOffset[static_cast<std::size_t>(mc::kEdgeCorners[ue][0])];
             const glm::ivec3 la = c + glm::ivec3(oa[0], oa[1], oa[2]);
             const int axis = mc::kEdgeAxis[ue];
             glm::ivec3 lb = la;
             lb[axis] += 1;
-            frac[ue] = static_cast<float>(
+            cell.frac[ue] = static_cast<float>(
                 crossing_fraction(iso, static_cast<double>(block.value(la.x, la.y, la.z)),
                                   static_cast<double>(block.value(lb.x, lb.y, lb.z))));
-            start[ue] = base + la;
-            at[ue] = glm::vec3(start[ue]);
-            at[ue][axis] += frac[ue];
+            cell.start[ue] = base + la;
+            cell.at[ue] = glm::vec3(cell.start[ue]);
+            cell.at[ue][axis] += cell.frac[ue];
         }
-        return at[ue];
+        return cell.at[ue];
     };
     int best = -1;
     float best_u = 0, best_w = 0;
@@ -282,8 +323,13 @@ bool hit_in_cell(const VolumeView<T>& v, const UnitBlock<T>& block, glm::ivec3 c
     glm::vec3 n(0.0f);
     const float weight[3] = {1.0f - best_u - best_w, best_u, best_w};
     for (int j = 0; j < 3; ++j) {
-        const auto e = static_cast<std::size_t>(edges[static_cast<std::size_t>(3 * best + j)]);
-        n += weight[j] * edge_normal(v, start[e], mc::kEdgeAxis[e], frac[e]);
+        const int e = edges[static_cast<std::size_t>(3 * best + j)];
+        const auto ue = static_cast<std::size_t>(e);
+        if (!((cell.normaled >> e) & 1u)) {
+            cell.normaled = static_cast<std::uint16_t>(cell.normaled | (1u << e));
+            cell.normal[ue] = edge_normal(v, cell.start[ue], mc::kEdgeAxis[ue], cell.frac[ue]);
+        }
+        n += weight[j] * cell.normal[ue];
     }
     const float len2 = glm::dot(n, n);
     hit.normal = len2 > 0 && std::isfinite(len2) ? n / std::sqrt(len2) : glm::vec3(0, 0, 1);
@@ -297,8 +343,8 @@ bool hit_in_cell(const VolumeView<T>& v, const UnitBlock<T>& block, glm::ivec3 c
 // walked: it answers no hit.
 template <class T>
 FootprintHit first_hit_in_unit(const VolumeView<T>& v, const UnitBlock<T>& block, double iso,
-                               const Ray& ray, const SampleDepths* depths = nullptr, int x = 0,
-                               int y = 0) {
+                               const Ray& ray, UnitCells& cells,
+                               const SampleDepths* depths = nullptr, int x = 0, int y = 0) {
     FootprintHit hit;
     const int s = block.side();
     const glm::ivec3 base = block.base();
@@ -332,7 +378,7 @@ FootprintHit first_hit_in_unit(const VolumeView<T>& v, const UnitBlock<T>& block
         }
     }
     for (;;) {
-        if (hit_in_cell(v, block, c, iso, ray, hit)) return hit;
+        if (hit_in_cell(v, block, c, iso, ray, hit, cells)) return hit;
         const int a =
             t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2) : (t_next.y < t_next.z ? 1 : 2);
         if (t_next[a] > t1) return hit;

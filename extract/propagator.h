@@ -381,6 +381,7 @@ class Propagator {
             return;
         }
         const FootprintGrid grid = p.samples.footprint();
+        unit_cells_.reset(s);
         SampleDepths* depths = p.samples.depths;
         const glm::vec3 centre = glm::vec3(base) + 0.5f * static_cast<float>(s);
         const SampleShape shape =
@@ -394,7 +395,8 @@ class Propagator {
         for (int y = std::max(y0, 0); y <= std::min(y1, grid.height - 1); ++y)
             for (int x = std::max(x0, 0); x <= std::min(x1, grid.width - 1); ++x) {
                 const Ray ray = grid.centre_ray(x, y);
-                const FootprintHit hit = first_hit_in_unit(v_, block, iso, ray, depths, x, y);
+                const FootprintHit hit =
+                    first_hit_in_unit(v_, block, iso, ray, unit_cells_, depths, x, y);
                 if (!hit.found) continue;
                 append_sample_triangle(hit, shape, v_.spacing, mesh);
                 if (depths) depths->take(x, y, hit.t);
@@ -403,6 +405,7 @@ class Propagator {
 
     const VolumeView<T>& v_;
     HashEdgeCache cache_;
+    UnitCells unit_cells_;  // a footprint unit's cells, shared by its centres' rays
     ResolutionMap resolution_;
     double extract_s_ = 0;
     struct QueueEntry {

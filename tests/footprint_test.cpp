@@ -164,7 +164,9 @@ TEST(FirstHitInUnit, IsTheNearestFullResolutionTriangleWithItsInterpolatedNormal
                 glm::normalize(glm::vec3(u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f));
             const Ray ray{target - 3.0f * float(s) * dir, dir};
             const UnitBlock<std::uint8_t> block(nv.view, base, level, inside);
-            const FootprintHit got = first_hit_in_unit(nv.view, block, kIso, ray);
+            UnitCells cells;
+            cells.reset(s);
+            const FootprintHit got = first_hit_in_unit(nv.view, block, kIso, ray, cells);
             const BruteHit want = brute_first_hit(nv.view, base, level, ray);
             ASSERT_EQ(got.found, want.found) << "level " << level << " trial " << trial;
             if (!want.found) {
