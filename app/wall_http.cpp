@@ -200,11 +200,13 @@ void WallHttp::drop(const std::shared_ptr<Page>& page, const std::string& reason
 }
 
 void WallHttp::begin() {
+    // The certificate first: whoever waits for the page's address (a script, a test reading the
+    // output as it comes) then has the certificate too.
+    if (o_.tls) std::printf("http: TLS certificate: %s\n", o_.tls->certificate_summary().c_str());
     std::printf("http: page at %s://%s:%d/ (WebSocket /ws)%s\n", o_.tls ? "https" : "http",
                 o_.address.find(':') != std::string::npos ? ("[" + o_.address + "]").c_str()
                                                           : o_.address.c_str(),
                 port(), o_.token.empty() ? "" : " (token required)");
-    if (o_.tls) std::printf("http: TLS certificate: %s\n", o_.tls->certificate_summary().c_str());
     std::fflush(stdout);
 }
 
