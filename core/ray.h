@@ -2,6 +2,8 @@
 // Rays for seed finding. Rays are cast in voxel space (object space divided by spacing), where
 // every cell is a unit cube with integer corners (chapter 2.1.1): box tests are then with
 // axis-aligned unit boxes, and the ray parameter t is the same as in object space.
+#include <cmath>
+#include <limits>
 #include <ostream>
 
 #include <glm/mat4x4.hpp>
@@ -27,6 +29,50 @@ Ray pixel_ray(const glm::mat4& view_inverse, const Frustum& frustum, int width, 
 inline Ray to_voxel_space(const Ray& r, glm::vec3 spacing) {
     return {r.o / spacing, r.d / spacing};
 }
+
+// 1 / r.d per axis, for slab tests and cell walks; a huge value of the same sign where r.d is 0.
+inline glm::vec3 inverse_direction(const Ray& r) {
+    glm::vec3 inv;
+    for (int a = 0; a < 3; ++a)
+        inv[a] = std::abs(r.d[a]) > 1e-20f ? 1.0f / r.d[a] : std::copysign(1e30f, r.d[a]);
+    return inv;
+}
+
+// 3D DDA over unit cells (Amanatides and Woo): the cells a ray passes, in its order, from the cell
+// it is in at the start; `inv_d` is inverse_direction(r). Shared by the ray caster's walk through a
+// leaf brick and a footprint unit's pixel rays.
+struct CellWalk {
+    glm::ivec3 cell, step;
+    glm::vec3 t_next, t_delta;
+
+    CellWalk(const Ray& r, const glm::vec3& inv_d, glm::ivec3 start) : cell(start) {
+        for (int a = 0; a < 3; ++a) {
+            if (r.d[a] > 0) {
+                step[a] = 1;
+                t_next[a] = (static_cast<float>(cell[a] + 1) - r.o[a]) * inv_d[a];
+                t_delta[a] = inv_d[a];
+            } else if (r.d[a] < 0) {
+                step[a] = -1;
+                t_next[a] = (static_cast<float>(cell[a]) - r.o[a]) * inv_d[a];
+                t_delta[a] = -inv_d[a];
+            } else {
+                step[a] = 0;
+                t_next[a] = std::numeric_limits<float>::max();
+                t_delta[a] = std::numeric_limits<float>::max();
+            }
+        }
+    }
+    // Steps into the next cell; false when the ray leaves the cells [lo, hi) or passes t1 first.
+    bool next(glm::ivec3 lo, glm::ivec3 hi, float t1) {
+        const int a =
+            t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2) : (t_next.y < t_next.z ? 1 : 2);
+        if (t_next[a] > t1) return false;
+        cell[a] += step[a];
+        if (cell[a] < lo[a] || cell[a] >= hi[a]) return false;
+        t_next[a] += t_delta[a];
+        return true;
+    }
+};
 
 // Slab test against [lo, hi]: the entry and exit parameters, or false when the ray misses.
 bool intersect_box(const Ray& r, const glm::vec3& inv_d, glm::vec3 lo, glm::vec3 hi, float& t0,

@@ -39,8 +39,10 @@ bool FrameRun::cast(const FrameView& view, RegionCursor& c, const FrameOutput& o
     params_.keep_frontier = opt_.frontier_seeds && shown_ != nullptr;
     if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
     refine_params_ = opt_.propagation;
-    if (opt_.sampled_triangles) {
+    if (opt_.sampled_triangles)
         params_.samples = refine_params_.samples = sample_grid(view, ex_.volume().spacing());
+    if (footprint_) {  // (footprint units come with sampled_triangles only)
+        // Only a frame with footprint units takes samples: the others keep no depths.
         const SampleGrid& g = params_.samples;
         if (g.clip_from_voxel != depths_clip_ || g.width != depths_width_ ||
             g.height != depths_height_) {
@@ -96,6 +98,7 @@ void FrameRun::begin(const FrameView& view) {
     start_ = Clock::now();
     const ResolutionLevels levels =
         frame_levels(opt_, view, ex_.volume().spacing(), ex_.volume().bounds());
+    footprint_ = levels.footprint;
     if (opt_.begin_extractor_frame) ex_.begin_frame(view.iso, levels);
     if (masked()) {
         active_ = screen_mask_nodes(ex_, view.iso, levels);

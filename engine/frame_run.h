@@ -128,6 +128,7 @@ class FrameRun {
     // The nearest footprint samples of the view whose sample grid is `depths_clip_` (reset when
     // a cast brings another view: a wall rank's jobs for other tiles).
     SampleDepths depths_;
+    bool footprint_ = false;  // the frame's levels have footprint units
     glm::mat4 depths_clip_{0.0f};
     int depths_width_ = 0, depths_height_ = 0;
     std::vector<std::size_t> extra_;

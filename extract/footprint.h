@@ -67,7 +67,6 @@ class SampleDepths {
         width_ = width;
         for (std::size_t i = 0; i < n; ++i) slots_[i].store(kFar, std::memory_order_relaxed);
     }
-    bool empty() const { return size_ == 0; }
 
     // Whether a unit the centre ray of pixel (x, y) enters at `t` lies behind a sample taken.
     bool behind(int x, int y, float t) const {
@@ -101,7 +100,7 @@ class UnitBlock {
     static constexpr int kMaxSide = (1 << kMaxFootprintLevel) + 1;
 
     UnitBlock(const VolumeView<T>& v, glm::ivec3 base, int level, const InsideTest<T>& inside)
-        : base_(base), s_(1 << level), n_(s_ + 1) {
+        : base_(base), level_(level), s_(1 << level), n_(s_ + 1) {
         for (int z = 0; z < n_; ++z)
             for (int y = 0; y < n_; ++y) {
                 T* row = &value_[static_cast<std::size_t>((z * n_ + y) * n_)];
@@ -117,10 +116,10 @@ class UnitBlock {
             in_[static_cast<std::size_t>(i)] = inside(value_[static_cast<std::size_t>(i)]);
     }
 
+    int level() const { return level_; }
     int side() const { return s_; }
     glm::ivec3 base() const { return base_; }
     T value(int x, int y, int z) const { return value_[index(x, y, z)]; }
-    bool in(int x, int y, int z) const { return in_[index(x, y, z)] != 0; }
 
     // Whether the voxels of face `f` (axis f >> 1, side f & 1) lie on both sides of the
     // isovalue: whether the full-resolution surface crosses that face.
@@ -162,7 +161,7 @@ class UnitBlock {
         return static_cast<std::size_t>((z * n_ + y) * n_ + x);
     }
     glm::ivec3 base_;
-    int s_, n_;
+    int level_, s_, n_;
     std::array<T, kMaxSide * kMaxSide * kMaxSide> value_;
     std::array<std::uint8_t, kMaxSide * kMaxSide * kMaxSide> in_;
 };
@@ -348,43 +347,19 @@ FootprintHit first_hit_in_unit(const VolumeView<T>& v, const UnitBlock<T>& block
     FootprintHit hit;
     const int s = block.side();
     const glm::ivec3 base = block.base();
-    glm::vec3 inv_d;
-    for (int a = 0; a < 3; ++a)
-        inv_d[a] = std::abs(ray.d[a]) > 1e-20f ? 1.0f / ray.d[a] : std::copysign(1e30f, ray.d[a]);
+    const glm::vec3 inv_d = inverse_direction(ray);
     float t0, t1;
     if (!intersect_box(ray, inv_d, glm::vec3(base), glm::vec3(base + s), t0, t1) || t1 < 0)
         return hit;
     t0 = std::max(t0, 0.0f);
     if (depths && depths->behind(x, y, t0)) return hit;
-    // Cells within the unit, from its first.
-    glm::ivec3 c =
-        glm::clamp(glm::ivec3(glm::floor(ray.at(t0))) - base, glm::ivec3(0), glm::ivec3(s - 1));
-    glm::ivec3 step;
-    glm::vec3 t_next, t_delta;
-    for (int a = 0; a < 3; ++a) {
-        const float cell_lo = static_cast<float>(base[a] + c[a]);
-        if (ray.d[a] > 0) {
-            step[a] = 1;
-            t_next[a] = (cell_lo + 1.0f - ray.o[a]) * inv_d[a];
-            t_delta[a] = inv_d[a];
-        } else if (ray.d[a] < 0) {
-            step[a] = -1;
-            t_next[a] = (cell_lo - ray.o[a]) * inv_d[a];
-            t_delta[a] = -inv_d[a];
-        } else {
-            step[a] = 0;
-            t_next[a] = std::numeric_limits<float>::max();
-            t_delta[a] = std::numeric_limits<float>::max();
-        }
-    }
+    // The cells the ray passes within the unit, from the one it enters.
+    CellWalk walk(ray, inv_d,
+                  base + glm::clamp(glm::ivec3(glm::floor(ray.at(t0))) - base, glm::ivec3(0),
+                                    glm::ivec3(s - 1)));
     for (;;) {
-        if (hit_in_cell(v, block, c, iso, ray, hit, cells)) return hit;
-        const int a =
-            t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2) : (t_next.y < t_next.z ? 1 : 2);
-        if (t_next[a] > t1) return hit;
-        c[a] += step[a];
-        if (c[a] < 0 || c[a] >= s) return hit;
-        t_next[a] += t_delta[a];
+        if (hit_in_cell(v, block, walk.cell - base, iso, ray, hit, cells)) return hit;
+        if (!walk.next(base, base + s, t1)) return hit;
     }
 }
 
@@ -421,7 +396,6 @@ struct FootprintGrid {
 // unit is seen in, worked out once per unit (its rays are all but parallel).
 struct SampleShape {
     bool usable = false;
-    glm::vec3 d{0};                     // along the rays, voxel space
     std::array<glm::vec3, 3> offset{};  // counter-clockwise about d seen from the eye: normal d
 
     // The shape at voxel-space point `p` seen along `dir`.
@@ -441,7 +415,6 @@ struct SampleShape {
         const float r = kSampleRadiusPx / px;
         constexpr float kC = 0.8660254f;  // cos 30 degrees: corners at 90, 210 and 330 degrees
         shape.usable = true;
-        shape.d = d;
         shape.offset = {r * e2, r * (-kC * e1 - 0.5f * e2), r * (kC * e1 - 0.5f * e2)};
         return shape;
     }

@@ -323,14 +323,7 @@ class Propagator {
         g.iso = iso;
         g.refinement = true;
         cache_.clear();
-        const int s = 1 << level;
-        double corner[8];
-        for (int z = 0; z < s; ++z)
-            for (int y = 0; y < s; ++y)
-                for (int x = 0; x < s; ++x)
-                    triangulate(base + glm::ivec3(x, y, z), 0, iso, p, g.mesh, corner,
-                                !p.samples.active ||
-                                    p.samples.may_cover_a_centre(base + glm::ivec3(x, y, z), 1));
+        triangulate_cells(base, level, iso, p, g.mesh);
         extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return g;
     }
@@ -359,6 +352,21 @@ class Propagator {
         return cs;
     }
 
+    // The cells of the meta-cell of `level` at `base` at full resolution, those that may cover a
+    // pixel centre triangulated.
+    void triangulate_cells(glm::ivec3 base, int level, double iso, const PropagationParams& p,
+                           Mesh& mesh) {
+        const int s = 1 << level;
+        double corner[8];
+        for (int z = 0; z < s; ++z)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x) {
+                    const glm::ivec3 c = base + glm::ivec3(x, y, z);
+                    triangulate(c, 0, iso, p, mesh, corner,
+                                !p.samples.active || p.samples.may_cover_a_centre(c, 1));
+                }
+    }
+
     // A footprint unit's picture: inside the frame, a sample triangle for each pixel centre whose
     // ray meets the full-resolution surface in it; reaching past the frame (whose neighbouring
     // frames' centres are not known here) or with no sample grid, its cells' full-resolution
@@ -370,14 +378,7 @@ class Propagator {
         const SampleGrid::WindowBox box =
             p.samples.active ? p.samples.window_box(base, s) : SampleGrid::WindowBox{};
         if (box.reach != SampleGrid::Reach::inside) {
-            double corner[8];
-            for (int z = 0; z < s; ++z)
-                for (int y = 0; y < s; ++y)
-                    for (int x = 0; x < s; ++x) {
-                        const glm::ivec3 c = base + glm::ivec3(x, y, z);
-                        triangulate(c, 0, iso, p, mesh, corner,
-                                    !p.samples.active || p.samples.may_cover_a_centre(c, 1));
-                    }
+            triangulate_cells(base, block.level(), iso, p, mesh);
             return;
         }
         const FootprintGrid grid = p.samples.footprint();

@@ -56,9 +56,7 @@ class RayCaster {
     RayHit cast(const Ray& ray, double iso, IntersectMode mode,
                 float t_max = std::numeric_limits<float>::max()) {
         ray_ = ray;
-        for (int a = 0; a < 3; ++a)
-            inv_d_[a] =
-                std::abs(ray.d[a]) > 1e-20f ? 1.0f / ray.d[a] : std::copysign(1e30f, ray.d[a]);
+        inv_d_ = inverse_direction(ray);
         iso_ = iso;
         inside_ = InsideTest<T>(iso);
         mode_ = mode;
@@ -138,32 +136,10 @@ class RayCaster {
     // 3D DDA through the cells of one leaf brick [b, e) from t0 to t1.
     bool walk_brick(glm::ivec3 b, glm::ivec3 e, float t0, float t1) {
         const glm::vec3 p = ray_.at(t0);
-        glm::ivec3 c = clamp_cells(glm::ivec3(glm::floor(p)), b, e - 1);
-        glm::ivec3 step;
-        glm::vec3 t_next, t_delta;
-        for (int a = 0; a < 3; ++a) {
-            if (ray_.d[a] > 0) {
-                step[a] = 1;
-                t_next[a] = (static_cast<float>(c[a] + 1) - ray_.o[a]) * inv_d_[a];
-                t_delta[a] = inv_d_[a];
-            } else if (ray_.d[a] < 0) {
-                step[a] = -1;
-                t_next[a] = (static_cast<float>(c[a]) - ray_.o[a]) * inv_d_[a];
-                t_delta[a] = -inv_d_[a];
-            } else {
-                step[a] = 0;
-                t_next[a] = std::numeric_limits<float>::max();
-                t_delta[a] = std::numeric_limits<float>::max();
-            }
-        }
+        CellWalk walk(ray_, inv_d_, clamp_cells(glm::ivec3(glm::floor(p)), b, e - 1));
         for (;;) {
-            if (test_unit(c, 0)) return true;
-            const int a =
-                t_next.x < t_next.y ? (t_next.x < t_next.z ? 0 : 2) : (t_next.y < t_next.z ? 1 : 2);
-            if (t_next[a] > t1) return false;
-            c[a] += step[a];
-            if (c[a] < b[a] || c[a] >= e[a]) return false;
-            t_next[a] += t_delta[a];
+            if (test_unit(walk.cell, 0)) return true;
+            if (!walk.next(b, e, t1)) return false;
         }
     }
 
