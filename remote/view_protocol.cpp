@@ -135,7 +135,13 @@ static HelloMsg decode_hello(std::span<const std::byte> bytes) {
         if (m.role == SessionRole::none && !m.session.empty())
             r.fail("session: a name without a role");
     }
-    if (version >= 3) m.takes_exact = get_flag(r, "takes_exact");
+    if (version >= 3) {
+        // Version 3 exists to say 1; a hello without it is version 1 or 2, so that every hello has
+        // one encoding.
+        m.takes_exact = get_flag(r, "takes_exact");
+        if (!m.takes_exact)
+            r.fail("takes_exact: 0 in a version 3 hello, which is sent only with 1");
+    }
     r.finish();
     return m;
 }

@@ -81,8 +81,8 @@ TEST(RemoteProtocolMalformed, SharedHelloFields) {
                               [](HelloMsg& m) { m.role = static_cast<SessionRole>(3); }}});
 }
 
-// A hello that takes exact values is version 3, with or without a role; its flag is 0 or 1, and
-// without a role it names no session.
+// A hello that takes exact values is version 3, with or without a role; its flag is 1 (0 is
+// version 1 or 2's), and without a role it names no session.
 TEST(RemoteProtocolMalformed, ExactHelloFields) {
     HelloMsg exact = sample_exact_hello();
     EXPECT_EQ(encode_payload(exact)[0], std::byte{3});
@@ -101,6 +101,15 @@ TEST(RemoteProtocolMalformed, ExactHelloFields) {
         what = e.what();
     }
     EXPECT_NE(what.find("takes_exact: expected 0 or 1, got 2"), std::string::npos) << what;
+    // A version 3 hello that says 0 would encode back as version 1: one message, one encoding.
+    bytes.back() = std::byte{0};
+    what.clear();
+    try {
+        decode_payload(RemoteTag::hello, bytes);
+    } catch (const WireError& e) {
+        what = e.what();
+    }
+    EXPECT_NE(what.find("takes_exact: 0 in a version 3 hello"), std::string::npos) << what;
     expect_faults<HelloMsg>(
         exact, {{"session: a name without a role", [](HelloMsg& m) { m.session.assign(1, 'x'); }},
                 {"role: 3, expected 0 (none), 1 (presenter) or 2 (follower)",

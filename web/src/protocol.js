@@ -257,7 +257,11 @@ const decoders = {
       m.session = getText(r, 'session', kMaxSessionNameBytes, m.role === 0);
       if (m.role === 0 && m.session !== '') r.fail('session: a name without a role');
     }
-    if (version >= 3) m.takes_exact = getFlag(r, 'takes_exact');
+    if (version >= 3) {
+      // Version 3 exists to say 1: a hello without it is version 1 or 2, one encoding per hello.
+      m.takes_exact = getFlag(r, 'takes_exact');
+      if (!m.takes_exact) r.fail('takes_exact: 0 in a version 3 hello, which is sent only with 1');
+    }
     return m;
   },
   session(r) {

@@ -118,6 +118,8 @@ test('a hello that takes exact values is version 3, with or without a role, as t
   const flag = encodePayload(MsgType.hello, mine);
   flag[flag.length - 1] = 2;
   assert.throws(() => decodePayload(MsgType.hello, flag), /^WireError: hello message: takes_exact: expected 0 or 1, got 2$/);
+  flag[flag.length - 1] = 0;  // would encode back as version 1: one encoding per hello
+  assert.throws(() => decodePayload(MsgType.hello, flag), /^WireError: hello message: takes_exact: 0 in a version 3 hello/);
   const named = encodePayload(MsgType.hello, { ...mine, session: 'x' });
   assert.throws(() => decodePayload(MsgType.hello, named), /^WireError: hello message: session: a name without a role$/);
 });
