@@ -4,8 +4,12 @@ at each isovalue its README suggests, at 1x, 2x and 4x a side where that fits in
 default `isowall render` (no engine option, warm, 1600x1200, front view) timed to C = 90/99/99.9%
 against the full surface at full resolution (`--against-full`: the truth, not the engine's own
 final image) and against its own final image, the final image against the truth (C, coverage
-IoU), the triangles drawn by C = 99%, and the FE + Embree peer at the same size (VTK flying edges
-on 2 threads, an Embree BVH and primary rays; scripts/fe_mesh.py and bench/peer).
+IoU), the triangles drawn by C = 99%, the FE + Embree peer at the same size (VTK flying edges
+on 2 threads, an Embree BVH and primary rays; scripts/fe_mesh.py and bench/peer), and the peak
+memory (RSS) of `isowall render` as a user runs it: once with no option but the volume, the
+isovalue and the size, and once with --warm-up (a second frame, as a wall's frames find the
+process; a volume of 256 MiB or more is then copied into huge pages). The timed runs compare with
+the full surface and the truth, whose renders would set their peak, so they are not used for it.
 
 Usage: /usr/bin/python3 scripts/bench_volumes.py [--scales 1,2,4] [--volumes engine,tooth]
            [--isos first|all] [--runs 3] [--size 1600x1200] [--build build]
@@ -137,6 +141,17 @@ def render(a, volume, iso, tmp):
     return res
 
 
+def peak_rss_mib(a, volume, iso, tmp, *extra):
+    """The peak RSS in MiB that `isowall render` prints, run with only the volume, the isovalue, the
+    size and `extra`."""
+    out = bs.run([a.isowall, "render", "-v", volume, "--iso", f"{iso:g}", "--size", a.size, "-q",
+                  "--out", os.path.join(tmp, "plain.png"), *extra], f"isowall render {volume} --iso {iso:g}")
+    m = re.search(r"\| peak RSS ([\d.]+) MiB", out)
+    if not m:
+        raise bs.BenchError(f"isowall render {volume}: no peak RSS in its timing line")
+    return float(m.group(1))
+
+
 def median_by_own_c99(runs):
     """The median run by time to C = 99% of its own final image; a run that never reached it counts
     as infinitely slow (it stays in the median, never dropped)."""
@@ -161,13 +176,17 @@ def measure(a, name, iso, mc_triangles, scale, tmp):
     bs.run([a.isowall, "info", "-v", volume], "isowall info")  # the octree cache, untimed
     runs = [render(a, volume, iso, tmp) for _ in range(a.runs)]
     case["engine"] = dict(median_by_own_c99(runs), runs=runs)
+    case["voxel_bytes"] = voxels * dtype.itemsize
+    case["rss_mib"] = {"plain": peak_rss_mib(a, volume, iso, tmp),
+                       "warm": peak_rss_mib(a, volume, iso, tmp, "--warm-up")}
     if not a.no_peer:
         a.iso = iso
         peers = [bs.peer(a, volume, tmp) for _ in range(a.runs)]
         case["peer"] = bs.median_run(peers, "total_s")
     e = case["engine"]
     print(f"{name} {iso:g} {scale:g}x: C=99% (own) {e['own']['c99']} s, C_T {e['ct']:.5f} (full {e['full_ct']:.5f}), "
-          f"gate {'holds' if e['gate'] else 'FAILS'}, peer {case.get('peer', {}).get('total_s')} s", flush=True)
+          f"gate {'holds' if e['gate'] else 'FAILS'}, peer {case.get('peer', {}).get('total_s')} s, "
+          f"peak RSS {case['rss_mib']['plain']:.0f} / {case['rss_mib']['warm']:.0f} MiB (plain / warm)", flush=True)
     return case
 
 

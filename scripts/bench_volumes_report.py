@@ -10,6 +10,9 @@ GATE_C, GATE_IOU = 0.005, 0.002
 GROWTH_LIMIT, GROWTH_RESOLVED = 1.5, 2.0  # time to C = 99% of the own final image, 1x to 4x
 PEER_LIMIT = 1 / 20  # that time over FE + Embree, at 4x
 TRIS_PER_PX_LIMIT = 2.0  # triangles drawn by C = 99% per covered pixel, every scale
+# Peak RSS of a default render at 4x, plain or warm: at most this many times the voxels' bytes
+# plus RSS_BASE_MIB. Memory is not a speed figure: it is judged without the gate.
+RSS_VOXELS, RSS_BASE_MIB = 1.5, 200
 
 
 def fmt(x, digits=3):
@@ -45,6 +48,15 @@ def drawn_per_px(case):
     if not e or e.get("drawn") is None or not e["covered_px"]:
         return None
     return e["drawn"] / e["covered_px"]
+
+
+def rss_ratio(case):
+    """The larger peak RSS of the plain and the warm render over its limit; None where not measured
+    (runs saved before it was)."""
+    r = case.get("rss_mib")
+    if not r or not case.get("voxel_bytes"):
+        return None
+    return max(r["plain"], r["warm"]) / (RSS_VOXELS * case["voxel_bytes"] / 2**20 + RSS_BASE_MIB)
 
 
 def peer_ratio(case):
@@ -98,6 +110,8 @@ def verdicts(cases):
              "skipped": [f"{c['scale']:g}x: {c['skipped']}" for c in cs if "skipped" in c]}
         r["peer_holds"] = judged(r["peer_ratio_4x"], PEER_LIMIT, gate(top) if top else None)
         r["tris_holds"] = judged(worst_tris, TRIS_PER_PX_LIMIT, gate_all)
+        r["rss_ratio_4x"] = rss_ratio(top) if at4 else None
+        r["rss_holds"] = None if r["rss_ratio_4x"] is None else r["rss_ratio_4x"] <= 1
         rows.append(r)
     return rows
 
@@ -109,10 +123,10 @@ def word(holds):
 def volume_table(cs):
     lines = ["| scale | voxels | C=99% own s | every ray s | C=99% vs full s | C_T final / full | "
              "IoU_T final / full | gate | C vs full | triangles by C=99% | per covered px | "
-             "drawn / px (frame) | FE+Embree s | C=99% / peer |", "|" + "---|" * 14]
+             "drawn / px (frame) | FE+Embree s | C=99% / peer | peak RSS MiB plain / warm |", "|" + "---|" * 15]
     for c in cs:
         if "skipped" in c:
-            lines.append(f"| {c['scale']:g}x | {c['voxels'] / 1e6:.0f} M | skipped: {c['skipped']} |" + " |" * 11)
+            lines.append(f"| {c['scale']:g}x | {c['voxels'] / 1e6:.0f} M | skipped: {c['skipped']} |" + " |" * 12)
             continue
         e = c["engine"]
         lines.append(
@@ -120,8 +134,14 @@ def volume_table(cs):
             f"{fmt(e['truth']['c99'])} | {e['ct']:.5f} / {e['full_ct']:.5f} | "
             f"{e['iou_t']:.5f} / {e['full_iou_t']:.5f} | {'holds' if e['gate'] else 'FAILS'} | "
             f"{e['c_vs_full']:.5f} | {e['own'].get('tris_c99') or '-'} | {fmt(tris_per_px(c), 2)} | "
-            f"{fmt(drawn_per_px(c), 2)} | {fmt(c.get('peer', {}).get('total_s'))} | {fmt(peer_ratio(c))} |")
+            f"{fmt(drawn_per_px(c), 2)} | {fmt(c.get('peer', {}).get('total_s'))} | {fmt(peer_ratio(c))} | "
+            f"{rss_cell(c)} |")
     return "\n".join(lines)
+
+
+def rss_cell(case):
+    r = case.get("rss_mib")
+    return "-" if not r else f"{r['plain']:.0f} / {r['warm']:.0f}"
 
 
 def report(meta, cases):
@@ -140,7 +160,8 @@ def report(meta, cases):
     out += ["## Targets", "",
             f"| volume | iso | fidelity gate, every scale | worst C_T - full C_T | growth of C=99%, 1x to "
             f"largest | {GROWTH_LIMIT}x ({GROWTH_RESOLVED}x to resolve) | C=99% / peer at 4x | 1/20 | "
-            f"worst triangles drawn per px | <= {TRIS_PER_PX_LIMIT:g} | skipped |", "|" + "---|" * 11]
+            f"worst triangles drawn per px | <= {TRIS_PER_PX_LIMIT:g} | peak RSS at 4x / "
+            f"({RSS_VOXELS:g} x voxels + {RSS_BASE_MIB} MiB) | <= 1 | skipped |", "|" + "---|" * 13]
     for r in rows:
         g = "-" if r["growth"] is None else (
             "missed" if r["growth"] == math.inf else f"{r['growth']:.2f}x (to {r['top_scale']:g}x)")
@@ -149,7 +170,7 @@ def report(meta, cases):
         out.append(f"| {r['volume']} | {r['iso']:g} | {word(r['gate_holds'])} | "
                    f"{fmt(r['worst_ct_margin'], 5)} | {g} | {gw} | {fmt(r['peer_ratio_4x'])} | "
                    f"{word(r['peer_holds'])} | {fmt(r['tris_per_px'], 2)} | {word(r['tris_holds'])} | "
-                   f"{'; '.join(r['skipped']) or '-'} |")
+                   f"{fmt(r['rss_ratio_4x'], 2)} | {word(r['rss_holds'])} | {'; '.join(r['skipped']) or '-'} |")
     out += ["", "## The worst case", ""]
 
     def worst(key, pick):
@@ -158,7 +179,8 @@ def report(meta, cases):
     for key, pick, what in (("growth", max, "growth of C = 99% of the own final image"),
                             ("worst_ct_margin", min, "final C_T less the full surface's"),
                             ("peer_ratio_4x", max, "C = 99% over FE + Embree at 4x"),
-                            ("tris_per_px", max, "triangles drawn per covered pixel (made, in older runs)")):
+                            ("tris_per_px", max, "triangles drawn per covered pixel (made, in older runs)"),
+                            ("rss_ratio_4x", max, "peak RSS at 4x over its limit")):
         r = worst(key, pick)
         out.append(f"- {what}: " + ("not measured" if r is None else
                                     f"{r[key]:.4g} ({r['volume']}, iso {r['iso']:g})"))

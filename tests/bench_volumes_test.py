@@ -3,7 +3,7 @@
 the shared tooth at half and full size on a small screen writes a table per isovalue, the
 targets, the worst case, the JSON and a plot, with times against the full surface in order and
 the final image matching it; a memory share too small for any case skips every case and says
-why; the verdicts judge the fidelity gate, growth, peer and triangles, with missed runs counted
+why; the verdicts judge the fidelity gate, growth, peer, triangles and peak memory, with missed runs counted
 as missed; bad options give one line and status 1. The runs skip without ../shared/data; the
 verdict tests do not.
 
@@ -106,6 +106,29 @@ class Verdicts(unittest.TestCase):
         self.assertAlmostEqual(w["tris_per_px"], 1.5)
         self.assertTrue(w["tris_holds"])
 
+    def test_peak_memory_is_judged_at_4x_on_the_larger_of_plain_and_warm(self):
+        top = case(4, 0.3)
+        top["voxel_bytes"] = 1000 * 2**20  # limit: 1.5 x 1000 + 200 = 1700 MiB
+        top["rss_mib"] = {"plain": 1200.0, "warm": 1700.0}
+        (v,) = report.verdicts([case(1, 0.2), top])
+        self.assertAlmostEqual(v["rss_ratio_4x"], 1.0)
+        self.assertTrue(v["rss_holds"])  # at the boundary
+        top["rss_mib"] = {"plain": 1700.5, "warm": 900.0}
+        (w,) = report.verdicts([case(1, 0.2), top])
+        self.assertFalse(w["rss_holds"])
+        # Memory is not a speed figure: a failed gate does not decide it.
+        top["engine"]["gate"] = False
+        top["rss_mib"] = {"plain": 1000.0, "warm": 1000.0}
+        (g,) = report.verdicts([case(1, 0.2), top])
+        self.assertTrue(g["rss_holds"])
+        # Not measured (an older saved run, or no 4x): no verdict, and the tables say "-".
+        (n,) = report.verdicts([case(1, 0.2), case(4, 0.3)])
+        self.assertIsNone(n["rss_holds"])
+        text = report.report({"date": "d", "cores": 2, "load_average": [0], "size": "s", "runs": 1,
+                              "seconds": 1}, [case(1, 0.2), top])
+        self.assertIn("| 1000 / 1000 |", text)
+        self.assertIn("peak RSS at 4x over its limit: 0.5882", text)
+
     def test_without_4x_growth_is_printed_not_judged(self):
         (h,) = report.verdicts([case(1, 0.1), case(2, 0.3)])
         self.assertAlmostEqual(h["growth"], 3.0)
@@ -157,6 +180,8 @@ class BenchVolumes(unittest.TestCase):
                 self.assertTrue(c["engine"]["gate"], c)
                 self.assertIsNotNone(c["engine"]["own"]["c99"], c)
                 self.assertGreater(c["engine"]["own"]["tris_c99"], 0)
+                # The plain and the warm render's peak memory, each more than the voxels.
+                self.assertGreater(min(c["rss_mib"].values()), c["voxel_bytes"] / 2**20, c)
             self.assertEqual(cases[1]["sizes"], [103, 94, 161])
             with open(os.path.join(out, "volumes.md")) as f:
                 text = f.read()

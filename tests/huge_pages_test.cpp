@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "tests/test_util.h"
 #include "volume/huge_pages.h"
+#include "volume/mapped_file.h"
 #include "volume/octree.h"
 #include "volume/phantom.h"
 #include "volume/volume.h"
@@ -204,6 +205,79 @@ TEST(HugePages, CopiedVolumesReadAsBefore) {
         const glm::ivec3 p(int(i % 9), int(i / 9 % 7), int(i / 63));
         ASSERT_EQ(view.at(p.x, p.y, p.z), voxels[i]) << "voxel " << i;
     }
+}
+
+// The resident bytes of the mapping that holds `at`, from /proc/self/smaps (its "Rss:" line).
+std::size_t resident_bytes(const void* at) {
+    std::ifstream smaps("/proc/self/smaps");
+    const auto a = reinterpret_cast<std::uintptr_t>(at);
+    bool inside = false;
+    for (std::string line; std::getline(smaps, line);) {
+        std::uintptr_t lo = 0, hi = 0;
+        char dash = 0;
+        std::istringstream range(line);
+        if (range >> std::hex >> lo >> dash >> hi && dash == '-') {
+            inside = lo <= a && a < hi;
+        } else if (inside && line.rfind("Rss:", 0) == 0) {
+            return std::stoull(line.substr(4)) * 1024;
+        }
+    }
+    ADD_FAILURE() << "no mapping holds the address in /proc/self/smaps";
+    return 0;
+}
+
+TEST(HugePages, AMapLetsGoOfThePartsItWasAskedTo) {
+    const auto dir = test::scratch_dir("huge_pages_release");
+    const std::size_t size = 8 * kMiB;
+    {
+        std::vector<char> bytes(size);
+        for (std::size_t i = 0; i < size; ++i) bytes[i] = char(i * 131 >> 7);
+        std::ofstream(dir / "f.bin", std::ios::binary).write(bytes.data(), std::streamsize(size));
+    }
+    const MappedFile map(dir / "f.bin", true);
+    const auto all = map.bytes();
+    std::size_t sum = 0;
+    for (std::size_t i = 0; i < size; i += 4096) sum += std::to_integer<unsigned>(all[i]);
+    EXPECT_GE(resident_bytes(all.data()), size);
+    // At least the part goes (a kernel that maps the file in large pages may drop the whole
+    // large page around the part's end, which a later read maps again).
+    map.release(all.first(size / 2 + 100));
+    EXPECT_LE(resident_bytes(all.data()), size / 2);
+    map.release(all.subspan(size / 2));
+    EXPECT_EQ(resident_bytes(all.data()), 0u);
+    // What was let go of reads as before.
+    std::size_t again = 0;
+    for (std::size_t i = 0; i < size; i += 4096) again += std::to_integer<unsigned>(all[i]);
+    EXPECT_EQ(again, sum);
+    EXPECT_EQ(all[size - 1], std::byte(char((size - 1) * 131 >> 7)));
+}
+
+// A volume of several of the copy's parts (64 MiB each), after a header: every voxel arrives.
+TEST(HugePages, AVolumeOfSeveralPartsIsCopiedWhole) {
+    const auto dir = test::scratch_dir("huge_pages_parts");
+    const glm::ivec3 dims(1024, 1024, 130);  // 130 MiB: two whole parts and a short one
+    const std::size_t n = std::size_t(dims.x) * dims.y * dims.z;
+    auto value = [](std::size_t i) { return std::uint8_t((i * 2654435761u) >> 13); };
+    {
+        std::vector<std::uint8_t> voxels(n);
+        for (std::size_t i = 0; i < n; ++i) voxels[i] = value(i);
+        std::ofstream out(dir / "v.raw", std::ios::binary);
+        out << "HEADER";
+        out.write(reinterpret_cast<const char*>(voxels.data()), std::streamsize(n));
+    }
+    RawSpec spec;
+    spec.dims = dims;
+    spec.type = VoxelType::u8;
+    spec.header_bytes = 6;
+    Volume v = load_volume(dir / "v.raw", spec);
+    ASSERT_TRUE(v.mapped());
+    v.copy_to_huge_pages();
+    ASSERT_TRUE(v.in_huge_pages());
+    const auto bytes = v.bytes();
+    ASSERT_EQ(bytes.size(), n);
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < n; ++i) wrong += bytes[i] != std::byte{value(i)};
+    EXPECT_EQ(wrong, 0u);
 }
 
 }  // namespace

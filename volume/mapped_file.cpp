@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
@@ -54,6 +56,20 @@ MappedFile& MappedFile::operator=(MappedFile&& other) noexcept {
         size_ = std::exchange(other.size_, 0);
     }
     return *this;
+}
+
+void MappedFile::release(std::span<const std::byte> part) const {
+    if (!data_ || part.empty()) return;
+    const auto lo = std::max(reinterpret_cast<std::uintptr_t>(part.data()),
+                             reinterpret_cast<std::uintptr_t>(data_));
+    const auto hi = std::min(reinterpret_cast<std::uintptr_t>(part.data() + part.size()),
+                             reinterpret_cast<std::uintptr_t>(data_ + size_));
+    if (lo >= hi) return;
+    // madvise takes a page-aligned start; the page it rounds down into is the map's too.
+    const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGE_SIZE));
+    const std::uintptr_t start = lo / page * page;
+    // Advice only: a map the kernel will not let go of keeps its pages, and nothing is lost.
+    ::madvise(reinterpret_cast<void*>(start), hi - start, MADV_DONTNEED);
 }
 
 MappedFile::~MappedFile() {

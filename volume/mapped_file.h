@@ -25,6 +25,10 @@ class MappedFile {
 
     std::span<const std::byte> bytes() const { return {data_, size_}; }
     std::size_t size() const { return size_; }
+    // Lets go of the pages of `part` (clipped to the map) in this process: the file's pages stay
+    // in the page cache, and a later read of them maps them again. A copy of the map taken part
+    // by part, each part let go of once copied, holds the file once instead of twice at its peak.
+    void release(std::span<const std::byte> part) const;
 
   private:
     const std::byte* data_ = nullptr;

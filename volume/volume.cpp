@@ -102,7 +102,16 @@ Volume::Volume(glm::ivec3 dims, VoxelType type, glm::vec3 spacing,
 void Volume::copy_to_huge_pages() {
     if (bricks_) return;  // a store's bricks: a copy would read every one
     HugePageBuffer buffer(bytes_.size());
-    std::copy(bytes_.begin(), bytes_.end(), buffer.bytes().begin());
+    // Part by part, each part of a file's map let go of once copied: the process holds the
+    // voxels about once while it copies them, where a whole copy before the unmap held them twice
+    // (7.6 GiB at its peak for the 3.9 GB head).
+    constexpr std::size_t kPart = std::size_t{64} << 20;
+    for (std::size_t at = 0; at < bytes_.size(); at += kPart) {
+        const auto part = bytes_.subspan(at, std::min(kPart, bytes_.size() - at));
+        std::copy(part.begin(), part.end(),
+                  buffer.bytes().begin() + static_cast<std::ptrdiff_t>(at));
+        file_.release(part);
+    }
     huge_ = std::move(buffer);
     bytes_ = huge_.bytes();
     file_ = MappedFile();
