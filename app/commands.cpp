@@ -15,7 +15,7 @@
 #include "engine/progressive_engine.h"
 #include "extract/surface_extractor.h"
 #include "files/image_io.h"
-#include "files/ply.h"
+#include "files/mesh_formats.h"
 #include "readers/voxel_ops.h"
 #include "render/renderer.h"
 #include "volume/phantom.h"
@@ -311,6 +311,12 @@ int run_info(const InfoOptions& o) {
 
 int run_extract(const ExtractOptions& o) {
     check_outputs({{"--out", o.out}});
+    const std::optional<MeshFormat> format = mesh_format_of(o.out);
+    if (!format)
+        throw InputError(o.out, "--out",
+                         "unknown mesh format " +
+                             quote(std::filesystem::path(o.out).extension().string()) +
+                             ": expected " + mesh_formats_named());
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
@@ -319,7 +325,7 @@ int run_extract(const ExtractOptions& o) {
     Mesh mesh = extract_timed(*ex, iso, t);
     print_paging(ov);
     Stopwatch sw;
-    write_ply(o.out, mesh);
+    write_mesh(o.out, mesh, *format);
     t.write = sw.seconds();
     std::printf("wrote %s\n", o.out.c_str());
     t.print(mesh.triangle_count());

@@ -237,10 +237,17 @@ ProgramCli::ProgramCli() {
     info_cmd = app.add_subcommand("info", "Print a volume's size, type, value range and octree");
     add_volume_options(*info_cmd, info.volume);
 
-    ex_cmd = app.add_subcommand("extract", "Extract the full isosurface to a binary PLY file");
+    ex_cmd = app.add_subcommand(
+        "extract",
+        "Extract the full isosurface to a mesh file: PLY, STL, OBJ, VTK PolyData or binary glTF");
     add_volume_options(*ex_cmd, ex.volume);
     add_iso_option(*ex_cmd, ex.iso);
-    ex_cmd->add_option("--out,-o", ex.out, "Output PLY file")->required();
+    ex_cmd
+        ->add_option("--out,-o", ex.out,
+                     "Output mesh, its format by the extension: .ply (binary, with normals), .stl "
+                     "(binary), .obj, .vtp (VTK XML PolyData, for ParaView) or .glb (binary glTF "
+                     "2.0). Positions in object units (voxel index times spacing)")
+        ->required();
 
     re_cmd = add_render_command(app, re);
     wall_cmd = add_wall_command(app, wall);
