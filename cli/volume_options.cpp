@@ -7,6 +7,7 @@
 #include "core/number.h"
 #include "core/util.h"
 #include "readers/read_volume.h"
+#include "readers/zarr_reader.h"
 #include "store/open_store.h"
 #include "store/store_format.h"
 #include "volume/octree.h"
@@ -100,8 +101,13 @@ std::filesystem::path cache_dir(const VolumeOptions& o) {
     return o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
 }
 
+// A store `isowall import` wrote (paged); another tool's Zarr store is read by the readers.
+bool own_store(const std::string& path) {
+    return store::is_store(path) && !formats::is_foreign_zarr(path);
+}
+
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
-    if (o.path.empty() || store::is_store(o.path)) return nullptr;
+    if (o.path.empty() || own_store(o.path)) return nullptr;
     check_no_memory_limit(o);
     return formats::open_planes(o.path, raw_spec(o));
 }
@@ -125,7 +131,7 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         if (!o.dims.empty() || !o.type.empty())
             throw InputError("--dims/--type", "--volume", "raw options need --volume FILE");
         out.volume = make_phantom();
-    } else if (store::is_store(o.path)) {
+    } else if (own_store(o.path)) {
         if (!o.dims.empty() || !o.type.empty())
             throw InputError(o.path, "--dims/--type", "a store carries its own size and type");
         const std::uint64_t cap = memory_limit(o, use);

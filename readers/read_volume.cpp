@@ -1,4 +1,5 @@
 #include "readers/read_volume.h"
+#include "readers/zarr_reader.h"
 
 #include <algorithm>
 #include <array>
@@ -69,6 +70,13 @@ std::unique_ptr<PlaneSource> dicom_stream(const fs::path& p) {
     return stream_isolated(p.string(), "the DICOM decoder (GDCM)", [&] { return dicom_planes(p); });
 }
 
+// Zarr chunks decoded by c-blosc, zstd, zlib and lz4 in a child as well: a decoder's crash on a
+// damaged chunk is one line.
+Volume zarr(const fs::path& dir) {
+    return read_isolated(dir.string(), "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)",
+                         [&] { return read_zarr(dir); });
+}
+
 std::unique_ptr<PlaneSource> hdf5_stream(const fs::path& file, const std::string& dataset) {
     return stream_isolated(file.string(), "the HDF5 library (libhdf5)",
                            [&] { return hdf5_planes(file, dataset); });
@@ -113,8 +121,10 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path,
     if (raw) return raw_planes(path, *raw);
     const fs::path p(path);
     std::error_code ec;
-    if (fs::is_directory(p, ec))
+    if (fs::is_directory(p, ec)) {
+        if (is_foreign_zarr(p)) return nullptr;  // read whole (read_volume)
         return is_tiff_folder(p) ? streamed(tiff_planes(p), p) : dicom_stream(p);
+    }
     const std::size_t colon = path.rfind(":/");
     if (colon != std::string::npos && !fs::exists(p, ec)) {
         const std::string file = path.substr(0, colon);
@@ -128,7 +138,10 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, b
     if (raw) return load_raw(path, *raw, populate);
     const fs::path p(path);
     std::error_code ec;
-    if (fs::is_directory(p, ec)) return is_tiff_folder(p) ? read_tiff_stack(p) : dicom(p);
+    if (fs::is_directory(p, ec)) {
+        if (is_foreign_zarr(p)) return zarr(p);
+        return is_tiff_folder(p) ? read_tiff_stack(p) : dicom(p);
+    }
     // FILE.h5:/path/to/dataset, when FILE.h5 is a file (a name may hold a colon itself).
     const std::size_t colon = path.rfind(":/");
     if (colon != std::string::npos && !fs::exists(p, ec)) {

@@ -1,6 +1,8 @@
 #pragma once
 // --volume: picks the reader by what the path is (readers/readers.h).
-//   a folder                     a DICOM series, or a stack of TIFF slices
+//   a folder                     a Zarr v2 array or OME-Zarr image (zarr_reader.h; isowall's own
+//                                stores page instead: store/open_store.h), a DICOM series, or a
+//                                stack of TIFF slices
 //   .nii .nii.gz .hdr .img       NIfTI-1 or NIfTI-2
 //   .mhd .mha                    MetaImage
 //   FILE.h5:/path (.hdf5 .he5)   the HDF5 dataset at /path (the file's only one without :/path)

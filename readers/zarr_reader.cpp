@@ -1,0 +1,431 @@
+#include "readers/zarr_reader.h"
+
+#include <blosc.h>
+#include <lz4.h>
+#include <zlib.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "files/input_file.h"
+#include "readers/voxel_ops.h"
+
+namespace isowall::formats {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr std::size_t kMaxMetadataBytes = std::size_t{1} << 20;
+// A chunk decoded at most: larger chunks than this are not a volume's (and would be a claim to
+// check before any allocation).
+constexpr std::size_t kMaxChunkBytes = std::size_t{1} << 30;
+
+json read_json(const fs::path& file) {
+    const std::string text = read_input_file(file, "metadata", kMaxMetadataBytes);
+    try {
+        return json::parse(text);
+    } catch (const json::exception& e) {
+        throw InputError(file.string(), "JSON", e.what());
+    }
+}
+
+// A folder's .zattrs, or null where it has none.
+json attributes(const fs::path& dir) {
+    std::error_code ec;
+    return fs::exists(dir / ".zattrs", ec) ? read_json(dir / ".zattrs") : json();
+}
+
+struct ZarrArray {
+    fs::path dir;
+    std::vector<std::int64_t> shape, chunks;  // slowest axis first, as Zarr lists them
+    VoxelType type = VoxelType::u8;
+    bool big_endian = false;
+    bool fortran = false;   // order "F": the first axis varies fastest in a chunk
+    std::string separator;  // between a chunk key's indices: "." or "/"
+    json compressor;        // null: none
+    json fill;              // null: 0
+
+    std::size_t item() const { return voxel_size(type); }
+    std::size_t chunk_elements() const {
+        std::size_t n = 1;
+        for (std::int64_t c : chunks) n *= static_cast<std::size_t>(c);
+        return n;
+    }
+};
+
+[[noreturn]] void bad(const fs::path& file, const std::string& field, const std::string& why) {
+    throw InputError(file.string(), field, why);
+}
+
+VoxelType dtype_of(const fs::path& file, const std::string& dtype, bool& big_endian) {
+    if (dtype.size() < 3 || (dtype[0] != '<' && dtype[0] != '>' && dtype[0] != '|'))
+        bad(file, "dtype", "expected a NumPy type string such as \"<u2\", got " + quote(dtype));
+    big_endian = dtype[0] == '>';
+    const std::string t = dtype.substr(1);
+    if (t == "u1") return VoxelType::u8;
+    if (t == "i1") return VoxelType::i8;
+    if (t == "u2") return VoxelType::u16;
+    if (t == "i2") return VoxelType::i16;
+    if (t == "u4") return VoxelType::u32;
+    if (t == "i4") return VoxelType::i32;
+    if (t == "f4") return VoxelType::f32;
+    if (t == "f8") return VoxelType::f64;
+    bad(file, "dtype",
+        quote(dtype) + " is not a voxel type isowall reads (u1 i1 u2 i2 u4 i4 f4 f8)");
+}
+
+std::vector<std::int64_t> sizes(const fs::path& file, const json& za, const char* field) {
+    const auto it = za.find(field);
+    if (it == za.end() || !it->is_array() || it->empty() || it->size() > 8)
+        bad(file, field, "expected a list of 1 to 8 sizes");
+    std::vector<std::int64_t> out;
+    for (const json& v : *it) {
+        if (!v.is_number_integer() || v.get<std::int64_t>() < 1 ||
+            v.get<std::int64_t>() > std::numeric_limits<int>::max())
+            bad(file, field, "expected sizes from 1 to 2147483647, got " + quote(it->dump()));
+        out.push_back(v.get<std::int64_t>());
+    }
+    return out;
+}
+
+ZarrArray read_zarray(const fs::path& dir) {
+    const fs::path file = dir / ".zarray";
+    const json za = read_json(file);
+    if (!za.is_object()) bad(file, "metadata", "expected a JSON object");
+    if (za.value("zarr_format", 0) != 2)
+        bad(file, "zarr_format",
+            "expected 2 (Zarr v2), got " + quote(za.value("zarr_format", json()).dump()));
+    ZarrArray a;
+    a.dir = dir;
+    a.shape = sizes(file, za, "shape");
+    a.chunks = sizes(file, za, "chunks");
+    if (a.chunks.size() != a.shape.size())
+        bad(file, "chunks",
+            "expected one size per axis of the shape (" + std::to_string(a.shape.size()) +
+                "), got " + std::to_string(a.chunks.size()));
+    if (a.shape.size() < 3)
+        bad(file, "shape",
+            "a volume has three axes (z, y, x), got " + std::to_string(a.shape.size()));
+    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i)
+        if (a.shape[i] != 1)
+            bad(file, "shape",
+                "every axis before the last three (z, y, x) must have one element; axis " +
+                    std::to_string(i) + " has " + std::to_string(a.shape[i]) +
+                    " (a time series or several channels: export the one to show)");
+    if (!za.contains("dtype") || !za["dtype"].is_string())
+        bad(file, "dtype", "expected a NumPy type string (a structured dtype is not a volume)");
+    a.type = dtype_of(file, za["dtype"].get<std::string>(), a.big_endian);
+    if (a.chunk_elements() > kMaxChunkBytes / a.item())
+        bad(file, "chunks", "a chunk of more than 1 GiB");
+    const std::string order = za.value("order", std::string("C"));
+    if (order != "C" && order != "F")
+        bad(file, "order", "expected \"C\" or \"F\", got " + quote(order));
+    a.fortran = order == "F";
+    if (za.contains("filters") && !za["filters"].is_null() && !za["filters"].empty())
+        bad(file, "filters",
+            "isowall reads arrays without filters, got " + quote(za["filters"].dump()));
+    a.separator = za.value("dimension_separator", std::string("."));
+    if (a.separator != "." && a.separator != "/")
+        bad(file, "dimension_separator", "expected \".\" or \"/\", got " + quote(a.separator));
+    a.compressor = za.value("compressor", json());
+    if (!a.compressor.is_null()) {
+        const std::string id = a.compressor.value("id", std::string());
+        if (id != "blosc" && id != "zstd" && id != "gzip" && id != "zlib" && id != "lz4")
+            bad(file, "compressor",
+                "isowall decodes blosc, zstd, gzip, zlib, lz4 or none, got " +
+                    quote(a.compressor.dump()));
+    }
+    a.fill = za.value("fill_value", json());
+    return a;
+}
+
+// The fill value as `type`'s bytes.
+std::vector<std::byte> fill_bytes(const ZarrArray& a) {
+    double v = 0;
+    if (a.fill.is_number()) {
+        v = a.fill.get<double>();
+    } else if (a.fill.is_string()) {
+        const std::string s = a.fill.get<std::string>();
+        if (s == "NaN")
+            v = std::numeric_limits<double>::quiet_NaN();
+        else if (s == "Infinity")
+            v = std::numeric_limits<double>::infinity();
+        else if (s == "-Infinity")
+            v = -std::numeric_limits<double>::infinity();
+        else
+            bad(a.dir / ".zarray", "fill_value",
+                "expected a number, null, NaN or Infinity, got " + quote(s));
+    } else if (!a.fill.is_null()) {
+        bad(a.dir / ".zarray", "fill_value",
+            "expected a number or null, got " + quote(a.fill.dump()));
+    }
+    std::vector<std::byte> out(a.item());
+    auto put = [&out](auto x) { std::memcpy(out.data(), &x, sizeof x); };
+    switch (a.type) {
+        case VoxelType::u8:
+            put(static_cast<std::uint8_t>(v));
+            break;
+        case VoxelType::i8:
+            put(static_cast<std::int8_t>(v));
+            break;
+        case VoxelType::u16:
+            put(static_cast<std::uint16_t>(v));
+            break;
+        case VoxelType::i16:
+            put(static_cast<std::int16_t>(v));
+            break;
+        case VoxelType::u32:
+            put(static_cast<std::uint32_t>(v));
+            break;
+        case VoxelType::i32:
+            put(static_cast<std::int32_t>(v));
+            break;
+        case VoxelType::f32:
+            put(static_cast<float>(v));
+            break;
+        case VoxelType::f64:
+            put(v);
+            break;
+    }
+    return out;  // host order
+}
+
+// One chunk's bytes decoded into `out` (exactly the chunk's size), or an InputError naming it.
+void decode_chunk(const ZarrArray& a, const std::vector<char>& in, const fs::path& file,
+                  std::vector<std::byte>& out) {
+    const std::size_t want = out.size();
+    auto wrong = [&](const std::string& why) { bad(file, "chunk", why); };
+    auto size_check = [&](std::size_t got) {
+        if (got != want)
+            wrong("decodes to " + std::to_string(got) + " bytes, expected " + std::to_string(want));
+    };
+    const std::string id = a.compressor.is_null() ? "" : a.compressor.value("id", std::string());
+    if (id.empty()) {
+        size_check(in.size());
+        std::memcpy(out.data(), in.data(), want);
+    } else if (id == "blosc") {
+        std::size_t nbytes = 0;
+        if (blosc_cbuffer_validate(in.data(), in.size(), &nbytes) != 0)
+            wrong("not a Blosc buffer, or cut short");
+        size_check(nbytes);
+        if (blosc_decompress_ctx(in.data(), out.data(), want, 1) != static_cast<int>(want))
+            wrong("Blosc could not decode it");
+    } else if (id == "zstd") {
+        const unsigned long long n = ZSTD_getFrameContentSize(in.data(), in.size());
+        if (n == ZSTD_CONTENTSIZE_ERROR) wrong("not a zstd frame");
+        if (n != ZSTD_CONTENTSIZE_UNKNOWN) size_check(static_cast<std::size_t>(n));
+        const std::size_t got = ZSTD_decompress(out.data(), want, in.data(), in.size());
+        if (ZSTD_isError(got)) wrong(std::string("zstd: ") + ZSTD_getErrorName(got));
+        size_check(got);
+    } else if (id == "gzip" || id == "zlib") {
+        z_stream z{};
+        if (inflateInit2(&z, 15 + 32) != Z_OK) wrong("zlib could not start");  // gzip or zlib
+        z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
+        z.avail_in = static_cast<uInt>(in.size());
+        z.next_out = reinterpret_cast<Bytef*>(out.data());
+        z.avail_out = static_cast<uInt>(want);
+        const int r = inflate(&z, Z_FINISH);
+        const std::size_t got = z.total_out;
+        inflateEnd(&z);
+        if (r != Z_STREAM_END && z.avail_out == 0)
+            wrong("decodes to more than " + std::to_string(want) + " bytes, expected " +
+                  std::to_string(want));
+        if (r != Z_STREAM_END) wrong(id + ": the stream is damaged or cut short");
+        size_check(got);
+    } else {  // lz4, as numcodecs frames it: the decoded size (u32 little-endian), then one block
+        if (in.size() < 4) wrong("lz4: shorter than its 4-byte size");
+        std::uint32_t n;
+        std::memcpy(&n, in.data(), 4);
+        size_check(n);
+        const int got =
+            LZ4_decompress_safe(in.data() + 4, reinterpret_cast<char*>(out.data()),
+                                static_cast<int>(in.size() - 4), static_cast<int>(want));
+        if (got < 0) wrong("lz4: the block is damaged");
+        size_check(static_cast<std::size_t>(got));
+    }
+}
+
+std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::int64_t x) {
+    std::string key;
+    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i) key += "0" + a.separator;
+    return key + std::to_string(z) + a.separator + std::to_string(y) + a.separator +
+           std::to_string(x);
+}
+
+std::vector<char> read_chunk_file(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) bad(file, "chunk", "cannot be read");
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    if (in.bad()) bad(file, "chunk", "cannot be read");
+    return bytes;
+}
+
+// Where the array's chunks go in the volume (x fastest): every chunk read, decoded and put in.
+std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector<fs::path>& files) {
+    const std::size_t n = static_cast<std::size_t>(dims.x) * dims.y * dims.z, e = a.item();
+    std::vector<std::byte> out;
+    try {
+        out.resize(n * e);
+    } catch (const std::bad_alloc&) {
+        bad(a.dir / ".zarray", "shape", "too large to read into memory here");
+    }
+    std::vector<std::byte> fill = fill_bytes(a);
+    // The voxels are swapped to host order at the end, the fill with them: put it in file order.
+    if (a.big_endian) std::reverse(fill.begin(), fill.end());
+    if (std::any_of(fill.begin(), fill.end(), [](std::byte b) { return b != std::byte{0}; }))
+        for (std::size_t i = 0; i < n; ++i) std::memcpy(out.data() + i * e, fill.data(), e);
+    const std::size_t k = a.shape.size();
+    const std::int64_t cz = a.chunks[k - 3], cy = a.chunks[k - 2], cx = a.chunks[k - 1];
+    // Element strides of z, y and x within a chunk: C order has the last axis fastest.
+    std::vector<std::size_t> stride(k, 1);
+    if (a.fortran)
+        for (std::size_t i = 1; i < k; ++i)
+            stride[i] = stride[i - 1] * static_cast<std::size_t>(a.chunks[i - 1]);
+    else
+        for (std::size_t i = k - 1; i-- > 0;)
+            stride[i] = stride[i + 1] * static_cast<std::size_t>(a.chunks[i + 1]);
+    const std::size_t sz = stride[k - 3], sy = stride[k - 2], sx = stride[k - 1];
+    std::vector<std::byte> chunk(a.chunk_elements() * e);
+    for (std::int64_t bz = 0; bz * cz < dims.z; ++bz)
+        for (std::int64_t by = 0; by * cy < dims.y; ++by)
+            for (std::int64_t bx = 0; bx * cx < dims.x; ++bx) {
+                const fs::path file = a.dir / chunk_key(a, bz, by, bx);
+                std::error_code ec;
+                if (!fs::exists(file, ec)) continue;  // a missing chunk is the fill value
+                decode_chunk(a, read_chunk_file(file), file, chunk);
+                files.push_back(file);
+                const std::int64_t nz = std::min(cz, dims.z - bz * cz),
+                                   ny = std::min(cy, dims.y - by * cy),
+                                   nx = std::min(cx, dims.x - bx * cx);
+                for (std::int64_t z = 0; z < nz; ++z)
+                    for (std::int64_t y = 0; y < ny; ++y) {
+                        std::byte* row =
+                            out.data() + ((static_cast<std::size_t>(bz * cz + z) * dims.y +
+                                           static_cast<std::size_t>(by * cy + y)) *
+                                              dims.x +
+                                          static_cast<std::size_t>(bx * cx)) *
+                                             e;
+                        const std::size_t base =
+                            static_cast<std::size_t>(z) * sz + static_cast<std::size_t>(y) * sy;
+                        if (sx == 1) {
+                            std::memcpy(row, chunk.data() + base * e,
+                                        static_cast<std::size_t>(nx) * e);
+                        } else {
+                            for (std::int64_t x = 0; x < nx; ++x)
+                                std::memcpy(
+                                    row + static_cast<std::size_t>(x) * e,
+                                    chunk.data() + (base + static_cast<std::size_t>(x) * sx) * e,
+                                    e);
+                        }
+                    }
+            }
+    if (a.big_endian && e > 1) swap_bytes(out, e);
+    return out;
+}
+
+// The spacing (x, y, z) of an OME-Zarr dataset: its "scale" transform's last three values (z, y,
+// x), times the multiscale's own scale where it has one.
+glm::vec3 ome_spacing(const fs::path& file, const json& multiscale, const json& dataset) {
+    glm::vec3 spacing(1.0f);
+    auto apply = [&](const json& transforms, const std::string& where) {
+        if (!transforms.is_array()) return;
+        for (const json& t : transforms) {
+            if (!t.is_object() || t.value("type", std::string()) != "scale") continue;
+            const json& s = t.value("scale", json());
+            if (!s.is_array() || s.size() < 3)
+                bad(file, where + ".scale", "expected a list of at least three numbers");
+            for (int i = 0; i < 3; ++i) {
+                const json& v = s[s.size() - 1 - static_cast<std::size_t>(i)];
+                if (!v.is_number() || !(v.get<double>() > 0) || !std::isfinite(v.get<double>()))
+                    bad(file, where + ".scale",
+                        "expected positive finite numbers, got " + quote(s.dump()));
+                spacing[i] *= static_cast<float>(v.get<double>());
+            }
+        }
+    };
+    apply(dataset.value("coordinateTransformations", json()),
+          "datasets[0].coordinateTransformations");
+    apply(multiscale.value("coordinateTransformations", json()),
+          "multiscales[0].coordinateTransformations");
+    return spacing;
+}
+
+}  // namespace
+
+bool is_foreign_zarr(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::is_directory(path, ec)) return false;
+    if (fs::exists(path / ".zarray", ec)) return true;
+    if (!fs::exists(path / ".zattrs", ec)) return false;
+    try {
+        const json at = read_json(path / ".zattrs");
+        return at.is_object() && at.contains("multiscales") && !at.contains("isowall");
+    } catch (const InputError&) {
+        return false;  // not readable as Zarr metadata: the other readers say what it is
+    }
+}
+
+Volume read_zarr(const fs::path& path) {
+    fs::path array_dir = path;
+    glm::vec3 spacing(1.0f);
+    std::vector<fs::path> files;
+    std::error_code ec;
+    std::string what = "Zarr v2 array";
+    if (!fs::exists(path / ".zarray", ec)) {
+        const fs::path file = path / ".zattrs";
+        const json at = attributes(path);
+        const json& ms = at.value("multiscales", json());
+        if (!ms.is_array() || ms.empty() || !ms[0].is_object())
+            bad(file, "multiscales", "expected a list of OME-Zarr multiscales");
+        const json& ds = ms[0].value("datasets", json());
+        if (!ds.is_array() || ds.empty() || !ds[0].is_object() ||
+            !ds[0].value("path", json()).is_string())
+            bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
+        const std::string sub = ds[0]["path"].get<std::string>();
+        if (sub.empty() || sub.find("..") != std::string::npos || sub.front() == '/')
+            bad(file, "multiscales[0].datasets[0].path",
+                "expected a folder inside the store, got " + quote(sub));
+        array_dir = path / sub;
+        spacing = ome_spacing(file, ms[0], ds[0]);
+        files.push_back(file);
+        what = "OME-Zarr " + ms[0].value("version", std::string("0.4")) + " (dataset " +
+               quote(sub) + ")";
+        if (!fs::exists(array_dir / ".zarray", ec))
+            bad(file, "multiscales[0].datasets[0].path", quote(sub) + " holds no .zarray");
+    }
+    const ZarrArray a = read_zarray(array_dir);
+    files.insert(files.begin(), array_dir / ".zarray");
+    const std::size_t k = a.shape.size();
+    const glm::ivec3 dims(static_cast<int>(a.shape[k - 1]), static_cast<int>(a.shape[k - 2]),
+                          static_cast<int>(a.shape[k - 3]));
+    Decoded d;
+    d.bytes = assemble(a, dims, files);
+    d.dims = dims;
+    d.type = a.type;
+    d.spacing = spacing;
+    d.format = what;
+    d.files = std::move(files);
+    const std::string codec =
+        a.compressor.is_null() ? "none" : a.compressor.value("id", std::string());
+    d.facts.push_back({"chunks", [&] {
+                           std::string s;
+                           for (std::size_t i = 0; i < k; ++i)
+                               s += (i ? "x" : "") + std::to_string(a.chunks[i]);
+                           return s + " (" + (a.fortran ? "F" : "C") + " order, " + codec + ")";
+                       }()});
+    return finish_volume(std::move(d), path.string(), "");
+}
+
+}  // namespace isowall::formats

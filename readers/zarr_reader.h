@@ -1,0 +1,30 @@
+#pragma once
+// Zarr v2 arrays and OME-Zarr 0.4 images written by other tools (zarr-python, napari's writers,
+// ome-zarr-py), read whole into memory as --volume or as an `import` source:
+//   - STORE holding .zarray: that array;
+//   - STORE holding .zattrs with OME "multiscales": the first multiscale's first dataset (the
+//     finest level), its spacing from that dataset's "scale" transform (times the multiscale's
+//     own scale, when it has one), the last three axes as z, y, x;
+//   - compressors: none, Blosc (every inner codec c-blosc has: lz4, lz4hc, zstd, zlib, blosclz;
+//     shuffle and bit-shuffle), zstd, gzip, zlib and lz4 (numcodecs' framing: the decoded size,
+//     then one LZ4 block), each through its library;
+//   - any chunk shape, C or F order, "." or "/" separators, any byte order; a missing chunk
+//     reads as the fill value (0 where it is null);
+//   - three axes, or more where every axis before the last three has one element (a 5D t, c, z,
+//     y, x image of one time point and one channel).
+// isowall's own stores (an "isowall" block in .zattrs) are not this reader's: they page
+// (store/open_store.h). Bad metadata or a damaged chunk is an InputError naming the store and
+// the field or the chunk's key.
+#include <filesystem>
+
+#include "volume/volume.h"
+
+namespace isowall::formats {
+
+// Whether `path` is a folder holding a Zarr array or an OME-Zarr group that is not an isowall
+// store (isowall's own go through store/open_store.h).
+bool is_foreign_zarr(const std::filesystem::path& path);
+
+Volume read_zarr(const std::filesystem::path& path);
+
+}  // namespace isowall::formats
