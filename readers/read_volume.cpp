@@ -5,7 +5,9 @@
 #include <array>
 #include <cctype>
 #include <fstream>
+#include <optional>
 #include <span>
+#include <utility>
 
 #include "core/error.h"
 #include "readers/dicom_lengths.h"
@@ -72,9 +74,19 @@ std::unique_ptr<PlaneSource> dicom_stream(const fs::path& p) {
 
 // Zarr chunks decoded by c-blosc, zstd, zlib and lz4 in a child as well: a decoder's crash on a
 // damaged chunk is one line.
-Volume zarr(const fs::path& dir) {
+Volume zarr(const fs::path& dir, const std::string& selection = "") {
     return read_isolated(dir.string(), "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)",
-                         [&] { return read_zarr(dir); });
+                         [&] { return read_zarr(dir, selection); });
+}
+
+// STORE:t=3,c=0 (zarr_reader.h): the store and the selection, when STORE is another tool's.
+std::optional<std::pair<fs::path, std::string>> zarr_selection(const std::string& path) {
+    const std::size_t colon = path.rfind(':');
+    std::error_code ec;
+    if (colon == std::string::npos || fs::exists(path, ec)) return std::nullopt;
+    const fs::path store = path.substr(0, colon);
+    if (!is_foreign_zarr(store)) return std::nullopt;
+    return std::pair{store, path.substr(colon + 1)};
 }
 
 std::unique_ptr<PlaneSource> hdf5_stream(const fs::path& file, const std::string& dataset) {
@@ -130,6 +142,7 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path,
         const std::string file = path.substr(0, colon);
         if (is_hdf5_name(file)) return hdf5_stream(file, path.substr(colon + 1));
     }
+    if (zarr_selection(path)) return nullptr;  // read whole (read_volume)
     check_regular_file(p, path, "file");
     return file_planes(p, p.filename().string());
 }
@@ -148,6 +161,7 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, b
         const std::string file = path.substr(0, colon);
         if (is_hdf5_name(file)) return hdf5(file, path.substr(colon + 1));
     }
+    if (const auto z = zarr_selection(path)) return zarr(z->first, z->second);
     check_regular_file(p, path, "file");
     return read_file(p, p.filename().string(), populate);
 }

@@ -1,6 +1,6 @@
 #pragma once
 // --volume: picks the reader by what the path is (readers/readers.h).
-//   a folder                     a Zarr v2 array or OME-Zarr image (zarr_reader.h; isowall's own
+//   a folder, FOLDER:t=3,c=0     a Zarr v2 array or OME-Zarr image (zarr_reader.h; isowall's own
 //                                stores page instead: store/open_store.h), a DICOM series, or a
 //                                stack of TIFF slices
 //   .nii .nii.gz .hdr .img       NIfTI-1 or NIfTI-2

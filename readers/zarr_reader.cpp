@@ -52,10 +52,11 @@ struct ZarrArray {
     std::vector<std::int64_t> shape, chunks;  // slowest axis first, as Zarr lists them
     VoxelType type = VoxelType::u8;
     bool big_endian = false;
-    bool fortran = false;   // order "F": the first axis varies fastest in a chunk
-    std::string separator;  // between a chunk key's indices: "." or "/"
-    json compressor;        // null: none
-    json fill;              // null: 0
+    bool fortran = false;            // order "F": the first axis varies fastest in a chunk
+    std::string separator;           // between a chunk key's indices: "." or "/"
+    json compressor;                 // null: none
+    json fill;                       // null: 0
+    std::vector<std::int64_t> pick;  // the element taken on each axis before z, y, x
 
     std::size_t item() const { return voxel_size(type); }
     std::size_t chunk_elements() const {
@@ -118,12 +119,6 @@ ZarrArray read_zarray(const fs::path& dir) {
     if (a.shape.size() < 3)
         bad(file, "shape",
             "a volume has three axes (z, y, x), got " + std::to_string(a.shape.size()));
-    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i)
-        if (a.shape[i] != 1)
-            bad(file, "shape",
-                "every axis before the last three (z, y, x) must have one element; axis " +
-                    std::to_string(i) + " has " + std::to_string(a.shape[i]) +
-                    " (a time series or several channels: export the one to show)");
     if (!za.contains("dtype") || !za["dtype"].is_string())
         bad(file, "dtype", "expected a NumPy type string (a structured dtype is not a volume)");
     a.type = dtype_of(file, za["dtype"].get<std::string>(), a.big_endian);
@@ -259,7 +254,8 @@ void decode_chunk(const ZarrArray& a, const std::vector<char>& in, const fs::pat
 
 std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::int64_t x) {
     std::string key;
-    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i) key += "0" + a.separator;
+    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i)
+        key += std::to_string(a.pick[i] / a.chunks[i]) + a.separator;
     return key + std::to_string(z) + a.separator + std::to_string(y) + a.separator +
            std::to_string(x);
 }
@@ -297,6 +293,9 @@ std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector
         for (std::size_t i = k - 1; i-- > 0;)
             stride[i] = stride[i + 1] * static_cast<std::size_t>(a.chunks[i + 1]);
     const std::size_t sz = stride[k - 3], sy = stride[k - 2], sx = stride[k - 1];
+    std::size_t picked = 0;  // where the picked time point and channel start in a chunk
+    for (std::size_t i = 0; i + 3 < k; ++i)
+        picked += static_cast<std::size_t>(a.pick[i] % a.chunks[i]) * stride[i];
     std::vector<std::byte> chunk(a.chunk_elements() * e);
     for (std::int64_t bz = 0; bz * cz < dims.z; ++bz)
         for (std::int64_t by = 0; by * cy < dims.y; ++by)
@@ -317,8 +316,8 @@ std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector
                                               dims.x +
                                           static_cast<std::size_t>(bx * cx)) *
                                              e;
-                        const std::size_t base =
-                            static_cast<std::size_t>(z) * sz + static_cast<std::size_t>(y) * sy;
+                        const std::size_t base = picked + static_cast<std::size_t>(z) * sz +
+                                                 static_cast<std::size_t>(y) * sy;
                         if (sx == 1) {
                             std::memcpy(row, chunk.data() + base * e,
                                         static_cast<std::size_t>(nx) * e);
@@ -362,6 +361,50 @@ glm::vec3 ome_spacing(const fs::path& file, const json& multiscale, const json& 
     return spacing;
 }
 
+// The element of each axis before z, y and x that `selection` ("t=3,c=0") picks, the axes named
+// by `names` (OME's; else their index). An axis of one element needs no pick.
+std::vector<std::int64_t> pick_axes(const ZarrArray& a, const std::vector<std::string>& names,
+                                    const std::string& selection, const std::string& where) {
+    const std::size_t lead = a.shape.size() - 3;
+    std::vector<std::int64_t> pick(lead, -1);
+    auto bad_pick = [&](const std::string& why) { throw InputError(where, "axes", why); };
+    std::string all;
+    for (std::size_t i = 0; i < lead; ++i) all += (i ? ", " : "") + names[i];
+    std::size_t at = 0;
+    while (at < selection.size()) {
+        const std::size_t end = std::min(selection.find(',', at), selection.size());
+        const std::string item = selection.substr(at, end - at);
+        at = end + 1;
+        const std::size_t eq = item.find('=');
+        const std::string name = item.substr(0, eq);
+        const auto it =
+            std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(lead), name);
+        if (eq == std::string::npos || it == names.begin() + static_cast<std::ptrdiff_t>(lead))
+            bad_pick("expected AXIS=INDEX for an axis before z, y, x (" +
+                     (all.empty() ? "none" : all) + "), got " + quote(item));
+        const std::size_t i = static_cast<std::size_t>(it - names.begin());
+        const std::string number = item.substr(eq + 1);
+        std::int64_t n = -1;
+        if (!number.empty() && number.size() < 10 &&
+            std::all_of(number.begin(), number.end(),
+                        [](unsigned char c) { return std::isdigit(c); }))
+            n = std::stoll(number);
+        if (n < 0 || n >= a.shape[i])
+            bad_pick(name + "=" + number + ": axis " + name + " has " + std::to_string(a.shape[i]) +
+                     " elements, expected an index from 0 to " + std::to_string(a.shape[i] - 1));
+        pick[i] = n;
+    }
+    for (std::size_t i = 0; i < lead; ++i) {
+        if (pick[i] >= 0) continue;
+        if (a.shape[i] != 1)
+            bad_pick("axis " + names[i] + " has " + std::to_string(a.shape[i]) +
+                     " elements (a time series or several channels): pick one, e.g. " + where +
+                     ":" + names[i] + "=0");
+        pick[i] = 0;
+    }
+    return pick;
+}
+
 }  // namespace
 
 bool is_foreign_zarr(const fs::path& path) {
@@ -377,12 +420,13 @@ bool is_foreign_zarr(const fs::path& path) {
     }
 }
 
-Volume read_zarr(const fs::path& path) {
+Volume read_zarr(const fs::path& path, const std::string& selection) {
     fs::path array_dir = path;
     glm::vec3 spacing(1.0f);
     std::vector<fs::path> files;
     std::error_code ec;
     std::string what = "Zarr v2 array";
+    std::vector<std::string> names;  // OME's axis names, slowest first
     if (!fs::exists(path / ".zarray", ec)) {
         const fs::path file = path / ".zattrs";
         const json at = attributes(path);
@@ -399,13 +443,21 @@ Volume read_zarr(const fs::path& path) {
                 "expected a folder inside the store, got " + quote(sub));
         array_dir = path / sub;
         spacing = ome_spacing(file, ms[0], ds[0]);
+        for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
+            names.push_back(ax.is_string() ? ax.get<std::string>()
+                                           : ax.value("name", std::string()));
         files.push_back(file);
         what = "OME-Zarr " + ms[0].value("version", std::string("0.4")) + " (dataset " +
                quote(sub) + ")";
         if (!fs::exists(array_dir / ".zarray", ec))
             bad(file, "multiscales[0].datasets[0].path", quote(sub) + " holds no .zarray");
     }
-    const ZarrArray a = read_zarray(array_dir);
+    ZarrArray a = read_zarray(array_dir);
+    if (names.size() != a.shape.size()) {  // no names, or not one per axis: their indices
+        names.clear();
+        for (std::size_t i = 0; i < a.shape.size(); ++i) names.push_back(std::to_string(i));
+    }
+    a.pick = pick_axes(a, names, selection, path.string());
     files.insert(files.begin(), array_dir / ".zarray");
     const std::size_t k = a.shape.size();
     const glm::ivec3 dims(static_cast<int>(a.shape[k - 1]), static_cast<int>(a.shape[k - 2]),

@@ -10,12 +10,13 @@
 //     then one LZ4 block), each through its library;
 //   - any chunk shape, C or F order, "." or "/" separators, any byte order; a missing chunk
 //     reads as the fill value (0 where it is null);
-//   - three axes, or more where every axis before the last three has one element (a 5D t, c, z,
-//     y, x image of one time point and one channel).
+//   - three axes (z, y, x), or more, the axes before them each given one element by `selection`
+//     ("t=3,c=0": OME's axis names, else each axis's index, "0=3"), or of one element.
 // isowall's own stores (an "isowall" block in .zattrs) are not this reader's: they page
 // (store/open_store.h). Bad metadata or a damaged chunk is an InputError naming the store and
 // the field or the chunk's key.
 #include <filesystem>
+#include <string>
 
 #include "volume/volume.h"
 
@@ -25,6 +26,6 @@ namespace isowall::formats {
 // store (isowall's own go through store/open_store.h).
 bool is_foreign_zarr(const std::filesystem::path& path);
 
-Volume read_zarr(const std::filesystem::path& path);
+Volume read_zarr(const std::filesystem::path& path, const std::string& selection = "");
 
 }  // namespace isowall::formats

@@ -3,10 +3,12 @@
 --volume: Blosc with lz4, zstd and zlib inside (shuffle, bit-shuffle and none), zstd, gzip, zlib,
 lz4 and no compression; non-cubic chunks and one chunk for the whole volume; C and F order; a
 big-endian dtype; "/" separators; chunks left out where they hold only the fill value; an
-OME-Zarr 0.4 image of five axes (t, c, z, y, x) with a scale. Each renders the image the NRRD of
+OME-Zarr 0.4 image of five axes (t, c, z, y, x) with a scale; a time point and a channel picked
+by name (STORE:t=2,c=1) from chunks that hold several of each. Each renders the image the NRRD of
 the same voxels renders, and `isowall info` states its size, type and spacing; one of them is
 imported and the store renders the same image too. Bad stores (an unknown codec, chunks that do
-not match the metadata, a dtype that is not a voxel type, a second time point) are one line
+not match the metadata, a dtype that is not a voxel type, a second time point not picked, a pick
+out of range or of an axis that is not there) are one line
 naming the file and the field, status 1, and no image.
 
 Run: /usr/bin/python3 tests/zarr_foreign_test.py ISOWALL_BINARY SCRATCH_DIR   (CTest passes them)
@@ -193,7 +195,34 @@ class ForeignZarr(unittest.TestCase):
         path = self.write("complex", data=self.v.astype(np.complex64))
         self.refused(path, "dtype", "<c8")
         path = self.write("two-times", data=np.stack([self.v, self.v]), chunks=(1, 8, 8, 8))
-        self.refused(path, "shape", "axis 0 has 2")
+        self.refused(path, "axes", "axis 0 has 2 elements", path + ":0=0")
+        self.refused(path + ":0=2", "axes", "0=2: axis 0 has 2 elements, expected an index from 0 to 1")
+        self.refused(path + ":t=1", "axes", "expected AXIS=INDEX", "(0)", '"t=1"')
+
+    def test_a_time_point_and_a_channel_picked_by_name(self):
+        """Five axes of 3 time points and 2 channels, chunks holding 2 time points and both
+        channels: each pick is the NRRD of its own voxels."""
+        path = os.path.join(SCRATCH, "series.zarr")
+        shutil.rmtree(path, ignore_errors=True)
+        frames = np.stack([np.stack([self.v // (t + 1), self.v // 2 + 60 * t]) for t in range(3)])
+        self.assertEqual(frames.shape[:2], (3, 2))
+        root = zarr.open_group(path, mode="w")
+        root.create_dataset("0", data=frames, chunks=(2, 2, 8, 16, 16), compressor=Zstd(level=1))
+        axes = [{"name": n, "type": t} for n, t in
+                (("t", "time"), ("c", "channel"), ("z", "space"), ("y", "space"), ("x", "space"))]
+        root.attrs["multiscales"] = [{"version": "0.4", "axes": axes, "datasets": [
+            {"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1, 1, 1, 1, 1]}]}]}]
+        for t, c in ((0, 0), (2, 1), (1, 1)):
+            with self.subTest(t=t, c=c):
+                nrrd = os.path.join(SCRATCH, f"frame{t}{c}.nhdr")
+                write_nrrd(nrrd, frames[t, c])
+                a, b = os.path.join(SCRATCH, f"pick{t}{c}.png"), os.path.join(SCRATCH, f"frame{t}{c}.png")
+                pa = render(f"{path}:t={t},c={c}", a, iso=200)
+                self.assertEqual(pa.returncode, 0, pa.stderr)
+                self.assertEqual(render(nrrd, b, iso=200).returncode, 0)
+                with open(a, "rb") as fa, open(b, "rb") as fb:
+                    self.assertEqual(fa.read(), fb.read())
+        self.refused(path + ":c=1", "axes", "axis t has 3 elements", path + ":t=0")
 
 
 if __name__ == "__main__":
