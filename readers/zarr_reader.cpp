@@ -19,6 +19,7 @@
 #include "core/error.h"
 #include "files/input_file.h"
 #include "readers/voxel_ops.h"
+#include "volume/load_checks.h"
 
 namespace isowall::formats {
 
@@ -31,6 +32,8 @@ constexpr std::size_t kMaxMetadataBytes = std::size_t{1} << 20;
 // A chunk decoded at most: larger chunks than this are not a volume's (and would be a claim to
 // check before any allocation).
 constexpr std::size_t kMaxChunkBytes = std::size_t{1} << 30;
+// Chunks a store may have (16 M: 256^3 chunks of 8^3 voxels, a 2048^3 volume).
+constexpr std::uint64_t kMaxChunks = std::uint64_t{1} << 24;
 
 json read_json(const fs::path& file) {
     const std::string text = read_input_file(file, "metadata", kMaxMetadataBytes);
@@ -460,8 +463,24 @@ Volume read_zarr(const fs::path& path, const std::string& selection) {
     a.pick = pick_axes(a, names, selection, path.string());
     files.insert(files.begin(), array_dir / ".zarray");
     const std::size_t k = a.shape.size();
-    const glm::ivec3 dims(static_cast<int>(a.shape[k - 1]), static_cast<int>(a.shape[k - 2]),
-                          static_cast<int>(a.shape[k - 3]));
+    const std::uint64_t sides[3] = {static_cast<std::uint64_t>(a.shape[k - 1]),
+                                    static_cast<std::uint64_t>(a.shape[k - 2]),
+                                    static_cast<std::uint64_t>(a.shape[k - 3])};
+    const fs::path zarray = array_dir / ".zarray";
+    const glm::ivec3 dims = checked_dims(zarray.string(), "shape", sides, a.type);
+    check_fits_memory(voxel_bytes(dims, a.type), zarray.string(), "shape");
+    // A chunk key per chunk of the grid is looked up: a grid of millions of tiny chunks over a
+    // large shape would take hours to find missing.
+    std::uint64_t grid = 1;
+    for (int i = 0; i < 3; ++i)
+        grid *= (sides[i] +
+                 static_cast<std::uint64_t>(a.chunks[k - 1 - static_cast<std::size_t>(i)]) - 1) /
+                static_cast<std::uint64_t>(a.chunks[k - 1 - static_cast<std::size_t>(i)]);
+    if (grid > kMaxChunks)
+        bad(zarray, "chunks",
+            std::to_string(grid) + " chunks; isowall reads stores of at most " +
+                std::to_string(kMaxChunks) +
+                " (larger chunks, or `isowall import` from the source)");
     Decoded d;
     d.bytes = assemble(a, dims, files);
     d.dims = dims;

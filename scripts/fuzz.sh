@@ -18,7 +18,7 @@ HARNESSES=("$@")
 # library is one InputError, not a finding. A finding is then anything that escapes the child:
 # a crash, hang or leak of the reading process itself. Coverage guidance stops at the fork, so
 # these two check the boundary on mutations of their corpus rather than explore the libraries.
-[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd store wall script wire view_protocol group_codec cell_body wall_page nifti metaimage tiff dicom hdf5)
+[ ${#HARNESSES[@]} -gt 0 ] || HARNESSES=(nrrd store wall script wire view_protocol group_codec cell_body wall_page nifti metaimage tiff dicom hdf5 zarr)
 BUILD=${ISOWALL_FUZZ_BUILD_DIR:-build-fuzz}
 
 cmake -S . -B "$BUILD" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
@@ -33,7 +33,7 @@ harness_flags() {
     case "$1" in
         nrrd) echo "-malloc_limit_mb=2048 -detect_leaks=0" ;;
         # Readers of other formats: a header may rightly ask for a large volume, as NRRD's.
-        nifti | dicom | tiff) echo "-malloc_limit_mb=2048" ;;
+        nifti | dicom | tiff | zarr) echo "-malloc_limit_mb=2048" ;;
         # libhdf5 leaks a little on some failed opens (its own metadata cache), as Teem does.
         hdf5) echo "-malloc_limit_mb=2048 -detect_leaks=0" ;;
         *) echo "-malloc_limit_mb=64" ;;
