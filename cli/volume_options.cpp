@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/number.h"
 #include "core/util.h"
+#include "readers/http_fetch.h"
 #include "readers/read_volume.h"
 #include "readers/zarr_reader.h"
 #include "store/open_store.h"
@@ -20,9 +21,10 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "Volume: NRRD (.nrrd/.nhdr), NIfTI (.nii, .nii.gz, .hdr/.img), a DICOM "
                    "series (its folder, or one file of it), MetaImage (.mhd/.mha), HDF5 "
                    "(FILE.h5:/dataset), TIFF (a multi-page .tif or a folder of slices), or "
-                   "headerless raw with --dims and --type, or a store made by `isowall import` "
-                   "(its folder; read on first touch under --memory-limit). Default: the "
-                   "built-in phantom");
+                   "headerless raw with --dims and --type, a Zarr array or OME-Zarr image "
+                   "(its folder; FOLDER:t=N,c=M picks a time point and a channel), the same over "
+                   "http:// or https://, or a store made by `isowall import` (its folder; read on "
+                   "first touch under --memory-limit). Default: the built-in phantom");
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
         ->expected(3)
         ->transform(number_in({1, 2147483647.0, false, true}));
@@ -44,6 +46,11 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "auto (from 256 MiB, when every rank's copy fits in half the available "
                    "memory), on, off (keep the shared memory map). Default: auto")
         ->check(CLI::IsMember({"auto", "on", "off"}));
+    app.add_option("--http-timeout", o.http_timeout,
+                   "A volume over HTTP: seconds without a byte from the server before the request "
+                   "is tried again (3 more tries, then an error naming the URL). Fetched objects "
+                   "are kept under the cache folder's http/ (not with --no-cache). Default: 30")
+        ->transform(number_in({0.1, 3600}));
     app.add_option("--memory-limit", o.memory_limit,
                    "A store's voxels in memory at most (e.g. 512M, 8G); the rest stays on disk "
                    "and is read when a ray or the surface first needs it. Default: half the "
@@ -101,6 +108,13 @@ std::filesystem::path cache_dir(const VolumeOptions& o) {
     return o.cache_dir.empty() ? octree_cache::default_dir() : std::filesystem::path(o.cache_dir);
 }
 
+formats::HttpOptions http_options(const VolumeOptions& o) {
+    formats::HttpOptions h;
+    h.stall_s = o.http_timeout;
+    if (!o.no_cache) h.cache_dir = cache_dir(o) / "http";
+    return h;
+}
+
 // A store `isowall import` wrote (paged); another tool's Zarr store is read by the readers.
 bool own_store(const std::string& path) {
     return store::is_store(path) && !formats::is_foreign_zarr(path);
@@ -144,7 +158,8 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         store_note = " (" + opened.how + ")";
     } else {
         // A volume not cast (import) streams its file itself, at the disk's pace.
-        out.volume = formats::read_volume(o.path, raw_spec(o), use.casts);
+        out.volume = formats::is_url(o.path) ? formats::read_url(o.path, http_options(o))
+                                             : formats::read_volume(o.path, raw_spec(o), use.casts);
         out.file = std::filesystem::path(o.path);
         check_no_memory_limit(o);
     }

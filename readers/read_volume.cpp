@@ -131,6 +131,7 @@ std::unique_ptr<PlaneSource> file_planes(const fs::path& p, const std::string& n
 std::unique_ptr<PlaneSource> open_planes(const std::string& path,
                                          const std::optional<RawSpec>& raw) {
     if (raw) return raw_planes(path, *raw);
+    if (is_url(path)) return nullptr;  // read whole (read_url)
     const fs::path p(path);
     std::error_code ec;
     if (fs::is_directory(p, ec)) {
@@ -145,6 +146,19 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path,
     if (zarr_selection(path)) return nullptr;  // read whole (read_volume)
     check_regular_file(p, path, "file");
     return file_planes(p, p.filename().string());
+}
+
+Volume read_url(const std::string& url, const HttpOptions& options) {
+    // A selection is a last ':' followed by AXIS=INDEX pairs, after the host's own colons.
+    std::string base = url, selection;
+    const std::size_t colon = url.rfind(':');
+    if (colon != std::string::npos && colon > url.find("://") + 2 &&
+        url.find('=', colon) != std::string::npos && url.find('/', colon) == std::string::npos) {
+        base = url.substr(0, colon);
+        selection = url.substr(colon + 1);
+    }
+    return read_isolated(url, "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)",
+                         [&] { return read_zarr_url(base, selection, options); });
 }
 
 Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, bool populate) {

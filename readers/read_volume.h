@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "readers/http_fetch.h"
 #include "volume/plane_source.h"
 #include "volume/volume.h"
 
@@ -22,6 +23,10 @@ namespace isowall::formats {
 // populate: as load_raw's (volume/volume.h), for the formats that map their file.
 Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw,
                    bool populate = true);
+
+// A Zarr store served over HTTP(S) (zarr_reader.h), URL or URL:t=3,c=0, decoded in a child
+// process as a folder's is.
+Volume read_url(const std::string& url, const HttpOptions& options);
 
 // The planes of the volume read_volume gives, for `isowall import` to stream a slab at a time:
 // TIFF stacks, NIfTI, MetaImage, DICOM series and HDF5 datasets (their readers' plane stacks,

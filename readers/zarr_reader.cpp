@@ -18,6 +18,7 @@
 
 #include "core/error.h"
 #include "files/input_file.h"
+#include "readers/http_fetch.h"
 #include "readers/voxel_ops.h"
 #include "volume/load_checks.h"
 
@@ -35,23 +36,71 @@ constexpr std::size_t kMaxChunkBytes = std::size_t{1} << 30;
 // Chunks a store may have (16 M: 256^3 chunks of 8^3 voxels, a 2048^3 volume).
 constexpr std::uint64_t kMaxChunks = std::uint64_t{1} << 24;
 
-json read_json(const fs::path& file) {
-    const std::string text = read_input_file(file, "metadata", kMaxMetadataBytes);
+// A store's keys in a folder (the key's path below it).
+class FolderSource : public ZarrSource {
+  public:
+    explicit FolderSource(fs::path dir) : dir_(std::move(dir)) {}
+    std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const override {
+        const fs::path file = dir_ / key;
+        std::error_code ec;
+        if (!fs::exists(file, ec)) return std::nullopt;
+        const std::string field = key.find(".z") != std::string::npos ? "metadata" : "chunk";
+        // Sized by the file (read_input_file would hold max_bytes, a gigabyte for a chunk).
+        if (!fs::is_regular_file(file, ec)) throw InputError(file.string(), field, "not a file");
+        const auto size = fs::file_size(file, ec);
+        if (ec || size > max_bytes)
+            throw InputError(
+                file.string(), field,
+                ec ? "cannot be read" : "larger than " + std::to_string(max_bytes) + " bytes");
+        std::string bytes(static_cast<std::size_t>(size), '\0');
+        std::ifstream in(file, std::ios::binary);
+        if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
+            throw InputError(file.string(), field, "cannot be read");
+        return bytes;
+    }
+    std::string where(const std::string& key) const override { return (dir_ / key).string(); }
+    fs::path file(const std::string& key) const override { return dir_ / key; }
+
+  private:
+    fs::path dir_;
+};
+
+// Objects under one URL (http_fetch.h).
+class UrlSource : public ZarrSource {
+  public:
+    UrlSource(std::string base, const HttpOptions& options)
+        : base_(std::move(base)), fetch_(options) {
+        while (base_.ends_with("/")) base_.pop_back();
+    }
+    std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const override {
+        return fetch_.get(where(key), key.find(".z") != std::string::npos ? "metadata" : "chunk",
+                          max_bytes);
+    }
+    std::string where(const std::string& key) const override { return base_ + "/" + key; }
+
+  private:
+    std::string base_;
+    HttpFetcher fetch_;
+};
+
+json parse_json(const std::string& text, const std::string& where) {
     try {
         return json::parse(text);
     } catch (const json::exception& e) {
-        throw InputError(file.string(), "JSON", e.what());
+        throw InputError(where, "JSON", e.what());
     }
 }
 
-// A folder's .zattrs, or null where it has none.
-json attributes(const fs::path& dir) {
-    std::error_code ec;
-    return fs::exists(dir / ".zattrs", ec) ? read_json(dir / ".zattrs") : json();
+// `key`'s JSON; an InputError where the store has none.
+json read_json(const ZarrSource& s, const std::string& key) {
+    const auto text = s.get(key, kMaxMetadataBytes);
+    if (!text) throw InputError(s.where(key), "metadata", "not found");
+    return parse_json(*text, s.where(key));
 }
 
 struct ZarrArray {
-    fs::path dir;
+    std::string prefix;                       // the array's keys start with this ("" or "0/")
+    std::string where;                        // its .zarray, for messages
     std::vector<std::int64_t> shape, chunks;  // slowest axis first, as Zarr lists them
     VoxelType type = VoxelType::u8;
     bool big_endian = false;
@@ -69,11 +118,11 @@ struct ZarrArray {
     }
 };
 
-[[noreturn]] void bad(const fs::path& file, const std::string& field, const std::string& why) {
-    throw InputError(file.string(), field, why);
+[[noreturn]] void bad(const std::string& where, const std::string& field, const std::string& why) {
+    throw InputError(where, field, why);
 }
 
-VoxelType dtype_of(const fs::path& file, const std::string& dtype, bool& big_endian) {
+VoxelType dtype_of(const std::string& file, const std::string& dtype, bool& big_endian) {
     if (dtype.size() < 3 || (dtype[0] != '<' && dtype[0] != '>' && dtype[0] != '|'))
         bad(file, "dtype", "expected a NumPy type string such as \"<u2\", got " + quote(dtype));
     big_endian = dtype[0] == '>';
@@ -90,7 +139,7 @@ VoxelType dtype_of(const fs::path& file, const std::string& dtype, bool& big_end
         quote(dtype) + " is not a voxel type isowall reads (u1 i1 u2 i2 u4 i4 f4 f8)");
 }
 
-std::vector<std::int64_t> sizes(const fs::path& file, const json& za, const char* field) {
+std::vector<std::int64_t> sizes(const std::string& file, const json& za, const char* field) {
     const auto it = za.find(field);
     if (it == za.end() || !it->is_array() || it->empty() || it->size() > 8)
         bad(file, field, "expected a list of 1 to 8 sizes");
@@ -104,15 +153,16 @@ std::vector<std::int64_t> sizes(const fs::path& file, const json& za, const char
     return out;
 }
 
-ZarrArray read_zarray(const fs::path& dir) {
-    const fs::path file = dir / ".zarray";
-    const json za = read_json(file);
+ZarrArray read_zarray(const ZarrSource& source, const std::string& prefix) {
+    const std::string file = source.where(prefix + ".zarray");
+    const json za = read_json(source, prefix + ".zarray");
     if (!za.is_object()) bad(file, "metadata", "expected a JSON object");
     if (za.value("zarr_format", 0) != 2)
         bad(file, "zarr_format",
             "expected 2 (Zarr v2), got " + quote(za.value("zarr_format", json()).dump()));
     ZarrArray a;
-    a.dir = dir;
+    a.prefix = prefix;
+    a.where = file;
     a.shape = sizes(file, za, "shape");
     a.chunks = sizes(file, za, "chunks");
     if (a.chunks.size() != a.shape.size())
@@ -163,11 +213,9 @@ std::vector<std::byte> fill_bytes(const ZarrArray& a) {
         else if (s == "-Infinity")
             v = -std::numeric_limits<double>::infinity();
         else
-            bad(a.dir / ".zarray", "fill_value",
-                "expected a number, null, NaN or Infinity, got " + quote(s));
+            bad(a.where, "fill_value", "expected a number, null, NaN or Infinity, got " + quote(s));
     } else if (!a.fill.is_null()) {
-        bad(a.dir / ".zarray", "fill_value",
-            "expected a number or null, got " + quote(a.fill.dump()));
+        bad(a.where, "fill_value", "expected a number or null, got " + quote(a.fill.dump()));
     }
     std::vector<std::byte> out(a.item());
     auto put = [&out](auto x) { std::memcpy(out.data(), &x, sizeof x); };
@@ -201,7 +249,7 @@ std::vector<std::byte> fill_bytes(const ZarrArray& a) {
 }
 
 // One chunk's bytes decoded into `out` (exactly the chunk's size), or an InputError naming it.
-void decode_chunk(const ZarrArray& a, const std::vector<char>& in, const fs::path& file,
+void decode_chunk(const ZarrArray& a, const std::string& in, const std::string& file,
                   std::vector<std::byte>& out) {
     const std::size_t want = out.size();
     auto wrong = [&](const std::string& why) { bad(file, "chunk", why); };
@@ -263,22 +311,15 @@ std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::i
            std::to_string(x);
 }
 
-std::vector<char> read_chunk_file(const fs::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) bad(file, "chunk", "cannot be read");
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
-    if (in.bad()) bad(file, "chunk", "cannot be read");
-    return bytes;
-}
-
 // Where the array's chunks go in the volume (x fastest): every chunk read, decoded and put in.
-std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector<fs::path>& files) {
+std::vector<std::byte> assemble(const ZarrSource& source, const ZarrArray& a, glm::ivec3 dims,
+                                std::vector<fs::path>& files) {
     const std::size_t n = static_cast<std::size_t>(dims.x) * dims.y * dims.z, e = a.item();
     std::vector<std::byte> out;
     try {
         out.resize(n * e);
     } catch (const std::bad_alloc&) {
-        bad(a.dir / ".zarray", "shape", "too large to read into memory here");
+        bad(a.where, "shape", "too large to read into memory here");
     }
     std::vector<std::byte> fill = fill_bytes(a);
     // The voxels are swapped to host order at the end, the fill with them: put it in file order.
@@ -303,11 +344,11 @@ std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector
     for (std::int64_t bz = 0; bz * cz < dims.z; ++bz)
         for (std::int64_t by = 0; by * cy < dims.y; ++by)
             for (std::int64_t bx = 0; bx * cx < dims.x; ++bx) {
-                const fs::path file = a.dir / chunk_key(a, bz, by, bx);
-                std::error_code ec;
-                if (!fs::exists(file, ec)) continue;  // a missing chunk is the fill value
-                decode_chunk(a, read_chunk_file(file), file, chunk);
-                files.push_back(file);
+                const std::string key = a.prefix + chunk_key(a, bz, by, bx);
+                const auto bytes = source.get(key, kMaxChunkBytes + (1 << 20));
+                if (!bytes) continue;  // a missing chunk is the fill value
+                decode_chunk(a, *bytes, source.where(key), chunk);
+                if (!source.file(key).empty()) files.push_back(source.file(key));
                 const std::int64_t nz = std::min(cz, dims.z - bz * cz),
                                    ny = std::min(cy, dims.y - by * cy),
                                    nx = std::min(cx, dims.x - bx * cx);
@@ -339,7 +380,7 @@ std::vector<std::byte> assemble(const ZarrArray& a, glm::ivec3 dims, std::vector
 
 // The spacing (x, y, z) of an OME-Zarr dataset: its "scale" transform's last three values (z, y,
 // x), times the multiscale's own scale where it has one.
-glm::vec3 ome_spacing(const fs::path& file, const json& multiscale, const json& dataset) {
+glm::vec3 ome_spacing(const std::string& file, const json& multiscale, const json& dataset) {
     glm::vec3 spacing(1.0f);
     auto apply = [&](const json& transforms, const std::string& where) {
         if (!transforms.is_array()) return;
@@ -416,7 +457,7 @@ bool is_foreign_zarr(const fs::path& path) {
     if (fs::exists(path / ".zarray", ec)) return true;
     if (!fs::exists(path / ".zattrs", ec)) return false;
     try {
-        const json at = read_json(path / ".zattrs");
+        const json at = read_json(FolderSource(path), ".zattrs");
         return at.is_object() && at.contains("multiscales") && !at.contains("isowall");
     } catch (const InputError&) {
         return false;  // not readable as Zarr metadata: the other readers say what it is
@@ -424,51 +465,60 @@ bool is_foreign_zarr(const fs::path& path) {
 }
 
 Volume read_zarr(const fs::path& path, const std::string& selection) {
-    fs::path array_dir = path;
+    return read_zarr(FolderSource(path), path.string(), selection);
+}
+
+Volume read_zarr_url(const std::string& url, const std::string& selection,
+                     const HttpOptions& options) {
+    return read_zarr(UrlSource(url, options), url, selection);
+}
+
+Volume read_zarr(const ZarrSource& source, const std::string& name, const std::string& selection) {
+    std::string prefix;
     glm::vec3 spacing(1.0f);
     std::vector<fs::path> files;
-    std::error_code ec;
     std::string what = "Zarr v2 array";
     std::vector<std::string> names;  // OME's axis names, slowest first
-    if (!fs::exists(path / ".zarray", ec)) {
-        const fs::path file = path / ".zattrs";
-        const json at = attributes(path);
-        const json& ms = at.value("multiscales", json());
+    std::optional<std::string> zarray = source.get(".zarray", kMaxMetadataBytes);
+    if (!zarray) {
+        const std::string file = source.where(".zattrs");
+        const json at = read_json(source, ".zattrs");
+        const json& ms = at.is_object() ? at.value("multiscales", json()) : json();
         if (!ms.is_array() || ms.empty() || !ms[0].is_object())
-            bad(file, "multiscales", "expected a list of OME-Zarr multiscales");
+            bad(file, "multiscales",
+                "expected a list of OME-Zarr multiscales (or a .zarray beside it)");
         const json& ds = ms[0].value("datasets", json());
         if (!ds.is_array() || ds.empty() || !ds[0].is_object() ||
             !ds[0].value("path", json()).is_string())
             bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
         const std::string sub = ds[0]["path"].get<std::string>();
-        if (sub.empty() || sub.find("..") != std::string::npos || sub.front() == '/')
+        if (sub.empty() || sub.find("..") != std::string::npos || sub.front() == '/' ||
+            sub.find_first_of("?#") != std::string::npos)
             bad(file, "multiscales[0].datasets[0].path",
                 "expected a folder inside the store, got " + quote(sub));
-        array_dir = path / sub;
+        prefix = sub + "/";
         spacing = ome_spacing(file, ms[0], ds[0]);
         for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
             names.push_back(ax.is_string() ? ax.get<std::string>()
                                            : ax.value("name", std::string()));
-        files.push_back(file);
+        if (!source.file(".zattrs").empty()) files.push_back(source.file(".zattrs"));
         what = "OME-Zarr " + ms[0].value("version", std::string("0.4")) + " (dataset " +
                quote(sub) + ")";
-        if (!fs::exists(array_dir / ".zarray", ec))
-            bad(file, "multiscales[0].datasets[0].path", quote(sub) + " holds no .zarray");
     }
-    ZarrArray a = read_zarray(array_dir);
+    ZarrArray a = read_zarray(source, prefix);
     if (names.size() != a.shape.size()) {  // no names, or not one per axis: their indices
         names.clear();
         for (std::size_t i = 0; i < a.shape.size(); ++i) names.push_back(std::to_string(i));
     }
-    a.pick = pick_axes(a, names, selection, path.string());
-    files.insert(files.begin(), array_dir / ".zarray");
+    a.pick = pick_axes(a, names, selection, name);
+    if (!source.file(prefix + ".zarray").empty())
+        files.insert(files.begin(), source.file(prefix + ".zarray"));
     const std::size_t k = a.shape.size();
     const std::uint64_t sides[3] = {static_cast<std::uint64_t>(a.shape[k - 1]),
                                     static_cast<std::uint64_t>(a.shape[k - 2]),
                                     static_cast<std::uint64_t>(a.shape[k - 3])};
-    const fs::path zarray = array_dir / ".zarray";
-    const glm::ivec3 dims = checked_dims(zarray.string(), "shape", sides, a.type);
-    check_fits_memory(voxel_bytes(dims, a.type), zarray.string(), "shape");
+    const glm::ivec3 dims = checked_dims(a.where, "shape", sides, a.type);
+    check_fits_memory(voxel_bytes(dims, a.type), a.where, "shape");
     // A chunk key per chunk of the grid is looked up: a grid of millions of tiny chunks over a
     // large shape would take hours to find missing.
     std::uint64_t grid = 1;
@@ -477,12 +527,12 @@ Volume read_zarr(const fs::path& path, const std::string& selection) {
                  static_cast<std::uint64_t>(a.chunks[k - 1 - static_cast<std::size_t>(i)]) - 1) /
                 static_cast<std::uint64_t>(a.chunks[k - 1 - static_cast<std::size_t>(i)]);
     if (grid > kMaxChunks)
-        bad(zarray, "chunks",
+        bad(a.where, "chunks",
             std::to_string(grid) + " chunks; isowall reads stores of at most " +
                 std::to_string(kMaxChunks) +
                 " (larger chunks, or `isowall import` from the source)");
     Decoded d;
-    d.bytes = assemble(a, dims, files);
+    d.bytes = assemble(source, a, dims, files);
     d.dims = dims;
     d.type = a.type;
     d.spacing = spacing;
@@ -496,7 +546,7 @@ Volume read_zarr(const fs::path& path, const std::string& selection) {
                                s += (i ? "x" : "") + std::to_string(a.chunks[i]);
                            return s + " (" + (a.fortran ? "F" : "C") + " order, " + codec + ")";
                        }()});
-    return finish_volume(std::move(d), path.string(), "");
+    return finish_volume(std::move(d), name, "");
 }
 
 }  // namespace isowall::formats

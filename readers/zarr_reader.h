@@ -12,12 +12,17 @@
 //     reads as the fill value (0 where it is null);
 //   - three axes (z, y, x), or more, the axes before them each given one element by `selection`
 //     ("t=3,c=0": OME's axis names, else each axis's index, "0=3"), or of one element.
-// isowall's own stores (an "isowall" block in .zattrs) are not this reader's: they page
+// Served over HTTP(S) (`--volume https://host/path.zarr`), the same objects are fetched through
+// libcurl (http_fetch.h). isowall's own stores (an "isowall" block in .zattrs) are not this
+// reader's on disk: they page
 // (store/open_store.h). Bad metadata or a damaged chunk is an InputError naming the store and
 // the field or the chunk's key.
+#include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 
+#include "readers/http_fetch.h"
 #include "volume/volume.h"
 
 namespace isowall::formats {
@@ -27,5 +32,24 @@ namespace isowall::formats {
 bool is_foreign_zarr(const std::filesystem::path& path);
 
 Volume read_zarr(const std::filesystem::path& path, const std::string& selection = "");
+
+// The same from a store served over HTTP(S) at `url` (http_fetch.h: one GET per object, 404 a
+// chunk left out, retries, an optional disk cache).
+Volume read_zarr_url(const std::string& url, const std::string& selection,
+                     const HttpOptions& options);
+
+// Where a store's objects come from: a folder, or a URL.
+class ZarrSource {
+  public:
+    virtual ~ZarrSource() = default;
+    // The bytes of `key` (".zattrs", "0/.zarray", "0/1.2.3"), nullopt where the store has none;
+    // an InputError past `max_bytes` or when it cannot be read.
+    virtual std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const = 0;
+    // `key` named for messages: its file or its URL.
+    virtual std::string where(const std::string& key) const = 0;
+    // The file that holds `key` (the octree cache's key covers it); empty for a URL.
+    virtual std::filesystem::path file(const std::string&) const { return {}; }
+};
+Volume read_zarr(const ZarrSource& source, const std::string& name, const std::string& selection);
 
 }  // namespace isowall::formats

@@ -11,7 +11,8 @@ PACKAGES=(
     libosmesa6-dev libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri libgles-dev
     libopenmpi-dev openmpi-bin
     libgtest-dev libgmock-dev libbenchmark-dev
-    libmeshoptimizer-dev libzstd-dev libblosc-dev liblz4-dev nlohmann-json3-dev libwebsocketpp-dev
+    libmeshoptimizer-dev libzstd-dev libblosc-dev liblz4-dev libcurl4-openssl-dev
+    nlohmann-json3-dev libwebsocketpp-dev
     libasio-dev
     libssl-dev openssl
     libembree-dev python3-vtk9

@@ -1,0 +1,166 @@
+#include "readers/http_fetch.h"
+
+#include <curl/curl.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <memory>
+#include <thread>
+
+#include "core/error.h"
+
+namespace isowall::formats {
+
+namespace {
+
+// One attempt's outcome: a status and a body, or a failure worth another try, or a final one.
+struct Attempt {
+    long status = 0;
+    std::string body;
+    std::string failure;  // non-empty: this try failed, with this reason
+    bool retry = false;   // whether another try may do better
+};
+
+struct Sink {
+    std::string* body;
+    std::size_t max;
+    bool over = false;
+};
+
+std::size_t write_body(char* data, std::size_t size, std::size_t count, void* user) {
+    auto* s = static_cast<Sink*>(user);
+    const std::size_t n = size * count;
+    if (s->body->size() + n > s->max) {
+        s->over = true;
+        return 0;  // aborts the transfer (CURLE_WRITE_ERROR)
+    }
+    s->body->append(data, n);
+    return n;
+}
+
+void global_init() {
+    static const bool done = [] {
+        curl_global_init(CURL_GLOBAL_DEFAULT);
+        return true;
+    }();
+    (void)done;
+}
+
+Attempt fetch_once(const std::string& url, std::size_t max_bytes, double stall_s) {
+    global_init();
+    Attempt a;
+    std::unique_ptr<CURL, void (*)(CURL*)> curl(curl_easy_init(), curl_easy_cleanup);
+    if (!curl) return {0, {}, "libcurl could not start", false};
+    Sink sink{&a.body, max_bytes};
+    const long stall = std::max(1L, std::lround(stall_s));
+    curl_easy_setopt(curl.get(), CURLOPT_URL, url.c_str());
+    curl_easy_setopt(curl.get(), CURLOPT_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(curl.get(), CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(curl.get(), CURLOPT_FOLLOWLOCATION, 1L);
+    curl_easy_setopt(curl.get(), CURLOPT_MAXREDIRS, 5L);
+    curl_easy_setopt(curl.get(), CURLOPT_NOSIGNAL, 1L);
+    curl_easy_setopt(curl.get(), CURLOPT_CONNECTTIMEOUT, stall);
+    // Less than a byte a second for `stall` seconds: the server stalled.
+    curl_easy_setopt(curl.get(), CURLOPT_LOW_SPEED_LIMIT, 1L);
+    curl_easy_setopt(curl.get(), CURLOPT_LOW_SPEED_TIME, stall);
+    curl_easy_setopt(curl.get(), CURLOPT_WRITEFUNCTION, write_body);
+    curl_easy_setopt(curl.get(), CURLOPT_WRITEDATA, &sink);
+    curl_easy_setopt(curl.get(), CURLOPT_USERAGENT, "isowall");
+    const CURLcode r = curl_easy_perform(curl.get());
+    curl_easy_getinfo(curl.get(), CURLINFO_RESPONSE_CODE, &a.status);
+    if (sink.over) {
+        a.failure = "the object is larger than " + std::to_string(max_bytes) + " bytes";
+        return a;
+    }
+    switch (r) {
+        case CURLE_OK:
+            break;
+        case CURLE_OPERATION_TIMEDOUT:
+            a.failure = "the server sent nothing for " + std::to_string(stall) + " s";
+            a.retry = true;
+            return a;
+        case CURLE_PARTIAL_FILE:
+            a.failure = "the body was cut short (" + std::to_string(a.body.size()) +
+                        " bytes, fewer than its Content-Length)";
+            a.retry = true;
+            return a;
+        case CURLE_COULDNT_CONNECT:
+        case CURLE_RECV_ERROR:
+        case CURLE_SEND_ERROR:
+        case CURLE_GOT_NOTHING:
+            a.failure = curl_easy_strerror(r);
+            a.retry = true;
+            return a;
+        default:
+            a.failure = curl_easy_strerror(r);
+            return a;
+    }
+    if (a.status >= 500) {
+        a.failure = "HTTP " + std::to_string(a.status);
+        a.retry = true;
+    } else if (a.status != 200 && a.status != 404) {
+        a.failure = "HTTP " + std::to_string(a.status);
+    }
+    return a;
+}
+
+// FNV-1a of the URL, as 16 hex digits: the cache file's name.
+std::string url_hash(const std::string& url) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const unsigned char c : url) h = (h ^ c) * 1099511628211ull;
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+    return buf;
+}
+
+}  // namespace
+
+bool is_url(std::string_view text) {
+    return text.starts_with("http://") || text.starts_with("https://");
+}
+
+HttpFetcher::HttpFetcher(HttpOptions options) : options_(std::move(options)) {}
+
+std::optional<std::string> HttpFetcher::get(const std::string& url, const std::string& field,
+                                            std::size_t max_bytes) const {
+    std::filesystem::path cached;
+    if (!options_.cache_dir.empty()) {
+        cached = options_.cache_dir / url_hash(url);
+        std::ifstream in(cached, std::ios::binary);
+        if (in) {
+            std::string body((std::istreambuf_iterator<char>(in)), {});
+            if (!in.bad() && body.size() <= max_bytes) return body;
+        }
+    }
+    Attempt a;
+    for (int attempt = 0;; ++attempt) {
+        a = fetch_once(url, max_bytes, options_.stall_s);
+        if (a.failure.empty() || !a.retry || attempt >= options_.retries) break;
+        ++retried_;
+        std::this_thread::sleep_for(std::chrono::milliseconds(250 << attempt));
+    }
+    if (!a.failure.empty())
+        throw InputError(
+            url, field,
+            a.failure +
+                (a.retry ? " (after " + std::to_string(options_.retries + 1) + " tries)" : ""));
+    if (a.status == 404) return std::nullopt;
+    if (!cached.empty()) {
+        // Written whole under a temporary name, then renamed: a cache file is never a part.
+        std::error_code ec;
+        std::filesystem::create_directories(cached.parent_path(), ec);
+        const auto part = cached.string() + ".part";
+        std::ofstream out(part, std::ios::binary | std::ios::trunc);
+        out.write(a.body.data(), static_cast<std::streamsize>(a.body.size()));
+        out.close();
+        if (out) std::filesystem::rename(part, cached, ec);
+        if (!out || ec) std::filesystem::remove(part, ec);  // a cache that cannot be written
+    }
+    return std::move(a.body);
+}
+
+}  // namespace isowall::formats

@@ -1,0 +1,43 @@
+#pragma once
+// Whole objects over HTTP(S) through libcurl, for stores served by a web server or an object store
+// (one GET per object, no ranges): what `--volume https://host/path.zarr` reads.
+//   - 200: the body; 404: absent (a Zarr chunk left out is the fill value); any other status, or
+//     a body past `max_bytes`, is an InputError naming the URL and the status.
+//   - A refused or dropped connection, a body cut short of its Content-Length, a server that
+//     sends nothing for `stall_s` seconds, and 5xx answers are tried again, `retries` more times,
+//     after 0.25 s, 0.5 s, 1 s...; the last failure is the error, naming the URL and what happened.
+//   - With `cache_dir`, each 200 body is kept there under a hash of its URL and read from there
+//     the next time (a store's objects do not change under one URL; remove the folder when one
+//     does).
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace isowall::formats {
+
+// "http://..." or "https://...".
+bool is_url(std::string_view text);
+
+struct HttpOptions {
+    double stall_s = 30;  // no byte for this long: the try failed
+    int retries = 3;
+    std::filesystem::path cache_dir;  // empty: no cache
+};
+
+class HttpFetcher {
+  public:
+    explicit HttpFetcher(HttpOptions options);
+    // The body of `url`, nullopt on 404; `field` names the object in errors ("chunk", ".zarray").
+    std::optional<std::string> get(const std::string& url, const std::string& field,
+                                   std::size_t max_bytes) const;
+    // How many tries the fetches so far took beyond the first (for messages and tests).
+    int retried() const { return retried_; }
+
+  private:
+    HttpOptions options_;
+    mutable int retried_ = 0;
+};
+
+}  // namespace isowall::formats
