@@ -34,6 +34,7 @@ const std::vector<CliSlot> kCliSlots = {
     {"render --spacing 1 {} 1", "--spacing", {"0", "-5", "1e300", "1e-300"}},
     {"render --dims 4 {} 4", "--dims", {"0", "-5", "2.5", "2147483648"}},
     {"render --header-bytes {}", "--header-bytes", {"-5", "2.5", "1e300"}},
+    {"render --http-timeout {}", "--http-timeout", {"0", "-5", "0.05", "3601", "1e300"}},
     {"extract --iso {} --out s.ply", "--iso", {}},
     {"wall --wall w.toml --iso {}", "--iso", {}},
     {"wall --wall w.toml --orbit 0 {}", "--orbit", {"1e300"}},
