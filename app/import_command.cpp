@@ -9,6 +9,7 @@
 
 #include "app/stop_signals.h"
 #include "cli/cli_checks.h"
+#include "cli/import_progress.h"
 #include "core/error.h"
 #include "core/util.h"
 #include "store/store_writer.h"
@@ -16,41 +17,7 @@
 #include "volume/octree.h"
 
 namespace isowall {
-namespace {
 
-// One line redrawn in place on a terminal; elsewhere (a log, CI) a line at each quarter.
-class ProgressBar {
-  public:
-    explicit ProgressBar(bool quiet) : quiet_(quiet), tty_(::isatty(2) == 1) {}
-    void update(const store::ImportProgress& p) {
-        if (quiet_ || p.chunks_total == 0) return;
-        const double done = double(p.chunks_done) / double(p.chunks_total);
-        const double s = sw_.seconds();
-        const double mib = double(p.bytes_in) / (1024.0 * 1024.0);
-        const double rate = mib / std::max(s, 1e-9);
-        const double left = done > 0 ? s * (1 - done) / done : 0;
-        const int quarter = static_cast<int>(done * 4);
-        if (!tty_ && quarter == last_quarter_) return;
-        last_quarter_ = quarter;
-        constexpr int kWidth = 30;
-        const int filled = static_cast<int>(done * kWidth);
-        std::string bar(static_cast<std::size_t>(filled), '#');
-        bar.append(static_cast<std::size_t>(kWidth - filled), '.');
-        std::fprintf(stderr, "%simport: [%s] %3.0f%%  %.0f MiB  %.0f MiB/s  %.1f s left%s",
-                     tty_ ? "\r" : "", bar.c_str(), 100 * done, mib, rate, left, tty_ ? "" : "\n");
-        std::fflush(stderr);
-    }
-    void finish() {
-        if (!quiet_ && tty_) std::fprintf(stderr, "\n");
-    }
-
-  private:
-    bool quiet_, tty_;
-    int last_quarter_ = -1;
-    Stopwatch sw_;
-};
-
-}  // namespace
 
 CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
     auto* c = app.add_subcommand(
@@ -107,7 +74,7 @@ int run_import(const ImportCommand& o) {
     OpenedVolume ov;
     if (!planes) ov = open_volume(vo, o.quiet, VolumeUse{.casts = false});
 
-    ProgressBar bar(o.quiet);
+    ImportProgressBar bar("import", o.quiet);
     store::ImportOptions opts;
     opts.replace = o.force;
     opts.zstd_level = o.level;

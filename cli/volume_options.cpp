@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli/cli_checks.h"
+#include "cli/rechunked_store.h"
 #include "core/error.h"
 #include "core/number.h"
 #include "core/util.h"
@@ -11,6 +12,7 @@
 #include "readers/zarr_reader.h"
 #include "store/open_store.h"
 #include "store/store_format.h"
+#include "volume/load_checks.h"
 #include "volume/octree.h"
 #include "volume/phantom.h"
 
@@ -53,7 +55,9 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
         ->transform(number_in({0.1, 3600}));
     app.add_option("--memory-limit", o.memory_limit,
                    "A store's voxels in memory at most (e.g. 512M, 8G); the rest stays on disk "
-                   "and is read when a ray or the surface first needs it. Default: half the "
+                   "and is read when a ray or the surface first needs it. Another tool's Zarr "
+                   "store (a folder or a URL) given a limit, or past it, is first copied into an "
+                   "isowall store in the cache folder (stores/), once. Default: half the "
                    "available memory, shared by the processes of this host")
         ->check([](const std::string& text) -> std::string {
             if (parse_byte_size(text)) return "";
@@ -123,8 +127,45 @@ bool own_store(const std::string& path) {
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
     if (o.path.empty() || own_store(o.path)) return nullptr;
     check_no_memory_limit(o);
-    return formats::open_planes(o.path, raw_spec(o));
+    return formats::open_planes(o.path, raw_spec(o), http_options(o));
 }
+
+namespace {
+
+// Another tool's Zarr store opened paged through its copy in the cache folder
+// (rechunked_store.h) when --memory-limit is given or its voxels pass the limit; nullopt when it
+// is read whole (and `planes`, opened to learn its size, is dropped).
+std::optional<OpenedVolume> open_rechunked(const VolumeOptions& o, bool quiet, VolumeUse use,
+                                           std::string& note) {
+    std::unique_ptr<PlaneSource> planes = formats::open_planes(o.path, std::nullopt, http_options(o));
+    const std::uint64_t cap = memory_limit(o, use);
+    const bool asked = !o.memory_limit.empty();
+    if (!asked && voxel_bytes(planes->dims(), planes->type()) <= cap) return std::nullopt;
+    const std::filesystem::path cache = cache_dir(o);
+    if (cache.empty()) {
+        if (!asked) return std::nullopt;  // read whole, as without a cache it must be
+        throw InputError("--memory-limit", "--no-cache",
+                         "paging " + quote(o.path) +
+                             " copies it into the cache folder first; drop --no-cache, or "
+                             "`isowall import` it and give the store");
+    }
+    const RechunkedStore copy = rechunk_into_cache(o.path, *planes, cache, quiet);
+    planes.reset();
+    store::OpenedStore opened = store::open_store(copy.store, cap);
+    OpenedVolume out;
+    out.volume = std::move(opened.volume);
+    out.pager = std::move(opened.pager);
+    out.store = std::move(opened.reader);
+    out.file = copy.store;
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.2f s", copy.seconds);
+    note = std::string(" (re-chunked into ") + copy.store.string() +
+           (copy.written ? std::string(" in ") + seconds : std::string(", an earlier copy")) +
+           "; " + opened.how + ")";
+    return out;
+}
+
+}  // namespace
 
 OpenedVolume open_volume(const VolumeOptions& o, std::shared_ptr<const store::StoreReader> reader,
                          const std::filesystem::path& octree, VolumeUse use) {
@@ -141,6 +182,8 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
     OpenedVolume out;
     Stopwatch sw;
     std::string store_note;
+    std::optional<OpenedVolume> out_rechunked;
+    std::string shown;  // the name the line gives; empty: the volume's source
     if (o.path.empty()) {
         if (!o.dims.empty() || !o.type.empty())
             throw InputError("--dims/--type", "--volume", "raw options need --volume FILE");
@@ -156,6 +199,10 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
         out.store = std::move(opened.reader);
         out.file = path;
         store_note = " (" + opened.how + ")";
+    } else if (formats::is_zarr_source(o.path) &&
+               (out_rechunked = open_rechunked(o, quiet, use, store_note))) {
+        out = std::move(*out_rechunked);
+        shown = o.path;  // the store given, not its copy (named in the note)
     } else {
         // A volume not cast (import) streams its file itself, at the disk's pace.
         out.volume = formats::is_url(o.path) ? formats::read_url(o.path, http_options(o))
@@ -197,7 +244,7 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
                         : v.mapped()      ? "memory-mapped"
                                           : "in memory";
     std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s%s  (%.2f s)\n",
-                v.source().c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
+                (shown.empty() ? v.source() : shown).c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
                 double(s.x), double(s.y), double(s.z), double(v.bytes().size()) / (1024.0 * 1024.0),
                 where, (huge_note + store_note).c_str(), out.load_s);
     return out;

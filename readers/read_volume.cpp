@@ -72,11 +72,27 @@ std::unique_ptr<PlaneSource> dicom_stream(const fs::path& p) {
     return stream_isolated(p.string(), "the DICOM decoder (GDCM)", [&] { return dicom_planes(p); });
 }
 
+constexpr const char* kZarrDecoders = "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)";
+
 // Zarr chunks decoded by c-blosc, zstd, zlib and lz4 in a child as well: a decoder's crash on a
 // damaged chunk is one line.
 Volume zarr(const fs::path& dir, const std::string& selection = "") {
-    return read_isolated(dir.string(), "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)",
-                         [&] { return read_zarr(dir, selection); });
+    return read_isolated(dir.string(), kZarrDecoders, [&] { return read_zarr(dir, selection); });
+}
+
+std::unique_ptr<PlaneSource> zarr_stream(const fs::path& dir, const std::string& selection = "") {
+    return stream_isolated(dir.string(), kZarrDecoders,
+                           [=] { return zarr_planes(dir, selection); });
+}
+
+// A URL's store and its selection: a last ':' followed by AXIS=INDEX pairs, after the host's own
+// colons.
+std::pair<std::string, std::string> url_selection(const std::string& url) {
+    const std::size_t colon = url.rfind(':');
+    if (colon != std::string::npos && colon > url.find("://") + 2 &&
+        url.find('=', colon) != std::string::npos && url.find('/', colon) == std::string::npos)
+        return {url.substr(0, colon), url.substr(colon + 1)};
+    return {url, ""};
 }
 
 // STORE:t=3,c=0 (zarr_reader.h): the store and the selection, when STORE is another tool's.
@@ -128,14 +144,23 @@ std::unique_ptr<PlaneSource> file_planes(const fs::path& p, const std::string& n
 
 }  // namespace
 
+bool is_zarr_source(const std::string& path) {
+    return is_url(path) || is_foreign_zarr(path) || zarr_selection(path).has_value();
+}
+
 std::unique_ptr<PlaneSource> open_planes(const std::string& path,
-                                         const std::optional<RawSpec>& raw) {
+                                         const std::optional<RawSpec>& raw,
+                                         const HttpOptions& http) {
     if (raw) return raw_planes(path, *raw);
-    if (is_url(path)) return nullptr;  // read whole (read_url)
+    if (is_url(path)) {
+        const auto [base, selection] = url_selection(path);
+        return stream_isolated(path, kZarrDecoders,
+                               [=] { return zarr_url_planes(base, selection, http); });
+    }
     const fs::path p(path);
     std::error_code ec;
     if (fs::is_directory(p, ec)) {
-        if (is_foreign_zarr(p)) return nullptr;  // read whole (read_volume)
+        if (is_foreign_zarr(p)) return zarr_stream(p);
         return is_tiff_folder(p) ? streamed(tiff_planes(p), p) : dicom_stream(p);
     }
     const std::size_t colon = path.rfind(":/");
@@ -143,21 +168,14 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path,
         const std::string file = path.substr(0, colon);
         if (is_hdf5_name(file)) return hdf5_stream(file, path.substr(colon + 1));
     }
-    if (zarr_selection(path)) return nullptr;  // read whole (read_volume)
+    if (const auto z = zarr_selection(path)) return zarr_stream(z->first, z->second);
     check_regular_file(p, path, "file");
     return file_planes(p, p.filename().string());
 }
 
 Volume read_url(const std::string& url, const HttpOptions& options) {
-    // A selection is a last ':' followed by AXIS=INDEX pairs, after the host's own colons.
-    std::string base = url, selection;
-    const std::size_t colon = url.rfind(':');
-    if (colon != std::string::npos && colon > url.find("://") + 2 &&
-        url.find('=', colon) != std::string::npos && url.find('/', colon) == std::string::npos) {
-        base = url.substr(0, colon);
-        selection = url.substr(colon + 1);
-    }
-    return read_isolated(url, "the Zarr chunk decoders (c-blosc, zstd, zlib, lz4)",
+    const auto [base, selection] = url_selection(url);
+    return read_isolated(url, kZarrDecoders,
                          [&] { return read_zarr_url(base, selection, options); });
 }
 

@@ -28,12 +28,18 @@ Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw,
 // process as a folder's is.
 Volume read_url(const std::string& url, const HttpOptions& options);
 
+// Whether `path` names another tool's Zarr store: a folder (zarr_reader.h: is_foreign_zarr), one
+// with a selection (FOLDER:t=3), or a URL.
+bool is_zarr_source(const std::string& path);
+
 // The planes of the volume read_volume gives, for `isowall import` to stream a slab at a time:
-// TIFF stacks, NIfTI, MetaImage, DICOM series and HDF5 datasets (their readers' plane stacks,
-// plane_stack.h; DICOM and HDF5 decoded in a child process as read_volume does), and gzip or
+// TIFF stacks, NIfTI, MetaImage, DICOM series, HDF5 datasets and Zarr stores, a folder or a URL
+// fetched with `http` (their readers' plane stacks, plane_stack.h; DICOM, HDF5 and Zarr decoded
+// in a child process as read_volume does), and gzip or
 // other-endian NRRD and raw (nrrd_planes, raw_planes). Null for what read_volume maps without
 // decoding (raw and raw NRRD in host order), and for bzip2, hex and ascii NRRD, decoded whole.
 std::unique_ptr<PlaneSource> open_planes(const std::string& path,
-                                         const std::optional<RawSpec>& raw);
+                                         const std::optional<RawSpec>& raw,
+                                         const HttpOptions& http = {});
 
 }  // namespace isowall::formats

@@ -19,6 +19,7 @@
 #include "core/error.h"
 #include "files/input_file.h"
 #include "readers/http_fetch.h"
+#include "readers/plane_stack.h"
 #include "readers/voxel_ops.h"
 #include "volume/load_checks.h"
 
@@ -311,72 +312,113 @@ std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::i
            std::to_string(x);
 }
 
-// Where the array's chunks go in the volume (x fastest): every chunk read, decoded and put in.
-std::vector<std::byte> assemble(const ZarrSource& source, const ZarrArray& a, glm::ivec3 dims,
-                                std::vector<fs::path>& files) {
-    const std::size_t n = static_cast<std::size_t>(dims.x) * dims.y * dims.z, e = a.item();
-    std::vector<std::byte> out;
-    try {
-        out.resize(n * e);
-    } catch (const std::bad_alloc&) {
-        bad(a.where, "shape", "too large to read into memory here");
+// The array's planes (x fastest, host order) a slab at a time, from the rows of chunks that
+// cross them (a row: the chunks of one chunk-index along z). A slab that ends inside a row keeps
+// the row decoded for the next slab, so each chunk is decoded once in a stream of slabs; a row
+// wholly inside the slab asked for is put straight into it.
+class ChunkRows {
+  public:
+    ChunkRows(std::shared_ptr<const ZarrSource> source, ZarrArray a, glm::ivec3 dims)
+        : source_(std::move(source)), a_(std::move(a)), dims_(dims), fill_(fill_bytes(a_)) {
+        const std::size_t k = a_.shape.size();
+        // Element strides of each axis within a chunk: C order has the last axis fastest.
+        std::vector<std::size_t> stride(k, 1);
+        if (a_.fortran)
+            for (std::size_t i = 1; i < k; ++i)
+                stride[i] = stride[i - 1] * static_cast<std::size_t>(a_.chunks[i - 1]);
+        else
+            for (std::size_t i = k - 1; i-- > 0;)
+                stride[i] = stride[i + 1] * static_cast<std::size_t>(a_.chunks[i + 1]);
+        sz_ = stride[k - 3], sy_ = stride[k - 2], sx_ = stride[k - 1];
+        for (std::size_t i = 0; i + 3 < k; ++i)
+            picked_ += static_cast<std::size_t>(a_.pick[i] % a_.chunks[i]) * stride[i];
+        // The voxels are swapped to host order once placed, the fill with them: file order.
+        if (a_.big_endian) std::reverse(fill_.begin(), fill_.end());
+        chunk_.resize(a_.chunk_elements() * a_.item());
     }
-    std::vector<std::byte> fill = fill_bytes(a);
-    // The voxels are swapped to host order at the end, the fill with them: put it in file order.
-    if (a.big_endian) std::reverse(fill.begin(), fill.end());
-    if (std::any_of(fill.begin(), fill.end(), [](std::byte b) { return b != std::byte{0}; }))
-        for (std::size_t i = 0; i < n; ++i) std::memcpy(out.data() + i * e, fill.data(), e);
-    const std::size_t k = a.shape.size();
-    const std::int64_t cz = a.chunks[k - 3], cy = a.chunks[k - 2], cx = a.chunks[k - 1];
-    // Element strides of z, y and x within a chunk: C order has the last axis fastest.
-    std::vector<std::size_t> stride(k, 1);
-    if (a.fortran)
-        for (std::size_t i = 1; i < k; ++i)
-            stride[i] = stride[i - 1] * static_cast<std::size_t>(a.chunks[i - 1]);
-    else
-        for (std::size_t i = k - 1; i-- > 0;)
-            stride[i] = stride[i + 1] * static_cast<std::size_t>(a.chunks[i + 1]);
-    const std::size_t sz = stride[k - 3], sy = stride[k - 2], sx = stride[k - 1];
-    std::size_t picked = 0;  // where the picked time point and channel start in a chunk
-    for (std::size_t i = 0; i + 3 < k; ++i)
-        picked += static_cast<std::size_t>(a.pick[i] % a.chunks[i]) * stride[i];
-    std::vector<std::byte> chunk(a.chunk_elements() * e);
-    for (std::int64_t bz = 0; bz * cz < dims.z; ++bz)
-        for (std::int64_t by = 0; by * cy < dims.y; ++by)
-            for (std::int64_t bx = 0; bx * cx < dims.x; ++bx) {
-                const std::string key = a.prefix + chunk_key(a, bz, by, bx);
-                const auto bytes = source.get(key, kMaxChunkBytes + (1 << 20));
-                if (!bytes) continue;  // a missing chunk is the fill value
-                decode_chunk(a, *bytes, source.where(key), chunk);
-                if (!source.file(key).empty()) files.push_back(source.file(key));
-                const std::int64_t nz = std::min(cz, dims.z - bz * cz),
-                                   ny = std::min(cy, dims.y - by * cy),
-                                   nx = std::min(cx, dims.x - bx * cx);
-                for (std::int64_t z = 0; z < nz; ++z)
-                    for (std::int64_t y = 0; y < ny; ++y) {
-                        std::byte* row =
-                            out.data() + ((static_cast<std::size_t>(bz * cz + z) * dims.y +
-                                           static_cast<std::size_t>(by * cy + y)) *
-                                              dims.x +
-                                          static_cast<std::size_t>(bx * cx)) *
-                                             e;
-                        const std::size_t base = picked + static_cast<std::size_t>(z) * sz +
-                                                 static_cast<std::size_t>(y) * sy;
-                        if (sx == 1) {
-                            std::memcpy(row, chunk.data() + base * e,
-                                        static_cast<std::size_t>(nx) * e);
-                        } else {
-                            for (std::int64_t x = 0; x < nx; ++x)
-                                std::memcpy(
-                                    row + static_cast<std::size_t>(x) * e,
-                                    chunk.data() + (base + static_cast<std::size_t>(x) * sx) * e,
-                                    e);
-                        }
-                    }
+
+    void read(int z0, int z1, std::byte* to) {
+        const std::int64_t cz = a_.chunks[a_.shape.size() - 3];
+        for (std::int64_t bz = z0 / cz; bz * cz < z1; ++bz) {
+            const std::int64_t r0 = bz * cz, r1 = std::min<std::int64_t>(r0 + cz, dims_.z);
+            const std::int64_t lo = std::max<std::int64_t>(z0, r0), hi = std::min<std::int64_t>(z1, r1);
+            if (lo == r0 && hi == r1) {
+                put_row(bz, to + static_cast<std::size_t>(r0 - z0) * plane());
+            } else {
+                if (row_ != bz) {
+                    row_bytes_.resize(static_cast<std::size_t>(r1 - r0) * plane());
+                    put_row(bz, row_bytes_.data());
+                    row_ = bz;
+                }
+                std::memcpy(to + static_cast<std::size_t>(lo - z0) * plane(),
+                            row_bytes_.data() + static_cast<std::size_t>(lo - r0) * plane(),
+                            static_cast<std::size_t>(hi - lo) * plane());
             }
-    if (a.big_endian && e > 1) swap_bytes(out, e);
-    return out;
-}
+        }
+        if (a_.big_endian && a_.item() > 1)
+            swap_bytes({to, static_cast<std::size_t>(z1 - z0) * plane()}, a_.item());
+    }
+
+    bool keep_files = false;      // whether to list the chunk files read (a whole read's)
+    std::vector<fs::path> files;  // the chunk files read, where the source has files
+
+  private:
+    std::size_t plane() const { return static_cast<std::size_t>(dims_.x) * dims_.y * a_.item(); }
+
+    // Row `bz`'s planes into `out` (file order): every chunk of it read, decoded and put in.
+    void put_row(std::int64_t bz, std::byte* out) {
+        const std::size_t k = a_.shape.size(), e = a_.item();
+        const std::int64_t cz = a_.chunks[k - 3], cy = a_.chunks[k - 2], cx = a_.chunks[k - 1];
+        const std::int64_t nz = std::min(cz, dims_.z - bz * cz);
+        const std::size_t n = static_cast<std::size_t>(nz) * dims_.x * dims_.y;
+        if (std::any_of(fill_.begin(), fill_.end(), [](std::byte b) { return b != std::byte{0}; }))
+            for (std::size_t i = 0; i < n; ++i) std::memcpy(out + i * e, fill_.data(), e);
+        else
+            std::memset(out, 0, n * e);
+        for (std::int64_t by = 0; by * cy < dims_.y; ++by)
+            for (std::int64_t bx = 0; bx * cx < dims_.x; ++bx) {
+                const std::string key = a_.prefix + chunk_key(a_, bz, by, bx);
+                const auto bytes = source_->get(key, kMaxChunkBytes + (1 << 20));
+                if (!bytes) continue;  // a missing chunk is the fill value
+                decode_chunk(a_, *bytes, source_->where(key), chunk_);
+                if (keep_files && !source_->file(key).empty()) files.push_back(source_->file(key));
+                const std::int64_t ny = std::min(cy, dims_.y - by * cy),
+                                   nx = std::min(cx, dims_.x - bx * cx);
+                for (std::int64_t z = 0; z < nz; ++z)
+                    for (std::int64_t y = 0; y < ny; ++y)
+                        put_chunk_row(out, z, by * cy + y, bx * cx, nx,
+                                      picked_ + static_cast<std::size_t>(z) * sz_ +
+                                          static_cast<std::size_t>(y) * sy_);
+            }
+    }
+
+    // `nx` voxels of the decoded chunk from element `base` on (x stride sx_) into plane z, row y,
+    // from column x of `out`.
+    void put_chunk_row(std::byte* out, std::int64_t z, std::int64_t y, std::int64_t x,
+                       std::int64_t nx, std::size_t base) const {
+        const std::size_t e = a_.item();
+        std::byte* row = out + ((static_cast<std::size_t>(z) * dims_.y + static_cast<std::size_t>(y)) *
+                                    dims_.x +
+                                static_cast<std::size_t>(x)) *
+                                   e;
+        if (sx_ == 1) {
+            std::memcpy(row, chunk_.data() + base * e, static_cast<std::size_t>(nx) * e);
+            return;
+        }
+        for (std::int64_t i = 0; i < nx; ++i)
+            std::memcpy(row + static_cast<std::size_t>(i) * e,
+                        chunk_.data() + (base + static_cast<std::size_t>(i) * sx_) * e, e);
+    }
+
+    std::shared_ptr<const ZarrSource> source_;
+    ZarrArray a_;
+    glm::ivec3 dims_;
+    std::vector<std::byte> fill_;
+    std::size_t sz_ = 0, sy_ = 0, sx_ = 0, picked_ = 0;
+    std::vector<std::byte> chunk_;
+    std::int64_t row_ = -1;  // the row held in row_bytes_
+    std::vector<std::byte> row_bytes_;
+};
 
 // The spacing (x, y, z) of an OME-Zarr dataset: its "scale" transform's last three values (z, y,
 // x), times the multiscale's own scale where it has one.
@@ -465,24 +507,43 @@ bool is_foreign_zarr(const fs::path& path) {
 }
 
 Volume read_zarr(const fs::path& path, const std::string& selection) {
-    return read_zarr(FolderSource(path), path.string(), selection);
+    return read_zarr(std::make_shared<FolderSource>(path), path.string(), selection);
 }
 
 Volume read_zarr_url(const std::string& url, const std::string& selection,
                      const HttpOptions& options) {
-    return read_zarr(UrlSource(url, options), url, selection);
+    return read_zarr(std::make_shared<UrlSource>(url, options), url, selection);
 }
 
-Volume read_zarr(const ZarrSource& source, const std::string& name, const std::string& selection) {
+PlaneStack zarr_planes(const fs::path& path, const std::string& selection) {
+    return zarr_planes(std::make_shared<FolderSource>(path), path.string(), selection);
+}
+
+PlaneStack zarr_url_planes(const std::string& url, const std::string& selection,
+                           const HttpOptions& options) {
+    return zarr_planes(std::make_shared<UrlSource>(url, options), url, selection);
+}
+
+namespace {
+
+// The array `source` holds (an OME image's first dataset), its axes before z, y, x picked by
+// `selection`, as a plane stack whose `read` puts the chunks' voxels in host order.
+struct OpenedArray {
+    PlaneStack stack;
+    std::shared_ptr<ChunkRows> rows;
+};
+
+OpenedArray open_array(std::shared_ptr<const ZarrSource> source, const std::string& name,
+                       const std::string& selection) {
     std::string prefix;
     glm::vec3 spacing(1.0f);
     std::vector<fs::path> files;
     std::string what = "Zarr v2 array";
     std::vector<std::string> names;  // OME's axis names, slowest first
-    std::optional<std::string> zarray = source.get(".zarray", kMaxMetadataBytes);
+    std::optional<std::string> zarray = source->get(".zarray", kMaxMetadataBytes);
     if (!zarray) {
-        const std::string file = source.where(".zattrs");
-        const json at = read_json(source, ".zattrs");
+        const std::string file = source->where(".zattrs");
+        const json at = read_json(*source, ".zattrs");
         const json& ms = at.is_object() ? at.value("multiscales", json()) : json();
         if (!ms.is_array() || ms.empty() || !ms[0].is_object())
             bad(file, "multiscales",
@@ -501,24 +562,23 @@ Volume read_zarr(const ZarrSource& source, const std::string& name, const std::s
         for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
             names.push_back(ax.is_string() ? ax.get<std::string>()
                                            : ax.value("name", std::string()));
-        if (!source.file(".zattrs").empty()) files.push_back(source.file(".zattrs"));
+        if (!source->file(".zattrs").empty()) files.push_back(source->file(".zattrs"));
         what = "OME-Zarr " + ms[0].value("version", std::string("0.4")) + " (dataset " +
                quote(sub) + ")";
     }
-    ZarrArray a = read_zarray(source, prefix);
+    ZarrArray a = read_zarray(*source, prefix);
     if (names.size() != a.shape.size()) {  // no names, or not one per axis: their indices
         names.clear();
         for (std::size_t i = 0; i < a.shape.size(); ++i) names.push_back(std::to_string(i));
     }
     a.pick = pick_axes(a, names, selection, name);
-    if (!source.file(prefix + ".zarray").empty())
-        files.insert(files.begin(), source.file(prefix + ".zarray"));
+    if (!source->file(prefix + ".zarray").empty())
+        files.insert(files.begin(), source->file(prefix + ".zarray"));
     const std::size_t k = a.shape.size();
     const std::uint64_t sides[3] = {static_cast<std::uint64_t>(a.shape[k - 1]),
                                     static_cast<std::uint64_t>(a.shape[k - 2]),
                                     static_cast<std::uint64_t>(a.shape[k - 3])};
     const glm::ivec3 dims = checked_dims(a.where, "shape", sides, a.type);
-    check_fits_memory(voxel_bytes(dims, a.type), a.where, "shape");
     // A chunk key per chunk of the grid is looked up: a grid of millions of tiny chunks over a
     // large shape would take hours to find missing.
     std::uint64_t grid = 1;
@@ -531,8 +591,8 @@ Volume read_zarr(const ZarrSource& source, const std::string& name, const std::s
             std::to_string(grid) + " chunks; isowall reads stores of at most " +
                 std::to_string(kMaxChunks) +
                 " (larger chunks, or `isowall import` from the source)");
-    Decoded d;
-    d.bytes = assemble(source, a, dims, files);
+    OpenedArray out;
+    Decoded& d = out.stack.head;
     d.dims = dims;
     d.type = a.type;
     d.spacing = spacing;
@@ -540,12 +600,33 @@ Volume read_zarr(const ZarrSource& source, const std::string& name, const std::s
     d.files = std::move(files);
     const std::string codec =
         a.compressor.is_null() ? "none" : a.compressor.value("id", std::string());
-    d.facts.push_back({"chunks", [&] {
-                           std::string s;
-                           for (std::size_t i = 0; i < k; ++i)
-                               s += (i ? "x" : "") + std::to_string(a.chunks[i]);
-                           return s + " (" + (a.fortran ? "F" : "C") + " order, " + codec + ")";
-                       }()});
+    std::string chunks;
+    for (std::size_t i = 0; i < k; ++i) chunks += (i ? "x" : "") + std::to_string(a.chunks[i]);
+    d.facts.push_back({"chunks", chunks + " (" + (a.fortran ? "F" : "C") + " order, " + codec + ")"});
+    out.stack.size_field = "shape";
+    out.rows = std::make_shared<ChunkRows>(std::move(source), std::move(a), dims);
+    out.stack.read = [rows = out.rows](int z0, int z1, std::byte* to) { rows->read(z0, z1, to); };
+    return out;
+}
+
+}  // namespace
+
+PlaneStack zarr_planes(std::shared_ptr<const ZarrSource> source, const std::string& name,
+                       const std::string& selection) {
+    return open_array(std::move(source), name, selection).stack;
+}
+
+Volume read_zarr(std::shared_ptr<const ZarrSource> source, const std::string& name,
+                 const std::string& selection) {
+    OpenedArray opened = open_array(std::move(source), name, selection);
+    Decoded& d = opened.stack.head;
+    const std::uint64_t need = voxel_bytes(d.dims, d.type);
+    check_fits_memory(need, name, "shape");
+    d.bytes = allocate_voxels(need, name, "shape");
+    opened.rows->keep_files = true;
+    opened.rows->read(0, d.dims.z, d.bytes.data());
+    // The chunk files join the metadata's: the octree cache's key covers every one.
+    d.files.insert(d.files.end(), opened.rows->files.begin(), opened.rows->files.end());
     return finish_volume(std::move(d), name, "");
 }
 

@@ -19,10 +19,12 @@
 // the field or the chunk's key.
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "readers/http_fetch.h"
+#include "readers/plane_stack.h"
 #include "volume/volume.h"
 
 namespace isowall::formats {
@@ -32,6 +34,13 @@ namespace isowall::formats {
 bool is_foreign_zarr(const std::filesystem::path& path);
 
 Volume read_zarr(const std::filesystem::path& path, const std::string& selection = "");
+
+// The same array's planes a slab at a time (plane_stack.h), for `isowall import` and for paging
+// a store through a re-chunked copy: a row of chunks along z is decoded once and held while the
+// slabs asked for cross it.
+PlaneStack zarr_planes(const std::filesystem::path& path, const std::string& selection = "");
+PlaneStack zarr_url_planes(const std::string& url, const std::string& selection,
+                           const HttpOptions& options);
 
 // The same from a store served over HTTP(S) at `url` (http_fetch.h: one GET per object, 404 a
 // chunk left out, retries, an optional disk cache).
@@ -50,6 +59,9 @@ class ZarrSource {
     // The file that holds `key` (the octree cache's key covers it); empty for a URL.
     virtual std::filesystem::path file(const std::string&) const { return {}; }
 };
-Volume read_zarr(const ZarrSource& source, const std::string& name, const std::string& selection);
+Volume read_zarr(std::shared_ptr<const ZarrSource> source, const std::string& name,
+                 const std::string& selection);
+PlaneStack zarr_planes(std::shared_ptr<const ZarrSource> source, const std::string& name,
+                       const std::string& selection);
 
 }  // namespace isowall::formats
