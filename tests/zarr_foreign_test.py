@@ -167,6 +167,54 @@ class ForeignZarr(unittest.TestCase):
         with open(c, "rb") as fc, open(b, "rb") as fb:
             self.assertEqual(fc.read(), fb.read())
 
+    def test_a_store_given_a_memory_limit_pages_through_its_copy(self):
+        path = self.write("slices", chunks=(1, 26, 30), compressor=Blosc(cname="lz4"))
+        out = os.path.join(SCRATCH, "paged.png")
+        first = run("render", "-v", path, "--iso", "300", "--size", SIZE, "-q", "--no-measure",
+                    "--memory-limit", "1M", "-o", out)
+        self.assertEqual(first.returncode, 0, first.stderr)
+        self.assertRegex(first.stdout, r"volume: .*slices.zarr .* in a store \(re-chunked into "
+                                       r".*stores/[0-9a-f]{16}\.zarr in [0-9.]+ s; paged, limit 1 MiB\)")
+        self.assertIn("re-chunk: [", first.stderr)  # the progress
+        with open(out, "rb") as a, open(self.reference, "rb") as b:
+            self.assertEqual(a.read(), b.read(), "the paged copy's image differs from the NRRD's")
+        # Unchanged, the copy is found again; changed, the store gets a new copy.
+        again = run("render", "-v", path, "--iso", "300", "--size", SIZE, "-q", "--no-measure",
+                    "--memory-limit", "1M", "-o", out)
+        self.assertIn("an earlier copy; paged", again.stdout)
+        copies = os.listdir(os.path.join(SCRATCH, "cache", "stores"))
+        a = zarr.open_array(path, mode="r+")
+        a[10:12] = 0
+        changed = run("render", "-v", path, "--iso", "300", "--size", SIZE, "-q", "--no-measure",
+                      "--memory-limit", "1M", "-o", out)
+        self.assertEqual(changed.returncode, 0, changed.stderr)
+        self.assertNotIn("an earlier copy", changed.stdout)
+        self.assertGreater(len(os.listdir(os.path.join(SCRATCH, "cache", "stores"))), len(copies))
+        with open(out, "rb") as a, open(self.reference, "rb") as b:
+            self.assertNotEqual(a.read(), b.read(), "the changed store drew the old copy")
+        # Without a cache folder there is nowhere to copy it: one line.
+        p = subprocess.run([ISOWALL, "render", "-v", path, "--memory-limit", "1M", "--no-cache",
+                            "-o", os.path.join(SCRATCH, "nocache.png")],
+                           capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+        self.assertIn("--memory-limit", p.stderr)
+        self.assertIn("--no-cache", p.stderr)
+        self.assertFalse(os.path.exists(os.path.join(SCRATCH, "nocache.png")))
+
+    def test_import_streams_a_store_a_slab_at_a_time(self):
+        path = self.write("to-import", chunks=(4, 26, 30), compressor=Zstd(level=1))
+        store = os.path.join(SCRATCH, "streamed.zarr")
+        shutil.rmtree(store, ignore_errors=True)
+        p = subprocess.run([ISOWALL, "import", path, "--out", store], capture_output=True,
+                           text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("source decoded a slab of planes at a time", p.stdout)
+        out = os.path.join(SCRATCH, "streamed.png")
+        self.assertEqual(render(store, out).returncode, 0)
+        with open(out, "rb") as a, open(self.reference, "rb") as b:
+            self.assertEqual(a.read(), b.read())
+
     def refused(self, path, *words):
         out = os.path.join(SCRATCH, "refused.png")
         if os.path.exists(out):

@@ -191,6 +191,23 @@ class ZarrOverHttp(unittest.TestCase):
         self.assertTrue(all(r.endswith((".zarray", ".zattrs", ".zgroup")) or r not in
                             self.faults.requests[:asked] for r in self.faults.requests[asked:]))
 
+    def test_a_store_over_http_pages_through_its_copy(self):
+        cache = os.path.join(SCRATCH, "paged-cache")
+        shutil.rmtree(cache, ignore_errors=True)
+        out = os.path.join(SCRATCH, "paged.png")
+        # A chunk cut short while it is copied: one line, no image, and no copy left to reuse.
+        self.faults.plan["/blob.zarr/1.1.1"] = ["cut"] * 4
+        p = render(self.url + "/blob.zarr", out, "--cache-dir", cache, "--memory-limit", "1M")
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn(self.url + "/blob.zarr/1.1.1", p.stderr.strip().splitlines()[-1])
+        self.assertFalse(os.path.exists(out))
+        self.assertEqual([f for f in os.listdir(os.path.join(cache, "stores")) if f.endswith(".zarr")], [])
+        self.faults.plan.clear()
+        p = render(self.url + "/blob.zarr", out, "--cache-dir", cache, "--memory-limit", "1M")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertRegex(p.stdout, r"volume: http://.*/blob.zarr .*\(re-chunked into .*; paged, limit 1 MiB\)")
+        self.same_as_folder(out)
+
     def test_every_failure_of_the_server_is_one_line(self):
         store = self.url + "/blob.zarr"
         self.faults.plan["/blob.zarr/0.1.0"] = ["500"]
