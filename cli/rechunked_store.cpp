@@ -58,19 +58,21 @@ std::string rechunk_key(const std::string& source, const PlaneSource& planes) {
     char shape[160];
     std::snprintf(shape, sizeof shape, "%d %d %d %d %.9g %.9g %.9g", d.x, d.y, d.z,
                   int(planes.type()), double(s.x), double(s.y), double(s.z));
-    std::string text = source + "\n" + shape + "\n";
-    // A folder's files, each by path, size, times and inode (a URL's objects cannot be stat'ed:
-    // its copy is kept until the cache folder is cleared, as its fetched objects are).
-    const std::string folder = source.substr(0, source.find(':') == std::string::npos
-                                                    ? source.size()
-                                                    : source.rfind(':'));
+    // A folder by its absolute path (with what follows it: a selection), and its files, each by
+    // path, size, times and inode; a URL's objects cannot be stat'ed: its copy is kept until the
+    // cache folder is cleared, as its fetched objects are.
+    std::string text = source;
     std::error_code ec;
-    for (const std::string& dir : {source, folder})
-        if (fs::is_directory(dir, ec)) {
+    const std::size_t colon = source.rfind(':');
+    for (const std::size_t end : {source.size(), colon})
+        if (end != std::string::npos && fs::is_directory(source.substr(0, end), ec)) {
+            const fs::path dir = fs::weakly_canonical(source.substr(0, end), ec);
             const auto key = octree_cache::key_for(files_under(dir), planes.type(), d);
-            text += key ? std::to_string(key->sources) : "unreadable";
+            text = dir.string() + source.substr(end) + "\n" +
+                   (key ? std::to_string(key->sources) : "unreadable");
             break;
         }
+    text += std::string("\n") + shape;
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx",
                   static_cast<unsigned long long>(octree_cache::checksum(

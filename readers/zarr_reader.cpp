@@ -1,16 +1,12 @@
 #include "readers/zarr_reader.h"
 
-#include <blosc.h>
-#include <lz4.h>
-#include <zlib.h>
-#include <zstd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <new>
+#include <numeric>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -21,21 +17,28 @@
 #include "readers/http_fetch.h"
 #include "readers/plane_stack.h"
 #include "readers/voxel_ops.h"
+#include "readers/zarr_array.h"
 #include "volume/load_checks.h"
 
 namespace isowall::formats {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using zarr::ZarrArray;
 
 namespace {
 
-constexpr std::size_t kMaxMetadataBytes = std::size_t{1} << 20;
-// A chunk decoded at most: larger chunks than this are not a volume's (and would be a claim to
-// check before any allocation).
-constexpr std::size_t kMaxChunkBytes = std::size_t{1} << 30;
+[[noreturn]] void bad(const std::string& where, const std::string& field, const std::string& why) {
+    throw InputError(where, field, why);
+}
+
 // Chunks a store may have (16 M: 256^3 chunks of 8^3 voxels, a 2048^3 volume).
 constexpr std::uint64_t kMaxChunks = std::uint64_t{1} << 24;
+
+bool is_metadata(const std::string& key) {
+    return key.ends_with(".zarray") || key.ends_with(".zattrs") || key.ends_with(".zgroup") ||
+           key.ends_with("zarr.json");
+}
 
 // A store's keys in a folder (the key's path below it).
 class FolderSource : public ZarrSource {
@@ -45,7 +48,7 @@ class FolderSource : public ZarrSource {
         const fs::path file = dir_ / key;
         std::error_code ec;
         if (!fs::exists(file, ec)) return std::nullopt;
-        const std::string field = key.find(".z") != std::string::npos ? "metadata" : "chunk";
+        const std::string field = is_metadata(key) ? "metadata" : "chunk";
         // Sized by the file (read_input_file would hold max_bytes, a gigabyte for a chunk).
         if (!fs::is_regular_file(file, ec)) throw InputError(file.string(), field, "not a file");
         const auto size = fs::file_size(file, ec);
@@ -74,8 +77,7 @@ class UrlSource : public ZarrSource {
         while (base_.ends_with("/")) base_.pop_back();
     }
     std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const override {
-        return fetch_.get(where(key), key.find(".z") != std::string::npos ? "metadata" : "chunk",
-                          max_bytes);
+        return fetch_.get(where(key), is_metadata(key) ? "metadata" : "chunk", max_bytes);
     }
     std::string where(const std::string& key) const override { return base_ + "/" + key; }
 
@@ -84,234 +86,6 @@ class UrlSource : public ZarrSource {
     HttpFetcher fetch_;
 };
 
-json parse_json(const std::string& text, const std::string& where) {
-    try {
-        return json::parse(text);
-    } catch (const json::exception& e) {
-        throw InputError(where, "JSON", e.what());
-    }
-}
-
-// `key`'s JSON; an InputError where the store has none.
-json read_json(const ZarrSource& s, const std::string& key) {
-    const auto text = s.get(key, kMaxMetadataBytes);
-    if (!text) throw InputError(s.where(key), "metadata", "not found");
-    return parse_json(*text, s.where(key));
-}
-
-struct ZarrArray {
-    std::string prefix;                       // the array's keys start with this ("" or "0/")
-    std::string where;                        // its .zarray, for messages
-    std::vector<std::int64_t> shape, chunks;  // slowest axis first, as Zarr lists them
-    VoxelType type = VoxelType::u8;
-    bool big_endian = false;
-    bool fortran = false;            // order "F": the first axis varies fastest in a chunk
-    std::string separator;           // between a chunk key's indices: "." or "/"
-    json compressor;                 // null: none
-    json fill;                       // null: 0
-    std::vector<std::int64_t> pick;  // the element taken on each axis before z, y, x
-
-    std::size_t item() const { return voxel_size(type); }
-    std::size_t chunk_elements() const {
-        std::size_t n = 1;
-        for (std::int64_t c : chunks) n *= static_cast<std::size_t>(c);
-        return n;
-    }
-};
-
-[[noreturn]] void bad(const std::string& where, const std::string& field, const std::string& why) {
-    throw InputError(where, field, why);
-}
-
-VoxelType dtype_of(const std::string& file, const std::string& dtype, bool& big_endian) {
-    if (dtype.size() < 3 || (dtype[0] != '<' && dtype[0] != '>' && dtype[0] != '|'))
-        bad(file, "dtype", "expected a NumPy type string such as \"<u2\", got " + quote(dtype));
-    big_endian = dtype[0] == '>';
-    const std::string t = dtype.substr(1);
-    if (t == "u1") return VoxelType::u8;
-    if (t == "i1") return VoxelType::i8;
-    if (t == "u2") return VoxelType::u16;
-    if (t == "i2") return VoxelType::i16;
-    if (t == "u4") return VoxelType::u32;
-    if (t == "i4") return VoxelType::i32;
-    if (t == "f4") return VoxelType::f32;
-    if (t == "f8") return VoxelType::f64;
-    bad(file, "dtype",
-        quote(dtype) + " is not a voxel type isowall reads (u1 i1 u2 i2 u4 i4 f4 f8)");
-}
-
-std::vector<std::int64_t> sizes(const std::string& file, const json& za, const char* field) {
-    const auto it = za.find(field);
-    if (it == za.end() || !it->is_array() || it->empty() || it->size() > 8)
-        bad(file, field, "expected a list of 1 to 8 sizes");
-    std::vector<std::int64_t> out;
-    for (const json& v : *it) {
-        if (!v.is_number_integer() || v.get<std::int64_t>() < 1 ||
-            v.get<std::int64_t>() > std::numeric_limits<int>::max())
-            bad(file, field, "expected sizes from 1 to 2147483647, got " + quote(it->dump()));
-        out.push_back(v.get<std::int64_t>());
-    }
-    return out;
-}
-
-ZarrArray read_zarray(const ZarrSource& source, const std::string& prefix) {
-    const std::string file = source.where(prefix + ".zarray");
-    const json za = read_json(source, prefix + ".zarray");
-    if (!za.is_object()) bad(file, "metadata", "expected a JSON object");
-    if (za.value("zarr_format", 0) != 2)
-        bad(file, "zarr_format",
-            "expected 2 (Zarr v2), got " + quote(za.value("zarr_format", json()).dump()));
-    ZarrArray a;
-    a.prefix = prefix;
-    a.where = file;
-    a.shape = sizes(file, za, "shape");
-    a.chunks = sizes(file, za, "chunks");
-    if (a.chunks.size() != a.shape.size())
-        bad(file, "chunks",
-            "expected one size per axis of the shape (" + std::to_string(a.shape.size()) +
-                "), got " + std::to_string(a.chunks.size()));
-    if (a.shape.size() < 3)
-        bad(file, "shape",
-            "a volume has three axes (z, y, x), got " + std::to_string(a.shape.size()));
-    if (!za.contains("dtype") || !za["dtype"].is_string())
-        bad(file, "dtype", "expected a NumPy type string (a structured dtype is not a volume)");
-    a.type = dtype_of(file, za["dtype"].get<std::string>(), a.big_endian);
-    if (a.chunk_elements() > kMaxChunkBytes / a.item())
-        bad(file, "chunks", "a chunk of more than 1 GiB");
-    const std::string order = za.value("order", std::string("C"));
-    if (order != "C" && order != "F")
-        bad(file, "order", "expected \"C\" or \"F\", got " + quote(order));
-    a.fortran = order == "F";
-    if (za.contains("filters") && !za["filters"].is_null() && !za["filters"].empty())
-        bad(file, "filters",
-            "isowall reads arrays without filters, got " + quote(za["filters"].dump()));
-    a.separator = za.value("dimension_separator", std::string("."));
-    if (a.separator != "." && a.separator != "/")
-        bad(file, "dimension_separator", "expected \".\" or \"/\", got " + quote(a.separator));
-    a.compressor = za.value("compressor", json());
-    if (!a.compressor.is_null()) {
-        const std::string id = a.compressor.value("id", std::string());
-        if (id != "blosc" && id != "zstd" && id != "gzip" && id != "zlib" && id != "lz4")
-            bad(file, "compressor",
-                "isowall decodes blosc, zstd, gzip, zlib, lz4 or none, got " +
-                    quote(a.compressor.dump()));
-    }
-    a.fill = za.value("fill_value", json());
-    return a;
-}
-
-// The fill value as `type`'s bytes.
-std::vector<std::byte> fill_bytes(const ZarrArray& a) {
-    double v = 0;
-    if (a.fill.is_number()) {
-        v = a.fill.get<double>();
-    } else if (a.fill.is_string()) {
-        const std::string s = a.fill.get<std::string>();
-        if (s == "NaN")
-            v = std::numeric_limits<double>::quiet_NaN();
-        else if (s == "Infinity")
-            v = std::numeric_limits<double>::infinity();
-        else if (s == "-Infinity")
-            v = -std::numeric_limits<double>::infinity();
-        else
-            bad(a.where, "fill_value", "expected a number, null, NaN or Infinity, got " + quote(s));
-    } else if (!a.fill.is_null()) {
-        bad(a.where, "fill_value", "expected a number or null, got " + quote(a.fill.dump()));
-    }
-    std::vector<std::byte> out(a.item());
-    auto put = [&out](auto x) { std::memcpy(out.data(), &x, sizeof x); };
-    switch (a.type) {
-        case VoxelType::u8:
-            put(static_cast<std::uint8_t>(v));
-            break;
-        case VoxelType::i8:
-            put(static_cast<std::int8_t>(v));
-            break;
-        case VoxelType::u16:
-            put(static_cast<std::uint16_t>(v));
-            break;
-        case VoxelType::i16:
-            put(static_cast<std::int16_t>(v));
-            break;
-        case VoxelType::u32:
-            put(static_cast<std::uint32_t>(v));
-            break;
-        case VoxelType::i32:
-            put(static_cast<std::int32_t>(v));
-            break;
-        case VoxelType::f32:
-            put(static_cast<float>(v));
-            break;
-        case VoxelType::f64:
-            put(v);
-            break;
-    }
-    return out;  // host order
-}
-
-// One chunk's bytes decoded into `out` (exactly the chunk's size), or an InputError naming it.
-void decode_chunk(const ZarrArray& a, const std::string& in, const std::string& file,
-                  std::vector<std::byte>& out) {
-    const std::size_t want = out.size();
-    auto wrong = [&](const std::string& why) { bad(file, "chunk", why); };
-    auto size_check = [&](std::size_t got) {
-        if (got != want)
-            wrong("decodes to " + std::to_string(got) + " bytes, expected " + std::to_string(want));
-    };
-    const std::string id = a.compressor.is_null() ? "" : a.compressor.value("id", std::string());
-    if (id.empty()) {
-        size_check(in.size());
-        std::memcpy(out.data(), in.data(), want);
-    } else if (id == "blosc") {
-        std::size_t nbytes = 0;
-        if (blosc_cbuffer_validate(in.data(), in.size(), &nbytes) != 0)
-            wrong("not a Blosc buffer, or cut short");
-        size_check(nbytes);
-        if (blosc_decompress_ctx(in.data(), out.data(), want, 1) != static_cast<int>(want))
-            wrong("Blosc could not decode it");
-    } else if (id == "zstd") {
-        const unsigned long long n = ZSTD_getFrameContentSize(in.data(), in.size());
-        if (n == ZSTD_CONTENTSIZE_ERROR) wrong("not a zstd frame");
-        if (n != ZSTD_CONTENTSIZE_UNKNOWN) size_check(static_cast<std::size_t>(n));
-        const std::size_t got = ZSTD_decompress(out.data(), want, in.data(), in.size());
-        if (ZSTD_isError(got)) wrong(std::string("zstd: ") + ZSTD_getErrorName(got));
-        size_check(got);
-    } else if (id == "gzip" || id == "zlib") {
-        z_stream z{};
-        if (inflateInit2(&z, 15 + 32) != Z_OK) wrong("zlib could not start");  // gzip or zlib
-        z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-        z.avail_in = static_cast<uInt>(in.size());
-        z.next_out = reinterpret_cast<Bytef*>(out.data());
-        z.avail_out = static_cast<uInt>(want);
-        const int r = inflate(&z, Z_FINISH);
-        const std::size_t got = z.total_out;
-        inflateEnd(&z);
-        if (r != Z_STREAM_END && z.avail_out == 0)
-            wrong("decodes to more than " + std::to_string(want) + " bytes, expected " +
-                  std::to_string(want));
-        if (r != Z_STREAM_END) wrong(id + ": the stream is damaged or cut short");
-        size_check(got);
-    } else {  // lz4, as numcodecs frames it: the decoded size (u32 little-endian), then one block
-        if (in.size() < 4) wrong("lz4: shorter than its 4-byte size");
-        std::uint32_t n;
-        std::memcpy(&n, in.data(), 4);
-        size_check(n);
-        const int got =
-            LZ4_decompress_safe(in.data() + 4, reinterpret_cast<char*>(out.data()),
-                                static_cast<int>(in.size() - 4), static_cast<int>(want));
-        if (got < 0) wrong("lz4: the block is damaged");
-        size_check(static_cast<std::size_t>(got));
-    }
-}
-
-std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::int64_t x) {
-    std::string key;
-    for (std::size_t i = 0; i + 3 < a.shape.size(); ++i)
-        key += std::to_string(a.pick[i] / a.chunks[i]) + a.separator;
-    return key + std::to_string(z) + a.separator + std::to_string(y) + a.separator +
-           std::to_string(x);
-}
-
 // The array's planes (x fastest, host order) a slab at a time, from the rows of chunks that
 // cross them (a row: the chunks of one chunk-index along z). A slab that ends inside a row keeps
 // the row decoded for the next slab, so each chunk is decoded once in a stream of slabs; a row
@@ -319,16 +93,13 @@ std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::i
 class ChunkRows {
   public:
     ChunkRows(std::shared_ptr<const ZarrSource> source, ZarrArray a, glm::ivec3 dims)
-        : source_(std::move(source)), a_(std::move(a)), dims_(dims), fill_(fill_bytes(a_)) {
+        : source_(std::move(source)), a_(std::move(a)), dims_(dims), fill_(zarr::fill_bytes(a_)) {
         const std::size_t k = a_.shape.size();
-        // Element strides of each axis within a chunk: C order has the last axis fastest.
+        // Element strides of each axis within a decoded chunk, the slowest axis first in order.
+        const std::vector<std::size_t> order = a_.grid_order();
         std::vector<std::size_t> stride(k, 1);
-        if (a_.fortran)
-            for (std::size_t i = 1; i < k; ++i)
-                stride[i] = stride[i - 1] * static_cast<std::size_t>(a_.chunks[i - 1]);
-        else
-            for (std::size_t i = k - 1; i-- > 0;)
-                stride[i] = stride[i + 1] * static_cast<std::size_t>(a_.chunks[i + 1]);
+        for (std::size_t i = k - 1; i-- > 0;)
+            stride[order[i]] = stride[order[i + 1]] * static_cast<std::size_t>(a_.chunks[order[i + 1]]);
         sz_ = stride[k - 3], sy_ = stride[k - 2], sx_ = stride[k - 1];
         for (std::size_t i = 0; i + 3 < k; ++i)
             picked_ += static_cast<std::size_t>(a_.pick[i] % a_.chunks[i]) * stride[i];
@@ -377,10 +148,10 @@ class ChunkRows {
             std::memset(out, 0, n * e);
         for (std::int64_t by = 0; by * cy < dims_.y; ++by)
             for (std::int64_t bx = 0; bx * cx < dims_.x; ++bx) {
-                const std::string key = a_.prefix + chunk_key(a_, bz, by, bx);
-                const auto bytes = source_->get(key, kMaxChunkBytes + (1 << 20));
+                const std::string key = a_.prefix + zarr::chunk_key(a_, bz, by, bx);
+                const auto bytes = source_->get(key, zarr::kMaxChunkBytes + (1 << 20));
                 if (!bytes) continue;  // a missing chunk is the fill value
-                decode_chunk(a_, *bytes, source_->where(key), chunk_);
+                zarr::decode_chunk(a_, *bytes, source_->where(key), chunk_);
                 if (keep_files && !source_->file(key).empty()) files.push_back(source_->file(key));
                 const std::int64_t ny = std::min(cy, dims_.y - by * cy),
                                    nx = std::min(cx, dims_.x - bx * cx);
@@ -422,7 +193,8 @@ class ChunkRows {
 
 // The spacing (x, y, z) of an OME-Zarr dataset: its "scale" transform's last three values (z, y,
 // x), times the multiscale's own scale where it has one.
-glm::vec3 ome_spacing(const std::string& file, const json& multiscale, const json& dataset) {
+glm::vec3 ome_spacing(const std::string& file, const json& multiscale, const json& dataset,
+                      const std::string& dataset_field) {
     glm::vec3 spacing(1.0f);
     auto apply = [&](const json& transforms, const std::string& where) {
         if (!transforms.is_array()) return;
@@ -441,7 +213,7 @@ glm::vec3 ome_spacing(const std::string& file, const json& multiscale, const jso
         }
     };
     apply(dataset.value("coordinateTransformations", json()),
-          "datasets[0].coordinateTransformations");
+          dataset_field + ".coordinateTransformations");
     apply(multiscale.value("coordinateTransformations", json()),
           "multiscales[0].coordinateTransformations");
     return spacing;
@@ -497,9 +269,15 @@ bool is_foreign_zarr(const fs::path& path) {
     std::error_code ec;
     if (!fs::is_directory(path, ec)) return false;
     if (fs::exists(path / ".zarray", ec)) return true;
-    if (!fs::exists(path / ".zattrs", ec)) return false;
     try {
-        const json at = read_json(FolderSource(path), ".zattrs");
+        if (fs::exists(path / "zarr.json", ec)) {  // Zarr v3: an array, or an OME-Zarr 0.5 group
+            const json z = zarr::read_json(FolderSource(path), "zarr.json");
+            const json at = z.is_object() ? z.value("attributes", json::object()) : json();
+            return z.is_object() && (z.value("node_type", std::string()) == "array" ||
+                                     (at.is_object() && (at.contains("ome") || at.contains("multiscales"))));
+        }
+        if (!fs::exists(path / ".zattrs", ec)) return false;
+        const json at = zarr::read_json(FolderSource(path), ".zattrs");
         return at.is_object() && at.contains("multiscales") && !at.contains("isowall");
     } catch (const InputError&) {
         return false;  // not readable as Zarr metadata: the other readers say what it is
@@ -533,47 +311,123 @@ struct OpenedArray {
     std::shared_ptr<ChunkRows> rows;
 };
 
+// Where an OME-Zarr image's chosen level lies, and what it says of it.
+struct Located {
+    ZarrArray array;
+    glm::vec3 spacing{1.0f};
+    std::vector<std::string> names;  // the axes', slowest first (OME's, else v3's)
+    std::string what;                // "Zarr v2 array", "OME-Zarr 0.4 (dataset "0")"
+    std::vector<fs::path> files;     // the metadata files
+};
+
+// "level=N" taken out of `selection` (the rest left for pick_axes); -1 where it is not there.
+int take_level(std::string& selection, const std::string& where) {
+    std::string rest;
+    int level = -1;
+    std::size_t at = 0;
+    while (at < selection.size()) {
+        const std::size_t end = std::min(selection.find(',', at), selection.size());
+        const std::string item = selection.substr(at, end - at);
+        at = end + 1;
+        if (!item.starts_with("level=")) {
+            rest += (rest.empty() ? "" : ",") + item;
+            continue;
+        }
+        const std::string n = item.substr(6);
+        if (n.empty() || n.size() > 3 || !std::all_of(n.begin(), n.end(), ::isdigit))
+            throw InputError(where, "level", "expected level=N, a dataset of the multiscale, got " + quote(item));
+        level = std::stoi(n);
+    }
+    selection = rest;
+    return level;
+}
+
+// The multiscale's dataset `level` (its finest, 0, by default) of the OME-Zarr image whose
+// attributes `ome` (0.4's .zattrs, 0.5's zarr.json "ome") are in `file`.
+Located locate_ome(const ZarrSource& source, const json& ome, const std::string& file, int level,
+                   int version) {
+    const json& ms = ome.is_object() ? ome.value("multiscales", json()) : json();
+    if (!ms.is_array() || ms.empty() || !ms[0].is_object())
+        bad(file, "multiscales", "expected a list of OME-Zarr multiscales (or an array beside it)");
+    const json& ds = ms[0].value("datasets", json());
+    const std::size_t n = ds.is_array() ? ds.size() : 0;
+    const int chosen = std::max(level, 0);
+    const std::string field = "multiscales[0].datasets[" + std::to_string(chosen) + "]";
+    if (n == 0) bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
+    if (static_cast<std::size_t>(chosen) >= n)
+        throw InputError(file, "level",
+                         "level=" + std::to_string(level) + ": the image has " + std::to_string(n) +
+                             " level" + (n == 1 ? "" : "s") + ", 0 (the finest) to " +
+                             std::to_string(n - 1));
+    const json& d = ds[static_cast<std::size_t>(chosen)];
+    if (!d.is_object() || !d.value("path", json()).is_string())
+        bad(file, field, "expected a dataset with a path");
+    const std::string sub = d["path"].get<std::string>();
+    if (sub.empty() || sub.find("..") != std::string::npos || sub.front() == '/' ||
+        sub.find_first_of("?#") != std::string::npos)
+        bad(file, field + ".path", "expected a folder inside the store, got " + quote(sub));
+    Located l;
+    l.array = version == 3 ? zarr::read_v3_array(source, sub + "/")
+                           : zarr::read_v2_array(source, sub + "/");
+    l.spacing = ome_spacing(file, ms[0], d, field);
+    for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
+        l.names.push_back(ax.is_string() ? ax.get<std::string>() : ax.value("name", std::string()));
+    const std::string v = ome.value("version", ms[0].value("version", std::string(version == 3 ? "0.5" : "0.4")));
+    l.what = "OME-Zarr " + v + " (level " + std::to_string(chosen) + " of " + std::to_string(n) +
+             ", dataset " + quote(sub) + ")";
+    return l;
+}
+
+// The array a store holds: a Zarr v2 or v3 array at its root, or an OME-Zarr 0.4 (v2) or 0.5
+// (v3) image's dataset `level`.
+Located locate(const ZarrSource& source, int level, const std::string& name) {
+    Located l;
+    const auto add_file = [&](const std::string& key) {
+        if (!source.file(key).empty()) l.files.push_back(source.file(key));
+    };
+    // .zarray first: a v2 array (the most common) costs one request.
+    if (source.get(".zarray", zarr::kMaxMetadataBytes)) {
+        l.array = zarr::read_v2_array(source, "");
+        l.what = "Zarr v2 array";
+        add_file(".zarray");
+    } else if (const auto v3 = source.get("zarr.json", zarr::kMaxMetadataBytes)) {
+        const json z = zarr::parse_json(*v3, source.where("zarr.json"));
+        if (z.is_object() && z.value("node_type", std::string()) == "group") {
+            const json at = z.value("attributes", json::object());
+            l = locate_ome(source, at.is_object() && at.contains("ome") ? at["ome"] : at,
+                           source.where("zarr.json"), level, 3);
+        } else {
+            l.array = zarr::read_v3_array(source, "");
+            l.what = "Zarr v3 array";
+        }
+        add_file("zarr.json");
+        if (!l.array.prefix.empty()) add_file(l.array.prefix + "zarr.json");
+    } else {
+        l = locate_ome(source, zarr::read_json(source, ".zattrs"), source.where(".zattrs"), level, 2);
+        add_file(".zattrs");
+        add_file(l.array.prefix + ".zarray");
+    }
+    if (level >= 0 && l.what.find("level") == std::string::npos)
+        throw InputError(name, "level", "level=" + std::to_string(level) +
+                                            ": a plain array has one level; levels are an OME-Zarr image's");
+    if (l.names.size() != l.array.shape.size()) l.names = l.array.names;
+    if (l.names.size() != l.array.shape.size() ||
+        std::any_of(l.names.begin(), l.names.end(), [](const std::string& s) { return s.empty(); })) {
+        l.names.clear();  // no names, or not one per axis: their indices
+        for (std::size_t i = 0; i < l.array.shape.size(); ++i) l.names.push_back(std::to_string(i));
+    }
+    return l;
+}
+
 OpenedArray open_array(std::shared_ptr<const ZarrSource> source, const std::string& name,
-                       const std::string& selection) {
-    std::string prefix;
-    glm::vec3 spacing(1.0f);
-    std::vector<fs::path> files;
-    std::string what = "Zarr v2 array";
-    std::vector<std::string> names;  // OME's axis names, slowest first
-    std::optional<std::string> zarray = source->get(".zarray", kMaxMetadataBytes);
-    if (!zarray) {
-        const std::string file = source->where(".zattrs");
-        const json at = read_json(*source, ".zattrs");
-        const json& ms = at.is_object() ? at.value("multiscales", json()) : json();
-        if (!ms.is_array() || ms.empty() || !ms[0].is_object())
-            bad(file, "multiscales",
-                "expected a list of OME-Zarr multiscales (or a .zarray beside it)");
-        const json& ds = ms[0].value("datasets", json());
-        if (!ds.is_array() || ds.empty() || !ds[0].is_object() ||
-            !ds[0].value("path", json()).is_string())
-            bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
-        const std::string sub = ds[0]["path"].get<std::string>();
-        if (sub.empty() || sub.find("..") != std::string::npos || sub.front() == '/' ||
-            sub.find_first_of("?#") != std::string::npos)
-            bad(file, "multiscales[0].datasets[0].path",
-                "expected a folder inside the store, got " + quote(sub));
-        prefix = sub + "/";
-        spacing = ome_spacing(file, ms[0], ds[0]);
-        for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
-            names.push_back(ax.is_string() ? ax.get<std::string>()
-                                           : ax.value("name", std::string()));
-        if (!source->file(".zattrs").empty()) files.push_back(source->file(".zattrs"));
-        what = "OME-Zarr " + ms[0].value("version", std::string("0.4")) + " (dataset " +
-               quote(sub) + ")";
-    }
-    ZarrArray a = read_zarray(*source, prefix);
-    if (names.size() != a.shape.size()) {  // no names, or not one per axis: their indices
-        names.clear();
-        for (std::size_t i = 0; i < a.shape.size(); ++i) names.push_back(std::to_string(i));
-    }
-    a.pick = pick_axes(a, names, selection, name);
-    if (!source->file(prefix + ".zarray").empty())
-        files.insert(files.begin(), source->file(prefix + ".zarray"));
+                       std::string selection) {
+    const int level = take_level(selection, name);
+    Located l = locate(*source, level, name);
+    ZarrArray& a = l.array;
+    a.pick = pick_axes(a, l.names, selection, name);
+    const glm::vec3 spacing = l.spacing;
+    std::vector<fs::path>& files = l.files;
+    const std::string& what = l.what;
     const std::size_t k = a.shape.size();
     const std::uint64_t sides[3] = {static_cast<std::uint64_t>(a.shape[k - 1]),
                                     static_cast<std::uint64_t>(a.shape[k - 2]),
@@ -600,9 +454,21 @@ OpenedArray open_array(std::shared_ptr<const ZarrSource> source, const std::stri
     d.files = std::move(files);
     const std::string codec =
         a.compressor.is_null() ? "none" : a.compressor.value("id", std::string());
-    std::string chunks;
-    for (std::size_t i = 0; i < k; ++i) chunks += (i ? "x" : "") + std::to_string(a.chunks[i]);
-    d.facts.push_back({"chunks", chunks + " (" + (a.fortran ? "F" : "C") + " order, " + codec + ")"});
+    const auto shape_of = [](const std::vector<std::int64_t>& v) {
+        std::string t;
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            if (i) t += 'x';
+            t += std::to_string(v[i]);
+        }
+        return t;
+    };
+    std::vector<std::size_t> c_order(k);
+    std::iota(c_order.begin(), c_order.end(), std::size_t{0});
+    const std::vector<std::size_t> f_order(c_order.rbegin(), c_order.rend());
+    const std::string order = a.order == c_order ? "C" : a.order == f_order ? "F" : "transposed";
+    d.facts.push_back({"chunks", a.shard ? shape_of(a.chunks) + " shards of " + shape_of(a.shard->inner) +
+                                               " (" + order + " order, " + codec + ")"
+                                         : shape_of(a.chunks) + " (" + order + " order, " + codec + ")"});
     out.stack.size_field = "shape";
     out.rows = std::make_shared<ChunkRows>(std::move(source), std::move(a), dims);
     out.stack.read = [rows = out.rows](int z0, int z1, std::byte* to) { rows->read(z0, z1, to); };
