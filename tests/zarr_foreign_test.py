@@ -6,7 +6,11 @@ big-endian dtype; "/" separators; chunks left out where they hold only the fill 
 OME-Zarr 0.4 image of five axes (t, c, z, y, x) with a scale; a time point and a channel picked
 by name (STORE:t=2,c=1) from chunks that hold several of each. Each renders the image the NRRD of
 the same voxels renders, and `isowall info` states its size, type and spacing; one of them is
-imported and the store renders the same image too. Bad stores (an unknown codec, chunks that do
+imported and the store renders the same image too. Zarr v3 arrays written by hand to its
+specification (zarr-python 2.13 writes only v2): Blosc, gzip with crc32c, zstd, transposed and
+big-endian chunks, both key encodings, and sharding_indexed with inner chunks and whole shards left
+out; an OME-Zarr 0.5 image of two levels, the second picked with STORE:level=1 and drawn at its
+own scale. A store given --memory-limit pages through its copy in the cache folder. Bad stores (an unknown codec, chunks that do
 not match the metadata, a dtype that is not a voxel type, a second time point not picked, a pick
 out of range or of an axis that is not there) are one line
 naming the file and the field, status 1, and no image.
@@ -271,6 +275,179 @@ class ForeignZarr(unittest.TestCase):
                 with open(a, "rb") as fa, open(b, "rb") as fb:
                     self.assertEqual(fa.read(), fb.read())
         self.refused(path + ":c=1", "axes", "axis t has 3 elements", path + ":t=0")
+
+
+def crc32c(data):
+    table = crc32c.table
+    if table is None:
+        table = crc32c.table = []
+        for i in range(256):
+            c = i
+            for _ in range(8):
+                c = (c >> 1) ^ (0x82F63B78 if c & 1 else 0)
+            table.append(c)
+    c = 0xFFFFFFFF
+    for b in data:
+        c = table[(c ^ b) & 0xFF] ^ (c >> 8)
+    return (c ^ 0xFFFFFFFF).to_bytes(4, "little")
+
+
+crc32c.table = None
+
+
+def v3_encode(block, order=None, endian="little", compressor=None, crc=False):
+    """One v3 chunk's bytes: transpose, bytes, a compressor, crc32c (each where given)."""
+    if order is not None:
+        block = np.transpose(block, order)
+    data = np.ascontiguousarray(block).astype(block.dtype.newbyteorder("<" if endian == "little" else ">")).tobytes()
+    if compressor is not None:
+        data = bytes(compressor.encode(data))
+    return data + crc32c(data) if crc else data
+
+
+def v3_codecs(order=None, endian="little", compressor=None, crc=False):
+    names = {Blosc: "blosc", GZip: "gzip", Zstd: "zstd"}
+    out = [{"name": "transpose", "configuration": {"order": list(order)}}] if order is not None else []
+    out.append({"name": "bytes", "configuration": {"endian": endian}})
+    if compressor is not None:
+        out.append({"name": names[type(compressor)], "configuration": {}})
+    if crc:
+        out.append({"name": "crc32c"})
+    return out
+
+
+def write_v3(path, v, chunks, shard=None, encoding="default", sep="/", names=("z", "y", "x"), **codec):
+    """A Zarr v3 array of `v` (zarr-python 2.13 writes only v2): chunks padded to their shape at
+    the edges; with `shard` (an inner chunk shape) each chunk is a shard of inner chunks under an
+    index with a CRC-32C at its end, an inner chunk of only zeros left out."""
+    shutil.rmtree(path, ignore_errors=True)
+    os.makedirs(path)
+    meta = {"zarr_format": 3, "node_type": "array", "shape": list(v.shape), "data_type": str(v.dtype),
+            "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": list(chunks)}},
+            "chunk_key_encoding": {"name": encoding, "configuration": {"separator": sep}},
+            "fill_value": 0, "dimension_names": list(names)}
+    if shard:
+        meta["codecs"] = [{"name": "sharding_indexed", "configuration": {
+            "chunk_shape": list(shard), "codecs": v3_codecs(**codec),
+            "index_codecs": [{"name": "bytes", "configuration": {"endian": "little"}}, {"name": "crc32c"}],
+            "index_location": "end"}}]
+    else:
+        meta["codecs"] = v3_codecs(**codec)
+    with open(os.path.join(path, "zarr.json"), "w") as f:
+        json.dump(meta, f)
+    grid = [-(-n // c) for n, c in zip(v.shape, chunks)]
+    for idx in np.ndindex(*grid):
+        block = np.zeros(chunks, v.dtype)
+        part = v[tuple(slice(i * c, (i + 1) * c) for i, c in zip(idx, chunks))]
+        block[tuple(slice(0, n) for n in part.shape)] = part
+        if shard:
+            body, index = b"", b""
+            inner_grid = [c // s for c, s in zip(chunks, shard)]
+            for j in np.ndindex(*inner_grid):
+                inner = block[tuple(slice(i * s, (i + 1) * s) for i, s in zip(j, shard))]
+                if not inner.any():
+                    index += b"\xff" * 16
+                    continue
+                data = v3_encode(inner, **codec)
+                index += len(body).to_bytes(8, "little") + len(data).to_bytes(8, "little")
+                body += data
+            data = body + index + crc32c(index)
+        else:
+            data = v3_encode(block, **codec)
+        key = ("c" + sep if encoding == "default" else "") + sep.join(str(i) for i in idx)
+        os.makedirs(os.path.dirname(os.path.join(path, key)), exist_ok=True)
+        with open(os.path.join(path, key), "wb") as f:
+            f.write(data)
+    return path
+
+
+class ZarrV3(unittest.TestCase):
+    """Zarr v3 arrays and OME-Zarr 0.5 images, written by hand to the v3 specification."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.v = blob()
+        cls.nrrd = os.path.join(SCRATCH, "v3-blob.nhdr")
+        write_nrrd(cls.nrrd, cls.v)
+        cls.reference = os.path.join(SCRATCH, "v3-nrrd.png")
+        assert render(cls.nrrd, cls.reference).returncode == 0
+
+    def same_image(self, path, reference=None):
+        out = path + ".png"
+        p = render(path, out)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(out, "rb") as a, open(reference or self.reference, "rb") as b:
+            self.assertEqual(a.read(), b.read(), f"{path}: the image differs from the NRRD's")
+
+    def test_arrays_of_each_codec_chain_render_the_nrrds_image(self):
+        cases = {
+            "v3-blosc": dict(chunks=(8, 8, 8), compressor=Blosc(cname="lz4", shuffle=Blosc.SHUFFLE)),
+            "v3-gzip-crc-transposed-big": dict(chunks=(5, 26, 7), order=(2, 1, 0), endian="big",
+                                               compressor=GZip(), crc=True, encoding="v2", sep="."),
+            "v3-zstd-permuted": dict(chunks=(21, 13, 16), order=(1, 2, 0), compressor=Zstd(level=1)),
+            "v3-sharded": dict(chunks=(16, 16, 16), shard=(8, 8, 8), compressor=Zstd(level=1), crc=True),
+            "v3-sharded-raw-F": dict(chunks=(8, 16, 32), shard=(4, 8, 8), order=(2, 1, 0)),
+        }
+        for name, kw in cases.items():
+            with self.subTest(name):
+                path = write_v3(os.path.join(SCRATCH, name + ".zarr"), self.v, **kw)
+                self.same_image(path)
+        # A shard left out entirely, and inner chunks left out, read as the fill value.
+        sharded = os.path.join(SCRATCH, "v3-sharded.zarr")
+        def index_has_a_gap(file):
+            with open(file, "rb") as f:
+                index = f.read()[-4 - 16 * 8:-4]
+            return b"\xff" * 16 in [index[i:i + 16] for i in range(0, len(index), 16)]
+        self.assertTrue(any(index_has_a_gap(os.path.join(r, f))
+                            for r, _, fs in os.walk(os.path.join(sharded, "c")) for f in fs))
+        p = run("info", "-v", sharded)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("Zarr v3 array", p.stdout)
+        self.assertIn("16x16x16 shards of 8x8x8", p.stdout)
+
+    def test_an_ome_zarr_05_image_and_its_levels(self):
+        group = os.path.join(SCRATCH, "ome05.zarr")
+        shutil.rmtree(group, ignore_errors=True)
+        os.makedirs(group)
+        write_v3(os.path.join(group, "0"), self.v, (8, 8, 8), compressor=Blosc(cname="zstd"))
+        half = np.ascontiguousarray(self.v[::2, ::2, ::2])
+        write_v3(os.path.join(group, "1"), half, (8, 8, 8), compressor=GZip())
+        axes = [{"name": n, "type": "space"} for n in ("z", "y", "x")]
+        datasets = [{"path": str(i), "coordinateTransformations": [{"type": "scale", "scale": [s] * 3}]}
+                    for i, s in ((0, 1), (1, 2))]
+        with open(os.path.join(group, "zarr.json"), "w") as f:
+            json.dump({"zarr_format": 3, "node_type": "group", "attributes": {"ome": {
+                "version": "0.5", "multiscales": [{"axes": axes, "datasets": datasets}]}}}, f)
+        self.same_image(group)
+        p = run("info", "-v", group + ":level=1")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("15x13x11 uint16", p.stdout)
+        self.assertIn("spacing 2 2 2", p.stdout)
+        self.assertIn("level 1 of 2", p.stdout)
+        nrrd = os.path.join(SCRATCH, "half.nhdr")
+        write_nrrd(nrrd, half, spacing=(2, 2, 2))
+        reference = os.path.join(SCRATCH, "half.png")
+        self.assertEqual(render(nrrd, reference).returncode, 0)
+        self.same_image(group + ":level=1", reference)
+        ForeignZarr.refused(self, group + ":level=2", "level=2: the image has 2 levels")
+
+    def test_bad_v3_stores_are_one_line(self):
+        path = write_v3(os.path.join(SCRATCH, "v3-bz2.zarr"), self.v, (8, 8, 8), compressor=Zstd(level=1))
+        with open(os.path.join(path, "zarr.json")) as f:
+            meta = json.load(f)
+        meta["codecs"][1]["name"] = "bz2"
+        with open(os.path.join(path, "zarr.json"), "w") as f:
+            json.dump(meta, f)
+        ForeignZarr.refused(self, path, "zarr.json", "codecs[1]", "bz2")
+        path = write_v3(os.path.join(SCRATCH, "v3-crc.zarr"), self.v, (8, 8, 8), compressor=GZip(), crc=True)
+        with open(os.path.join(path, "c", "1", "1", "1"), "r+b") as f:
+            data = bytearray(f.read())
+            data[len(data) // 2] ^= 0xFF
+            f.seek(0)
+            f.write(data)
+        ForeignZarr.refused(self, path, "c/1/1/1", "chunk")
+        path = write_v3(os.path.join(SCRATCH, "v3-level.zarr"), self.v, (8, 8, 8))
+        ForeignZarr.refused(self, path + ":level=1", "level=1", "a plain array has one level")
 
 
 if __name__ == "__main__":
