@@ -23,8 +23,9 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "Volume: NRRD (.nrrd/.nhdr), NIfTI (.nii, .nii.gz, .hdr/.img), a DICOM "
                    "series (its folder, or one file of it), MetaImage (.mhd/.mha), HDF5 "
                    "(FILE.h5:/dataset), TIFF (a multi-page .tif or a folder of slices), or "
-                   "headerless raw with --dims and --type, a Zarr array or OME-Zarr image "
-                   "(its folder; FOLDER:t=N,c=M picks a time point and a channel), the same over "
+                   "headerless raw with --dims and --type, a Zarr v2/v3 array or OME-Zarr image "
+                   "(its folder; FOLDER:t=N,c=M picks a time point and a channel, "
+                   "FOLDER:level=N a multiscale level), the same over "
                    "http:// or https://, or a store made by `isowall import` (its folder; read on "
                    "first touch under --memory-limit). Default: the built-in phantom");
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
@@ -137,7 +138,8 @@ namespace {
 // is read whole (and `planes`, opened to learn its size, is dropped).
 std::optional<OpenedVolume> open_rechunked(const VolumeOptions& o, bool quiet, VolumeUse use,
                                            std::string& note) {
-    std::unique_ptr<PlaneSource> planes = formats::open_planes(o.path, std::nullopt, http_options(o));
+    std::unique_ptr<PlaneSource> planes =
+        formats::open_planes(o.path, std::nullopt, http_options(o));
     const std::uint64_t cap = memory_limit(o, use);
     const bool asked = !o.memory_limit.empty();
     if (!asked && voxel_bytes(planes->dims(), planes->type()) <= cap) return std::nullopt;
@@ -244,9 +246,10 @@ OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
                         : v.mapped()      ? "memory-mapped"
                                           : "in memory";
     std::printf("volume: %s  %dx%dx%d %s  spacing %g %g %g  %.1f MiB %s%s  (%.2f s)\n",
-                (shown.empty() ? v.source() : shown).c_str(), d.x, d.y, d.z, std::string(type_name(v.type())).c_str(),
-                double(s.x), double(s.y), double(s.z), double(v.bytes().size()) / (1024.0 * 1024.0),
-                where, (huge_note + store_note).c_str(), out.load_s);
+                (shown.empty() ? v.source() : shown).c_str(), d.x, d.y, d.z,
+                std::string(type_name(v.type())).c_str(), double(s.x), double(s.y), double(s.z),
+                double(v.bytes().size()) / (1024.0 * 1024.0), where,
+                (huge_note + store_note).c_str(), out.load_s);
     return out;
 }
 
