@@ -125,6 +125,13 @@ bool is_url(std::string_view text) {
 
 HttpFetcher::HttpFetcher(HttpOptions options) : options_(std::move(options)) {}
 
+std::filesystem::path HttpFetcher::cached_file(const std::string& url) const {
+    if (options_.cache_dir.empty()) return {};
+    std::filesystem::path file = options_.cache_dir / url_hash(url);
+    std::error_code ec;
+    return std::filesystem::is_regular_file(file, ec) ? file : std::filesystem::path();
+}
+
 std::optional<std::string> HttpFetcher::get(const std::string& url, const std::string& field,
                                             std::size_t max_bytes) const {
     std::filesystem::path cached;

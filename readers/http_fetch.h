@@ -32,6 +32,8 @@ class HttpFetcher {
     // The body of `url`, nullopt on 404; `field` names the object in errors ("chunk", ".zarray").
     std::optional<std::string> get(const std::string& url, const std::string& field,
                                    std::size_t max_bytes) const;
+    // The file that keeps `url`'s body in the cache, where it has been fetched; else empty.
+    std::filesystem::path cached_file(const std::string& url) const;
     // How many tries the fetches so far took beyond the first (for messages and tests).
     int retried() const { return retried_; }
 

@@ -148,8 +148,7 @@ bool is_zarr_source(const std::string& path) {
     return is_url(path) || is_foreign_zarr(path) || zarr_selection(path).has_value();
 }
 
-std::unique_ptr<PlaneSource> open_planes(const std::string& path,
-                                         const std::optional<RawSpec>& raw,
+std::unique_ptr<PlaneSource> open_planes(const std::string& path, const std::optional<RawSpec>& raw,
                                          const HttpOptions& http) {
     if (raw) return raw_planes(path, *raw);
     if (is_url(path)) {

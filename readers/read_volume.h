@@ -38,8 +38,7 @@ bool is_zarr_source(const std::string& path);
 // in a child process as read_volume does), and gzip or
 // other-endian NRRD and raw (nrrd_planes, raw_planes). Null for what read_volume maps without
 // decoding (raw and raw NRRD in host order), and for bzip2, hex and ascii NRRD, decoded whole.
-std::unique_ptr<PlaneSource> open_planes(const std::string& path,
-                                         const std::optional<RawSpec>& raw,
+std::unique_ptr<PlaneSource> open_planes(const std::string& path, const std::optional<RawSpec>& raw,
                                          const HttpOptions& http = {});
 
 }  // namespace isowall::formats

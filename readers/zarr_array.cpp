@@ -43,7 +43,6 @@ json read_json(const ZarrSource& s, const std::string& key) {
     return parse_json(*text, s.where(key));
 }
 
-
 namespace {
 
 VoxelType dtype_of(const std::string& file, const std::string& dtype, bool& big_endian) {
@@ -242,8 +241,9 @@ void decode_plain(const ZarrArray& a, std::string_view in, const std::string& fi
 }
 
 VoxelType v3_type(const std::string& file, const json& j) {
-    const std::string t = j.value("data_type", json()).is_string() ? j["data_type"].get<std::string>()
-                                                                   : std::string();
+    const std::string t = j.value("data_type", json()).is_string()
+                              ? j["data_type"].get<std::string>()
+                              : std::string();
     static const std::array<std::pair<const char*, VoxelType>, 8> kTypes = {{
         {"uint8", VoxelType::u8},
         {"int8", VoxelType::i8},
@@ -266,7 +266,8 @@ VoxelType v3_type(const std::string& file, const json& j) {
 void v3_codecs(const std::string& file, const std::string& field, const json& codecs, ZarrArray& a,
                bool shard) {
     if (!codecs.is_array() || codecs.empty())
-        bad(file, field, "expected a list of codecs, with one of \"bytes\" or \"sharding_indexed\"");
+        bad(file, field,
+            "expected a list of codecs, with one of \"bytes\" or \"sharding_indexed\"");
     const std::size_t k = a.shape.size();
     int stage = 0;  // 0: array to array, 1: bytes to bytes
     for (std::size_t i = 0; i < codecs.size(); ++i) {
@@ -286,7 +287,8 @@ void v3_codecs(const std::string& file, const std::string& field, const json& co
             }
             std::vector<std::size_t> sorted = order;
             std::sort(sorted.begin(), sorted.end());
-            if (order.size() != k || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+            if (order.size() != k ||
+                std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
                 bad(file, at + ".order",
                     "expected a permutation of the " + std::to_string(k) + " axes, got " +
                         quote(o.dump()));
@@ -302,8 +304,7 @@ void v3_codecs(const std::string& file, const std::string& field, const json& co
         } else if (name == "sharding_indexed" && stage == 0 && shard) {
             ZarrArray::Shard s;
             s.inner = sizes(file, cfg, "chunk_shape");
-            if (s.inner.size() != k)
-                bad(file, at + ".chunk_shape", "expected one size per axis");
+            if (s.inner.size() != k) bad(file, at + ".chunk_shape", "expected one size per axis");
             for (std::size_t n = 0; n < k; ++n)
                 if (a.chunks[n] % s.inner[n] != 0)
                     bad(file, at + ".chunk_shape",
@@ -333,7 +334,8 @@ void v3_codecs(const std::string& file, const std::string& field, const json& co
         } else {
             bad(file, at,
                 "isowall reads transpose, bytes and sharding_indexed, then blosc, gzip or zstd, "
-                "then crc32c, in that order; got " + quote(c.dump()));
+                "then crc32c, in that order; got " +
+                    quote(c.dump()));
         }
     }
     if (stage == 0) bad(file, field, "no \"bytes\" or \"sharding_indexed\" codec");
@@ -354,21 +356,27 @@ void decode_shard(const ZarrArray& a, const std::string& in, const std::string& 
     }
     const std::size_t index_bytes = 16 * n + (s.index_crc32c ? 4 : 0);
     if (in.size() < index_bytes)
-        bad(file, "chunk", "a shard of " + std::to_string(in.size()) +
-                               " bytes, shorter than its index of " + std::to_string(index_bytes));
-    std::string_view index(in.data() + (s.index_at_start ? 0 : in.size() - index_bytes), index_bytes);
+        bad(file, "chunk",
+            "a shard of " + std::to_string(in.size()) + " bytes, shorter than its index of " +
+                std::to_string(index_bytes));
+    std::string_view index(in.data() + (s.index_at_start ? 0 : in.size() - index_bytes),
+                           index_bytes);
     if (s.index_crc32c) {
         std::uint32_t sum;
         std::memcpy(&sum, index.data() + 16 * n, 4);
-        if (crc32c(index.data(), 16 * n) != sum) bad(file, "chunk", "its shard index's CRC-32C does not match");
+        if (crc32c(index.data(), 16 * n) != sum)
+            bad(file, "chunk", "its shard index's CRC-32C does not match");
     }
     std::vector<std::byte> fill = fill_bytes(a);
     if (a.big_endian) std::reverse(fill.begin(), fill.end());
-    for (std::size_t i = 0; i < out.size() / e; ++i) std::memcpy(out.data() + i * e, fill.data(), e);
+    for (std::size_t i = 0; i < out.size() / e; ++i)
+        std::memcpy(out.data() + i * e, fill.data(), e);
     // Strides: the shard's, C order; an inner chunk's, its codecs' order.
     std::vector<std::size_t> outer(k, 1), within(k, 1);
-    for (std::size_t i = k - 1; i-- > 0;) outer[i] = outer[i + 1] * static_cast<std::size_t>(a.chunks[i + 1]);
-    for (std::size_t i = k - 1; i-- > 0;) within[a.order[i]] = within[a.order[i + 1]] * inner[a.order[i + 1]];
+    for (std::size_t i = k - 1; i-- > 0;)
+        outer[i] = outer[i + 1] * static_cast<std::size_t>(a.chunks[i + 1]);
+    for (std::size_t i = k - 1; i-- > 0;)
+        within[a.order[i]] = within[a.order[i + 1]] * inner[a.order[i + 1]];
     std::vector<std::byte> chunk(inner_n * e);
     for (std::size_t j = 0; j < n; ++j) {
         std::uint64_t entry[2];
@@ -408,31 +416,37 @@ ZarrArray read_v3_array(const ZarrSource& source, const std::string& prefix) {
     if (j.value("zarr_format", 0) != 3)
         bad(file, "zarr_format", "expected 3, got " + quote(j.value("zarr_format", json()).dump()));
     if (j.value("node_type", std::string()) != "array")
-        bad(file, "node_type", "expected \"array\", got " + quote(j.value("node_type", json()).dump()));
+        bad(file, "node_type",
+            "expected \"array\", got " + quote(j.value("node_type", json()).dump()));
     ZarrArray a;
     a.version = 3;
     a.prefix = prefix;
     a.where = file;
     a.shape = sizes(file, j, "shape");
     if (a.shape.size() < 3)
-        bad(file, "shape", "a volume has three axes (z, y, x), got " + std::to_string(a.shape.size()));
+        bad(file, "shape",
+            "a volume has three axes (z, y, x), got " + std::to_string(a.shape.size()));
     a.type = v3_type(file, j);
     const json grid = j.value("chunk_grid", json());
     if (!grid.is_object() || grid.value("name", std::string()) != "regular")
         bad(file, "chunk_grid", "expected a \"regular\" grid, got " + quote(grid.dump()));
     a.chunks = sizes(file, grid.value("configuration", json::object()), "chunk_shape");
     if (a.chunks.size() != a.shape.size())
-        bad(file, "chunk_grid.configuration.chunk_shape", "expected one size per axis of the shape");
+        bad(file, "chunk_grid.configuration.chunk_shape",
+            "expected one size per axis of the shape");
     if (a.chunk_elements() > kMaxChunkBytes / a.item())
         bad(file, "chunk_grid", "a chunk of more than 1 GiB");
     const json keys = j.value("chunk_key_encoding", json{{"name", "default"}});
-    const std::string encoding = keys.is_object() ? keys.value("name", std::string()) : std::string();
+    const std::string encoding =
+        keys.is_object() ? keys.value("name", std::string()) : std::string();
     if (encoding != "default" && encoding != "v2")
-        bad(file, "chunk_key_encoding", "expected \"default\" or \"v2\", got " + quote(keys.dump()));
-    a.separator = keys.value("configuration", json::object()).value(
-        "separator", std::string(encoding == "default" ? "/" : "."));
+        bad(file, "chunk_key_encoding",
+            "expected \"default\" or \"v2\", got " + quote(keys.dump()));
+    a.separator = keys.value("configuration", json::object())
+                      .value("separator", std::string(encoding == "default" ? "/" : "."));
     if (a.separator != "." && a.separator != "/")
-        bad(file, "chunk_key_encoding.separator", "expected \".\" or \"/\", got " + quote(a.separator));
+        bad(file, "chunk_key_encoding.separator",
+            "expected \".\" or \"/\", got " + quote(a.separator));
     if (encoding == "default") a.key_prefix = "c" + a.separator;
     a.order.resize(a.shape.size());
     std::iota(a.order.begin(), a.order.end(), std::size_t{0});
@@ -481,6 +495,5 @@ std::string chunk_key(const ZarrArray& a, std::int64_t z, std::int64_t y, std::i
     return key + std::to_string(z) + a.separator + std::to_string(y) + a.separator +
            std::to_string(x);
 }
-
 
 }  // namespace isowall::formats::zarr

@@ -33,13 +33,13 @@ struct ZarrArray {
     // order; a v3 transpose's permutation. A sharded array's inner chunks are laid out so; its
     // shards, once decoded, are in C order.
     std::vector<std::size_t> order;
-    std::string key_prefix;           // before a chunk key's indices: "c/" (v3's default) or ""
-    std::string separator = ".";      // between them: "." or "/"
-    nlohmann::json compressor;        // {"id": "blosc"|"zstd"|"gzip"|"zlib"|"lz4"}, or null
-    bool crc32c = false;              // a CRC-32C of the chunk's bytes follows them (v3)
-    nlohmann::json fill;              // null: 0
-    std::vector<std::string> names;   // v3's dimension_names (empty where it gives none)
-    std::vector<std::int64_t> pick;   // the element taken on each axis before z, y, x
+    std::string key_prefix;          // before a chunk key's indices: "c/" (v3's default) or ""
+    std::string separator = ".";     // between them: "." or "/"
+    nlohmann::json compressor;       // {"id": "blosc"|"zstd"|"gzip"|"zlib"|"lz4"}, or null
+    bool crc32c = false;             // a CRC-32C of the chunk's bytes follows them (v3)
+    nlohmann::json fill;             // null: 0
+    std::vector<std::string> names;  // v3's dimension_names (empty where it gives none)
+    std::vector<std::int64_t> pick;  // the element taken on each axis before z, y, x
     struct Shard {
         std::vector<std::int64_t> inner;  // an inner chunk's shape, dividing a shard's
         bool index_at_start = false;

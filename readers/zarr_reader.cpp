@@ -6,8 +6,8 @@
 #include <fstream>
 #include <limits>
 #include <new>
-#include <numeric>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
@@ -80,6 +80,9 @@ class UrlSource : public ZarrSource {
         return fetch_.get(where(key), is_metadata(key) ? "metadata" : "chunk", max_bytes);
     }
     std::string where(const std::string& key) const override { return base_ + "/" + key; }
+    // The object's copy in the HTTP cache, once fetched: the octree cache keys on it as on a
+    // folder's file (a store's objects do not change under one URL).
+    fs::path file(const std::string& key) const override { return fetch_.cached_file(where(key)); }
 
   private:
     std::string base_;
@@ -99,7 +102,8 @@ class ChunkRows {
         const std::vector<std::size_t> order = a_.grid_order();
         std::vector<std::size_t> stride(k, 1);
         for (std::size_t i = k - 1; i-- > 0;)
-            stride[order[i]] = stride[order[i + 1]] * static_cast<std::size_t>(a_.chunks[order[i + 1]]);
+            stride[order[i]] =
+                stride[order[i + 1]] * static_cast<std::size_t>(a_.chunks[order[i + 1]]);
         sz_ = stride[k - 3], sy_ = stride[k - 2], sx_ = stride[k - 1];
         for (std::size_t i = 0; i + 3 < k; ++i)
             picked_ += static_cast<std::size_t>(a_.pick[i] % a_.chunks[i]) * stride[i];
@@ -112,7 +116,8 @@ class ChunkRows {
         const std::int64_t cz = a_.chunks[a_.shape.size() - 3];
         for (std::int64_t bz = z0 / cz; bz * cz < z1; ++bz) {
             const std::int64_t r0 = bz * cz, r1 = std::min<std::int64_t>(r0 + cz, dims_.z);
-            const std::int64_t lo = std::max<std::int64_t>(z0, r0), hi = std::min<std::int64_t>(z1, r1);
+            const std::int64_t lo = std::max<std::int64_t>(z0, r0),
+                               hi = std::min<std::int64_t>(z1, r1);
             if (lo == r0 && hi == r1) {
                 put_row(bz, to + static_cast<std::size_t>(r0 - z0) * plane());
             } else {
@@ -168,10 +173,10 @@ class ChunkRows {
     void put_chunk_row(std::byte* out, std::int64_t z, std::int64_t y, std::int64_t x,
                        std::int64_t nx, std::size_t base) const {
         const std::size_t e = a_.item();
-        std::byte* row = out + ((static_cast<std::size_t>(z) * dims_.y + static_cast<std::size_t>(y)) *
-                                    dims_.x +
-                                static_cast<std::size_t>(x)) *
-                                   e;
+        std::byte* row =
+            out + ((static_cast<std::size_t>(z) * dims_.y + static_cast<std::size_t>(y)) * dims_.x +
+                   static_cast<std::size_t>(x)) *
+                      e;
         if (sx_ == 1) {
             std::memcpy(row, chunk_.data() + base * e, static_cast<std::size_t>(nx) * e);
             return;
@@ -273,8 +278,9 @@ bool is_foreign_zarr(const fs::path& path) {
         if (fs::exists(path / "zarr.json", ec)) {  // Zarr v3: an array, or an OME-Zarr 0.5 group
             const json z = zarr::read_json(FolderSource(path), "zarr.json");
             const json at = z.is_object() ? z.value("attributes", json::object()) : json();
-            return z.is_object() && (z.value("node_type", std::string()) == "array" ||
-                                     (at.is_object() && (at.contains("ome") || at.contains("multiscales"))));
+            return z.is_object() &&
+                   (z.value("node_type", std::string()) == "array" ||
+                    (at.is_object() && (at.contains("ome") || at.contains("multiscales"))));
         }
         if (!fs::exists(path / ".zattrs", ec)) return false;
         const json at = zarr::read_json(FolderSource(path), ".zattrs");
@@ -335,7 +341,8 @@ int take_level(std::string& selection, const std::string& where) {
         }
         const std::string n = item.substr(6);
         if (n.empty() || n.size() > 3 || !std::all_of(n.begin(), n.end(), ::isdigit))
-            throw InputError(where, "level", "expected level=N, a dataset of the multiscale, got " + quote(item));
+            throw InputError(where, "level",
+                             "expected level=N, a dataset of the multiscale, got " + quote(item));
         level = std::stoi(n);
     }
     selection = rest;
@@ -353,7 +360,8 @@ Located locate_ome(const ZarrSource& source, const json& ome, const std::string&
     const std::size_t n = ds.is_array() ? ds.size() : 0;
     const int chosen = std::max(level, 0);
     const std::string field = "multiscales[0].datasets[" + std::to_string(chosen) + "]";
-    if (n == 0) bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
+    if (n == 0)
+        bad(file, "multiscales[0].datasets", "expected a list of datasets, each with a path");
     if (static_cast<std::size_t>(chosen) >= n)
         throw InputError(file, "level",
                          "level=" + std::to_string(level) + ": the image has " + std::to_string(n) +
@@ -372,7 +380,8 @@ Located locate_ome(const ZarrSource& source, const json& ome, const std::string&
     l.spacing = ome_spacing(file, ms[0], d, field);
     for (const json& ax : ms[0].value("axes", json::array()))  // 0.4: objects; 0.3: names
         l.names.push_back(ax.is_string() ? ax.get<std::string>() : ax.value("name", std::string()));
-    const std::string v = ome.value("version", ms[0].value("version", std::string(version == 3 ? "0.5" : "0.4")));
+    const std::string v =
+        ome.value("version", ms[0].value("version", std::string(version == 3 ? "0.5" : "0.4")));
     l.what = "OME-Zarr " + v + " (level " + std::to_string(chosen) + " of " + std::to_string(n) +
              ", dataset " + quote(sub) + ")";
     return l;
@@ -403,16 +412,19 @@ Located locate(const ZarrSource& source, int level, const std::string& name) {
         add_file("zarr.json");
         if (!l.array.prefix.empty()) add_file(l.array.prefix + "zarr.json");
     } else {
-        l = locate_ome(source, zarr::read_json(source, ".zattrs"), source.where(".zattrs"), level, 2);
+        l = locate_ome(source, zarr::read_json(source, ".zattrs"), source.where(".zattrs"), level,
+                       2);
         add_file(".zattrs");
         add_file(l.array.prefix + ".zarray");
     }
     if (level >= 0 && l.what.find("level") == std::string::npos)
-        throw InputError(name, "level", "level=" + std::to_string(level) +
-                                            ": a plain array has one level; levels are an OME-Zarr image's");
+        throw InputError(name, "level",
+                         "level=" + std::to_string(level) +
+                             ": a plain array has one level; levels are an OME-Zarr image's");
     if (l.names.size() != l.array.shape.size()) l.names = l.array.names;
     if (l.names.size() != l.array.shape.size() ||
-        std::any_of(l.names.begin(), l.names.end(), [](const std::string& s) { return s.empty(); })) {
+        std::any_of(l.names.begin(), l.names.end(),
+                    [](const std::string& s) { return s.empty(); })) {
         l.names.clear();  // no names, or not one per axis: their indices
         for (std::size_t i = 0; i < l.array.shape.size(); ++i) l.names.push_back(std::to_string(i));
     }
@@ -466,9 +478,10 @@ OpenedArray open_array(std::shared_ptr<const ZarrSource> source, const std::stri
     std::iota(c_order.begin(), c_order.end(), std::size_t{0});
     const std::vector<std::size_t> f_order(c_order.rbegin(), c_order.rend());
     const std::string order = a.order == c_order ? "C" : a.order == f_order ? "F" : "transposed";
-    d.facts.push_back({"chunks", a.shard ? shape_of(a.chunks) + " shards of " + shape_of(a.shard->inner) +
-                                               " (" + order + " order, " + codec + ")"
-                                         : shape_of(a.chunks) + " (" + order + " order, " + codec + ")"});
+    d.facts.push_back(
+        {"chunks", a.shard ? shape_of(a.chunks) + " shards of " + shape_of(a.shard->inner) + " (" +
+                                 order + " order, " + codec + ")"
+                           : shape_of(a.chunks) + " (" + order + " order, " + codec + ")"});
     out.stack.size_field = "shape";
     out.rows = std::make_shared<ChunkRows>(std::move(source), std::move(a), dims);
     out.stack.read = [rows = out.rows](int z0, int z1, std::byte* to) { rows->read(z0, z1, to); };

@@ -23,7 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ArrayShape {
-    int x = 11, y = 9, z = 13;  // voxels
+    int x = 11, y = 9, z = 13;   // voxels
     int cx = 4, cy = 5, cz = 3;  // a chunk
     bool fortran = false, big_endian = false;
     std::vector<std::string> left_out;  // chunk keys not written

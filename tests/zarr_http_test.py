@@ -187,6 +187,8 @@ class ZarrOverHttp(unittest.TestCase):
         p = render(self.url + "/blob.zarr", out, "--cache-dir", cache)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.same_as_folder(out)
+        # The octree cache keys on the objects' copies, so the octree is found, not built.
+        self.assertIn("octree: mapped", p.stdout)
         # Only what was absent (a 404, which is not kept) was asked again.
         self.assertTrue(all(r.endswith((".zarray", ".zattrs", ".zgroup")) or r not in
                             self.faults.requests[:asked] for r in self.faults.requests[asked:]))

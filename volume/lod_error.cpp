@@ -44,9 +44,8 @@ LodTable load_or_build_lod(const OctreeSource& src, VoxelType type, glm::ivec3 d
     const std::size_t bytes = LodErrors::byte_count(cells);
     std::optional<octree_cache::Key> key;
     std::filesystem::path file;
-    std::vector<std::filesystem::path> sources{src.volume_path};
-    sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
-    if (!src.volume_path.empty() && !src.cache_dir.empty() &&
+    const std::vector<std::filesystem::path> sources = src.key_files();
+    if (!src.volume_path.empty() && !src.cache_dir.empty() && !sources.empty() &&
         (key = octree_cache::key_for(sources, type, dims))) {
         file = lod_file_for(src);
         std::error_code ec;

@@ -68,6 +68,17 @@ struct OctreeSource {
     // Every other file the voxels come from (a detached header's data file): the key covers each,
     // so data replaced behind an unchanged header is never served a stale octree.
     std::vector<std::filesystem::path> data_files{};
+    // The files the key digests: the volume's path and its data files. A URL ("scheme://...")
+    // cannot be stat'ed: its objects' copies in the HTTP cache are its data files, and without
+    // them (--no-cache) there is nothing to key on: empty.
+    std::vector<std::filesystem::path> key_files() const {
+        const bool remote = volume_path.native().find("://") != std::string::npos;
+        if (remote && data_files.empty()) return {};
+        std::vector<std::filesystem::path> files;
+        if (!remote) files.push_back(volume_path);
+        files.insert(files.end(), data_files.begin(), data_files.end());
+        return files;
+    }
     // A volume that carries its own octree (a store, store/open_store.h): the file, and
     // the key of the content it was built from (the store's identity, not where it lies, so a
     // moved or shared store keeps its octree). Empty/nullopt: the cache folder and the files'
@@ -344,8 +355,7 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     OctreeStats& st = stats ? *stats : local;
     std::optional<octree_cache::Key> key;
     std::filesystem::path file;
-    std::vector<std::filesystem::path> sources{src.volume_path};
-    sources.insert(sources.end(), src.data_files.begin(), src.data_files.end());
+    const std::vector<std::filesystem::path> sources = src.key_files();
     // A volume's own octree (a store's) is part of the volume, not of the cache: it is used
     // with the cache off too.
     if (src.own_file.empty() && (src.volume_path.empty() || src.cache_dir.empty())) {
@@ -354,7 +364,9 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
                           ? std::optional(
                                 octree_cache::Key{static_cast<std::uint32_t>(voxel_type_of<T>()),
                                                   v.dims, *src.content_key})
-                          : octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
+                          : sources.empty()
+                              ? std::nullopt
+                              : octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
         file = src.own_file.empty() ? octree_cache::file_for(src.cache_dir, src.volume_path)
                                     : src.own_file;
         st.cache_file = file;
