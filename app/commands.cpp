@@ -317,6 +317,11 @@ int run_extract(const ExtractOptions& o) {
                          "unknown mesh format " +
                              quote(std::filesystem::path(o.out).extension().string()) +
                              ": expected " + mesh_formats_named());
+    const bool meshopt = o.compress == "meshopt";
+    if (meshopt && *format != MeshFormat::glb)
+        throw InputError(
+            "--compress", "value",
+            "meshopt compresses a .glb, not " + quote(o.out) + "; give --out FILE.glb");
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
@@ -325,7 +330,7 @@ int run_extract(const ExtractOptions& o) {
     Mesh mesh = extract_timed(*ex, iso, t);
     print_paging(ov);
     Stopwatch sw;
-    write_mesh(o.out, mesh, *format);
+    write_mesh(o.out, mesh, *format, meshopt);
     t.write = sw.seconds();
     std::printf("wrote %s\n", o.out.c_str());
     t.print(mesh.triangle_count());

@@ -16,6 +16,7 @@ struct ExtractOptions {
     VolumeOptions volume;
     std::optional<double> iso;
     std::string out;
+    std::string compress = "none";  // a .glb's: none or meshopt
 };
 
 struct RenderOptions {

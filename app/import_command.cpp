@@ -18,7 +18,6 @@
 
 namespace isowall {
 
-
 CLI::App* add_import_command(CLI::App& app, ImportCommand& o) {
     auto* c = app.add_subcommand(
         "import",

@@ -248,6 +248,12 @@ ProgramCli::ProgramCli() {
                      "(binary), .obj, .vtp (VTK XML PolyData, for ParaView) or .glb (binary glTF "
                      "2.0). Positions in object units (voxel index times spacing)")
         ->required();
+    ex_cmd
+        ->add_option("--compress", ex.compress,
+                     "A .glb's compression: none, or meshopt (EXT_meshopt_compression: lossless, "
+                     "the vertices reordered for the GPU's caches; three.js, Babylon.js and "
+                     "glTF-Transform read it). Default: none")
+        ->check(CLI::IsMember({"none", "meshopt"}));
 
     re_cmd = add_render_command(app, re);
     wall_cmd = add_wall_command(app, wall);

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """`isowall extract` to every mesh format, each file opened by its reference reader: VTK's PLY,
 STL, OBJ and XML PolyData readers (python3-vtk9) and the Khronos glTF validator (npm's
-gltf-validator, web/tools/validate_glb.mjs). Every file has the PLY's triangles and bounds; the
+gltf-validator, web/tools/validate_glb.mjs); a .glb compressed with meshopt is decoded by
+meshoptimizer's own decoder (web/tools/decode_meshopt_glb.mjs) and validated again. Every file
+has the PLY's triangles and bounds; the
 volumes are the built-in phantom and a small sphere with anisotropic spacing (bounds in object
 units). An unknown extension is one line, status 1, and no file.
 
@@ -16,6 +18,7 @@ import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VALIDATE = os.path.join(ROOT, "web", "tools", "validate_glb.mjs")
+DECODE = os.path.join(ROOT, "web", "tools", "decode_meshopt_glb.mjs")
 ISOWALL = SCRATCH = None
 FORMATS = ("ply", "stl", "obj", "vtp", "glb")
 
@@ -98,7 +101,31 @@ class MeshExport(unittest.TestCase):
         for a in range(3):
             self.assertAlmostEqual(lo[a], bounds[2 * a], places=4)
             self.assertAlmostEqual(hi[a], bounds[2 * a + 1], places=4)
+        self.check_meshopt(out, volume, tris, bounds, ply.GetNumberOfPoints())
         return bounds
+
+    def check_meshopt(self, out, volume, tris, bounds, points):
+        """The meshopt-compressed .glb: smaller, valid, and decoded by meshoptimizer's own decoder
+        into the plain file's mesh (the validator cannot decode the extension itself)."""
+        packed, decoded = os.path.join(out, "s-meshopt.glb"), os.path.join(out, "s-decoded.glb")
+        p = extract(packed, *volume, "--compress", "meshopt")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertLess(os.path.getsize(packed), 0.7 * os.path.getsize(os.path.join(out, "s.glb")))
+        r = glb_report(packed)
+        self.assertEqual((r["errors"], r["warnings"]), (0, 0), r["messages"])
+        self.assertTrue(any("EXT_meshopt_compression" in m for m in r["messages"]), r["messages"])
+        d = subprocess.run(["node", DECODE, packed, decoded], capture_output=True, text=True, timeout=120)
+        self.assertEqual(d.returncode, 0, d.stderr)
+        self.assertEqual(json.loads(d.stdout)["views"], 3)
+        r = glb_report(decoded)
+        self.assertEqual((r["errors"], r["warnings"], r["infos"]), (0, 0, 0), r["messages"])
+        self.assertEqual(r["triangles"], tris)
+        self.assertLessEqual(r["vertices"], points)  # a vertex no triangle uses is left out
+        self.assertGreater(r["vertices"], points // 2)
+        lo, hi = glb_bounds(decoded)
+        for a in range(3):
+            self.assertAlmostEqual(lo[a], bounds[2 * a], places=4)
+            self.assertAlmostEqual(hi[a], bounds[2 * a + 1], places=4)
 
     def test_the_phantom_in_every_format(self):
         self.check_all_formats("phantom", [])
@@ -119,6 +146,11 @@ class MeshExport(unittest.TestCase):
         lines = p.stderr.strip().splitlines()
         self.assertEqual(len(lines), 1, p.stderr)
         self.assertIn("--out: unknown mesh format \".gltf\"", lines[0])
+        self.assertEqual(os.listdir(out), [])
+        p = extract(os.path.join(out, "s.ply"), "--compress", "meshopt")
+        self.assertEqual(p.returncode, 1)
+        self.assertEqual(len(p.stderr.strip().splitlines()), 1, p.stderr)
+        self.assertIn("--compress", p.stderr)
         self.assertEqual(os.listdir(out), [])
 
 

@@ -10,6 +10,14 @@
 #include <string>
 
 #include "files/mesh_formats.h"
+
+#include <meshoptimizer.h>
+
+#include <array>
+#include <set>
+#include <tuple>
+
+#include <glm/geometric.hpp>
 #include "files/ply.h"
 #include "tests/test_util.h"
 
@@ -136,6 +144,71 @@ TEST(MeshFormats, GlbHasAHeaderAJsonChunkAndABinaryChunk) {
     EXPECT_EQ(read_at<std::uint32_t>(e, 8), e.size());
     EXPECT_EQ(e.size(), 20 + read_at<std::uint32_t>(e, 12));
     EXPECT_FALSE(nlohmann::json::parse(text(e).substr(20)).contains("meshes"));
+}
+
+// A glb's JSON chunk and BIN chunk.
+std::pair<nlohmann::json, std::span<const std::byte>> glb_parts(const std::vector<std::byte>& b) {
+    const auto json_bytes = read_at<std::uint32_t>(b, 12);
+    const std::size_t bin = 20 + json_bytes;
+    return {nlohmann::json::parse(text(b).substr(20, json_bytes)),
+            std::span<const std::byte>(b).subspan(bin + 8, read_at<std::uint32_t>(b, bin))};
+}
+
+TEST(MeshFormats, MeshoptGlbDecodesToTheSameTriangles) {
+    Mesh m = square();
+    m.positions.push_back({9, 9, 9});  // a vertex no triangle uses: left out
+    m.normals.push_back({0, 0, 1});
+    const auto b = encode_glb_meshopt(m);
+    EXPECT_EQ(read_at<std::uint32_t>(b, 8), b.size());
+    const auto [doc, bin] = glb_parts(b);
+    EXPECT_EQ(doc["extensionsRequired"], nlohmann::json({"EXT_meshopt_compression"}));
+    EXPECT_TRUE(doc["buffers"][1]["extensions"]["EXT_meshopt_compression"]["fallback"]);
+    EXPECT_EQ(doc["buffers"][0]["byteLength"].get<std::size_t>(), bin.size());
+    EXPECT_EQ(doc["accessors"][0]["count"], 4);
+    EXPECT_EQ(doc["accessors"][0]["max"], nlohmann::json({1.0, 1.0, 2.0}));  // not (9, 9, 9)
+    // Each view decoded as a reader would, then the triangles' corners compared as sets.
+    auto view = [&, &doc = doc, &bin = bin](int i) {
+        const auto& e = doc["bufferViews"][i]["extensions"]["EXT_meshopt_compression"];
+        return std::tuple{
+            bin.subspan(e["byteOffset"].get<std::size_t>(), e["byteLength"].get<std::size_t>()),
+            e["count"].get<std::size_t>(), e["byteStride"].get<std::size_t>(),
+            e["mode"].get<std::string>()};
+    };
+    std::vector<glm::vec3> points(4), normals(4);
+    std::vector<std::uint32_t> indices(6);
+    for (int i = 0; i < 2; ++i) {
+        const auto [data, count, stride, mode] = view(i);
+        ASSERT_EQ(mode, "ATTRIBUTES");
+        ASSERT_EQ(count * stride, 4u * 12);
+        ASSERT_EQ(meshopt_decodeVertexBuffer(i == 0 ? points.data() : normals.data(), count, stride,
+                                             reinterpret_cast<const unsigned char*>(data.data()),
+                                             data.size()),
+                  0);
+    }
+    const auto [data, count, stride, mode] = view(2);
+    ASSERT_EQ(mode, "TRIANGLES");
+    ASSERT_EQ(
+        meshopt_decodeIndexBuffer(indices.data(), count, stride,
+                                  reinterpret_cast<const unsigned char*>(data.data()), data.size()),
+        0);
+    auto corners = [](const std::vector<glm::vec3>& p, const std::vector<std::uint32_t>& ix) {
+        std::multiset<std::array<float, 9>> tris;
+        for (std::size_t t = 0; t < ix.size(); t += 3) {
+            std::array<glm::vec3, 3> c = {p[ix[t]], p[ix[t + 1]], p[ix[t + 2]]};
+            // The same triangle from any of its corners (the winding kept).
+            std::rotate(c.begin(),
+                        std::min_element(c.begin(), c.end(),
+                                         [](auto a, auto b) {
+                                             return std::tie(a.x, a.y, a.z) <
+                                                    std::tie(b.x, b.y, b.z);
+                                         }),
+                        c.end());
+            tris.insert({c[0].x, c[0].y, c[0].z, c[1].x, c[1].y, c[1].z, c[2].x, c[2].y, c[2].z});
+        }
+        return tris;
+    };
+    EXPECT_EQ(corners(points, indices), corners(m.positions, m.indices));
+    for (const glm::vec3& n : normals) EXPECT_NEAR(glm::length(n), 1.0f, 1e-6f);
 }
 
 TEST(MeshFormats, WritesEachFormatWhole) {
