@@ -360,13 +360,12 @@ MinMaxOctree<T> MinMaxOctree<T>::load_or_build(const VolumeView<T>& v, const Oct
     // with the cache off too.
     if (src.own_file.empty() && (src.volume_path.empty() || src.cache_dir.empty())) {
         st.cache_note = src.volume_path.empty() ? "generated volume, not cached" : "cache disabled";
-    } else if ((key = src.content_key
-                          ? std::optional(
-                                octree_cache::Key{static_cast<std::uint32_t>(voxel_type_of<T>()),
-                                                  v.dims, *src.content_key})
-                          : sources.empty()
-                              ? std::nullopt
-                              : octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
+    } else if ((key = src.content_key ? std::optional(octree_cache::Key{
+                                            static_cast<std::uint32_t>(voxel_type_of<T>()), v.dims,
+                                            *src.content_key})
+                      : sources.empty()
+                          ? std::nullopt
+                          : octree_cache::key_for(sources, voxel_type_of<T>(), v.dims))) {
         file = src.own_file.empty() ? octree_cache::file_for(src.cache_dir, src.volume_path)
                                     : src.own_file;
         st.cache_file = file;
