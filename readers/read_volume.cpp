@@ -152,9 +152,9 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path, const std::opt
                                          const HttpOptions& http) {
     if (raw) return raw_planes(path, *raw);
     if (is_url(path)) {
-        const auto [base, selection] = url_selection(path);
+        const auto url = url_selection(path);  // (a structured binding clang 14 cannot capture)
         return stream_isolated(path, kZarrDecoders,
-                               [=] { return zarr_url_planes(base, selection, http); });
+                               [=] { return zarr_url_planes(url.first, url.second, http); });
     }
     const fs::path p(path);
     std::error_code ec;
@@ -173,9 +173,9 @@ std::unique_ptr<PlaneSource> open_planes(const std::string& path, const std::opt
 }
 
 Volume read_url(const std::string& url, const HttpOptions& options) {
-    const auto [base, selection] = url_selection(url);
+    const auto store = url_selection(url);
     return read_isolated(url, kZarrDecoders,
-                         [&] { return read_zarr_url(base, selection, options); });
+                         [&] { return read_zarr_url(store.first, store.second, options); });
 }
 
 Volume read_volume(const std::string& path, const std::optional<RawSpec>& raw, bool populate) {
