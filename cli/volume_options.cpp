@@ -54,6 +54,11 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "is tried again (3 more tries, then an error naming the URL). Fetched objects "
                    "are kept under the cache folder's http/ (not with --no-cache). Default: 30")
         ->transform(number_in({0.1, 3600}));
+    app.add_option("--http-connections", o.http_connections,
+                   "A volume over HTTP: how many of a row's chunks are fetched at once, each "
+                   "connection kept for the next (fewer spare a small server; more hide a far "
+                   "server's round trips). Default: 8")
+        ->transform(number_in({1, 64, false, true}));
     app.add_option("--memory-limit", o.memory_limit,
                    "A store's voxels in memory at most (e.g. 512M, 8G); the rest stays on disk "
                    "and is read when a ray or the surface first needs it. Another tool's Zarr "
@@ -116,6 +121,7 @@ std::filesystem::path cache_dir(const VolumeOptions& o) {
 formats::HttpOptions http_options(const VolumeOptions& o) {
     formats::HttpOptions h;
     h.stall_s = o.http_timeout;
+    h.connections = o.http_connections;
     if (!o.no_cache) h.cache_dir = cache_dir(o) / "http";
     return h;
 }

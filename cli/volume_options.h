@@ -26,6 +26,7 @@ struct VolumeOptions {
     std::string huge_pages = "auto";  // auto, on, off (volume/huge_pages.h)
     std::string memory_limit;         // a store's cap ("512M", "8G"); empty: the default share
     double http_timeout = 30;         // a volume over HTTP: seconds without a byte before a retry
+    int http_connections = 8;         // a volume over HTTP: objects fetched at once
 };
 
 void add_volume_options(CLI::App& app, VolumeOptions& opts);

@@ -2,6 +2,7 @@
 
 #include <curl/curl.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,8 @@
 #include <iterator>
 #include <memory>
 #include <thread>
+
+#include <unistd.h>
 
 #include "core/error.h"
 
@@ -50,28 +53,27 @@ void global_init() {
     (void)done;
 }
 
-Attempt fetch_once(const std::string& url, std::size_t max_bytes, double stall_s) {
-    global_init();
+Attempt fetch_once(CURL* handle, const std::string& url, std::size_t max_bytes, double stall_s) {
     Attempt a;
-    std::unique_ptr<CURL, void (*)(CURL*)> curl(curl_easy_init(), curl_easy_cleanup);
-    if (!curl) return {0, {}, "libcurl could not start", false};
+    if (!handle) return {0, {}, "libcurl could not start", false};
+    curl_easy_reset(handle);  // its options go; its connections stay
     Sink sink{&a.body, max_bytes};
     const long stall = std::max(1L, std::lround(stall_s));
-    curl_easy_setopt(curl.get(), CURLOPT_URL, url.c_str());
-    curl_easy_setopt(curl.get(), CURLOPT_PROTOCOLS_STR, "http,https");
-    curl_easy_setopt(curl.get(), CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
-    curl_easy_setopt(curl.get(), CURLOPT_FOLLOWLOCATION, 1L);
-    curl_easy_setopt(curl.get(), CURLOPT_MAXREDIRS, 5L);
-    curl_easy_setopt(curl.get(), CURLOPT_NOSIGNAL, 1L);
-    curl_easy_setopt(curl.get(), CURLOPT_CONNECTTIMEOUT, stall);
+    curl_easy_setopt(handle, CURLOPT_URL, url.c_str());
+    curl_easy_setopt(handle, CURLOPT_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(handle, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(handle, CURLOPT_FOLLOWLOCATION, 1L);
+    curl_easy_setopt(handle, CURLOPT_MAXREDIRS, 5L);
+    curl_easy_setopt(handle, CURLOPT_NOSIGNAL, 1L);
+    curl_easy_setopt(handle, CURLOPT_CONNECTTIMEOUT, stall);
     // Less than a byte a second for `stall` seconds: the server stalled.
-    curl_easy_setopt(curl.get(), CURLOPT_LOW_SPEED_LIMIT, 1L);
-    curl_easy_setopt(curl.get(), CURLOPT_LOW_SPEED_TIME, stall);
-    curl_easy_setopt(curl.get(), CURLOPT_WRITEFUNCTION, write_body);
-    curl_easy_setopt(curl.get(), CURLOPT_WRITEDATA, &sink);
-    curl_easy_setopt(curl.get(), CURLOPT_USERAGENT, "isowall");
-    const CURLcode r = curl_easy_perform(curl.get());
-    curl_easy_getinfo(curl.get(), CURLINFO_RESPONSE_CODE, &a.status);
+    curl_easy_setopt(handle, CURLOPT_LOW_SPEED_LIMIT, 1L);
+    curl_easy_setopt(handle, CURLOPT_LOW_SPEED_TIME, stall);
+    curl_easy_setopt(handle, CURLOPT_WRITEFUNCTION, write_body);
+    curl_easy_setopt(handle, CURLOPT_WRITEDATA, &sink);
+    curl_easy_setopt(handle, CURLOPT_USERAGENT, "isowall");
+    const CURLcode r = curl_easy_perform(handle);
+    curl_easy_getinfo(handle, CURLINFO_RESPONSE_CODE, &a.status);
     if (sink.over) {
         a.failure = "the object is larger than " + std::to_string(max_bytes) + " bytes";
         return a;
@@ -125,6 +127,31 @@ bool is_url(std::string_view text) {
 
 HttpFetcher::HttpFetcher(HttpOptions options) : options_(std::move(options)) {}
 
+HttpFetcher::~HttpFetcher() {
+    for (void* h : handles_) curl_easy_cleanup(static_cast<CURL*>(h));
+}
+
+// A handle from the ones kept (their connections kept with them, so the next object from the
+// same server needs no TCP or TLS handshake), or a new one.
+void* HttpFetcher::borrow() const {
+    global_init();
+    {
+        const std::lock_guard lock(handles_mu_);
+        if (!handles_.empty()) {
+            void* h = handles_.back();
+            handles_.pop_back();
+            return h;
+        }
+    }
+    return curl_easy_init();
+}
+
+void HttpFetcher::give_back(void* handle) const {
+    if (!handle) return;
+    const std::lock_guard lock(handles_mu_);
+    handles_.push_back(handle);
+}
+
 std::filesystem::path HttpFetcher::cached_file(const std::string& url) const {
     if (options_.cache_dir.empty()) return {};
     std::filesystem::path file = options_.cache_dir / url_hash(url);
@@ -145,7 +172,9 @@ std::optional<std::string> HttpFetcher::get(const std::string& url, const std::s
     }
     Attempt a;
     for (int attempt = 0;; ++attempt) {
-        a = fetch_once(url, max_bytes, options_.stall_s);
+        void* handle = borrow();
+        a = fetch_once(static_cast<CURL*>(handle), url, max_bytes, options_.stall_s);
+        give_back(handle);
         if (a.failure.empty() || !a.retry || attempt >= options_.retries) break;
         ++retried_;
         std::this_thread::sleep_for(std::chrono::milliseconds(250 << attempt));
@@ -160,7 +189,10 @@ std::optional<std::string> HttpFetcher::get(const std::string& url, const std::s
         // Written whole under a temporary name, then renamed: a cache file is never a part.
         std::error_code ec;
         std::filesystem::create_directories(cached.parent_path(), ec);
-        const auto part = cached.string() + ".part";
+        // A part of its own: other processes (a wall's ranks) may fetch the same object at once.
+        static std::atomic<unsigned> parts{0};
+        const auto part = cached.string() + "." + std::to_string(::getpid()) + "." +
+                          std::to_string(parts++) + ".part";
         std::ofstream out(part, std::ios::binary | std::ios::trunc);
         out.write(a.body.data(), static_cast<std::streamsize>(a.body.size()));
         out.close();
@@ -168,6 +200,33 @@ std::optional<std::string> HttpFetcher::get(const std::string& url, const std::s
         if (!out || ec) std::filesystem::remove(part, ec);  // a cache that cannot be written
     }
     return std::move(a.body);
+}
+
+std::vector<std::optional<std::string>> HttpFetcher::get_many(const std::vector<std::string>& urls,
+                                                              const std::string& field,
+                                                              std::size_t max_bytes) const {
+    std::vector<std::optional<std::string>> out(urls.size());
+    std::vector<std::exception_ptr> errors(urls.size());
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t i; (i = next++) < urls.size();) {
+            try {
+                out[i] = get(urls[i], field, max_bytes);
+            } catch (...) {
+                errors[i] = std::current_exception();
+                next = urls.size();  // no new object once one failed
+            }
+        }
+    };
+    const std::size_t n = std::min<std::size_t>(
+        static_cast<std::size_t>(std::max(1, options_.connections)), urls.size());
+    std::vector<std::thread> threads;
+    for (std::size_t t = 1; t < n; ++t) threads.emplace_back(work);
+    work();
+    for (std::thread& t : threads) t.join();
+    for (const std::exception_ptr& e : errors)  // the first failure in the order asked
+        if (e) std::rethrow_exception(e);
+    return out;
 }
 
 }  // namespace isowall::formats

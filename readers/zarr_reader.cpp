@@ -79,6 +79,12 @@ class UrlSource : public ZarrSource {
     std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const override {
         return fetch_.get(where(key), is_metadata(key) ? "metadata" : "chunk", max_bytes);
     }
+    std::vector<std::optional<std::string>> get_many(const std::vector<std::string>& keys,
+                                                     std::size_t max_bytes) const override {
+        std::vector<std::string> urls;
+        for (const std::string& key : keys) urls.push_back(where(key));
+        return fetch_.get_many(urls, "chunk", max_bytes);
+    }
     std::string where(const std::string& key) const override { return base_ + "/" + key; }
     // The object's copy in the HTTP cache, once fetched: the octree cache keys on it as on a
     // folder's file (a store's objects do not change under one URL).
@@ -151,12 +157,21 @@ class ChunkRows {
             for (std::size_t i = 0; i < n; ++i) std::memcpy(out + i * e, fill_.data(), e);
         else
             std::memset(out, 0, n * e);
+        // The row's chunks asked for at once (a URL's fetched several at a time), then decoded.
+        std::vector<std::string> keys;
+        for (std::int64_t by = 0; by * cy < dims_.y; ++by)
+            for (std::int64_t bx = 0; bx * cx < dims_.x; ++bx)
+                keys.push_back(a_.prefix + zarr::chunk_key(a_, bz, by, bx));
+        std::vector<std::optional<std::string>> chunks =
+            source_->get_many(keys, zarr::kMaxChunkBytes + (1 << 20));
+        std::size_t next = 0;
         for (std::int64_t by = 0; by * cy < dims_.y; ++by)
             for (std::int64_t bx = 0; bx * cx < dims_.x; ++bx) {
-                const std::string key = a_.prefix + zarr::chunk_key(a_, bz, by, bx);
-                const auto bytes = source_->get(key, zarr::kMaxChunkBytes + (1 << 20));
+                const std::string& key = keys[next];
+                std::optional<std::string> bytes = std::move(chunks[next++]);
                 if (!bytes) continue;  // a missing chunk is the fill value
                 zarr::decode_chunk(a_, *bytes, source_->where(key), chunk_);
+                bytes.reset();
                 if (keep_files && !source_->file(key).empty()) files.push_back(source_->file(key));
                 const std::int64_t ny = std::min(cy, dims_.y - by * cy),
                                    nx = std::min(cx, dims_.x - bx * cx);

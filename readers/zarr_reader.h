@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "readers/http_fetch.h"
 #include "readers/plane_stack.h"
@@ -54,6 +55,13 @@ class ZarrSource {
     // The bytes of `key` (".zattrs", "0/.zarray", "0/1.2.3"), nullopt where the store has none;
     // an InputError past `max_bytes` or when it cannot be read.
     virtual std::optional<std::string> get(const std::string& key, std::size_t max_bytes) const = 0;
+    // The bytes of each of `keys`, as get() gives them; a URL's are fetched several at once.
+    virtual std::vector<std::optional<std::string>> get_many(const std::vector<std::string>& keys,
+                                                             std::size_t max_bytes) const {
+        std::vector<std::optional<std::string>> out;
+        for (const std::string& key : keys) out.push_back(get(key, max_bytes));
+        return out;
+    }
     // `key` named for messages: its file or its URL.
     virtual std::string where(const std::string& key) const = 0;
     // The file that holds `key` (the octree cache's key covers it); empty for a URL.

@@ -7,6 +7,8 @@ front view):
   - read whole from its folder, and over HTTP from a server on loopback (python's
     ThreadingHTTPServer in this process), both with --no-cache so every object is read: time to
     the first picture, --runs times each; the verdict: HTTP's median within 2x of the folder's;
+  - over HTTP from a far server (each request answered --latency-ms late), one connection at a
+    time against the default 8: time to the first picture;
   - paged under --memory-limit (default 256M) through its copy in a fresh cache folder (the first
     run writes the copy, the second finds it): the volume line, the store's reading line, the
     first picture, the peak resident memory, and whether the picture equals the one read whole.
@@ -26,6 +28,7 @@ import shutil
 import statistics
 import sys
 import threading
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
@@ -45,6 +48,8 @@ def parse_args(argv):
     p.add_argument("--size", default="1600x1200")
     p.add_argument("--out", default=os.path.join(ROOT, "out", "bench-zarr"))
     p.add_argument("--isowall", help="the binary (default BUILD/bin/isowall)")
+    p.add_argument("--latency-ms", type=float, default=20,
+                   help="the far server's delay per request (default 20 ms)")
     a = p.parse_args(argv)
     if a.runs < 1:
         p.error("--runs: expected at least 1")
@@ -76,8 +81,17 @@ def slices_store(a):
     return path, nhdr
 
 
-def serve(folder):
+def serve(folder, latency_s=0.0):
+    """A server of `folder` on loopback, answering each request `latency_s` late (a far server's
+    round trip), keeping connections open (HTTP/1.1) as a web server or an object store does."""
     class Quiet(http.server.SimpleHTTPRequestHandler):
+        protocol_version = "HTTP/1.1"
+
+        def do_GET(self):
+            if latency_s:
+                time.sleep(latency_s)
+            super().do_GET()
+
         def log_message(self, *args):
             pass
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Quiet, directory=folder))
@@ -119,6 +133,12 @@ def main(argv):
         folder.append(render(a, store, whole_png, "--no-cache"))
         over_http.append(render(a, url, os.path.join(a.out, "http.png"), "--no-cache"))
     server.shutdown()
+    # A far server: every request answered --latency-ms late, one connection against the default.
+    far = serve(os.path.dirname(store), a.latency_ms / 1000)
+    far_url = f"http://127.0.0.1:{far.server_address[1]}/{os.path.basename(store)}"
+    far_runs = {n: render(a, far_url, os.path.join(a.out, f"far{n}.png"), "--no-cache",
+                          "--http-connections", str(n)) for n in (1, 8)}
+    far.shutdown()
     cache = os.path.join(a.out, "cache")
     shutil.rmtree(cache, ignore_errors=True)
     paged_png = os.path.join(a.out, "paged.png")
@@ -136,6 +156,9 @@ def main(argv):
     times = lambda runs: " / ".join(f"{r['first_s']:.2f}" for r in runs)  # noqa: E731
     rows.append(f"| folder, whole | {times(folder)} | {max(r['rss_mib'] for r in folder):.0f} |")
     rows.append(f"| HTTP, whole | {times(over_http)} | {max(r['rss_mib'] for r in over_http):.0f} |")
+    for n, r in far_runs.items():
+        rows.append(f"| HTTP, {a.latency_ms:g} ms a request, --http-connections {n}"
+                    f"{' (default)' if n == 8 else ''} | {r['first_s']:.2f} | {r['rss_mib']:.0f} |")
     for name, r in zip(("paged, copy written", "paged, copy found"), paged):
         rows.append(f"| {name} (--memory-limit {a.limit}) | {r['first_s']:.2f} | {r['rss_mib']:.0f} |")
     lines = [f"store: {store}: {sizes[0]}x{sizes[1]}x{sizes[2]} {dtype}, {voxels_gb:.2f} GB of voxels "
@@ -144,6 +167,8 @@ def main(argv):
              f"paged picture: {differ} px differ from the picture read whole; over HTTP: {http_differ} px",
              f"verdict: HTTP first picture {h_med / f_med:.2f}x the folder's (median of {a.runs}; "
              f"target at most 2x): {'holds' if h_med <= 2 * f_med else 'MISSED'}",
+             f"far server: 8 connections {far_runs[1]['first_s'] / far_runs[8]['first_s']:.1f}x as fast "
+             f"as 1 to the first picture",
              f"verdict: paged under {a.limit}, its picture the one read whole (at most {SAME_PX:g} of the "
              f"pixels differ: a progressive frame's last groups vary by a pixel or two between runs): "
              f"{'holds' if differ <= SAME_PX * pixels and 'paged, limit' in paged[0]['volume'] else 'MISSED'}"]

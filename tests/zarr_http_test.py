@@ -29,13 +29,35 @@ SIZE = "96x72"
 class Faults:
     """What the server does per path: a list of actions taken one per request (the last one
     repeats): "ok", "503", "500", "403", "stall", "cut" (a Content-Length the body does not
-    reach), "short" (half the body, with a Content-Length that says so)."""
+    reach), "short" (half the body, with a Content-Length that says so), "hold" (answered only
+    once another request has come in: a client that fetches one object at a time never gets
+    it, and the test's end lets it go). `most_at_once` counts the requests in flight together;
+    `connections` the client's connections (a kept one serves several requests)."""
 
     def __init__(self):
         self.lock = threading.Lock()
         self.plan = {}
         self.requests = []
         self.stop = threading.Event()
+        self.arrived = threading.Condition(self.lock)
+        self.in_flight = self.most_at_once = 0
+        self.peers = set()
+
+    def begin(self, peer):
+        with self.lock:
+            self.in_flight += 1
+            self.most_at_once = max(self.most_at_once, self.in_flight)
+            self.peers.add(peer)
+            self.arrived.notify_all()
+
+    def end(self):
+        with self.lock:
+            self.in_flight -= 1
+
+    def hold(self, seen):
+        """Until a request after the `seen`-th has come in (or the test ends)."""
+        with self.lock:
+            self.arrived.wait_for(lambda: len(self.requests) > seen or self.stop.is_set())
 
     def next(self, path):
         with self.lock:
@@ -54,7 +76,16 @@ def make_handler(root, faults):
             pass
 
         def do_GET(self):
+            faults.begin(self.client_address)
+            try:
+                self.answer()
+            finally:
+                faults.end()
+
+        def answer(self):
             action = faults.next(self.path)
+            if action == "hold":
+                faults.hold(len(faults.requests))
             file = os.path.join(root, self.path.lstrip("/"))
             if action in ("503", "500", "403"):
                 self.send_response(int(action))
@@ -209,6 +240,20 @@ class ZarrOverHttp(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertRegex(p.stdout, r"volume: http://.*/blob.zarr .*\(re-chunked into .*; paged, limit 1 MiB\)")
         self.same_as_folder(out)
+
+    def test_a_rows_chunks_come_over_kept_connections_several_at_once(self):
+        self.faults.peers.clear()
+        self.faults.most_at_once = 0
+        self.faults.plan["/blob.zarr/0.0.0"] = ["hold"]  # waits for a second request
+        out = os.path.join(SCRATCH, "parallel.png")
+        p = render(self.url + "/blob.zarr", out, "--no-cache", "--http-connections", "4")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.same_as_folder(out)
+        self.assertGreaterEqual(self.faults.most_at_once, 2)
+        # 3x4x4 chunks and the metadata over at most 4 connections per process (the child that
+        # learns the size, then the one that reads), each kept for the next object.
+        self.assertLessEqual(len(self.faults.peers), 2 * 4 + 2)
+        self.assertGreater(len(self.faults.requests), 3 * 4 * 4)
 
     def test_every_failure_of_the_server_is_one_line(self):
         store = self.url + "/blob.zarr"
