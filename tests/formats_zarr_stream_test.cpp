@@ -35,9 +35,8 @@ std::uint16_t value(int x, int y, int z) {
 
 // An uncompressed Zarr v2 array of uint16 `value`s, fill value 7, written chunk by chunk.
 fs::path write_array(const std::string& name, const ArrayShape& s) {
-    const fs::path dir = test::scratch_dir("zarr_stream") / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    // A folder of its own (scratch_dir empties it): tests run at once must not share one.
+    const fs::path dir = test::scratch_dir("zarr_stream_" + name);
     std::ofstream(dir / ".zarray")
         << R"({"zarr_format": 2, "shape": [)" << s.z << ", " << s.y << ", " << s.x
         << R"(], "chunks": [)" << s.cz << ", " << s.cy << ", " << s.cx << R"(], "dtype": ")"
