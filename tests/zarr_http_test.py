@@ -71,6 +71,7 @@ class Faults:
 def make_handler(root, faults):
     class Handler(http.server.BaseHTTPRequestHandler):
         protocol_version = "HTTP/1.1"
+        disable_nagle_algorithm = True  # as web servers do on kept connections
 
         def log_message(self, *args):
             pass
