@@ -155,8 +155,7 @@ OpenedVolume open_tile_volume(const WallOptions& o, Comm& comm,
                               std::optional<StoreClient>& remote) {
     const VolumeUse use{.copies_on_host = comm.ranks_on_host()};
     const std::string& path = o.volume.path;
-    std::error_code ec;
-    if (path.empty() || (o.bricks_from != "master" && std::filesystem::exists(path, ec)))
+    if (path.empty() || (o.bricks_from != "master" && readable_here(path)))
         return open_volume(o.volume, /*quiet=*/true, use);
     remote.emplace(comm, o.timeout_s);
     // The octree's copy lives in the cache folder (a temporary one with --no-cache).

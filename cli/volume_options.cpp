@@ -131,6 +131,15 @@ bool own_store(const std::string& path) {
     return store::is_store(path) && !formats::is_foreign_zarr(path);
 }
 
+bool readable_here(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) || formats::is_url(path)) return true;
+    // FILE.h5:/dataset, STORE:t=3: what comes before the last ':' is here.
+    const std::size_t colon = path.rfind(':');
+    return colon != std::string::npos && colon > 0 &&
+           std::filesystem::exists(path.substr(0, colon), ec);
+}
+
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& o) {
     if (o.path.empty() || own_store(o.path)) return nullptr;
     check_no_memory_limit(o);

@@ -69,6 +69,12 @@ OpenedVolume open_volume(const VolumeOptions& opts,
                          std::shared_ptr<const store::StoreReader> reader,
                          const std::filesystem::path& octree, VolumeUse use);
 
+// Whether this host reads `path` itself: a file or folder that is here, one with a part after it
+// (an HDF5 file's FILE.h5:/dataset, a Zarr store's pick STORE:t=3) whose file or folder is here,
+// or a URL (fetched by each process that opens it). A wall's rank that cannot asks the master for a
+// store's bricks instead.
+bool readable_here(const std::string& path);
+
 // The volume's planes for `isowall import` to stream (readers/read_volume.h: open_planes),
 // or null where open_volume serves (the phantom, a store, raw data and raw NRRD it maps).
 std::unique_ptr<PlaneSource> open_planes(const VolumeOptions& opts);

@@ -256,6 +256,33 @@ class ZarrOverHttp(unittest.TestCase):
         self.assertLessEqual(len(self.faults.peers), 2 * 4 + 2)
         self.assertGreater(len(self.faults.requests), 3 * 4 * 4)
 
+    def test_a_wall_reads_a_url_and_a_picked_folder_on_every_rank(self):
+        """Each rank fetches the URL (or reads the folder of STORE:0=1) itself; before, a rank
+        that found no such file asked the master for a store's bricks and the job ended. The
+        mosaic is the single render's within the wall tests' thresholds."""
+        from PIL import Image
+        wall = os.path.join(SCRATCH, "2x2.toml")
+        with open(wall, "w") as f:
+            f.write("tiles = [2, 2]\ntile_size_px = [48, 36]\n")
+        env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        for name, volume, folder in (
+                ("url", self.url + "/series.zarr:0=1", os.path.join(SCRATCH, "series.zarr") + ":0=1"),
+                ("picked", os.path.join(SCRATCH, "series.zarr") + ":0=1", None)):
+            with self.subTest(name):
+                mosaic, single = (os.path.join(SCRATCH, f"wall-{name}-{k}.png") for k in ("mosaic", "single"))
+                p = subprocess.run(["mpirun", "--oversubscribe", "-np", "5", ISOWALL, "wall", "--wall", wall,
+                                    "-v", volume, "--iso", "300", "--no-cache", "--out", mosaic],
+                                   capture_output=True, text=True, timeout=300, env=env)
+                self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+                self.assertEqual(render(folder or volume, single, "--no-cache").returncode, 0)
+                a, b = (np.asarray(Image.open(f).convert("RGB")).astype(int) for f in (mosaic, single))
+                self.assertEqual(a.shape, b.shape)
+                covered_a, covered_b = a.any(axis=2), b.any(axis=2)
+                iou = (covered_a & covered_b).sum() / max(1, (covered_a | covered_b).sum())
+                self.assertGreaterEqual(iou, 0.999)
+                self.assertGreaterEqual((np.abs(a - b).max(axis=2) == 0).mean(), 0.999)
+                self.assertGreater(covered_a.mean(), 0.02)  # a surface was drawn
+
     def test_every_failure_of_the_server_is_one_line(self):
         store = self.url + "/blob.zarr"
         self.faults.plan["/blob.zarr/0.1.0"] = ["500"]
