@@ -23,6 +23,7 @@ TestFault fault_of(std::string_view kind) {
     if (kind == "exit") return {FaultAction::exit};
     if (kind == "throw") return {FaultAction::throw_error};
     if (kind == "slow") return {FaultAction::slow};
+    if (kind == "late") return {FaultAction::late};
     const auto at = kind.find('@');
     if (at == std::string_view::npos) return {};
     const FaultMoment moment = moment_of(kind.substr(at + 1));

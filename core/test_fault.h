@@ -6,6 +6,9 @@
 //   throw           a tile, or the master, throws an error after its first view
 //   slow            a tile's engine stops for kSlowSampleS at every sample point, so that its
 //                   frames last seconds whatever the machine (tests of what happens mid-frame)
+//   late            a tile that finishes another tile's job of its first view tells the master,
+//                   then holds the region result until a newer view reaches it, and sends it
+//                   only then: a helper finishing an old view's job after the view changed
 //   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
 //   kill@MOMENT     the same with SIGKILL
 //   term@MOMENT     the same with SIGTERM, which the process may catch (import: a stop mid-way)
@@ -17,7 +20,17 @@
 
 namespace isowall {
 
-enum class FaultAction : std::uint8_t { none, hang, exit, throw_error, slow, stop, kill, term };
+enum class FaultAction : std::uint8_t {
+    none,
+    hang,
+    exit,
+    throw_error,
+    slow,
+    late,
+    stop,
+    kill,
+    term
+};
 enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather, end, slab };
 
 struct TestFault {

@@ -294,6 +294,7 @@ void WallMaster::wait(const WaitCmd& w) {
         // next view sent meanwhile would find some tiles still measuring (late on 2 cores) and
         // hand their regions to others: the measurement would change the next frame's figures.
         if (frame_done() && (!o_.measure || curves_in())) return true;
+        if (w.until == WaitCmd::Until::helped) return double(migrations_.size()) >= w.amount;
         return w.until == WaitCmd::Until::rays && double(total_rays()) >= w.amount;
     };
     wait_until(done, o_.timeout_s);

@@ -75,8 +75,9 @@ inline bool operator==(const TileResultMsg& a, const TileResultMsg& b) {
            a.rss_mib == b.rss_mib && a.rays == b.rays && a.groups == b.groups &&
            a.triangles == b.triangles && a.frames == b.frames && a.interrupted == b.interrupted &&
            a.jobs_own == b.jobs_own && a.jobs_helped == b.jobs_helped &&
-           a.bytes_sent == b.bytes_sent && a.significant == b.significant && a.curve == b.curve &&
-           a.earlier == b.earlier && a.spans == b.spans;
+           a.bytes_sent == b.bytes_sent && a.late_dropped == b.late_dropped &&
+           a.significant == b.significant && a.curve == b.curve && a.earlier == b.earlier &&
+           a.spans == b.spans;
 }
 inline bool operator==(const ReleaseMsg&, const ReleaseMsg&) {
     return true;
@@ -163,7 +164,8 @@ inline void PrintTo(const TileResultMsg& m, std::ostream* os) {
         << m.interrupted << ", spans";
     for (const TraceSpan& s : m.spans) *os << " " << s;
     *os << ", jobs " << m.jobs_own << "+" << m.jobs_helped << ", bytes " << m.bytes_sent
-        << ", significant " << m.significant << ", " << m.curve.size() << " curve points}";
+        << ", late dropped " << m.late_dropped << ", significant " << m.significant << ", "
+        << m.curve.size() << " curve points}";
 }
 inline void PrintTo(const ReleaseMsg&, std::ostream* os) {
     *os << "ReleaseMsg{}";
@@ -308,6 +310,7 @@ inline TileResultMsg sample_tile_result() {
     m.jobs_own = 31;
     m.jobs_helped = 12;
     m.bytes_sent = 1u << 30;
+    m.late_dropped = 5;
     m.significant = 209000;
     m.curve = {{0.125, 1000, 512.5}, {0.5, 208000, 3.25}};
     m.earlier = {{1, 207000, {{0.25, 5, 100.5}}}, {2, 0, {}}};

@@ -17,11 +17,12 @@ TEST(Script, ParsesEveryCommand) {
         "iso 105\n"
         "wait rays 10000\n"
         "wait time 0.5\n"
+        "wait helped 3\n"
         "wait done\n"
         "snapshot bone\n"
         "quit",
         "demo.txt");
-    ASSERT_EQ(lines.size(), 9u);
+    ASSERT_EQ(lines.size(), 10u);
     EXPECT_EQ(lines[0].line, 2);
     EXPECT_FLOAT_EQ(std::get<OrbitCmd>(lines[0].command).pitch_deg, -10.0f);
     EXPECT_EQ(lines[1].line, 4);
@@ -30,9 +31,11 @@ TEST(Script, ParsesEveryCommand) {
     EXPECT_DOUBLE_EQ(std::get<IsoCmd>(lines[3].command).iso, 105.0);
     EXPECT_EQ(std::get<WaitCmd>(lines[4].command).until, WaitCmd::Until::rays);
     EXPECT_DOUBLE_EQ(std::get<WaitCmd>(lines[5].command).amount, 0.5);
-    EXPECT_EQ(std::get<WaitCmd>(lines[6].command).until, WaitCmd::Until::done);
-    EXPECT_EQ(std::get<SnapshotCmd>(lines[7].command).name, "bone");
-    EXPECT_TRUE(std::holds_alternative<QuitCmd>(lines[8].command));
+    EXPECT_EQ(std::get<WaitCmd>(lines[6].command).until, WaitCmd::Until::helped);
+    EXPECT_DOUBLE_EQ(std::get<WaitCmd>(lines[6].command).amount, 3.0);
+    EXPECT_EQ(std::get<WaitCmd>(lines[7].command).until, WaitCmd::Until::done);
+    EXPECT_EQ(std::get<SnapshotCmd>(lines[8].command).name, "bone");
+    EXPECT_TRUE(std::holds_alternative<QuitCmd>(lines[9].command));
 }
 
 TEST(Script, EmptyScriptHasNoCommands) {
@@ -51,6 +54,8 @@ TEST(Script, MistakesNameTheFileLineAndCommand) {
         {"iso abc", "s.txt:1: iso: expected a finite number, got \"abc\""},
         {"wait forever", "s.txt:1: wait: expected"},
         {"wait rays -5", "s.txt:1: wait: expected an integer in [0, "},
+        {"wait helped 1.5", "s.txt:1: wait: expected an integer in [0, "},
+        {"wait helped", "s.txt:1: wait: expected \"wait rays N\", \"wait helped N\""},
         {"snapshot a/b", "s.txt:1: snapshot: expected a plain name"},
         {"fly 1 2", "s.txt:1: command: unknown command \"fly\""},
         {"quit now", "s.txt:1: quit: expected \"quit\""},

@@ -23,14 +23,18 @@ TEST(TestFault, EachKindParsesToItsActionMomentAndRank) {
     EXPECT_EQ(f.action, FaultAction::slow);
     EXPECT_TRUE(f.on(1) && f.on(7));
     EXPECT_FALSE(f.on(0));
+    f = parse_test_fault("late:tiles");
+    EXPECT_EQ(f.action, FaultAction::late);
+    EXPECT_TRUE(f.on(2));
     f = parse_test_fault("slow:3");
     EXPECT_TRUE(f.on(3));
     EXPECT_FALSE(f.on(2));
 }
 
 TEST(TestFault, AnythingElseIsNoFault) {
-    for (const char* spec : {"", "hang", "hang:", "hang:x", "hang:2x", "jump:1", "stop@never:1",
-                             "stop:1", "pause@frame:1", ":1", "slow:tile", "slow@frame:tiles"}) {
+    for (const char* spec :
+         {"", "hang", "hang:", "hang:x", "hang:2x", "jump:1", "stop@never:1", "stop:1",
+          "pause@frame:1", ":1", "slow:tile", "slow@frame:tiles", "late@frame:1"}) {
         const TestFault f = parse_test_fault(spec);
         EXPECT_EQ(f.action, FaultAction::none) << spec;
     }

@@ -68,4 +68,9 @@ void TileInbox::wait_closed() {
     changed_.wait(lock, [&] { return closed_; });
 }
 
+void TileInbox::wait_interrupt() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return interrupts_ > 0 || closed_; });
+}
+
 }  // namespace isowall

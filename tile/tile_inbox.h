@@ -36,6 +36,8 @@ class TileInbox {
     int take_snapshots();
     // Blocks until close() (a rank told to stop answering, for the fault tests).
     void wait_closed();
+    // Blocks until a view or quit is queued, or close() (the `late` test fault's hold).
+    void wait_interrupt();
 
     const std::atomic<bool>& stop_flag() const { return stop_; }
 

@@ -116,6 +116,7 @@ class TileRank {
         if (setup_.fault.action == FaultAction::throw_error)
             throw std::runtime_error("test fault: a tile throws");
         raise_test_signal(setup_.fault, FaultMoment::frame);
+        if (first_view_ == 0) first_view_ = v.generation;
         keep_curve();
         close_frame();
         // Setting up the frame (its engine frame, the tile's image cleared) is part of the frame's
@@ -209,8 +210,18 @@ class TileRank {
             auto bytes = encode(*out.result);
             out.done.bytes = bytes.size();
             result_.bytes_sent += bytes.size();
-            comm_.send(j.owner, Tag::region, std::move(bytes));
             ++result_.jobs_helped;
+            if (setup_.fault.action == FaultAction::late && j.generation == first_view_) {
+                // The `late` test fault: the master learns the job is done, and its result
+                // leaves only once a newer view is here, as from a helper that finished the old
+                // view's job just after the change (a late result the owner must drop).
+                send_message(comm_, kMasterRank, out.done);
+                inbox_.wait_interrupt();
+                comm_.send(j.owner, Tag::region, std::move(bytes));
+                trace_.switch_to(Stage::comm);
+                return;
+            }
+            comm_.send(j.owner, Tag::region, std::move(bytes));
             jobs_.add_busy(thread_cpu_seconds() - c0);  // sending is part of the job
             trace_.switch_to(Stage::comm);
         } else {
@@ -227,7 +238,10 @@ class TileRank {
             early_.push_back(std::move(r));
             return;
         }
-        if (r.generation != jobs_.generation()) return;
+        if (r.generation != jobs_.generation()) {
+            ++result_.late_dropped;  // its view was replaced: the master no longer counts on it
+            return;
+        }
         const LandedMsg landed{r.generation, r.job};
         trace_.switch_to(Stage::compose);
         jobs_.land(std::move(r));
@@ -280,8 +294,7 @@ class TileRank {
     void land_early() {
         std::vector<RegionMsg> waiting;
         waiting.swap(early_);
-        for (RegionMsg& r : waiting)
-            if (r.generation >= jobs_.generation()) land(std::move(r));
+        for (RegionMsg& r : waiting) land(std::move(r));
     }
 
     void answer_snapshots() {
@@ -328,6 +341,7 @@ class TileRank {
     std::vector<Shown> shows_;
     Stopwatch shown_clock_;
     double cpu0_ = 0, last_progress_s_ = -1;
+    std::uint64_t first_view_ = 0;  // the generation of the first view (the `late` test fault)
     double io_charged_s_ = 0, comm_charged_s_ = 0;
     bool interrupted_ = false;
 };

@@ -231,6 +231,7 @@ std::vector<std::byte> encode(const TileResultMsg& m) {
     w.put(m.jobs_own);
     w.put(m.jobs_helped);
     w.put(m.bytes_sent);
+    w.put(m.late_dropped);
     w.put(m.significant);
     job_wire::put_curve(w, m.curve);
     w.put(static_cast<std::uint64_t>(m.earlier.size()));
@@ -259,6 +260,7 @@ static TileResultMsg decode_tile_result(std::span<const std::byte> bytes) {
     m.jobs_own = r.get<std::uint64_t>();
     m.jobs_helped = r.get<std::uint64_t>();
     m.bytes_sent = r.get<std::uint64_t>();
+    m.late_dropped = r.get<std::uint64_t>();
     m.significant = r.get<std::uint64_t>();
     m.curve = job_wire::get_curve(r);
     const std::size_t frames = r.get_count(3 * 8);  // checked before the reserve

@@ -109,7 +109,7 @@ struct FrameCurve {
 
 struct TileResultMsg {
     static constexpr Tag kTag = Tag::tile_result;
-    static constexpr std::uint8_t kVersion = 4;
+    static constexpr std::uint8_t kVersion = 5;
     std::string host;
     double cpu_s = 0;    // the frame thread's CPU seconds, all frames
     double frame_s = 0;  // wall seconds of all frames
@@ -117,9 +117,10 @@ struct TileResultMsg {
     std::uint64_t rays = 0, groups = 0, triangles = 0, frames = 0, interrupted = 0;
     std::uint64_t jobs_own = 0, jobs_helped = 0;  // jobs run for its own tile and for others
     std::uint64_t bytes_sent = 0;                 // region results sent to other tiles
-    std::uint64_t significant = 0;                // covered pixels of the last frame's final image
-    std::vector<CurvePoint> curve;                // empty unless measured (--measure)
-    std::vector<FrameCurve> earlier;              // the earlier frames' curves (--measure)
+    std::uint64_t late_dropped = 0;   // helpers' results of a view already replaced, dropped
+    std::uint64_t significant = 0;    // covered pixels of the last frame's final image
+    std::vector<CurvePoint> curve;    // empty unless measured (--measure)
+    std::vector<FrameCurve> earlier;  // the earlier frames' curves (--measure)
     std::vector<TraceSpan> spans;
 };
 

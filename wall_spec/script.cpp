@@ -74,13 +74,14 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
     }
     if (c == "wait") {
         if (w.size() == 2 && w[1] == "done") return WaitCmd{WaitCmd::Until::done, 0};
-        if (w.size() == 3 && (w[1] == "rays" || w[1] == "time")) {
-            const bool rays = w[1] == "rays";
-            return WaitCmd{rays ? WaitCmd::Until::rays : WaitCmd::Until::time,
-                           num(2, rays ? limits::kRayCount : limits::kWaitSeconds)};
-        }
+        if (w.size() == 3 && (w[1] == "rays" || w[1] == "helped"))
+            return WaitCmd{w[1] == "rays" ? WaitCmd::Until::rays : WaitCmd::Until::helped,
+                           num(2, limits::kRayCount)};
+        if (w.size() == 3 && w[1] == "time")
+            return WaitCmd{WaitCmd::Until::time, num(2, limits::kWaitSeconds)};
         throw InputError(where, c,
-                         "expected \"wait rays N\", \"wait time SECONDS\" or \"wait done\"");
+                         "expected \"wait rays N\", \"wait helped N\", \"wait time SECONDS\" or "
+                         "\"wait done\"");
     }
     if (c == "snapshot") {
         expect_args(w, 1, where, "snapshot NAME");

@@ -7,6 +7,7 @@
 //   iso V                      new isovalue
 //   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
 //   wait time S                a pause of S seconds, whether or not the frame ends first
+//   wait helped N              until tiles have run N jobs of other tiles this frame (or its end)
 //   snapshot NAME              write the mosaic as NAME.png
 //   quit
 // '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
@@ -40,8 +41,8 @@ struct IsoCmd {
     double iso = 0;
 };
 struct WaitCmd {
-    enum class Until { rays, time, done } until = Until::done;
-    double amount = 0;  // rays or seconds
+    enum class Until { rays, time, helped, done } until = Until::done;
+    double amount = 0;  // rays, seconds, or jobs run by a tile other than their owner
 };
 struct SnapshotCmd {
     std::string name;
