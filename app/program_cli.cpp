@@ -124,6 +124,14 @@ void add_rank_options(CLI::App& wall_cmd, WallOptions& wall) {
         ->transform(number_in({0, 1024, false, true}))
         ->capture_default_str();
     wall_cmd
+        .add_option("--emulate-cores", wall.emulate_cores,
+                    "At most N tile ranks of a host run a job at once, each holding one of N "
+                    "slots while it works: a cluster with a core per rank emulated on a host of N "
+                    "cores, where a job's CPU is then less inflated by ranks competing for the "
+                    "cores and their caches (for studies). 0: no limit")
+        ->transform(number_in({0, 4096, false, true}))
+        ->capture_default_str();
+    wall_cmd
         .add_option("--bricks-from", wall.bricks_from,
                     "Where tile ranks read a store (--volume STORE): auto, on their own host when "
                     "they can see its folder, else from the master over MPI; master, always "

@@ -15,6 +15,7 @@
 #include "app/wall_http.h"
 #include "app/wall_outputs.h"
 #include "cli/iso_option.h"
+#include "comm/host_slots.h"
 #include "core/error.h"
 #include "core/fatal.h"
 #include "core/util.h"
@@ -191,6 +192,19 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.tile_height = tile.height;
     if (ov.pager) setup.io_cpu_s = [pager = ov.pager] { return pager->stats().cpu_s; };
     if (remote) setup.store_client = &*remote;
+    std::optional<HostSlots> slots;
+    if (o.emulate_cores > 0) {
+        slots.emplace(comm.job_id(), o.emulate_cores);
+        setup.slots = &*slots;
+    }
+    // The name goes when the rank ends, however it ends (every rank of the host has opened it
+    // by then: the master starts no frame before every tile has said hello).
+    struct UnlinkAtEnd {
+        std::optional<HostSlots>& slots;
+        ~UnlinkAtEnd() {
+            if (slots) slots->unlink();
+        }
+    } const unlink_slots{slots};
     std::optional<TileWindow> window;
     if (o.windows) {
         const int t = tile_of_rank(spec, comm.rank());

@@ -59,6 +59,9 @@ struct WallOptions {
     // propagating side by side): ranks share nodes, so this is the rank's budget, not the
     // machine's core count. 0: the rank's share of its node (rank_budget in wall_run.cpp).
     int threads = 0;
+    // At most this many tile ranks of a host run a job at once (comm/host_slots.h): a cluster
+    // with a core per rank emulated on a host with this many cores. 0: no limit.
+    int emulate_cores = 0;
     // Test hook (ISOWALL_TEST_FAULT=KIND:RANK, core/test_fault.h): the rank named fails in
     // the way named (tile: hang, exit, throw; master: throw; either: stop or kill at a moment).
     TestFault fault;

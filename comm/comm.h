@@ -48,6 +48,9 @@ class Comm {
     virtual std::string host() const = 0;
     // How many ranks of the job run on this rank's host (they share its cores).
     virtual int ranks_on_host() const = 0;
+    // A name that every rank of this job shares and no other job on the host has (for what the
+    // host's ranks share: comm/host_slots.h).
+    virtual std::string job_id() const = 0;
     // Whether this rank has its process to itself (MPI), so that it may change the process's
     // environment; false where ranks are threads of one process (in-process transport).
     virtual bool owns_process() const = 0;

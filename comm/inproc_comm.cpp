@@ -1,5 +1,8 @@
 #include "comm/inproc_comm.h"
 
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -13,6 +16,7 @@ class InProcComm final : public Comm {
     int size() const override { return world_.size(); }
     std::string host() const override { return "inproc"; }
     int ranks_on_host() const override { return world_.size(); }  // one process, one machine
+    std::string job_id() const override { return world_.id(); }
     bool owns_process() const override { return false; }
     void send(int dest, Tag tag, std::span<const std::byte> bytes) override {
         world_.post(dest, Envelope{rank_, tag, std::vector<std::byte>(bytes.begin(), bytes.end())});
@@ -31,7 +35,10 @@ class InProcComm final : public Comm {
     int rank_;
 };
 
-InProcWorld::InProcWorld(int size) : mailboxes_(static_cast<std::size_t>(size)) {}
+InProcWorld::InProcWorld(int size) : mailboxes_(static_cast<std::size_t>(size)) {
+    static std::atomic<std::uint64_t> worlds{0};
+    id_ = "inproc-" + std::to_string(::getpid()) + "-" + std::to_string(worlds++);
+}
 
 std::unique_ptr<Comm> InProcWorld::comm(int rank) {
     return std::make_unique<InProcComm>(*this, rank);

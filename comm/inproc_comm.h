@@ -18,6 +18,8 @@ class InProcWorld {
   public:
     explicit InProcWorld(int size);
     int size() const { return static_cast<int>(mailboxes_.size()); }
+    // This process's id and the world's number in it: no two worlds share it.
+    const std::string& id() const { return id_; }
     // The Comm of one rank; it refers to this world, which must outlive it.
     std::unique_ptr<Comm> comm(int rank);
     // The code of the first abort, if any rank aborted.
@@ -37,6 +39,7 @@ class InProcWorld {
     mutable std::mutex mutex_;
     std::condition_variable changed_;
     std::vector<Mailbox> mailboxes_;
+    std::string id_;
     std::optional<int> abort_code_;
     int barrier_waiting_ = 0;
     std::uint64_t barrier_round_ = 0;

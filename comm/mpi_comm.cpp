@@ -6,12 +6,14 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <iterator>
 #include <list>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -128,6 +130,12 @@ class MpiComm final : public Comm {
         ISOWALL_MPI_CALL(MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
         ISOWALL_MPI_CALL(MPI_Comm_size(node, &on_host_));
         MPI_Comm_free(&node);
+        // The job's name: rank 0's process id and start time, the same on every rank.
+        std::uint64_t id[2] = {static_cast<std::uint64_t>(::getpid()),
+                               static_cast<std::uint64_t>(
+                                   std::chrono::steady_clock::now().time_since_epoch().count())};
+        ISOWALL_MPI_CALL(MPI_Bcast(id, 2, MPI_UINT64_T, 0, comm_));
+        job_id_ = std::to_string(id[0]) + "-" + std::to_string(id[1]);
     }
     ~MpiComm() override {
         end_watch_.arm();
@@ -157,6 +165,7 @@ class MpiComm final : public Comm {
     int rank() const override { return rank_; }
     int size() const override { return size_; }
     int ranks_on_host() const override { return on_host_; }
+    std::string job_id() const override { return job_id_; }
     bool owns_process() const override { return true; }
     std::string host() const override {
         char name[MPI_MAX_PROCESSOR_NAME];
@@ -274,6 +283,7 @@ class MpiComm final : public Comm {
     int rank_ = 0;
     int size_ = 1;
     int on_host_ = 1;  // ranks sharing this host (MPI_COMM_TYPE_SHARED)
+    std::string job_id_;
     EndWatch end_watch_;
 };
 

@@ -67,11 +67,12 @@ def volume_args(name, data):
     return ["-v", os.path.join(data, "vhp_ct_head.nhdr"), "--iso", "40"]
 
 
-def run_wall(isowall, vol, case, balance, region, out_png):
+def run_wall(isowall, vol, case, balance, region, out_png, emulate_cores=0):
     _, zoom, dx, dy = case
     cmd = ["mpirun", "--oversubscribe", "-np", "25", "-x", "LP_NUM_THREADS=0", isowall, "wall",
            "--wall", WALL, *vol, "--zoom", str(zoom), "--pan", str(dx), str(dy), "--measure",
-           "--balance", "on" if balance else "off", "--out", out_png]
+           "--balance", "on" if balance else "off", "--out", out_png,
+           "--emulate-cores", str(emulate_cores)]
     if region:
         # "auto:emulated": the default regions, jobs handed out in emulated-time order
         # (--dispatch emulated) instead of on arrival.
@@ -132,6 +133,10 @@ def parse(text, cmd):
         if key not in r:
             sys.exit(f"balance_study: no '{key}' in the output of {cmd}:\n{text[-2000:]}")
     r["tiles_with_rays"] = sum(1 for n in r["rays"] if n > 0)
+    # Busy CPU per ray cast, every rank's: how much dearer a ray (and the work that follows it)
+    # is on the balanced wall than on the static one, where a tile works mostly alone.
+    rays = sum(r["rays"])
+    r["us_per_ray"] = 1e6 * r["total"] / rays if rays else float("inf")
     return r
 
 
@@ -271,6 +276,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "study"))
     ap.add_argument("--volumes", default="head,phantom")
     ap.add_argument("--regions", default="auto,auto:emulated,256x192,128x96,64x48")
+    ap.add_argument("--emulate-cores", type=int, default=0,
+                    help="isowall wall --emulate-cores for every run (0: no limit)")
     ap.add_argument("--repeat", type=int, default=1,
                     help="runs per configuration (the run with the median makespan is kept)")
     a = ap.parse_args()
@@ -294,7 +301,8 @@ def main():
                 png = os.path.join(a.out, f"mosaic_{tag}.png")
                 runs = [run_wall(isowall, vol, case, region != "static",
                                  None if region == "static" else region,
-                                 os.path.join(a.out, f"mosaic_{tag}.run{i}.png"))
+                                 os.path.join(a.out, f"mosaic_{tag}.run{i}.png"),
+                                 a.emulate_cores)
                         for i in range(a.repeat)]
                 r = median_run(runs)
                 keep_mosaic(r, runs, png)
@@ -311,12 +319,16 @@ def main():
                       f"{r['mb_moved']:.1f} MB moved, tiles with rays of their own "
                       f"{r['tiles_with_rays']}; every thread: makespan {r['all_makespan']:.3f} s, "
                       f"communication {r['comm']:.3f} s, at most {r['comm_pct']}% of a rank's "
-                      f"busy CPU" + (f"; against static: {r['picture']}" if "picture" in r else ""),
+                      f"busy CPU; busy CPU per ray {r['us_per_ray']:.2f} us"
+                      + (f" ({r['us_per_ray'] / static['us_per_ray']:.2f}x static's)"
+                         if region != "static" else "")
+                      + (f"; against static: {r['picture']}" if "picture" in r else ""),
                       flush=True)
         plot(rows, a.out, volume)
     fields = ["volume", "case", "region", "runs", "makespan", "total", "balance", "c90", "c99",
               "c100", "px90", "px99", "px100", "job_count", "migrated", "mb_moved",
-              "tiles_with_rays", "all_makespan", "all_total", "comm", "comm_pct", "same_picture"]
+              "tiles_with_rays", "all_makespan", "all_total", "comm", "comm_pct", "us_per_ray",
+              "same_picture"]
     with open(os.path.join(a.out, "study.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()

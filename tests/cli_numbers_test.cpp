@@ -44,6 +44,7 @@ const std::vector<CliSlot> kCliSlots = {
     {"wall --wall w.toml --timeout {}", "--timeout", kTimeouts},
     {"wall --wall w.toml --startup-timeout {}", "--startup-timeout", kTimeouts},
     {"wall --wall w.toml --threads {}", "--threads", {"-5", "1025", "2.5"}},
+    {"wall --wall w.toml --emulate-cores {}", "--emulate-cores", {"-1", "4097", "1.5", "x"}},
 };
 
 std::string cli_fill(const std::string& slot, const std::string& value) {

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "comm/end_watch.h"
+#include "comm/host_slots.h"
 #include "comm/inproc_comm.h"
 #include "tile/tile_inbox.h"
 
@@ -66,6 +67,51 @@ TEST(InProcComm, AnEscapingExceptionAbortsTheWorld) {
         return 0;
     });
     EXPECT_EQ(codes, (std::vector<int>{1, 1}));
+}
+
+TEST(InProcComm, EachWorldHasAJobIdOfItsOwnThatItsRanksShare) {
+    InProcWorld a(2), b(2);
+    EXPECT_EQ(a.comm(0)->job_id(), a.comm(1)->job_id());
+    EXPECT_NE(a.comm(0)->job_id(), b.comm(0)->job_id());
+}
+
+// Two holders of a host's two slots leave none; a third waits, and gives up when its stop flag
+// rises; a slot given back is taken again; a second opening of the job's name shares the count
+// (another rank of the host), another job's name does not.
+TEST(HostSlots, AtMostNHoldAtOnceAndAWaiterGivesUpOnStop) {
+    InProcWorld world(1);
+    const std::string job = world.id() + "-slots";
+    HostSlots slots(job, 2);
+    HostSlots same(job, 2);
+    HostSlots other(job + "-other", 2);
+    std::atomic<bool> stop{false};
+    ASSERT_TRUE(slots.acquire(stop));
+    ASSERT_TRUE(same.acquire(stop));
+    EXPECT_EQ(slots.free_slots(), 0);
+    EXPECT_EQ(other.free_slots(), 2);
+    std::atomic<bool> gave_up{false};
+    std::thread waiter([&] { gave_up = !slots.acquire(stop); });
+    stop = true;
+    waiter.join();
+    EXPECT_TRUE(gave_up);
+    stop = false;
+    same.release();
+    EXPECT_EQ(slots.free_slots(), 1);
+    {
+        const SlotHold hold(&slots, stop);
+        EXPECT_TRUE(hold.ok());
+        EXPECT_EQ(same.free_slots(), 0);
+    }
+    EXPECT_EQ(same.free_slots(), 1);
+    slots.release();
+    EXPECT_TRUE(slots.unlink());
+    EXPECT_TRUE(same.unlink());  // already gone: no failure
+    EXPECT_TRUE(other.unlink());
+    EXPECT_TRUE(SlotHold(nullptr, stop).ok());  // no slots: no limit
+}
+
+TEST(HostSlots, NoSlotsIsRefused) {
+    EXPECT_THROW(HostSlots("isowall-test-none", 0), std::runtime_error);
 }
 
 TEST(TileInbox, ViewsAndQuitRaiseStopSnapshotsDoNot) {

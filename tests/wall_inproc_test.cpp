@@ -4,7 +4,9 @@
 // failures on either side, each ending every rank.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -13,6 +15,7 @@
 #include "comm/inproc_comm.h"
 #include "files/image_io.h"
 #include "master/wall_report.h"
+#include "progressive/trace.h"
 #include "tests/image_compare.h"
 #include "tests/test_util.h"
 #include "wire/wire.h"
@@ -365,6 +368,69 @@ TEST(WallBalance, AnInterruptWhileJobsMigrateLeavesNothingOfTheOldView) {
     const test::ImageComparison m = expect_same_view(o.out, direct.out);
     std::printf("%llu late results dropped, %llu jobs migrated; %s\n", (unsigned long long)dropped,
                 (unsigned long long)jobs_helped(r), testing::PrintToString(m).c_str());
+}
+
+// The wall-clock spans of one stage that some rank's span overlaps another rank's by more than
+// `slack_s` (the ranks' traces: spans of the ranks' own frame threads).
+int overlapping_spans(const std::vector<TileResultMsg>& results, Stage a, Stage b, double slack_s) {
+    struct Span {
+        double start, end;
+        std::size_t rank;
+    };
+    std::vector<Span> spans;
+    for (std::size_t rank = 1; rank < results.size(); ++rank)
+        for (const TraceSpan& s : results[rank].spans)
+            if (s.stage == static_cast<std::uint8_t>(a) || s.stage == static_cast<std::uint8_t>(b))
+                spans.push_back({s.start_s, s.start_s + s.wall_s, rank});
+    std::sort(spans.begin(), spans.end(),
+              [](const Span& x, const Span& y) { return x.start < y.start; });
+    std::vector<double> end_of(results.size(), -HUGE_VAL);  // each rank's latest end so far
+    int overlaps = 0;
+    for (const Span& s : spans) {
+        for (std::size_t r = 1; r < end_of.size(); ++r)
+            if (r != s.rank && end_of[r] > s.start + slack_s) {
+                ++overlaps;
+                break;
+            }
+        end_of[s.rank] = std::max(end_of[s.rank], s.end);
+    }
+    return overlaps;
+}
+
+// A wall emulated with one compute slot (--emulate-cores 1: one tile rank runs a job at a time)
+// gives the mosaic of the wall without the limit, jobs still migrate, no two ranks' engines
+// ever run at once (their traces' intersection and propagation spans never overlap), and the
+// slots' name is gone from the host once the ranks end.
+TEST(WallBalance, OneComputeSlotGivesTheSameMosaic) {
+    const WallOptions plain = balance_wall(test::scratch_dir("slots_plain"), true, true);
+    WallOptions one = balance_wall(test::scratch_dir("slots_one"), true, true);
+    one.emulate_cores = 1;
+    std::string job;
+    WallRun r;
+    r.codes = [&] {
+        one.results_out = &r.results;
+        testing::internal::CaptureStderr();
+        auto codes = run_in_process(5, [&](Comm& comm) {
+            if (comm.rank() == 0) job = comm.job_id();
+            return run_wall(one, comm);
+        });
+        r.err = testing::internal::GetCapturedStderr();
+        return codes;
+    }();
+    for (int code : r.codes) ASSERT_EQ(code, 0) << r.err;
+    EXPECT_GT(jobs_helped(r), 0u);
+    std::size_t spans = 0;
+    for (const TileResultMsg& t : r.results) spans += t.spans.size();
+    EXPECT_GT(spans, 100u);
+    EXPECT_EQ(overlapping_spans(r.results, Stage::intersection, Stage::propagation, 1e-4), 0);
+    EXPECT_FALSE(std::filesystem::exists("/dev/shm/sem.isowall-slots-" + job)) << job;
+    const WallRun p = run_wall_in_process(plain);
+    for (int code : p.codes) ASSERT_EQ(code, 0) << p.err;
+    const test::ImageComparison m = expect_same_view(one.out, plain.out);
+    EXPECT_GT(m.covered_both, 1000u) << m;
+    std::printf("one slot: %d overlapping engine spans; without the limit: %d\n",
+                overlapping_spans(r.results, Stage::intersection, Stage::propagation, 1e-4),
+                overlapping_spans(p.results, Stage::intersection, Stage::propagation, 1e-4));
 }
 
 // A rank that speaks garbage: the master names it and the job ends, on every rank.

@@ -120,7 +120,10 @@ class TileRank {
         keep_curve();
         close_frame();
         // Setting up the frame (its engine frame, the tile's image cleared) is part of the frame's
-        // busy CPU (TileJobs::begin), so it is render here, not comm.
+        // busy CPU (TileJobs::begin), so it is render here, not comm; with compute slots it holds
+        // one, as a job does (the engine frame starts its first stages), or goes on without one
+        // when a newer view is already waiting.
+        const SlotHold hold(setup_.slots, inbox_.stop_flag());
         trace_.switch_to(Stage::render);
         jobs_.begin(v, inbox_.stop_flag(), [&](const TimelineSample& s) {
             if (setup_.fault.action == FaultAction::slow)
@@ -197,9 +200,15 @@ class TileRank {
         if (j.owner != comm_.rank()) raise_test_signal(setup_.fault, FaultMoment::migration);
         // A job starts by setting up its region (the help image and the groups that may show in
         // it: render work) before the engine's stages take over.
-        trace_.switch_to(Stage::render);
-        TileJobs::Outcome out = jobs_.run(j, comm_.rank());
-        trace_.switch_to(Stage::comm);
+        TileJobs::Outcome out;
+        {
+            // With compute slots (--emulate-cores), the job runs while it holds one; a view that
+            // comes while the rank waits for it ends the wait, as it would end the job.
+            const SlotHold hold(setup_.slots, inbox_.stop_flag());
+            trace_.switch_to(Stage::render);
+            if (hold.ok()) out = jobs_.run(j, comm_.rank());
+            trace_.switch_to(Stage::comm);
+        }
         if (!out.completed) {
             interrupted_ = true;
             return;

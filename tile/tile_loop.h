@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "comm/host_slots.h"
 #include "core/test_fault.h"
 #include "engine/progressive_engine.h"
 #include "extract/surface_extractor.h"
@@ -38,6 +39,8 @@ struct TileSetup {
     std::function<double()> io_cpu_s = {};
     // The store's chunks when this rank's host cannot see it: the master's answers go here.
     StoreClient* store_client = nullptr;
+    // The host's compute slots (--emulate-cores): a job runs while holding one; none: no limit.
+    HostSlots* slots = nullptr;
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the
