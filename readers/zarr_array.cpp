@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "readers/voxel_ops.h"
+#include "volume/volume.h"
 
 namespace isowall::formats::zarr {
 
@@ -145,33 +146,10 @@ std::vector<std::byte> fill_bytes(const ZarrArray& a) {
         bad(a.where, "fill_value", "expected a number or null, got " + quote(a.fill.dump()));
     }
     std::vector<std::byte> out(a.item());
-    auto put = [&out](auto x) { std::memcpy(out.data(), &x, sizeof x); };
-    switch (a.type) {
-        case VoxelType::u8:
-            put(static_cast<std::uint8_t>(v));
-            break;
-        case VoxelType::i8:
-            put(static_cast<std::int8_t>(v));
-            break;
-        case VoxelType::u16:
-            put(static_cast<std::uint16_t>(v));
-            break;
-        case VoxelType::i16:
-            put(static_cast<std::int16_t>(v));
-            break;
-        case VoxelType::u32:
-            put(static_cast<std::uint32_t>(v));
-            break;
-        case VoxelType::i32:
-            put(static_cast<std::int32_t>(v));
-            break;
-        case VoxelType::f32:
-            put(static_cast<float>(v));
-            break;
-        case VoxelType::f64:
-            put(v);
-            break;
-    }
+    dispatch_voxel_type(a.type, [&](auto t) {
+        const auto x = static_cast<decltype(t)>(v);
+        std::memcpy(out.data(), &x, sizeof x);
+    });
     return out;  // host order
 }
 
