@@ -186,7 +186,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.engine.region_clip = o.region_clip;
     setup.engine.threads = budget.usable();
     if (o.fault.on(comm.rank())) setup.fault = o.fault;
-    const PixelRect tile = tile_rect(spec, tile_of_rank(spec, comm.rank()));
+    const PixelRect tile = eye_rect(spec, tile_of_rank(spec, comm.rank()));
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;
     setup.tile_height = tile.height;
@@ -248,8 +248,7 @@ void await_start(Comm& comm, double timeout_s) {
 }
 
 std::string role(const WallSpec& spec, int rank) {
-    return rank == kMasterRank ? std::string("master")
-                               : "tile " + std::to_string(tile_of_rank(spec, rank));
+    return rank == kMasterRank ? std::string("master") : tile_name(spec, rank);
 }
 
 // The job's one error line, then every rank ended. Bad input names its source and field already;

@@ -29,6 +29,7 @@ inline constexpr NumberRange kAngleDeg{-1e6, 1e6};
 inline constexpr NumberRange kZoom{1e-6, 1e6};
 inline constexpr NumberRange kPan{-1e3, 1e3};         // screen widths / heights
 inline constexpr NumberRange kCoordinate{-1e6, 1e6};  // look-at eye and target, object units
+inline constexpr NumberRange kHead{-1e7, 1e7};        // `head`: mm, or widths of the wall
 inline constexpr NumberRange kPercent{0, 100, true};  // --snapshots
 inline constexpr NumberRange kSeconds{0, 1e6, true};  // --timeout, --startup-timeout
 inline constexpr NumberRange kWaitSeconds{0, 1e6};    // `wait time`

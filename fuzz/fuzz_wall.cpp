@@ -67,13 +67,18 @@ void check_bezel_mm(const isowall::WallSpec& s) {
 
 void check_ranks(const isowall::WallSpec& s) {
     const int ranks = isowall::rank_count(s);
-    check(ranks >= 2 && ranks <= isowall::tile_count(s) + 1, "one master and 1..T tile ranks");
+    check(ranks >= 2 && ranks <= isowall::tile_count(s) * isowall::eyes_per_tile(s) + 1,
+          "one master and 1..T tile ranks per eye");
     if (isowall::tile_count(s) > 64) return;  // tile_of_rank walks the wall: keep it quick
     for (int rank = 1; rank < ranks; ++rank) {
         const int tile = isowall::tile_of_rank(s, rank);
-        check(tile >= 0 && isowall::rank_of_tile(s, tile) == rank, "ranks and tiles 1:1");
+        check(tile >= 0 && isowall::rank_of_tile(s, tile, isowall::eye_of_rank(s, rank)) == rank,
+              "ranks and tiles' eyes 1:1");
         const isowall::PixelRect r = isowall::tile_rect(s, tile);
         check(r.width == s.tile_width_px && r.height == s.tile_height_px, "tile_rect size");
+        const isowall::PixelRect e = isowall::eye_rect(s, tile);
+        check(e.width >= 1 && e.height >= 1 && e.width <= r.width && e.height <= r.height,
+              "an eye's frame is the tile's, or half of it");
     }
 }
 

@@ -82,7 +82,8 @@ std::vector<Image> tile_previews(const WallSpec& spec,
                                  const std::vector<std::optional<PreviewMsg>>& by_rank) {
     std::vector<Image> previews(static_cast<std::size_t>(tile_count(spec)));
     for (std::size_t rank = 1; rank < by_rank.size(); ++rank)
-        if (by_rank[rank]) {
+        // With stereo the left eye stands for its tile.
+        if (by_rank[rank] && eye_of_rank(spec, static_cast<int>(rank)) != Eye::right) {
             const int tile = tile_of_rank(spec, static_cast<int>(rank));
             previews.at(static_cast<std::size_t>(tile)) = preview_image(*by_rank[rank]);
         }

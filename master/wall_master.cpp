@@ -11,6 +11,7 @@
 #include "core/number.h"
 #include "files/image_io.h"
 #include "master/wall_report.h"
+#include "wall_spec/eyes.h"
 
 namespace isowall {
 namespace {
@@ -39,6 +40,8 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
     if (std::string p = camera_problem(camera_); !p.empty())
         throw InputError("--orbit/--zoom/--pan", "value", p);
+    if (std::string p = head_problem(camera_, aspect_, spec_, head_); !p.empty())
+        throw InputError(o.wall_name, "stereo", p);
     tiles_.resize(static_cast<std::size_t>(comm.size()));
     previews_.resize(tiles_.size());
 }
@@ -71,7 +74,7 @@ void WallMaster::handle(const Envelope& e) {
     } else if (std::holds_alternative<JobDoneMsg>(m) || std::holds_alternative<LandedMsg>(m)) {
         handle_job(e.from, m);
     } else if (auto* img = std::get_if<ImageMsg>(&m)) {
-        const PixelRect r = tile_rect(spec_, tile_of_rank(spec_, e.from));
+        const PixelRect r = eye_rect(spec_, tile_of_rank(spec_, e.from));
         if (img->width != r.width || img->height != r.height)
             throw std::runtime_error(
                 rank_label(spec_, e.from) + ": tile image of the wrong size (" +
@@ -193,15 +196,25 @@ void WallMaster::print_map() const {
         "wall: %s: %dx%d tiles of %dx%d, virtual screen %dx%d, %d tile ranks, master on %s\n",
         o_.wall_name.c_str(), spec_.columns, spec_.rows, spec_.tile_width_px, spec_.tile_height_px,
         vs.width, vs.height, comm_.size() - 1, comm_.host().c_str());
+    if (spec_.stereo)
+        std::printf("stereo: %s, a rank per eye, eye separation %g %s, convergence %g\n",
+                    to_string(spec_.stereo->mode).c_str(), spec_.stereo->separation,
+                    spec_.physical ? "mm" : "of the wall's width", spec_.stereo->convergence);
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         const PixelRect r = tile_rect(spec_, tile);
+        const PixelRect e = eye_rect(spec_, tile);
+        const Eye eye = eye_of_rank(spec_, rank);
+        const std::string eye_part = eye == Eye::centre ? ""
+                                                        : ", " + to_string(eye) + " eye " +
+                                                              std::to_string(e.width) + "x" +
+                                                              std::to_string(e.height);
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
         std::printf(
-            "  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d, %u "
+            "  rank %2d on %-12s -> tile %2d (column %d, row %d) viewport x=%d y=%d %dx%d%s, %u "
             "thread%s\n",
             rank, t.host.c_str(), tile, tile % spec_.columns, tile / spec_.columns, r.x, r.y,
-            r.width, r.height, t.threads, t.threads == 1 ? "" : "s");
+            r.width, r.height, eye_part.c_str(), t.threads, t.threads == 1 ? "" : "s");
     }
     std::fflush(stdout);
 }
@@ -212,14 +225,16 @@ void WallMaster::send_views() {
     const Stage left = trace_.switch_to(Stage::comm);
     if (board_ && board_->complete()) completed_.push_back(generation_);
     ++generation_;
-    const Camera cam = fit_depth_range(camera_, bounds_);
-    const Frustum wall = cam.frustum(aspect_);
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
-        const PixelRect r = tile_rect(spec_, tile);
+        const EyeView eye =
+            eye_view(camera_, aspect_, spec_, eye_of_rank(spec_, rank), head_, bounds_);
+        // An eye's frame may be squeezed (side-by-side, top-bottom): the tile's whole frustum
+        // on eye_rect's pixels.
+        const PixelRect r = eye_rect(spec_, tile);
         ViewMsg v;
         v.generation = generation_;
-        v.view = {cam, tile_frustum(wall, spec_, tile), r.width, r.height, iso_};
+        v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_};
         send_message(comm_, rank, v);
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
@@ -250,10 +265,16 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
     // A command that would leave the view degenerate (a run of zooms or pans past float
     // precision) is refused naming its line, and the view stays as it was.
     const Camera before = camera_;
+    const glm::dvec3 head_before = head_;
     const bool moved = change_view(cmd, where);
     if (std::string p = camera_problem(camera_); !p.empty()) {
         camera_ = before;
         throw InputError(where, "view", p);
+    }
+    if (std::string p = head_problem(camera_, aspect_, spec_, head_); !p.empty()) {
+        camera_ = before;
+        head_ = head_before;
+        throw InputError(where, std::holds_alternative<HeadCmd>(cmd) ? "head" : "view", p);
     }
     if (moved) send_views();
     return !std::holds_alternative<QuitCmd>(cmd);
@@ -263,12 +284,14 @@ bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where)
     if (apply_camera_command(cmd, camera_, aspect_)) {
     } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
         iso_ = checked_isovalue(c->iso, lo_, hi_, where, "iso");
+    } else if (const auto* c = std::get_if<HeadCmd>(&cmd)) {
+        head_ = c->offset;
     } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
         wait(*c);
         return false;
     } else if (const auto* c = std::get_if<SnapshotCmd>(&cmd)) {
         const auto path = std::filesystem::path(o_.out).parent_path() / (c->name + ".png");
-        write_image(path, gather_snapshot());
+        write_mosaics(path, gather_snapshot());
         std::printf("snapshot: %s (frame %llu, %.3f s into it, %llu rays)\n", path.c_str(),
                     (unsigned long long)generation_, frame_start_.seconds(),
                     (unsigned long long)total_rays());
@@ -300,30 +323,46 @@ void WallMaster::wait(const WaitCmd& w) {
     wait_until(done, o_.timeout_s);
 }
 
-Image WallMaster::gather_snapshot() {
+std::vector<Mosaic> WallMaster::gather_snapshot() {
     for (TileState& t : tiles_) t.image.reset();
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, SnapshotMsg{});
     wait_for_tiles([](const TileState& t) { return t.image.has_value(); }, o_.timeout_s);
-    return compose().image;
+    return compose();
 }
 
-Mosaic WallMaster::compose(OutputFiles* batch) {
+std::vector<Mosaic> WallMaster::compose(OutputFiles* batch) {
     const Stage left = trace_.switch_to(Stage::compose);
-    const PixelSize vs = virtual_screen_size(spec_);
-    Mosaic mosaic = empty_mosaic(vs.width, vs.height);
+    const PixelSize es = eye_screen_size(spec_);
+    std::vector<Mosaic> mosaics;
+    for (int e = 0; e < eyes_per_tile(spec_); ++e)
+        mosaics.push_back(empty_mosaic(es.width, es.height));
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
+        const Eye eye = eye_of_rank(spec_, rank);
         ImageMsg& m = *tiles_[static_cast<std::size_t>(rank)].image;
         Image img{m.width, m.height, std::move(m.rgba), {}};
-        paste(mosaic, img, tile_rect(spec_, tile));
+        paste(mosaics[eye == Eye::right ? 1 : 0], img, eye_rect(spec_, tile));
+        std::string suffix;  // appended, not concatenated: GCC 12 warns of a false overlap
+        if (eye != Eye::centre) suffix.append("-").append(to_string(eye));
         if (batch && !o_.tiles_out.empty())
-            write_image(
-                *batch,
-                std::filesystem::path(o_.tiles_out) / ("tile_" + std::to_string(tile) + ".png"),
-                img);
+            write_image(*batch,
+                        std::filesystem::path(o_.tiles_out) /
+                            ("tile_" + std::to_string(tile) + suffix + ".png"),
+                        img);
     }
     trace_.switch_to(left);
-    return mosaic;
+    return mosaics;
+}
+
+void WallMaster::write_mosaics(const std::filesystem::path& path, std::vector<Mosaic> mosaics,
+                               OutputFiles* batch) const {
+    const PixelSize vs = virtual_screen_size(spec_);
+    for (auto& [file, image] : mosaic_files(path, std::move(mosaics), vs.width, vs.height)) {
+        if (batch)
+            write_image(*batch, file, image);
+        else
+            write_image(file, image);
+    }
 }
 
 int WallMaster::finish() {
@@ -337,16 +376,20 @@ int WallMaster::finish() {
     // was finished must be on disk by then (the first image written also loads OpenImageIO,
     // half a second).
     OutputFiles batch;
-    const Mosaic mosaic = compose(&batch);
+    std::vector<Mosaic> mosaics = compose(&batch);
     trace_.switch_to(Stage::compose);
-    write_image(batch, o_.out, mosaic.image);
+    write_mosaics(o_.out, std::move(mosaics), &batch);
     report(batch);
     batch.commit();
     if (!o_.trace.empty())
         std::printf("wrote %s.json (Chrome trace: open in Perfetto) and %s.csv\n", o_.trace.c_str(),
                     o_.trace.c_str());
     if (!o_.tiles_out.empty()) std::printf("wrote the tiles' images in %s\n", o_.tiles_out.c_str());
-    std::printf("wrote %s\n", o_.out.c_str());
+    if (spec_.stereo)
+        std::printf("wrote %s (anaglyph: red left, cyan right) and the eyes' mosaics beside it\n",
+                    o_.out.c_str());
+    else
+        std::printf("wrote %s\n", o_.out.c_str());
     std::fflush(stdout);
     // Every rank has stopped working, so no helper's result is on its way any more.
     for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});

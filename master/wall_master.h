@@ -168,10 +168,15 @@ class WallMaster {
     void wait(const WaitCmd& w);
     // Applies `cmd` (waits, snapshots); true when it changed the view or isovalue.
     bool change_view(const ScriptCommand& cmd, const std::string& where);
-    // Asks every tile for its image (snapshot) and composes the mosaic.
-    Image gather_snapshot();
-    // With `batch`, also stages each tile's image in --tiles-out (the run's end, not snapshots).
-    Mosaic compose(OutputFiles* batch = nullptr);
+    // Asks every tile for its image (snapshot) and composes the mosaics.
+    std::vector<Mosaic> gather_snapshot();
+    // The mosaics to `path` (mosaic_files: with stereo, the anaglyph and both eyes), staged in
+    // `batch` when given, else written at once.
+    void write_mosaics(const std::filesystem::path& path, std::vector<Mosaic> mosaics,
+                       OutputFiles* batch = nullptr) const;
+    // One mosaic per eye (one without stereo). With `batch`, also stages each tile's image in
+    // --tiles-out (the run's end, not snapshots).
+    std::vector<Mosaic> compose(OutputFiles* batch = nullptr);
     void print_map() const;
     void report(OutputFiles& batch);
 
@@ -182,6 +187,7 @@ class WallMaster {
     double iso_, lo_, hi_;
     float aspect_ = 1;
     Camera camera_;
+    glm::dvec3 head_{0};  // the viewer's head from its nominal place (HeadCmd)
     std::uint64_t generation_ = 0;
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;

@@ -4,6 +4,17 @@
 #include <cmath>
 
 namespace isowall {
+namespace {
+
+// The rank table's tile column: "3", with stereo "3L" or "3R".
+std::string tile_column(const WallSpec& spec, int rank) {
+    const Eye eye = eye_of_rank(spec, rank);
+    return std::to_string(tile_of_rank(spec, rank)) + (eye == Eye::left    ? "L"
+                                                       : eye == Eye::right ? "R"
+                                                                           : "");
+}
+
+}  // namespace
 
 WallFigures wall_figures(const std::vector<TileResultMsg>& results) {
     WallFigures f;
@@ -44,18 +55,18 @@ void print_rank_table(std::FILE* out, const WallSpec& spec,
         out,
         "per rank (CPU seconds of each tile's frame thread, plus what its engine workers ran "
         "past it; all frames; makespan = the largest):\n");
-    std::fprintf(out, "  %4s %-12s %4s %8s %8s %7s %6s %10s %7s %10s %8s %5s %6s %8s\n", "rank",
+    std::fprintf(out, "  %4s %-12s %5s %8s %8s %7s %6s %10s %7s %10s %8s %5s %6s %8s\n", "rank",
                  "host", "tile", "cpu s", "frame s", "frames", "intr", "rays", "groups",
                  "triangles", "RSS MiB", "jobs", "helped", "MB sent");
     for (std::size_t rank = 1; rank < results.size(); ++rank) {
         const TileResultMsg& s = results[rank];
         std::fprintf(out,
-                     "  %4zu %-12s %4d %8.3f %8.3f %7llu %6llu %10llu %7llu %10llu %8.1f %5llu "
+                     "  %4zu %-12s %5s %8.3f %8.3f %7llu %6llu %10llu %7llu %10llu %8.1f %5llu "
                      "%6llu %8.2f\n",
-                     rank, s.host.c_str(), tile_of_rank(spec, static_cast<int>(rank)), s.cpu_s,
-                     s.frame_s, (unsigned long long)s.frames, (unsigned long long)s.interrupted,
-                     (unsigned long long)s.rays, (unsigned long long)s.groups,
-                     (unsigned long long)s.triangles, s.rss_mib,
+                     rank, s.host.c_str(), tile_column(spec, static_cast<int>(rank)).c_str(),
+                     s.cpu_s, s.frame_s, (unsigned long long)s.frames,
+                     (unsigned long long)s.interrupted, (unsigned long long)s.rays,
+                     (unsigned long long)s.groups, (unsigned long long)s.triangles, s.rss_mib,
                      (unsigned long long)(s.jobs_own + s.jobs_helped),
                      (unsigned long long)s.jobs_helped, double(s.bytes_sent) / 1e6);
     }
@@ -129,8 +140,7 @@ void print_earlier_frames(std::FILE* out, const std::vector<TileResultMsg>& resu
 }
 
 std::string rank_label(const WallSpec& spec, int rank) {
-    return "rank " + std::to_string(rank) + " (tile " + std::to_string(tile_of_rank(spec, rank)) +
-           ")";
+    return "rank " + std::to_string(rank) + " (" + tile_name(spec, rank) + ")";
 }
 
 void print_scheduler(std::FILE* out, bool balance, bool complete, const JobBoard& board,
@@ -187,9 +197,8 @@ void write_wall_traces(OutputFiles& batch, const std::string& prefix, const Wall
                        const std::vector<Migration>& migrations) {
     std::vector<RankTrace> ranks{{kMasterRank, "master", master}};
     for (std::size_t rank = 1; rank < results.size(); ++rank)
-        ranks.push_back({static_cast<int>(rank),
-                         "tile " + std::to_string(tile_of_rank(spec, static_cast<int>(rank))),
-                         results[rank].spans});
+        ranks.push_back(
+            {static_cast<int>(rank), tile_name(spec, static_cast<int>(rank)), results[rank].spans});
     std::vector<TraceFlow> flows;
     for (const Migration& m : migrations) {
         flows.push_back({m.owner, m.helper, m.start_s, m.start_s, "job", 0});

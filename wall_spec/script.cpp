@@ -91,13 +91,18 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
                                  std::to_string(kMaxSnapshotName) + " bytes), got " + quote(w[1]));
         return SnapshotCmd{w[1]};
     }
+    if (c == "head") {
+        expect_args(w, 3, where, "head X Y Z");
+        return HeadCmd{{num(1, limits::kHead), num(2, limits::kHead), num(3, limits::kHead)}};
+    }
     if (c == "quit") {
         expect_args(w, 0, where, "quit");
         return QuitCmd{};
     }
-    throw InputError(where, "command",
-                     "unknown command " + quote(c) +
-                         " (expected orbit, look-at, zoom, pan, iso, wait, snapshot or quit)");
+    throw InputError(
+        where, "command",
+        "unknown command " + quote(c) +
+            " (expected orbit, look-at, zoom, pan, iso, head, wait, snapshot or quit)");
 }
 
 std::vector<ScriptLine> parse_script(std::string_view text, const std::string& file) {

@@ -5,6 +5,9 @@
 //   zoom F                     F > 1 moves closer
 //   pan DX DY                  move the view by DX screen widths right and DY heights up
 //   iso V                      new isovalue
+//   head X Y Z                 the viewer's head moved from its nominal place (x right, y up, z
+//                              towards the viewer; mm on a wall with [physical], else widths of
+//                              the wall): both eyes' off-axis frusta follow
 //   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
 //   wait time S                a pause of S seconds, whether or not the frame ends first
 //   wait helped N              until tiles have run N jobs of other tiles this frame (or its end)
@@ -47,10 +50,13 @@ struct WaitCmd {
 struct SnapshotCmd {
     std::string name;
 };
+struct HeadCmd {
+    glm::dvec3 offset{0};
+};
 struct QuitCmd {};
 
-using ScriptCommand =
-    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd, SnapshotCmd, QuitCmd>;
+using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd,
+                                   SnapshotCmd, HeadCmd, QuitCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages

@@ -56,6 +56,29 @@ struct TileOverride {
     std::string display = {};              // X display of this tile's window; empty: the wall's
 };
 
+// Stereo: every enabled tile is driven by a pair of ranks, one per eye, on consecutive ranks
+// (left, then right), so a hostfile's slots keep a tile's two eyes on one host. How the tile's
+// display takes the two eyes decides the pixels of each:
+//   side_by_side: each eye W/2 x H, the left eye on the screen's left half (passive 3D panels
+//                 and projectors that stretch each half back to the full width);
+//   top_bottom:   each eye W x H/2, the left eye on the top half;
+//   full:         each eye W x H (a pair of projectors per screen, one per eye, or any display
+//                 fed a full frame per eye).
+enum class StereoMode { side_by_side, top_bottom, full };
+enum class Eye { centre, left, right };
+
+struct Stereo {
+    StereoMode mode = StereoMode::side_by_side;
+    // The distance between the eyes: in mm on a wall with [physical], else as a fraction of the
+    // virtual screen's width.
+    double separation = 0;
+    // The zero-parallax plane's distance as a fraction of the camera's distance to its target:
+    // 1 puts what lies at the target on the screen's plane, nearer in front of it.
+    double convergence = 1;
+};
+inline constexpr double kDefaultEyeSeparationMm = 65;
+inline constexpr double kDefaultEyeSeparation = 0.03;
+
 struct WallSpec {
     int columns = 1, rows = 1;
     int tile_width_px = 1024, tile_height_px = 768;
@@ -66,6 +89,7 @@ struct WallSpec {
     // The X display (and screen) every tile's window opens with --windows, as "[host]:D[.S]";
     // empty: each tile rank's $DISPLAY.
     std::string display;
+    std::optional<Stereo> stereo;  // none: one rank per tile, the centre eye
 };
 
 struct PixelSize {
@@ -85,8 +109,9 @@ std::string to_string(RankOrder order);  // "row-major", "column-major", "serpen
 int tile_count(const WallSpec& spec);  // columns * rows, disabled tiles included
 int tile_index(const WallSpec& spec, int column, int row);
 bool tile_enabled(const WallSpec& spec, int tile_index);
-// 1 (the master) + the enabled tiles: the -np of a wall run.
+// 1 (the master) + the enabled tiles times the eyes per tile: the -np of a wall run.
 int rank_count(const WallSpec& spec);
+int eyes_per_tile(const WallSpec& spec);  // 2 with stereo, else 1
 
 // All tiles plus the bezels between them (not around the outside).
 PixelSize virtual_screen_size(const WallSpec& spec);
@@ -97,13 +122,28 @@ PixelRect tile_rect(const WallSpec& spec, int tile_index);
 // tile.
 Frustum tile_frustum(const Frustum& wall, const WallSpec& spec, int tile_index);
 
-// Rank 0 is the master (kNoTile); ranks 1..T own the enabled tiles in rank order. Ranks outside
-// [0, rank_count) and tile indices outside [0, tile_count) throw std::out_of_range.
+// Rank 0 is the master (kNoTile); ranks 1..T own the enabled tiles in rank order (with stereo,
+// ranks 2k+1 and 2k+2 the left and right eyes of the k-th). Ranks outside [0, rank_count) and
+// tile indices outside [0, tile_count) throw std::out_of_range.
 int tile_of_rank(const WallSpec& spec, int rank);
+// Eye::centre without stereo (and for the master), else the rank's eye.
+Eye eye_of_rank(const WallSpec& spec, int rank);
+// The images of one eye: tile_rect and virtual_screen_size scaled as the stereo mode squeezes
+// them (the same as those without stereo, or in the full mode). A tile rank's frame is
+// eye_rect's size; an eye's mosaic is eye_screen_size.
+PixelRect eye_rect(const WallSpec& spec, int tile_index);
+PixelSize eye_screen_size(const WallSpec& spec);
 // The X display of tile `tile_index`'s window: its [[tile]] display, else the wall's, else empty
 // (the rank's $DISPLAY).
 std::string tile_display(const WallSpec& spec, int tile_index);
-int rank_of_tile(const WallSpec& spec, int tile_index);  // kNoRank for a disabled tile
+// kNoRank for a disabled tile; with stereo, the rank of `eye` (left for Eye::centre).
+int rank_of_tile(const WallSpec& spec, int tile_index, Eye eye = Eye::centre);
+
+// How the report names a tile rank's screen: "tile 3", with stereo "tile 3, left eye".
+std::string tile_name(const WallSpec& spec, int rank);
+
+std::string to_string(StereoMode mode);  // "side-by-side", "top-bottom", "full"
+std::string to_string(Eye eye);          // "centre", "left", "right"
 
 std::ostream& operator<<(std::ostream& os, const WallSpec& spec);
 std::ostream& operator<<(std::ostream& os, const PixelRect& r);

@@ -29,6 +29,9 @@ constexpr long long kMaxBezelPx = 1'000'000;
 constexpr NumberRange kTileMm{1e-3, 1e6};
 constexpr NumberRange kBezelMm{-1e6, 1e6};
 constexpr NumberRange kViewerMm{-1e7, 1e7};
+constexpr NumberRange kEyeSeparationMm{0, 1e4};
+constexpr NumberRange kEyeSeparation{0, 1};
+constexpr NumberRange kConvergence{1e-3, 1e3};
 
 // A TOML value as the user wrote it, for "got ..." in error messages (toml++'s own printer
 // pads arrays as "[ 6, 0 ]" and can span lines).
@@ -255,6 +258,50 @@ std::string read_display(const Reader& r) {
     return s->get();
 }
 
+// [stereo]: after [physical], which decides the unit of the eye separation.
+Stereo read_stereo(const Reader& top, const WallSpec& spec) {
+    const toml::node* n = top.find("stereo");
+    const auto* t = n->as_table();
+    if (!t) top.fail("stereo", "expected a table, got " + describe(*n));
+    const Reader r(top.where(), *t, "stereo.");
+    r.check_keys({"mode", "eye_separation_mm", "eye_separation", "convergence"});
+    Stereo st;
+    const toml::node& mode = r.require("mode", "\"side-by-side\", \"top-bottom\" or \"full\"");
+    const auto* m = mode.as_string();
+    bool known = false;
+    for (StereoMode o : {StereoMode::side_by_side, StereoMode::top_bottom, StereoMode::full})
+        if (m && m->get() == to_string(o)) st.mode = o, known = true;
+    if (!known)
+        r.fail("mode",
+               "expected \"side-by-side\", \"top-bottom\" or \"full\", got " + describe(mode));
+    const auto number = [&](std::string_view key, const NumberRange& range,
+                            const std::string& expected, double otherwise) {
+        const toml::node* v = r.find(key);
+        if (!v) return otherwise;
+        const auto x = Reader::number(*v, range);
+        if (!x) r.fail(key, "expected " + expected + ", got " + describe(*v));
+        return *x;
+    };
+    // The separation's unit follows the wall: millimetres where its size is known.
+    const char* other = spec.physical ? "eye_separation" : "eye_separation_mm";
+    if (r.find(other))
+        r.fail(other, spec.physical ? "a wall with [physical] gives eye_separation_mm"
+                                    : "needs [physical] (the wall's size in mm); give "
+                                      "eye_separation, a fraction of the wall's width");
+    st.separation = spec.physical
+                        ? number("eye_separation_mm", kEyeSeparationMm, "mm in [0, 1e4]",
+                                 kDefaultEyeSeparationMm)
+                        : number("eye_separation", kEyeSeparation,
+                                 "a fraction of the wall's width in [0, 1]", kDefaultEyeSeparation);
+    st.convergence = number("convergence", kConvergence,
+                            "a fraction of the distance to the target in [1e-3, 1e3]", 1.0);
+    if (st.mode == StereoMode::side_by_side && spec.tile_width_px < 2)
+        r.fail("mode", "side-by-side halves the tile's width: expected tiles at least 2 px wide");
+    if (st.mode == StereoMode::top_bottom && spec.tile_height_px < 2)
+        r.fail("mode", "top-bottom halves the tile's height: expected tiles at least 2 px high");
+    return st;
+}
+
 void read_overrides(const Reader& top, WallSpec& spec) {
     const toml::node* n = top.find("tile");
     const auto* a = n->as_array();
@@ -347,8 +394,8 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
             "TOML syntax: " + msg);
     }
     const Reader r(where, doc, "");
-    r.check_keys(
-        {"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile", "display"});
+    r.check_keys({"tiles", "tile_size_px", "bezel_px", "rank_order", "physical", "tile", "display",
+                  "stereo"});
 
     WallSpec spec;
     const auto tiles = r.ints("tiles", 2, 1, std::numeric_limits<int>::max(),
@@ -382,6 +429,7 @@ WallSpec parse_wall(std::string_view toml_text, const std::string& where) {
 
     check_screen_size(where, bezel_field, spec);
     if (r.find("tile")) read_overrides(r, spec);
+    if (r.find("stereo")) spec.stereo = read_stereo(r, spec);
     return spec;
 }
 
