@@ -37,12 +37,16 @@ constexpr double kCoarseShare = 1.0 / 16.0;  // the coarse band ends after ~1/16
 }
 
 JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
-                   const std::vector<std::vector<double>>& rays, bool balance, int depth)
+                   const std::vector<std::vector<double>>& rays, bool balance, int depth,
+                   std::vector<int> pools)
     : balance_(balance),
       depth_(depth),
       in_hand_(regions.size(), 0),
+      pools_(pools.empty() ? std::vector<int>(regions.size(), 0) : std::move(pools)),
       cpu_(2 * regions.size(), 0.0),
       rays_(2 * regions.size(), 0.0) {
+    if (pools_.size() != regions.size())
+        throw std::invalid_argument("job board: a pool for every rank, or none");
     for (std::size_t owner = 0; owner < regions.size(); ++owner) {
         for (std::size_t i = 0; i < regions[owner].size(); ++i) {
             const double r = rays.at(owner).at(i);
@@ -77,12 +81,13 @@ double JobBoard::cost(const BoardJob& j) const {
     return j.rays * (rays_any > 0 ? cpu_any / rays_any : 1e-6);
 }
 
-JobBoard::Queues JobBoard::queued(Band band) const {
+JobBoard::Queues JobBoard::queued(Band band, int pool) const {
     Queues q{std::vector<double>(in_hand_.size(), 0.0),
              std::vector<std::optional<std::uint32_t>>(in_hand_.size())};
     for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
         const BoardJob& j = jobs_[id];
         if (j.state != BoardJob::State::queued || j.band != band) continue;
+        if (pools_[static_cast<std::size_t>(j.owner)] != pool) continue;
         const auto k = static_cast<std::size_t>(key(j));
         q.work[k] += cost(j);
         q.last[k] = id;
@@ -119,7 +124,7 @@ std::optional<std::uint32_t> JobBoard::pick(int rank) const {
         }
         // A rank keeps to its own queue while it holds at least half the work of the busiest
         // one; else it helps there first (its own cheap jobs wait, and anyone may take them).
-        const Queues q = queued(band);
+        const Queues q = queued(band, pools_[r]);
         const double most = *std::max_element(q.work.begin(), q.work.end());
         if (q.last[r] && q.work[r] >= 0.5 * most)
             if (auto id = first(band)) return id;

@@ -50,9 +50,14 @@ struct BoardJob {
 class JobBoard {
   public:
     // regions[rank] and rays[rank]: the rank's regions and the estimated work of each (rank 0,
-    // the master, has none). Regions with no estimated ray get no job.
+    // the master, has none). Regions with no estimated ray get no job. pools[rank] (empty: one
+    // pool): a rank takes jobs only of owners in its own pool. A stereo wall's eyes are two
+    // pools: a rank's frame shares its visited cells and extraction choices between its jobs,
+    // and those hold for one camera (a group extracted and culled for one eye misses triangles
+    // the other sees at the silhouettes).
     JobBoard(const std::vector<std::vector<PixelRect>>& regions,
-             const std::vector<std::vector<double>>& rays, bool balance, int depth = 1);
+             const std::vector<std::vector<double>>& rays, bool balance, int depth = 1,
+             std::vector<int> pools = {});
 
     // The next job for `rank`, now marked running, or nullopt when it has `depth` jobs in hand
     // or none is left for it.
@@ -79,7 +84,7 @@ class JobBoard {
         std::vector<double> work;
         std::vector<std::optional<std::uint32_t>> last;
     };
-    Queues queued(Band band) const;
+    Queues queued(Band band, int pool) const;
     std::optional<std::uint32_t> pick(int rank) const;
     std::optional<std::uint32_t> steal(const Queues& q, Band band) const;
     double cost(const BoardJob& j) const;
@@ -89,6 +94,7 @@ class JobBoard {
     bool balance_;
     int depth_;
     std::vector<int> in_hand_;
+    std::vector<int> pools_;          // by rank
     std::vector<double> cpu_, rays_;  // by owner and band (2 * owner + band): of the jobs done
     std::size_t landed_ = 0, migrated_ = 0;
 };

@@ -247,7 +247,10 @@ void WallMaster::send_views() {
             ? planner_.next(views, iso_, board_ ? &*board_ : nullptr, bounds_, o_.screen_box)
             : grid_plan(views, o_.balance ? o_.region_w : 0, o_.balance ? o_.region_h : 0, bounds_,
                         o_.screen_box);
-    board_.emplace(plan.regions, plan.work, o_.balance);
+    std::vector<int> pools;  // by rank: each eye's ranks help only each other
+    for (int rank = 0; rank < comm_.size(); ++rank)
+        pools.push_back(static_cast<int>(eye_of_rank(spec_, rank)));
+    board_.emplace(plan.regions, plan.work, o_.balance, 1, std::move(pools));
     migrations_.clear();
     frame_busy_s_.assign(tiles_.size(), 0.0);
     frame_clock_s_.assign(tiles_.size(), 0.0);

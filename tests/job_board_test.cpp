@@ -54,6 +54,30 @@ TEST(JobBoard, RegionsOutsideTheScreenBoxGetNoJob) {
     EXPECT_EQ(board.size(), 2u) << "one region with rays: its coarse and its fine job";
 }
 
+TEST(JobBoard, RanksHelpOnlyOwnersOfTheirPool) {
+    // Ranks 1 and 3 are one eye, 2 and 4 the other; ranks 1 and 2 hold all the work.
+    std::vector<std::vector<PixelRect>> regions(5);
+    std::vector<std::vector<double>> rays(5);
+    for (int r : {1, 2})
+        for (int i = 0; i < 6; ++i) {
+            regions[r].push_back({i * 10, 0, 10, 10});
+            rays[r].push_back(100);
+        }
+    JobBoard b(regions, rays, true, 1, {0, 1, 2, 1, 2});
+    std::set<int> owners3, owners4;
+    while (auto id = b.next_for(3)) {
+        owners3.insert(b.job(*id).owner);
+        b.done(*id, 0.01);
+    }
+    while (auto id = b.next_for(4)) {
+        owners4.insert(b.job(*id).owner);
+        b.done(*id, 0.01);
+    }
+    EXPECT_EQ(owners3, std::set<int>{1});
+    EXPECT_EQ(owners4, std::set<int>{2});
+    EXPECT_THROW(JobBoard(regions, rays, true, 1, {0, 1}), std::invalid_argument);
+}
+
 TEST(JobBoard, StaticHandsEachRankItsOwnJobsCoarseFirst) {
     JobBoard b = board_of({0, 3, 0}, false, 10);
     std::vector<Band> bands;
