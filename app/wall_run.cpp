@@ -37,6 +37,26 @@
 namespace isowall {
 namespace {
 
+// A stereo eye's window covers its half of the tile's screen (side-by-side, top-bottom), or the
+// whole of its own screen (full).
+WindowOptions::Part window_part(const WallSpec& spec, Eye eye) {
+    using Part = WindowOptions::Part;
+    if (!spec.stereo || eye == Eye::centre || spec.stereo->mode == StereoMode::full)
+        return Part::whole;
+    if (spec.stereo->mode == StereoMode::side_by_side)
+        return eye == Eye::left ? Part::left_half : Part::right_half;
+    return eye == Eye::left ? Part::top_half : Part::bottom_half;
+}
+
+// The full mode shows each eye on a screen of its own: with --windows, the right eyes need theirs.
+void check_windows(const WallSpec& spec, const WallOptions& o) {
+    if (o.windows && spec.stereo && spec.stereo->mode == StereoMode::full &&
+        spec.stereo->right_display.empty())
+        throw InputError(o.wall, "stereo.right_display",
+                         "--windows with the full mode shows each eye on a screen of its own; give "
+                         "the right eyes' X display");
+}
+
 std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadBudget budget) {
     OctreeSource src;
     if (ov.file) src.volume_path = *ov.file;
@@ -208,7 +228,8 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     std::optional<TileWindow> window;
     if (o.windows) {
         const int t = tile_of_rank(spec, comm.rank());
-        window.emplace(tile_display(spec, t), t, comm.host());
+        const Eye eye = eye_of_rank(spec, comm.rank());
+        window.emplace(tile_display(spec, t, eye), t, comm.host(), window_part(spec, eye), eye);
         setup.shows.push_back(&*window);
     }
     std::optional<PreviewShow> preview;
@@ -312,6 +333,7 @@ int run_wall(const WallOptions& o, Comm& comm) {
     WallSpec spec;
     try {
         spec = load_wall(o.wall);
+        check_windows(spec, o);
     } catch (const std::exception& e) {
         if ((comm.rank() == kMasterRank))
             std::fprintf(stderr, "isowall: error: %s\n", clip(e.what(), 800).c_str());

@@ -185,9 +185,19 @@ XWindow::XWindow(const WindowOptions& o) : impl_(std::make_unique<Impl>()) {
     a.event_mask =
         StructureNotifyMask | ExposureMask |
         (o.input ? ButtonPressMask | ButtonReleaseMask | PointerMotionMask | KeyPressMask : 0);
-    const int w = o.fullscreen ? DisplayWidth(m.dpy, m.screen) : o.width;
-    const int h = o.fullscreen ? DisplayHeight(m.dpy, m.screen) : o.height;
-    m.window = XCreateWindow(m.dpy, root, 0, 0, static_cast<unsigned>(w), static_cast<unsigned>(h),
+    int w = o.fullscreen ? DisplayWidth(m.dpy, m.screen) : o.width;
+    int h = o.fullscreen ? DisplayHeight(m.dpy, m.screen) : o.height;
+    int x = 0, y = 0;
+    using Part = WindowOptions::Part;
+    if (o.fullscreen && (o.part == Part::left_half || o.part == Part::right_half)) {
+        w /= 2;
+        x = o.part == Part::right_half ? DisplayWidth(m.dpy, m.screen) - w : 0;
+    }
+    if (o.fullscreen && (o.part == Part::top_half || o.part == Part::bottom_half)) {
+        h /= 2;
+        y = o.part == Part::bottom_half ? DisplayHeight(m.dpy, m.screen) - h : 0;
+    }
+    m.window = XCreateWindow(m.dpy, root, x, y, static_cast<unsigned>(w), static_cast<unsigned>(h),
                              0, m.depth, InputOutput, m.visual,
                              CWBackPixel | CWOverrideRedirect | CWEventMask, &a);
     m.note_size(w, h);

@@ -32,6 +32,8 @@ struct WindowOptions {
     bool input = false;  // deliver mouse and key events to poll()
     // Try MIT-SHM first (off: always XPutImage, as with a display on another host).
     bool shared_memory = true;
+    // Fullscreen only: the part of the screen the window covers (a stereo eye's half).
+    enum class Part { whole, left_half, right_half, top_half, bottom_half } part = Part::whole;
 };
 
 // One input event in window pixels (x right, y down).

@@ -42,6 +42,13 @@ TEST(StereoWallFile, ModesDefaultsAndUnits) {
                                      "p.toml");
     EXPECT_DOUBLE_EQ(phys.stereo->separation, kDefaultEyeSeparationMm);
     EXPECT_FALSE(parse_wall(kTwoByTwo, "m.toml").stereo);
+    // The full mode's right eyes show on a display of their own.
+    const WallSpec two = parse_wall(kTwoByTwo + "display = \":0.0\"\n[stereo]\nmode = \"full\"\n" +
+                                        "right_display = \":0.1\"\n",
+                                    "two.toml");
+    EXPECT_EQ(tile_display(two, 3, Eye::left), ":0.0");
+    EXPECT_EQ(tile_display(two, 3, Eye::right), ":0.1");
+    EXPECT_EQ(tile_display(sbs, 3, Eye::right), "");
 }
 
 TEST(StereoWallFile, BadTablesNameTheField) {
@@ -61,6 +68,10 @@ TEST(StereoWallFile, BadTablesNameTheField) {
              {"[stereo]\nmode = \"full\"\nconvergence = 0\n", "stereo.convergence", "got 0"},
              {"[stereo]\nmode = \"full\"\neyes = 2\n", "stereo.eyes", "unknown key"},
              {"stereo = true\n", "stereo", "expected a table"},
+             {"[stereo]\nmode = \"side-by-side\"\nright_display = \":0.1\"\n",
+              "stereo.right_display", "only the full mode"},
+             {"[stereo]\nmode = \"full\"\nright_display = \"screen two\"\n", "stereo.right_display",
+              "expected an X display"},
          }) {
         try {
             parse_wall(kTwoByTwo + c.text, "bad.toml");

@@ -46,13 +46,31 @@ std::size_t covered(const Image& img) {
     return n;
 }
 
-// Every distinct picture tile `t`'s window showed while `running` holds.
-std::vector<Image> watch(const test::Xvfb& x, int t, const std::atomic<bool>& running) {
+// Where window `id` sits on its screen, as xwininfo says ("Absolute upper-left X"); -1 unknown.
+int window_x(const std::string& display, std::uint64_t id) {
+    const std::string cmd =
+        "xwininfo -display '" + display + "' -id " + std::to_string(id) + " 2>/dev/null";
+    std::FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return -1;
+    char line[256];
+    int x = -1;
+    while (std::fgets(line, sizeof(line), p)) std::sscanf(line, " Absolute upper-left X: %d", &x);
+    pclose(p);
+    return x;
+}
+
+// Every distinct picture tile `t`'s window (of `eye`, with stereo) showed while `running` holds;
+// `x`, when given, where the window sits on its screen.
+std::vector<Image> watch(const test::Xvfb& x, int t, const std::atomic<bool>& running,
+                         Eye eye = Eye::centre, int* at = nullptr) {
     std::vector<Image> seen;
     std::uint64_t id = 0;
     while (running) {
         try {
-            if (!id) id = find_window(x.screen(t), tile_window_title(t));
+            if (!id) {
+                id = find_window(x.screen(t), tile_window_title(t, eye));
+                if (id && at) *at = window_x(x.screen(t), id);
+            }
             if (!id) continue;
             Image img = capture_window(x.screen(t), id);
             if (seen.empty() || img.rgba != seen.back().rgba) seen.push_back(std::move(img));
@@ -114,6 +132,59 @@ TEST(TileWindows, ShowTheFrameAsItBuildsAndThenExactlyTheTileImage) {
             partial = c > 0 && c < covered(final_tile) * 99 / 100;
         }
         EXPECT_TRUE(partial) << "no capture showed the frame part built";
+    }
+}
+
+// The last picture a window showed that shows anything (the window may be black once its rank
+// has ended).
+const Image* last_lit(const std::vector<Image>& seen) {
+    for (auto it = seen.rbegin(); it != seen.rend(); ++it)
+        if (covered(*it) > 0) return &*it;
+    return nullptr;
+}
+
+// A side-by-side stereo wall: each tile's screen shows its left eye's frame on its left half and
+// its right eye's on its right half, each the eye's tile image.
+TEST(TileWindows, StereoEyesShowOnTheirHalvesOfTheTilesScreen) {
+    test::Xvfb x({"320x240", "320x240", "320x240", "320x240"});
+    if (!x.ok()) GTEST_SKIP() << "no Xvfb: " << x.why_not();
+    const auto dir = test::scratch_dir("tile_windows_stereo");
+    std::ofstream(dir / "wall.toml")
+        << wall_file(x.display(), 320, 240)
+        << "[stereo]\nmode = \"side-by-side\"\neye_separation = 0.05\n";
+    std::ofstream(dir / "show.txt") << "wait done\nwait time 1.5\nquit\n";
+    std::atomic<bool> running{true};
+    int rc = -1;
+    std::thread wall([&] {
+        rc = run(mpirun(9) + "wall --windows --wall '" + (dir / "wall.toml").string() +
+                     "' --script '" + (dir / "show.txt").string() + "' --tiles-out '" +
+                     dir.string() + "' --out '" + (dir / "m.png").string() + "'",
+                 dir / "log.txt");
+        running = false;
+    });
+    std::vector<std::vector<Image>> seen(8);
+    std::vector<int> at(8, -1);
+    {
+        std::vector<std::thread> watchers;
+        for (int k = 0; k < 8; ++k)
+            watchers.emplace_back([&, k] {
+                seen[k] = watch(x, k / 2, running, k % 2 ? Eye::right : Eye::left, &at[k]);
+            });
+        wall.join();
+        for (auto& w : watchers) w.join();
+    }
+    ASSERT_EQ(rc, 0) << test::slurp(dir / "log.txt");
+    for (int k = 0; k < 8; ++k) {
+        const std::string eye = k % 2 ? "right" : "left";
+        SCOPED_TRACE("tile " + std::to_string(k / 2) + ", " + eye + " eye");
+        const Image* shown = last_lit(seen[k]);
+        ASSERT_NE(shown, nullptr) << "the window showed nothing";
+        EXPECT_EQ(shown->width, 160);
+        EXPECT_EQ(shown->height, 240);
+        EXPECT_EQ(at[k], k % 2 ? 160 : 0) << "the eye's window is not on its half";
+        const Image tile = read_image(dir / ("tile_" + std::to_string(k / 2) + "-" + eye + ".png"));
+        const auto m = test::compare_images(*shown, tile, kColour);
+        EXPECT_GE(m.equal_share, 0.999) << m;
     }
 }
 

@@ -359,6 +359,42 @@ TEST(WallRun, WaitTimeHoldsTheFinishedFrameLongerThanTheTimeout) {
     EXPECT_EQ(m.differing_pixels, 0u) << m;
 }
 
+// A stereo wall under mpirun: a pair of ranks per tile (9 for 2x2), the eyes' top-bottom
+// frames, both eyes' mosaics and their anaglyph; a head moved by the script; and the rank count
+// a stereo wall file needs.
+TEST(WallRun, AStereoWallRunsARankPerEye) {
+    const auto dir = test::scratch_dir("wall_stereo");
+    const auto wall_file = dir / "tb.toml";
+    std::ofstream(wall_file) << "tiles = [2, 2]\ntile_size_px = [96, 72]\n"
+                                "[stereo]\nmode = \"top-bottom\"\neye_separation = 0.04\n";
+    std::ofstream(dir / "s.txt") << "head 0.1 0 0.2\nwait done\n";
+    ASSERT_EQ(run(isowall_cmd() + "wall --wall '" + wall_file.string() + "' --ranks-needed",
+                  dir / "n.log"),
+              0);
+    EXPECT_EQ(slurp(dir / "n.log"), "9\n");
+    const std::string wall =
+        "wall --wall '" + wall_file.string() + "' --out '" + (dir / "m.png").string() + "'";
+    ASSERT_EQ(
+        run(mpirun(9) + wall + " --script '" + (dir / "s.txt").string() + "'", dir / "wall.log"), 0)
+        << slurp(dir / "wall.log");
+    const std::string log = slurp(dir / "wall.log");
+    EXPECT_NE(log.find("stereo: top-bottom, a rank per eye"), std::string::npos) << log;
+    EXPECT_NE(log.find("rank  8 on "), std::string::npos) << log;
+    EXPECT_NE(log.find("right eye 96x36"), std::string::npos) << log;
+    const Image left = read_image(dir / "m-left.png"), right = read_image(dir / "m-right.png");
+    const Image both = read_image(dir / "m.png");
+    EXPECT_EQ(left.width, 192);
+    EXPECT_EQ(left.height, 72);
+    EXPECT_EQ(both.height, 144);
+    // Both eyes show the surface, and not the same picture.
+    const test::ImageComparison lr = test::compare_images(left, right, kFromFiles);
+    EXPECT_GT(lr.covered_both, 1000u) << lr;
+    EXPECT_LT(lr.equal_share, 0.97) << lr;
+    EXPECT_NE(run(mpirun(5) + wall, dir / "np.log"), 0);
+    EXPECT_NE(slurp(dir / "np.log").find("needs mpirun -np 9"), std::string::npos)
+        << slurp(dir / "np.log");
+}
+
 TEST(WallRun, BadInputEndsEveryRank) {
     const auto dir = test::scratch_dir("wall_bad");
     std::ofstream(dir / "2x2.toml") << "tiles = [2, 2]\ntile_size_px = [64, 48]\n";

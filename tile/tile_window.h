@@ -8,6 +8,7 @@
 
 #include "display/x_window.h"
 #include "tile/frame_show.h"
+#include "wall_spec/wall.h"
 
 namespace isowall {
 
@@ -18,7 +19,10 @@ class TileWindow final : public FrameShow {
   public:
     // Opens the window; a display that cannot be used throws a runtime_error naming `host` and
     // the display (the caller's failure path adds the rank and tile).
-    TileWindow(const std::string& display, int tile, const std::string& host);
+    // `part`: the screen's half a stereo eye shows on (side-by-side, top-bottom), else whole;
+    // `eye` names the window of a stereo eye ("isowall tile 3 left").
+    TileWindow(const std::string& display, int tile, const std::string& host,
+               WindowOptions::Part part = WindowOptions::Part::whole, Eye eye = Eye::centre);
     double interval_s() const override { return 1.0 / kWindowRefreshHz; }
     void show(const Image& tile, std::uint64_t generation) override;
     int presents() const { return presents_; }
@@ -29,6 +33,6 @@ class TileWindow final : public FrameShow {
 };
 
 // The title of tile `tile`'s window (tests and operators find it by this name).
-std::string tile_window_title(int tile);
+std::string tile_window_title(int tile, Eye eye = Eye::centre);
 
 }  // namespace isowall

@@ -75,6 +75,9 @@ struct Stereo {
     // The zero-parallax plane's distance as a fraction of the camera's distance to its target:
     // 1 puts what lies at the target on the screen's plane, nearer in front of it.
     double convergence = 1;
+    // The X display of every right eye's window (--windows) in the full mode, where each eye
+    // has a screen (a projector) of its own; the left eyes use the tiles' displays.
+    std::string right_display;
 };
 inline constexpr double kDefaultEyeSeparationMm = 65;
 inline constexpr double kDefaultEyeSeparation = 0.03;
@@ -134,8 +137,8 @@ Eye eye_of_rank(const WallSpec& spec, int rank);
 PixelRect eye_rect(const WallSpec& spec, int tile_index);
 PixelSize eye_screen_size(const WallSpec& spec);
 // The X display of tile `tile_index`'s window: its [[tile]] display, else the wall's, else empty
-// (the rank's $DISPLAY).
-std::string tile_display(const WallSpec& spec, int tile_index);
+// (the rank's $DISPLAY). The right eye of a full-mode stereo wall: stereo.right_display.
+std::string tile_display(const WallSpec& spec, int tile_index, Eye eye = Eye::centre);
 // kNoRank for a disabled tile; with stereo, the rank of `eye` (left for Eye::centre).
 int rank_of_tile(const WallSpec& spec, int tile_index, Eye eye = Eye::centre);
 

@@ -248,13 +248,12 @@ bool valid_display(const std::string& d) {
            (dot == std::string::npos || digits(rest.substr(dot + 1)));
 }
 
-std::string read_display(const Reader& r) {
-    const toml::node* n = r.find("display");
+std::string read_display(const Reader& r, std::string_view key = "display") {
+    const toml::node* n = r.find(key);
     if (!n) return {};
     const auto* s = n->as_string();
     if (!s || !valid_display(s->get()))
-        r.fail("display",
-               "expected an X display such as \":0\" or \"node7:0.1\", got " + describe(*n));
+        r.fail(key, "expected an X display such as \":0\" or \"node7:0.1\", got " + describe(*n));
     return s->get();
 }
 
@@ -264,7 +263,7 @@ Stereo read_stereo(const Reader& top, const WallSpec& spec) {
     const auto* t = n->as_table();
     if (!t) top.fail("stereo", "expected a table, got " + describe(*n));
     const Reader r(top.where(), *t, "stereo.");
-    r.check_keys({"mode", "eye_separation_mm", "eye_separation", "convergence"});
+    r.check_keys({"mode", "eye_separation_mm", "eye_separation", "convergence", "right_display"});
     Stereo st;
     const toml::node& mode = r.require("mode", "\"side-by-side\", \"top-bottom\" or \"full\"");
     const auto* m = mode.as_string();
@@ -295,6 +294,11 @@ Stereo read_stereo(const Reader& top, const WallSpec& spec) {
                                  "a fraction of the wall's width in [0, 1]", kDefaultEyeSeparation);
     st.convergence = number("convergence", kConvergence,
                             "a fraction of the distance to the target in [1e-3, 1e3]", 1.0);
+    if (r.find("right_display")) {
+        st.right_display = read_display(r, "right_display");
+        if (st.mode != StereoMode::full)
+            r.fail("right_display", "only the full mode shows an eye on a screen of its own");
+    }
     if (st.mode == StereoMode::side_by_side && spec.tile_width_px < 2)
         r.fail("mode", "side-by-side halves the tile's width: expected tiles at least 2 px wide");
     if (st.mode == StereoMode::top_bottom && spec.tile_height_px < 2)

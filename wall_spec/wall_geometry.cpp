@@ -193,8 +193,10 @@ std::ostream& operator<<(std::ostream& os, const PixelRect& r) {
     return os << "PixelRect{" << r.x << ", " << r.y << ", " << r.width << "x" << r.height << "}";
 }
 
-std::string tile_display(const WallSpec& spec, int tile_index) {
+std::string tile_display(const WallSpec& spec, int tile_index, Eye eye) {
     check_tile(spec, tile_index);
+    if (spec.stereo && spec.stereo->mode == StereoMode::full && eye == Eye::right)
+        return spec.stereo->right_display;
     const TileOverride* o = override_of(spec, tile_index);
     return o && !o->display.empty() ? o->display : spec.display;
 }
