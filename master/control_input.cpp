@@ -43,6 +43,10 @@ int first_free_snapshot(const std::string& out, int from, std::string_view prefi
     return n;
 }
 
+std::string head_line(const glm::dvec3& head) {
+    return "head " + number(head.x) + " " + number(head.y) + " " + number(head.z);
+}
+
 std::string iso_line(double iso, double lo, double hi) {
     for (int digits : {6, 9, 17}) {
         const std::string v = number(iso, digits);
@@ -76,10 +80,14 @@ void ControlInput::flush(std::vector<std::string>& out) {
             // The next iso key of this poll starts from the value just asked for.
             state_.iso = std::strtod(out.back().c_str() + 4, nullptr);
         }
+    } else if (kind == Pending::head && head_steps_ != 0) {
+        state_.head.x += head_steps_ * state_.head_step;
+        out.push_back(head_line(state_.head));
     }
     drag_x_ = drag_y_ = 0;
     zoom_steps_ = 0;
     iso_steps_ = 0;
+    head_steps_ = 0;
 }
 
 void ControlInput::drag_to(int x, int y) {
@@ -95,6 +103,13 @@ void ControlInput::key(const std::string& name, std::vector<std::string>& out) {
     if (const double steps = iso_steps_of(name); steps != 0) {
         accumulate(Pending::iso, out);
         iso_steps_ += steps;
+    } else if ((name == "Left" || name == "Right") && state_.head_step > 0) {
+        accumulate(Pending::head, out);
+        head_steps_ += name == "Right" ? 1 : -1;
+    } else if (name == "Home" && state_.head_step > 0) {
+        flush(out);
+        state_.head = glm::dvec3(0);
+        out.push_back(head_line(state_.head));
     } else if (name == "s" || name == "S") {
         flush(out);
         out.push_back("snapshot " + snapshot_name(next_snapshot_++));

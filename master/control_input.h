@@ -10,11 +10,16 @@
 //   wheel up/down  zoom kZoomStep / 1/kZoomStep
 //   Up, plus       iso + kIsoStep of the value range (Down, minus: -); Page_Up/Page_Down: x10;
 //                  clamped to the range
+//   Left/Right     the viewer's head kHeadStepMm (a wall with [physical]) or kHeadStepWidths
+//                  (of the wall's width) left or right: both eyes' frusta follow; Home: back to
+//                  its nominal place
 //   s              snapshot control-NNN (beside --out)
 //   Escape, close  quit
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "display/x_window.h"
 
@@ -23,11 +28,15 @@ namespace isowall {
 inline constexpr double kOrbitDegPerPx = 0.5;
 inline constexpr double kZoomStep = 1.25;
 inline constexpr double kIsoStep = 0.01;  // of the volume's value range, per key
+inline constexpr double kHeadStepMm = 50;
+inline constexpr double kHeadStepWidths = 0.01;
 
 // What the mapping needs to know of the wall when the events are taken.
 struct ControlState {
     double iso = 0, value_min = 0, value_max = 0;
     int mosaic_width = 1, mosaic_height = 1;  // the wall in the window (pan is in screen sizes)
+    glm::dvec3 head{0};                       // the viewer's head now (head command)
+    double head_step = 0;                     // per Left/Right key; 0: the keys do nothing
 };
 
 // "control-001" ...: the name of snapshot n.
@@ -39,6 +48,8 @@ int first_free_snapshot(const std::string& out, int from = 1, std::string_view p
 // "iso V" with V written so that it reads back as itself inside [lo, hi] (six significant
 // digits when that suffices, so the line stays readable).
 std::string iso_line(double iso, double lo, double hi);
+// "head X Y Z".
+std::string head_line(const glm::dvec3& head);
 
 class ControlInput {
   public:
@@ -53,7 +64,7 @@ class ControlInput {
                                       const ControlState& state);
 
   private:
-    enum class Pending { none, orbit, pan, zoom, iso };
+    enum class Pending { none, orbit, pan, zoom, iso, head };
     void accumulate(Pending kind, std::vector<std::string>& out);
     void flush(std::vector<std::string>& out);
     void drag_to(int x, int y);
@@ -68,6 +79,7 @@ class ControlInput {
     double drag_x_ = 0, drag_y_ = 0;  // pixels
     int zoom_steps_ = 0;
     double iso_steps_ = 0;  // in kIsoStep of the range
+    int head_steps_ = 0;    // of head_step, right
     bool quit_ = false;
 };
 

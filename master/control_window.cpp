@@ -53,8 +53,13 @@ void ControlWindow::begin() {
 }
 
 std::vector<SteeringLine> ControlWindow::take(const WallMaster& master) {
-    const ControlState state{master.iso(), master.value_min(), master.value_max(),
-                             layout_.mosaic.width, layout_.mosaic.height};
+    const ControlState state{master.iso(),
+                             master.value_min(),
+                             master.value_max(),
+                             layout_.mosaic.width,
+                             layout_.mosaic.height,
+                             master.head(),
+                             master.spec().physical ? kHeadStepMm : kHeadStepWidths};
     std::vector<SteeringLine> lines;
     for (std::string& text : input_.commands(window_.poll(), state))
         lines.push_back({std::move(text), "control"});

@@ -120,6 +120,7 @@ class WallMaster {
     // With --measure, every tile's curve of the finished frame has come in (ask_curves).
     bool curves_in() const;
     double iso() const { return iso_; }
+    const glm::dvec3& head() const { return head_; }
     double value_min() const { return lo_; }
     double value_max() const { return hi_; }
     // For the control window (--control): the latest preview of each tile rank ([0], the

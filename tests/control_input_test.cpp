@@ -78,6 +78,23 @@ TEST(ControlInput, IsovalueKeysStepByOnePercentOfTheRangeClamped) {
     EXPECT_EQ(in.commands({key("Up")}, {5, 5, 5, 1, 1}), Lines{});
 }
 
+TEST(ControlInput, LeftAndRightMoveTheHeadAndHomeBringsItBack) {
+    ControlState state = kPhantom;
+    // Without a step (the keys are off) nothing happens.
+    ControlInput in;
+    EXPECT_EQ(in.commands({key("Right"), key("Home")}, state), Lines{});
+    state.head_step = kHeadStepMm;
+    state.head = {0, -100, 0};
+    const Lines lines = in.commands({key("Right"), key("Right"), key("Left"), key("Right")}, state);
+    EXPECT_EQ(lines, Lines{"head 100 -100 0"});
+    state.head = {100, -100, 0};
+    EXPECT_EQ(in.commands({key("Home"), key("Left")}, state),
+              (Lines{"head 0 0 0", "head -50 0 0"}));
+    const ScriptCommand c = parse_command(lines[0], "control");
+    ASSERT_TRUE(std::holds_alternative<HeadCmd>(c));
+    EXPECT_EQ(std::get<HeadCmd>(c).offset, glm::dvec3(100, -100, 0));
+}
+
 TEST(ControlInput, KindsKeepTheirOrderAndQuitEndsThePoll) {
     ControlInput in(7);
     const Lines lines = in.commands({press(1, 0, 0), motion(10, 0), release(1, 10, 0), press(4),

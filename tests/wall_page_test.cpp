@@ -25,7 +25,7 @@ TEST(WallPage, TheFourMessagesParse) {
     EXPECT_EQ(parse_page_message(R"({"snapshot": true})", "p").kind, PageKind::snapshot);
     EXPECT_EQ(parse_page_message(R"({"take": true})", "p").kind, PageKind::take);
     for (const char* line :
-         {"zoom 1.25", "iso 52.2", "pan 0.1 -0.2", "quit", "look-at 0 0 5 0 0 0"})
+         {"zoom 1.25", "iso 52.2", "pan 0.1 -0.2", "quit", "look-at 0 0 5 0 0 0", "head 50 0 -20"})
         EXPECT_EQ(parse_page_message(nlohmann::json{{"run", line}}.dump(), "p").text, line);
 }
 
