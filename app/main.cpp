@@ -72,7 +72,10 @@ int main(int argc, char** argv) {
             if (env_rank && std::atoi(env_rank) == wall.fault.rank)
                 raise_test_signal(wall.fault, FaultMoment::init);
             auto comm = make_mpi_comm(argc, argv, {wall.startup_timeout_s, wall.timeout_s});
-            return run_wall(wall, *comm);
+            const int status = run_wall(wall, *comm);
+            // A wall that lost a rank ends without MPI_Finalize, which may wait for it for ever.
+            if (comm->forgot_any()) comm->leave(status);
+            return status;
         }
     } catch (const std::exception& e) {
         print_error(e.what());

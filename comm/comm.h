@@ -6,6 +6,8 @@
 // wall_protocol/protocol.h's.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -68,6 +70,31 @@ class Comm {
     virtual void barrier() = 0;
     // Ends every rank of the job at once (a failing rank must not leave others waiting).
     [[noreturn]] virtual void abort(int code) = 0;
+    // Whether the job goes on when a rank dies: Open MPI started with --enable-recovery (or
+    // --mca orte_enable_recovery 1); otherwise mpirun ends every rank once one dies. False in
+    // process.
+    virtual bool survives_rank_loss() const { return false; }
+    // Whether `rank`'s process has ended, as far as this rank can see: only a rank on this host
+    // (its process id is known here); false for any other, which only its silence gives away.
+    virtual bool peer_gone(int rank) const {
+        (void)rank;
+        return false;
+    }
+    // Ends `rank`'s process (SIGKILL) when it is on this host: a stopped rank that the job has
+    // given up on, which mpirun would otherwise wait for at the end. Nothing elsewhere.
+    virtual void end_peer(int rank) { (void)rank; }
+    // `rank` is gone for good: sends to it in flight are cancelled and later ones dropped (a dead
+    // peer never takes a large message, and MPI would wait for it at the end).
+    virtual void forget(int rank) { (void)rank; }
+    // Whether this rank has forgotten a peer (forget).
+    virtual bool forgot_any() const { return false; }
+    // Ends this process with `status` once its sends in flight are taken, without MPI_Finalize:
+    // with a rank gone, Open MPI 4's finalize (a fence over every rank of the job, the dead one
+    // included) may never return. Under --enable-recovery mpirun takes such an exit quietly.
+    [[noreturn]] virtual void leave(int status) {
+        std::fflush(nullptr);
+        std::_Exit(status);
+    }
     // This rank's last phase has begun (a tile released, the master finishing): from here a stop
     // of this process that lasts the end limit is ended from outside (comm/end_watch.h), since
     // no message of the wall reaches a rank that the others no longer wait for. In process:

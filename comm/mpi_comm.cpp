@@ -4,14 +4,19 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iterator>
 #include <list>
+#include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -129,6 +134,12 @@ class MpiComm final : public Comm {
         MPI_Comm node = MPI_COMM_NULL;
         ISOWALL_MPI_CALL(MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
         ISOWALL_MPI_CALL(MPI_Comm_size(node, &on_host_));
+        // Every rank of this host and its process id, so a rank that dies here is seen at once
+        // (peer_gone), without waiting for its silence.
+        const int mine[2] = {rank_, static_cast<int>(::getpid())};
+        std::vector<int> all(2 * static_cast<std::size_t>(on_host_));
+        ISOWALL_MPI_CALL(MPI_Allgather(mine, 2, MPI_INT, all.data(), 2, MPI_INT, node));
+        for (std::size_t i = 0; i + 1 < all.size(); i += 2) host_pids_[all[i]] = all[i + 1];
         MPI_Comm_free(&node);
         // The job's name: rank 0's process id and start time, the same on every rank.
         std::uint64_t id[2] = {static_cast<std::uint64_t>(::getpid()),
@@ -146,18 +157,7 @@ class MpiComm final : public Comm {
                               "): MPI did not end within " + seconds(limits_.end_s) +
                               " (--timeout): a rank of this job has stopped or cannot be "
                               "reached\n");
-        // Sends still in flight complete before MPI ends; a peer that is gone cannot take them,
-        // so the wait is bounded (the master releases tiles only once every result is in).
-        const auto start = std::chrono::steady_clock::now();
-        while (true) {
-            {
-                std::lock_guard lock(mutex_);
-                progress_sends();
-                if (pending_.empty()) break;
-            }
-            if (std::chrono::steady_clock::now() - start > kFinalSendWait) break;
-            std::this_thread::sleep_for(kPollSleep);
-        }
+        wait_for_sends();
         MPI_Comm_free(&comm_);
         MPI_Finalize();
     }
@@ -167,6 +167,47 @@ class MpiComm final : public Comm {
     int ranks_on_host() const override { return on_host_; }
     std::string job_id() const override { return job_id_; }
     bool owns_process() const override { return true; }
+    bool survives_rank_loss() const override {
+        const char* v = std::getenv("OMPI_MCA_orte_enable_recovery");
+        const std::string s = v ? v : "";
+        return s == "1" || s == "true" || s == "yes" || s == "on";
+    }
+    bool peer_gone(int rank) const override {
+        const auto it = host_pids_.find(rank);
+        if (it == host_pids_.end() || rank == rank_) return false;
+        if (::kill(it->second, 0) != 0) return errno == ESRCH;
+        // Killed but not yet reaped by its launcher: a zombie.
+        std::ifstream stat("/proc/" + std::to_string(it->second) + "/stat");
+        std::string pid, name, state;
+        return stat >> pid >> name >> state && state == "Z";
+    }
+    void end_peer(int rank) override {
+        const auto it = host_pids_.find(rank);
+        if (it != host_pids_.end() && rank != rank_) ::kill(it->second, SIGKILL);
+    }
+    bool forgot_any() const override {
+        std::lock_guard lock(mutex_);
+        return !forgotten_.empty();
+    }
+    [[noreturn]] void leave(int status) override {
+        end_watch_.arm();
+        wait_for_sends();
+        std::fflush(nullptr);
+        std::_Exit(status);
+    }
+    void forget(int rank) override {
+        std::lock_guard lock(mutex_);
+        forgotten_.insert(rank);
+        for (auto it = pending_.begin(); it != pending_.end();) {
+            if (it->dest != rank) {
+                ++it;
+                continue;
+            }
+            MPI_Cancel(&it->request);
+            MPI_Request_free(&it->request);
+            it = pending_.erase(it);
+        }
+    }
     std::string host() const override {
         char name[MPI_MAX_PROCESSOR_NAME];
         int len = 0;
@@ -185,7 +226,9 @@ class MpiComm final : public Comm {
     }
     void send(int dest, Tag tag, std::vector<std::byte>&& bytes) override {
         std::lock_guard lock(mutex_);
+        if (forgotten_.count(dest)) return;
         PendingSend& p = pending_.emplace_back();
+        p.dest = dest;
         p.bytes = std::move(bytes);
         ISOWALL_MPI_CALL(MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, dest,
                                    static_cast<int>(tag), comm_, &p.request));
@@ -240,6 +283,21 @@ class MpiComm final : public Comm {
     }
 
   private:
+    // Sends still in flight complete before MPI ends; a peer that is gone cannot take them, so
+    // the wait is bounded (the master releases tiles only once every result is in).
+    void wait_for_sends() {
+        const auto start = std::chrono::steady_clock::now();
+        while (true) {
+            {
+                std::lock_guard lock(mutex_);
+                progress_sends();
+                if (pending_.empty()) break;
+            }
+            if (std::chrono::steady_clock::now() - start > kFinalSendWait) break;
+            std::this_thread::sleep_for(kPollSleep);
+        }
+    }
+
     static std::string seconds(double s) {
         char text[32];
         std::snprintf(text, sizeof(text), "%g s", s);
@@ -248,6 +306,7 @@ class MpiComm final : public Comm {
 
     struct PendingSend {
         MPI_Request request = MPI_REQUEST_NULL;
+        int dest = -1;
         std::vector<std::byte> bytes;
     };
 
@@ -284,6 +343,8 @@ class MpiComm final : public Comm {
     int size_ = 1;
     int on_host_ = 1;  // ranks sharing this host (MPI_COMM_TYPE_SHARED)
     std::string job_id_;
+    std::map<int, int> host_pids_;  // rank -> process id, for the ranks on this host
+    std::set<int> forgotten_;       // ranks gone for good (forget)
     EndWatch end_watch_;
 };
 

@@ -12,6 +12,7 @@ FaultMoment moment_of(std::string_view s) {
     if (s == "load") return FaultMoment::load;
     if (s == "frame") return FaultMoment::frame;
     if (s == "migration") return FaultMoment::migration;
+    if (s == "next") return FaultMoment::next;
     if (s == "gather") return FaultMoment::gather;
     if (s == "end") return FaultMoment::end;
     if (s == "slab") return FaultMoment::slab;

@@ -12,7 +12,8 @@
 //   stop@MOMENT     the rank sends itself SIGSTOP at MOMENT, as an operator's `kill -STOP` would
 //   kill@MOMENT     the same with SIGKILL
 //   term@MOMENT     the same with SIGTERM, which the process may catch (import: a stop mid-way)
-// MOMENT is init, load, frame, migration, gather or end (a tile released, the master after its
+// MOMENT is init, load, frame, migration, next (a tile's second view as it comes: between frames
+// when the script waited for the first), gather or end (a tile released, the master after its
 // outputs), or slab (import: after its first slab of chunks). RANK is a rank, or "tiles" for
 // every tile; a command that is not the wall is rank 0.
 #include <cstdint>
@@ -31,7 +32,17 @@ enum class FaultAction : std::uint8_t {
     kill,
     term
 };
-enum class FaultMoment : std::uint8_t { none, init, load, frame, migration, gather, end, slab };
+enum class FaultMoment : std::uint8_t {
+    none,
+    init,
+    load,
+    frame,
+    migration,
+    next,
+    gather,
+    end,
+    slab
+};
 
 struct TestFault {
     FaultAction action = FaultAction::none;

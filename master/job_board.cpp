@@ -45,6 +45,7 @@ JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
       pools_(pools.empty() ? std::vector<int>(regions.size(), 0) : std::move(pools)),
       cpu_(2 * regions.size(), 0.0),
       rays_(2 * regions.size(), 0.0) {
+    orphans_.assign(regions.size(), false);
     if (pools_.size() != regions.size())
         throw std::invalid_argument("job board: a pool for every rank, or none");
     for (std::size_t owner = 0; owner < regions.size(); ++owner) {
@@ -131,7 +132,20 @@ std::optional<std::uint32_t> JobBoard::pick(int rank) const {
         if (auto id = steal(q, band)) return id;
         if (auto id = first(band)) return id;
     }
+    // A lost rank's jobs: whoever of its pool asks.
+    for (const Band band : {Band::coarse, Band::fine})
+        for (std::uint32_t id = 0; id < jobs_.size(); ++id) {
+            const BoardJob& j = jobs_[id];
+            const auto k = static_cast<std::size_t>(key(j));
+            if (j.state == BoardJob::State::queued && j.band == band && orphans_[k] &&
+                pools_[static_cast<std::size_t>(j.owner)] == pools_[r])
+                return id;
+        }
     return std::nullopt;
+}
+
+void JobBoard::orphan(int rank) {
+    orphans_.at(static_cast<std::size_t>(rank)) = true;
 }
 
 std::optional<std::uint32_t> JobBoard::next_for(int rank) {

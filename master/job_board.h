@@ -68,6 +68,9 @@ class JobBoard {
     // so in either order).
     void done(std::uint32_t id, double cpu_s);
     void landed(std::uint32_t id);
+    // `rank` is lost (master/wall_master.h): it takes no job, and any rank of its pool takes its
+    // jobs when none of its own or a steal is left, balanced or not. Call before handing out.
+    void orphan(int rank);
 
     const BoardJob& job(std::uint32_t id) const { return jobs_.at(id); }
     std::size_t size() const { return jobs_.size(); }
@@ -95,6 +98,7 @@ class JobBoard {
     int depth_;
     std::vector<int> in_hand_;
     std::vector<int> pools_;          // by rank
+    std::vector<bool> orphans_;       // by rank: lost, its jobs anyone's
     std::vector<double> cpu_, rays_;  // by owner and band (2 * owner + band): of the jobs done
     std::size_t landed_ = 0, migrated_ = 0;
 };

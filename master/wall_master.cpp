@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -51,6 +52,10 @@ void WallMaster::handle(const Envelope& e) {
     if (e.from < 1 || e.from >= comm_.size())
         throw std::runtime_error("a message from unknown rank " + std::to_string(e.from));
     TileState& t = tiles_[static_cast<std::size_t>(e.from)];
+    if (t.lost) {  // a stopped rank let go after the wall gave up on it: it is not heard
+        trace_.switch_to(left);
+        return;
+    }
     Message m;
     try {
         m = decode_message(e.tag, e.bytes);
@@ -71,6 +76,8 @@ void WallMaster::handle(const Envelope& e) {
             order_.clock(e.from, p->cpu_s);
             dispatch();
         }
+    } else if (auto* reg = std::get_if<RegionMsg>(&m)) {
+        land_for_lost(e.from, std::move(*reg));
     } else if (std::holds_alternative<JobDoneMsg>(m) || std::holds_alternative<LandedMsg>(m)) {
         handle_job(e.from, m);
     } else if (auto* img = std::get_if<ImageMsg>(&m)) {
@@ -107,14 +114,17 @@ void WallMaster::handle(const Envelope& e) {
 
 void WallMaster::wait_until(const std::function<bool()>& done, double timeout_s) {
     const Stage left = trace_.switch_to(Stage::idle);
-    Stopwatch silent;  // since the last message other than alive
+    silent_.restart();  // since the last message other than alive (or a rank lost)
     while (!done()) {
         keep_alive();
         if (auto e = comm_.receive(-1, kReceiveSliceS)) {
             const bool alive = e->tag == Tag::alive;
             handle(*e);
-            if (!alive) silent.restart();
-        } else if (silent.seconds() > timeout_s) {
+            if (!alive) silent_.restart();
+        } else if (silent_.seconds() > timeout_s + (comm_.survives_rank_loss() ? 1.0 : 0.0)) {
+            // (A wall that survives a lost rank gives check_tiles, in keep_alive, a second to
+            // lose a silent rank first: its alive messages may have come after the last other
+            // message.)
             char msg[96];
             std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", timeout_s);
             throw std::runtime_error(std::string(msg) + " (waiting on " + waiting_on() +
@@ -138,21 +148,43 @@ void WallMaster::keep_alive() {
     if (alive_checked_.seconds() > o_.timeout_s / 2)
         for (TileState& t : tiles_) t.heard.restart();
     alive_checked_.restart();
+    check_tiles();
     if (alive_sent_.seconds() < kAliveIntervalS) return;
     alive_sent_.restart();
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
-        if (!t.joined) continue;  // it is not yet listening
-        send_message(comm_, rank, AliveMsg{});
-        if (t.hello && t.heard.seconds() > o_.timeout_s) {
-            char msg[160];
-            std::snprintf(msg, sizeof(msg),
-                          " on %s has sent nothing for %g s (--timeout): it has stopped, or its "
-                          "host cannot be reached; ending the job",
-                          t.host.c_str(), o_.timeout_s);
-            throw std::runtime_error(rank_label(spec_, rank) + msg);
+        if (t.joined && !t.lost) send_message(comm_, rank, AliveMsg{});
+    }
+}
+
+bool WallMaster::check_tiles() {
+    bool lost_one = false;
+    for (int rank = 1; rank < comm_.size(); ++rank) {
+        const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        if (!t.hello || t.lost) continue;  // not yet taking views, or given up on
+        // A wall that survives a lost rank sees one on its own host go at once; elsewhere its
+        // silence gives it away.
+        if (comm_.survives_rank_loss() && comm_.peer_gone(rank)) {
+            lose(rank, "its process has ended");
+            lost_one = true;
+            continue;
+        }
+        if (t.heard.seconds() > o_.timeout_s) {
+            char why[120];
+            std::snprintf(why, sizeof(why),
+                          "has sent nothing for %g s (--timeout): it has stopped, or its host "
+                          "cannot be reached",
+                          o_.timeout_s);
+            if (comm_.survives_rank_loss() && !gathering_) {
+                lose(rank, why);
+                lost_one = true;
+                continue;
+            }
+            throw std::runtime_error(rank_label(spec_, rank) + " on " + t.host + " " + why +
+                                     "; ending the job");
         }
     }
+    return lost_one;
 }
 
 void WallMaster::idle() {
@@ -162,14 +194,82 @@ void WallMaster::idle() {
 
 bool WallMaster::all_tiles(const std::function<bool(const TileState&)>& pred) const {
     for (std::size_t rank = 1; rank < tiles_.size(); ++rank)
-        if (!pred(tiles_[rank])) return false;
+        if (!tiles_[rank].lost && !pred(tiles_[rank])) return false;
     return true;
+}
+
+std::string WallMaster::whole_again(const TileState& t) {
+    if (t.whole_after_s < 0) return "no frame was complete after it";
+    char text[64];
+    std::snprintf(text, sizeof(text), "a frame was complete %.2f s after it", t.whole_after_s);
+    return text;
+}
+
+int WallMaster::lost_count() const {
+    return static_cast<int>(
+        std::count_if(tiles_.begin(), tiles_.end(), [](const TileState& t) { return t.lost; }));
+}
+
+void WallMaster::lose(int rank, const std::string& why) {
+    TileState& t = tiles_[static_cast<std::size_t>(rank)];
+    if (gathering_)
+        throw std::runtime_error(rank_label(spec_, rank) + " on " + t.host + ": " + why +
+                                 ", while the outputs were gathered; ending the job");
+    t.lost = true;
+    t.lost_why = why;
+    t.lost_at_s = run_clock_.seconds();
+    t.image.reset();
+    comm_.forget(rank);
+    comm_.end_peer(rank);  // stopped on this host: ended, so that mpirun does not wait for it
+    for (int r = 1; r < comm_.size(); ++r)
+        if (living(r)) send_message(comm_, r, LostMsg{rank});
+    std::fflush(stdout);
+    std::fprintf(stderr,
+                 "isowall: warning: %s on %s is lost (%s); the other ranks draw its screen\n",
+                 rank_label(spec_, rank).c_str(), t.host.c_str(), why.c_str());
+    std::fflush(stderr);
+    silent_.restart();
+    if (living_tiles() == 0) throw std::runtime_error("every tile rank is lost; ending the job");
+    if (board_) send_views();  // the frame again, its screen as jobs of the others
+}
+
+int WallMaster::living_tiles() const {
+    int n = 0;
+    for (int rank = 1; rank < comm_.size(); ++rank) n += living(rank) ? 1 : 0;
+    return n;
+}
+
+void WallMaster::land_for_lost(int from, RegionMsg r) {
+    if (r.generation != generation_ || !board_) return;  // an interrupted frame's
+    if (r.job >= board_->size())
+        throw WireError(rank_label(spec_, from) + ": no job " + std::to_string(r.job) +
+                        " in this frame");
+    const BoardJob& j = board_->job(r.job);
+    TileState& owner = tiles_[static_cast<std::size_t>(j.owner)];
+    if (!owner.lost || j.worker != from || j.state == BoardJob::State::queued)
+        throw WireError(rank_label(spec_, from) + " sent the master a region message for job " +
+                        std::to_string(r.job) + ", whose owner is not lost");
+    const Stage left = trace_.switch_to(Stage::compose);
+    Image& dst = owner.stand_in;
+    if (r.rect.x < 0 || r.rect.y < 0 || r.rect.x + r.rect.width > dst.width ||
+        r.rect.y + r.rect.height > dst.height)
+        throw WireError(rank_label(spec_, from) + ": region message: rect outside the screen");
+    Image img;
+    img.width = r.rect.width;
+    img.height = r.rect.height;
+    img.rgba = std::move(r.rgba);
+    img.depth = std::move(r.depth);
+    composite_by_depth(dst, img, r.rect);
+    board_->landed(r.job);
+    trace_.switch_to(left);
+    ask_curves();
 }
 
 std::string WallMaster::waiting_on() const {
     std::string list;
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        if (t.lost) continue;
         const bool busy = board_ && !board_->complete() && board_->in_hand(rank) > 0;
         if (awaited_ ? !awaited_(t) : busy)
             list += (list.empty() ? "" : ", ") + rank_label(spec_, rank);
@@ -235,10 +335,18 @@ void WallMaster::send_views() {
         ViewMsg v;
         v.generation = generation_;
         v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_};
-        send_message(comm_, rank, v);
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
         t.view = v.view;
+        if (t.lost) {
+            // Its screen, drawn by the others: the background, then their results by depth.
+            t.stand_in.resize(r.width, r.height);
+            for (std::size_t i = 0; i < t.stand_in.pixel_count(); ++i)
+                t.stand_in.rgba[4 * i + 3] = 255;
+            t.stand_in.depth.assign(t.stand_in.pixel_count(), 1.0f);
+            continue;
+        }
+        send_message(comm_, rank, v);
     }
     std::vector<FrameView> views;  // by rank: the master's is empty (width 0)
     for (const TileState& t : tiles_) views.push_back(t.view);
@@ -247,17 +355,28 @@ void WallMaster::send_views() {
             ? planner_.next(views, iso_, board_ ? &*board_ : nullptr, bounds_, o_.screen_box)
             : grid_plan(views, o_.balance ? o_.region_w : 0, o_.balance ? o_.region_h : 0, bounds_,
                         o_.screen_box);
-    std::vector<int> pools;  // by rank: each eye's ranks help only each other
-    for (int rank = 0; rank < comm_.size(); ++rank)
+    // By rank: each eye's ranks help only each other, unless every rank of an eye is lost (its
+    // screens are then drawn by the other eye's ranks rather than never).
+    std::vector<int> pools;
+    std::vector<int> living_in(3, 0);
+    for (int rank = 0; rank < comm_.size(); ++rank) {
         pools.push_back(static_cast<int>(eye_of_rank(spec_, rank)));
+        if (rank != kMasterRank && living(rank))
+            ++living_in[static_cast<std::size_t>(pools.back())];
+    }
+    for (int& p : pools)
+        if (living_in[static_cast<std::size_t>(p)] == 0) p = living_in[1] > 0 ? 1 : 2;
     board_.emplace(plan.regions, plan.work, o_.balance, 1, std::move(pools));
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (!living(rank)) board_->orphan(rank);
     migrations_.clear();
     frame_busy_s_.assign(tiles_.size(), 0.0);
     frame_clock_s_.assign(tiles_.size(), 0.0);
     curves_asked_ = false;
     frame_curves_.assign(tiles_.size(), TileResultMsg{});
     order_.begin_frame();
-    for (int rank = 1; rank < comm_.size(); ++rank) order_.ask(rank);
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (living(rank)) order_.ask(rank);
     dispatch();
     ask_curves();  // a frame with no job (nothing of the volume on the wall) is complete at once
     frame_start_ = Stopwatch();
@@ -328,7 +447,8 @@ void WallMaster::wait(const WaitCmd& w) {
 
 std::vector<Mosaic> WallMaster::gather_snapshot() {
     for (TileState& t : tiles_) t.image.reset();
-    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, SnapshotMsg{});
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (living(rank)) send_message(comm_, rank, SnapshotMsg{});
     wait_for_tiles([](const TileState& t) { return t.image.has_value(); }, o_.timeout_s);
     return compose();
 }
@@ -342,8 +462,14 @@ std::vector<Mosaic> WallMaster::compose(OutputFiles* batch) {
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const int tile = tile_of_rank(spec_, rank);
         const Eye eye = eye_of_rank(spec_, rank);
-        ImageMsg& m = *tiles_[static_cast<std::size_t>(rank)].image;
-        Image img{m.width, m.height, std::move(m.rgba), {}};
+        TileState& t = tiles_[static_cast<std::size_t>(rank)];
+        Image img;
+        if (t.lost) {
+            img = Image{t.stand_in.width, t.stand_in.height, t.stand_in.rgba, {}};
+        } else {
+            ImageMsg& m = *t.image;
+            img = Image{m.width, m.height, std::move(m.rgba), {}};
+        }
         paste(mosaics[eye == Eye::right ? 1 : 0], img, eye_rect(spec_, tile));
         std::string suffix;  // appended, not concatenated: GCC 12 warns of a false overlap
         if (eye != Eye::centre) suffix.append("-").append(to_string(eye));
@@ -370,8 +496,10 @@ void WallMaster::write_mosaics(const std::filesystem::path& path, std::vector<Mo
 
 int WallMaster::finish() {
     comm_.ending();
+    gathering_ = true;
     for (TileState& t : tiles_) t.image.reset();
-    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, QuitMsg{});
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (living(rank)) send_message(comm_, rank, QuitMsg{});
     wait_for_tiles([](const TileState& t) { return t.result && t.image; }, o_.timeout_s);
     // The run's outputs (per-tile images, the mosaic, the traces) are one batch, committed after
     // everything that can fail: all of them or none, and the last line says which. They are
@@ -395,15 +523,37 @@ int WallMaster::finish() {
         std::printf("wrote %s\n", o_.out.c_str());
     std::fflush(stdout);
     // Every rank has stopped working, so no helper's result is on its way any more.
-    for (int rank = 1; rank < comm_.size(); ++rank) send_message(comm_, rank, ReleaseMsg{});
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (living(rank)) send_message(comm_, rank, ReleaseMsg{});
     raise_test_signal(o_.fault, FaultMoment::end);
-    return 0;
+    if (lost_count() == 0) return 0;
+    std::fflush(stdout);
+    std::fprintf(stderr,
+                 "isowall: the wall lost %d tile rank%s (listed above); the outputs show every "
+                 "screen, drawn by the others (exit status %d)\n",
+                 lost_count(), lost_count() == 1 ? "" : "s", kLostRankExit);
+    return kLostRankExit;
 }
 
 void WallMaster::report(OutputFiles& batch) {
     std::vector<TileResultMsg> results(tiles_.size());
-    for (std::size_t rank = 1; rank < tiles_.size(); ++rank) results[rank] = *tiles_[rank].result;
+    for (std::size_t rank = 1; rank < tiles_.size(); ++rank) {
+        const TileState& t = tiles_[rank];
+        if (t.lost)
+            results[rank].host = t.host;  // nothing came: zeros in the tables
+        else
+            results[rank] = *t.result;
+    }
     print_rank_table(stdout, spec_, results);
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (!living(rank)) {
+            const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+            std::printf(
+                "lost: %s on %s, %.1f s into the run: %s; its screen was drawn by the "
+                "other ranks (its row above: zeros); %s\n",
+                rank_label(spec_, rank).c_str(), t.host.c_str(), t.lost_at_s, t.lost_why.c_str(),
+                whole_again(t).c_str());
+        }
     print_scheduler(stdout, o_.balance, frame_done(), *board_, order_, migrations_, results);
     print_earlier_frames(stdout, results, completed_);
     if (o_.results_out) *o_.results_out = results;
@@ -424,6 +574,7 @@ void WallMaster::fill(int rank) {
         m.generation = generation_;
         m.job = *id;
         m.owner = j.owner;
+        m.deliver = living(j.owner) ? j.owner : kMasterRank;
         m.band = j.band;
         m.view = tiles_[static_cast<std::size_t>(j.owner)].view;
         m.rect = j.rect;
@@ -475,10 +626,13 @@ void WallMaster::handle_job(int from, const Message& m) {
 }
 
 void WallMaster::ask_curves() {
+    if (board_ && board_->complete())
+        for (TileState& t : tiles_)
+            if (t.lost && t.whole_after_s < 0) t.whole_after_s = run_clock_.seconds() - t.lost_at_s;
     if (!o_.measure || curves_asked_ || !board_ || !board_->complete()) return;
     curves_asked_ = true;
     for (int rank = 1; rank < comm_.size(); ++rank)
-        send_message(comm_, rank, CurveAskMsg{generation_});
+        if (living(rank)) send_message(comm_, rank, CurveAskMsg{generation_});
 }
 
 FrameFigures WallMaster::frame_figures() const {
@@ -502,7 +656,8 @@ FrameFigures WallMaster::frame_figures() const {
 
 bool WallMaster::curves_in() const {
     bool all = curves_asked_;
-    for (std::size_t r = 1; r < frame_curves_.size(); ++r) all = all && frame_curves_[r].frames;
+    for (std::size_t r = 1; r < frame_curves_.size(); ++r)
+        all = all && (frame_curves_[r].frames || tiles_[r].lost);
     return all;
 }
 

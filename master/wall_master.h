@@ -39,6 +39,10 @@ class TileFailed : public std::runtime_error {
     bool input_;
 };
 
+// The exit status of a wall that finished with a tile rank lost: the outputs are complete (the
+// other ranks drew its screen), and the status says the wall was not whole.
+inline constexpr int kLostRankExit = 3;
+
 struct MasterOptions {
     std::string wall_name;  // for the start-up line
     std::string out = "mosaic.png";
@@ -132,6 +136,8 @@ class WallMaster {
     const StoreSent& store_sent() const { return store_sent_; }
     FrameFigures frame_figures() const;
     const WallSpec& spec() const { return spec_; }
+    // Tile ranks lost so far (TileState::lost); finish() then returns kLostRankExit.
+    int lost_count() const;
 
   private:
     struct TileState {
@@ -144,7 +150,26 @@ class WallMaster {
         FrameView view;             // of the current generation
         std::optional<ImageMsg> image;  // the answer to the pending image request
         std::optional<TileResultMsg> result;
+        // Lost: its process ended, or it was silent past --timeout, on a wall that survives a
+        // lost rank (Comm::survives_rank_loss). The other ranks draw its screen as jobs whose
+        // results come to the master, composed by depth into `stand_in`.
+        bool lost = false;
+        std::string lost_why;
+        double lost_at_s = 0;       // seconds into the run
+        double whole_after_s = -1;  // from then until a frame was complete again
+        Image stand_in;
     };
+    // Gives up on `rank` and starts the frame again without it (see TileState::lost).
+    void lose(int rank, const std::string& why);
+    // Loses every tile rank that is gone or silent past --timeout on a wall that survives a lost
+    // rank (else a silent one ends the job); whether one was lost.
+    bool check_tiles();
+    // A helper's result for a lost rank's screen.
+    void land_for_lost(int from, RegionMsg r);
+    bool living(int rank) const { return !tiles_[static_cast<std::size_t>(rank)].lost; }
+    int living_tiles() const;
+    // "a frame was complete 0.41 s after it" (or that none was), for the report's lost line.
+    static std::string whole_again(const TileState& t);
 
     void handle(const Envelope& e);
     void handle_job(int from, const Message& m);
@@ -205,6 +230,9 @@ class WallMaster {
     RegionPlanner planner_;  // the regions of each frame, from the work (regions_from_work)
     DispatchOrder order_;    // which asking rank is served next
     Stopwatch alive_sent_, alive_checked_;
+    Stopwatch run_clock_;     // since the master was made
+    Stopwatch silent_;        // since the last message other than alive (wait_until)
+    bool gathering_ = false;  // finish() waits for the tiles' outputs
     std::function<bool(const TileState&)> awaited_;    // set by wait_for_tiles, for waiting_on
     std::vector<std::optional<PreviewMsg>> previews_;  // by rank
     std::uint64_t previews_taken_ = 0;

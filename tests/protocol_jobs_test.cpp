@@ -24,6 +24,8 @@ TEST(ProtocolJobs, JobFaultsThrowNamingTheField) {
         {"owner", [](JobMsg& m) { m.owner = 0; }},  // the master owns no tile
         {"owner", [](JobMsg& m) { m.owner = -3; }},
         {"band", [](JobMsg& m) { m.band = Band{2}; }},
+        {"deliver", [](JobMsg& m) { m.deliver = 3; }},  // neither the owner nor the master
+        {"deliver", [](JobMsg& m) { m.deliver = -1; }},
         {"band", [](JobMsg& m) { m.band = Band{255}; }},
         {"camera.eye", [](JobMsg& m) { m.view.camera.eye.x = kNaN; }},
         {"view.width", [](JobMsg& m) { m.view.width = 0; }},

@@ -37,6 +37,7 @@ TEST(Protocol, DegenerateMessagesRoundTrip) {
     expect_round_trip(JobDoneMsg{});
     expect_round_trip(LandedMsg{});
     expect_round_trip(CurveAskMsg{});
+    expect_round_trip(LostMsg{7});
 }
 
 TEST(Protocol, ViewAtTheLimitsRoundTrips) {
@@ -156,6 +157,7 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::job_done), "job_done");
     EXPECT_STREQ(to_string(Tag::region), "region");
     EXPECT_STREQ(to_string(Tag::landed), "landed");
+    EXPECT_STREQ(to_string(Tag::lost), "lost");
     EXPECT_STREQ(to_string(static_cast<Tag>(0)), "unknown");
     EXPECT_STREQ(to_string(Tag::store_ask), "store_ask");
     EXPECT_STREQ(to_string(Tag::store_meta), "store_meta");
@@ -164,7 +166,7 @@ TEST(Protocol, TagNames) {
     EXPECT_STREQ(to_string(Tag::curve_ask), "curve_ask");
     EXPECT_STREQ(to_string(Tag::curve), "curve");
     EXPECT_STREQ(to_string(Tag::failed), "failed");
-    EXPECT_STREQ(to_string(static_cast<Tag>(23)), "unknown");
+    EXPECT_STREQ(to_string(static_cast<Tag>(24)), "unknown");
     EXPECT_STREQ(to_string(static_cast<Tag>(-1)), "unknown");
 }
 

@@ -94,7 +94,7 @@ inline bool operator==(const PreviewMsg& a, const PreviewMsg& b) {
 }
 inline bool operator==(const JobMsg& a, const JobMsg& b) {
     return a.generation == b.generation && a.job == b.job && a.owner == b.owner &&
-           a.band == b.band && a.view == b.view && a.rect == b.rect;
+           a.deliver == b.deliver && a.band == b.band && a.view == b.view && a.rect == b.rect;
 }
 inline bool operator==(const JobDoneMsg& a, const JobDoneMsg& b) {
     return a.generation == b.generation && a.job == b.job && a.rays == b.rays &&
@@ -108,6 +108,9 @@ inline bool operator==(const RegionMsg& a, const RegionMsg& b) {
 }
 inline bool operator==(const LandedMsg& a, const LandedMsg& b) {
     return a.generation == b.generation && a.job == b.job;
+}
+inline bool operator==(const LostMsg& a, const LostMsg& b) {
+    return a.rank == b.rank;
 }
 inline bool operator==(const CurveAskMsg& a, const CurveAskMsg& b) {
     return a.generation == b.generation;
@@ -255,6 +258,7 @@ inline JobMsg sample_job() {
     m.generation = 0x1122334455667788ULL;
     m.job = 0xa1b2c3d4u;
     m.owner = 17;
+    m.deliver = 17;
     m.band = Band::fine;
     m.view = sample_view().view;
     m.rect = {640, 360, 320, 240};

@@ -70,12 +70,12 @@ TEST(TileLoopShows, TheLastChangeIsShownWhileMessagesKeepTheInboxFull) {
         await<TileHelloMsg>(comm);
         send_message(comm, 1, ViewMsg{1, fv});
         send_message(comm, 1,
-                     JobMsg{1, 0, 1, Band::fine, fv, PixelRect{0, 0, fv.width, fv.height}});
+                     JobMsg{1, 0, 1, 1, Band::fine, fv, PixelRect{0, 0, fv.width, fv.height}});
         await<JobDoneMsg>(comm);
         // The frame is done; its last change may wait for the show's interval. Messages now
         // come faster than the tile takes them, for three intervals: jobs of an older frame,
         // which the tile drops.
-        const JobMsg stale{0, 0, 1, Band::fine, fv, PixelRect{0, 0, fv.width, fv.height}};
+        const JobMsg stale{0, 0, 1, 1, Band::fine, fv, PixelRect{0, 0, fv.width, fv.height}};
         const auto t0 = std::chrono::steady_clock::now();
         while (std::chrono::steady_clock::now() - t0 <
                std::chrono::duration<double>(3 * kInterval)) {

@@ -116,6 +116,8 @@ class TileRank {
         if (setup_.fault.action == FaultAction::throw_error)
             throw std::runtime_error("test fault: a tile throws");
         raise_test_signal(setup_.fault, FaultMoment::frame);
+        if (first_view_ != 0 && v.generation != first_view_)
+            raise_test_signal(setup_.fault, FaultMoment::next);
         if (first_view_ == 0) first_view_ = v.generation;
         keep_curve();
         close_frame();
@@ -226,11 +228,11 @@ class TileRank {
                 // view's job just after the change (a late result the owner must drop).
                 send_message(comm_, kMasterRank, out.done);
                 inbox_.wait_interrupt();
-                comm_.send(j.owner, Tag::region, std::move(bytes));
+                comm_.send(j.deliver, Tag::region, std::move(bytes));
                 trace_.switch_to(Stage::comm);
                 return;
             }
-            comm_.send(j.owner, Tag::region, std::move(bytes));
+            comm_.send(j.deliver, Tag::region, std::move(bytes));
             jobs_.add_busy(thread_cpu_seconds() - c0);  // sending is part of the job
             trace_.switch_to(Stage::comm);
         } else {

@@ -54,6 +54,7 @@ MasterUnreachable Receiver::silent_master() const {
 void Receiver::loop() {
     try {
         Stopwatch alive_sent, master_heard, turn;
+        bool master_gone = false;
         while (!ending_) {
             // A turn of this loop takes kReceivePollS; one far longer means this process was
             // stopped (SIGSTOP, a debugger) and has just been let go: the master is not the
@@ -63,8 +64,15 @@ void Receiver::loop() {
             if (alive_sent.seconds() >= kAliveIntervalS) {
                 send_message(comm_, kMasterRank, AliveMsg{});
                 alive_sent.restart();
+                // Where the job outlives a rank, mpirun does not end the tiles when the master
+                // dies: one on this host is seen at once. What it sent before it ended (the
+                // release, at the end of a wall that lost a rank) is taken first.
+                master_gone = comm_.survives_rank_loss() && comm_.peer_gone(kMasterRank);
             }
-            auto e = comm_.receive(-1, kReceivePollS);
+            auto e = comm_.receive(-1, master_gone ? 0 : kReceivePollS);
+            if (!e && master_gone)
+                throw MasterUnreachable(
+                    "the master (rank 0) has ended: the wall cannot go on without it");
             if (!e) {
                 if (master_heard.seconds() > limit_s()) throw silent_master();
                 continue;
@@ -72,6 +80,12 @@ void Receiver::loop() {
             if (e->from == kMasterRank) master_heard.restart();
             Message m = decode_message(e->tag, e->bytes);
             if (std::holds_alternative<AliveMsg>(m) && e->from == kMasterRank) continue;
+            if (auto* lost = std::get_if<LostMsg>(&m); lost && e->from == kMasterRank) {
+                // Results for it in flight are dropped; stopped on this host, it is ended.
+                comm_.forget(lost->rank);
+                comm_.end_peer(lost->rank);
+                continue;
+            }
             if (auto* part = std::get_if<StorePartMsg>(&m); part && e->from == kMasterRank) {
                 if (!store_)
                     throw WireError("a store_part message, and this rank reads its own store");

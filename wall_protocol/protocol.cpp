@@ -333,6 +333,8 @@ const char* to_string(Tag tag) {
             return "curve";
         case Tag::failed:
             return "failed";
+        case Tag::lost:
+            return "lost";
     }
     // A tag comes off the wire as any int32, so this is reachable.
     return "unknown";
@@ -382,6 +384,8 @@ Message decode_message(Tag tag, std::span<const std::byte> bytes) {
             return job_wire::decode_curve(bytes);
         case Tag::failed:
             return decode_failed(bytes);
+        case Tag::lost:
+            return job_wire::decode_lost(bytes);
     }
     throw WireError("message with tag " + std::to_string(static_cast<std::int32_t>(tag)) +
                     ": unknown tag, expected 1..14 or 16..22");

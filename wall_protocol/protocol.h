@@ -42,6 +42,7 @@ enum class Tag : std::int32_t {
     curve_ask = 20,   // master -> tile (--measure): the frame is complete; send its curve
     curve = 21,       // tile -> master: that frame's correctness curve (the page's C = 99%)
     failed = 22,      // tile -> master: the rank has failed; the master says why, once, and ends
+    lost = 23,        // master -> tile: a tile rank is gone; never send to it again
 };
 const char* to_string(Tag tag);
 
@@ -191,10 +192,13 @@ enum class Band : std::uint8_t { coarse = 0, fine = 1 };
 
 struct JobMsg {
     static constexpr Tag kTag = Tag::job;
-    static constexpr std::uint8_t kVersion = 1;
+    static constexpr std::uint8_t kVersion = 2;
     std::uint64_t generation = 0;
     std::uint32_t job = 0;   // the master's id, unique within a generation
     std::int32_t owner = 0;  // the rank whose tile the region is on
+    // Where a helper sends the region's result: the owner, or the master when the owner is lost
+    // (the master then composes the lost tile's screen itself).
+    std::int32_t deliver = 0;
     Band band = Band::coarse;
     FrameView view;  // the owner's view
     PixelRect rect;  // in the owner's screen; not empty
@@ -263,10 +267,19 @@ class MasterUnreachable : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// A tile rank is gone (its process ended, or it was silent past --timeout on a wall that survives
+// a lost rank): the others cancel their sends to it, and a rank on its host ends it if it is
+// still there (stopped), so that mpirun does not wait for it at the end.
+struct LostMsg {
+    static constexpr Tag kTag = Tag::lost;
+    static constexpr std::uint8_t kVersion = 1;
+    std::int32_t rank = 0;
+};
+
 using Message = std::variant<TileHelloMsg, ViewMsg, ProgressMsg, SnapshotMsg, ImageMsg, QuitMsg,
                              TileResultMsg, ReleaseMsg, StartMsg, AliveMsg, PreviewMsg, JobMsg,
                              JobDoneMsg, RegionMsg, LandedMsg, StoreAskMsg, StoreMetaMsg,
-                             StorePartMsg, CurveAskMsg, CurveMsg, FailedMsg>;
+                             StorePartMsg, CurveAskMsg, CurveMsg, FailedMsg, LostMsg>;
 
 std::vector<std::byte> encode(const TileHelloMsg& m);
 std::vector<std::byte> encode(const ViewMsg& m);
@@ -289,6 +302,7 @@ std::vector<std::byte> encode(const StorePartMsg& m);
 std::vector<std::byte> encode(const CurveAskMsg& m);
 std::vector<std::byte> encode(const CurveMsg& m);
 std::vector<std::byte> encode(const FailedMsg& m);
+std::vector<std::byte> encode(const LostMsg& m);
 std::vector<std::byte> encode(const Message& m);
 Tag tag_of(const Message& m);
 

@@ -21,6 +21,21 @@ ReleaseMsg job_wire::decode_release(std::span<const std::byte> bytes) {
     return {};
 }
 
+std::vector<std::byte> encode(const LostMsg& m) {
+    MessageWriter w(LostMsg::kVersion);
+    w.put(m.rank);
+    return w.take();
+}
+
+LostMsg job_wire::decode_lost(std::span<const std::byte> bytes) {
+    MessageReader r(bytes, LostMsg::kVersion, "lost message");
+    LostMsg m;
+    m.rank = r.get<std::int32_t>();
+    if (m.rank < 1) r.fail("rank: expected a tile rank (>= 1), got " + std::to_string(m.rank));
+    r.finish();
+    return m;
+}
+
 std::vector<std::byte> encode(const StartMsg&) {
     return MessageWriter(StartMsg::kVersion).take();
 }
@@ -46,6 +61,7 @@ std::vector<std::byte> encode(const JobMsg& m) {
     w.put(m.generation);
     w.put(m.job);
     w.put(m.owner);
+    w.put(m.deliver);
     w.put(static_cast<std::uint8_t>(m.band));
     put_frame_view(w, m.view);
     put_pixel_rect(w, m.rect);
@@ -79,6 +95,10 @@ JobMsg job_wire::decode_job(std::span<const std::byte> bytes) {
     m.job = r.get<std::uint32_t>();
     m.owner = r.get<std::int32_t>();
     if (m.owner < 1) r.fail("owner: expected a tile rank (>= 1), got " + std::to_string(m.owner));
+    m.deliver = r.get<std::int32_t>();
+    if (m.deliver != 0 && m.deliver != m.owner)
+        r.fail("deliver: expected the owner (" + std::to_string(m.owner) +
+               ") or the master (0), got " + std::to_string(m.deliver));
     const auto band = r.get<std::uint8_t>();
     if (band > static_cast<std::uint8_t>(Band::fine))
         r.fail("band: expected 0 (coarse) or 1 (fine), got " + std::to_string(band));

@@ -9,6 +9,7 @@
 namespace isowall::job_wire {
 
 ReleaseMsg decode_release(std::span<const std::byte> bytes);
+LostMsg decode_lost(std::span<const std::byte> bytes);
 StartMsg decode_start(std::span<const std::byte> bytes);
 AliveMsg decode_alive(std::span<const std::byte> bytes);
 JobMsg decode_job(std::span<const std::byte> bytes);

@@ -1,0 +1,131 @@
+// The show goes on: a 6x4 wall (25 ranks, mpirun --enable-recovery) whose tile rank 9 (tile 8) is
+// killed (SIGKILL) mid-frame, while it runs another tile's job, or between two frames, or stopped
+// (SIGSTOP) mid-frame past --timeout. Each run goes through four views, a snapshot after each;
+// every snapshot and the final mosaic must equal the same run's without a fault (the mosaic
+// tests' thresholds), the report must name the lost rank and tile, the master's last line must
+// say the wall lost a rank, and no process of the run may be left.
+//
+// The signal comes from the rank itself at the named moment (ISOWALL_TEST_FAULT=kill@frame:9),
+// which is exact where an outside kill would race the run.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "core/util.h"
+#include "files/image_io.h"
+#include "tests/image_compare.h"
+#include "tests/run_util.h"
+#include "tests/test_util.h"
+
+namespace isowall {
+namespace {
+
+using test::mpirun;
+using test::run;
+using test::slurp;
+
+constexpr int kGuardS = 240;  // the test's own limit on one run
+constexpr int kViews = 4;
+const test::CompareOptions kFromFiles{.coverage = test::Coverage::colour};
+
+struct Lost {
+    const char* fault;  // ISOWALL_TEST_FAULT
+    const char* name;
+};
+
+// The run's folder: the wall file, the script of four views with a snapshot after each.
+std::filesystem::path prepare(const std::string& name) {
+    const auto dir = test::scratch_dir("lost_" + name);
+    std::ofstream(dir / "6x4.toml") << "tiles = [6, 4]\ntile_size_px = [64, 48]\n";
+    std::ofstream script(dir / "views.txt");
+    for (int v = 1; v <= kViews; ++v)
+        script << (v > 1 ? "orbit 25 5\n" : "") << "wait done\nsnapshot view" << v << "\n";
+    return dir;
+}
+
+// --timeout 4: a stopped rank is given up on after 4 s of silence.
+std::string wall_cmd(const std::filesystem::path& dir) {
+    return mpirun(25, "--enable-recovery ") + "wall --wall '" + (dir / "6x4.toml").string() +
+           "' --out '" + (dir / "m.png").string() + "' --script '" + (dir / "views.txt").string() +
+           "' --timeout 4 --zoom 1.6";
+}
+
+bool any_process_of(const std::filesystem::path& dir) {
+    const std::string cmd =
+        "pgrep -f '[w]all --wall " + (dir / "6x4.toml").string() + "' >/dev/null";
+    return std::system(cmd.c_str()) == 0;
+}
+
+// The same run without a fault, in a folder of the case's own (CTest runs the cases at once).
+std::filesystem::path reference(const std::string& name) {
+    const auto d = prepare(name + "_reference");
+    const int rc = run(wall_cmd(d), d / "run.log", kGuardS);
+    EXPECT_EQ(rc, 0) << slurp(d / "run.log");
+    return d;
+}
+
+void expect_same(const std::filesystem::path& a, const std::filesystem::path& b) {
+    const test::ImageComparison m = test::compare_images(read_image(a), read_image(b), kFromFiles);
+    EXPECT_GE(m.mask_iou, 0.999) << a << ": " << m;
+    EXPECT_GE(m.equal_share, 0.999) << a << ": " << m;
+}
+
+class LostTile : public testing::TestWithParam<Lost> {};
+
+TEST_P(LostTile, TheOthersDrawItsScreenAndTheShowGoesOn) {
+    const Lost& l = GetParam();
+    const auto ref = reference(l.name);
+    const auto dir = prepare(l.name);
+    Stopwatch took;
+    const int rc = run(std::string("env ISOWALL_TEST_FAULT=") + l.fault + " " + wall_cmd(dir),
+                       dir / "run.log", kGuardS);
+    const std::string log = slurp(dir / "run.log");
+    std::printf("%s: exit %d after %.1f s\n", l.fault, rc, took.seconds());
+    EXPECT_NE(rc, 124) << "still running after " << kGuardS << " s: " << log;
+    EXPECT_FALSE(any_process_of(dir)) << "a rank outlived mpirun\n" << log;
+    // Named when lost and in the report, with how soon the frame was whole again.
+    EXPECT_NE(log.find("isowall: warning: rank 9 (tile 8) on "), std::string::npos) << log;
+    const auto lost = log.find("lost: rank 9 (tile 8) on ");
+    ASSERT_NE(lost, std::string::npos) << log;
+    const std::string line = log.substr(lost, log.find('\n', lost) - lost);
+    std::printf("%s\n", line.c_str());
+    EXPECT_NE(line.find("a frame was complete "), std::string::npos) << line;
+    // Open MPI's mpirun exits 0 under --enable-recovery whatever the ranks' statuses; the master
+    // says the wall was not whole.
+    EXPECT_NE(log.find("isowall: the wall lost 1 tile rank"), std::string::npos) << log;
+    EXPECT_EQ(test::count_of(log, "isowall: error:"), 0u) << log;
+    // Every view whole: each snapshot and the mosaic are the run's without a fault.
+    for (int v = 1; v <= kViews; ++v) {
+        const std::string png = "view" + std::to_string(v) + ".png";
+        ASSERT_TRUE(std::filesystem::exists(dir / png)) << png << "\n" << log;
+        expect_same(dir / png, ref / png);
+    }
+    expect_same(dir / "m.png", ref / "m.png");
+}
+
+INSTANTIATE_TEST_SUITE_P(Wall, LostTile,
+                         testing::Values(Lost{"kill@frame:9", "kill_mid_frame"},
+                                         Lost{"kill@migration:9", "kill_while_helping"},
+                                         Lost{"kill@next:9", "kill_between_frames"},
+                                         Lost{"stop@frame:9", "stop_past_the_timeout"}),
+                         [](const testing::TestParamInfo<Lost>& i) { return i.param.name; });
+
+// Without --enable-recovery Open MPI ends every rank once one dies: the wall stops, named, as
+// before (the fault matrix covers every moment).
+TEST(LostTile, WithoutRecoveryAKilledTileStillEndsTheJob) {
+    const auto dir = prepare("no_recovery");
+    std::string cmd = wall_cmd(dir);
+    cmd.replace(cmd.find("--enable-recovery "), std::string("--enable-recovery ").size(), "");
+    const int rc = run("env ISOWALL_TEST_FAULT=kill@frame:9 " + cmd, dir / "run.log", kGuardS);
+    const std::string log = slurp(dir / "run.log");
+    EXPECT_NE(rc, 0) << log;
+    EXPECT_NE(rc, 124) << log;
+    EXPECT_EQ(log.find("isowall: warning:"), std::string::npos) << log;
+    EXPECT_FALSE(any_process_of(dir)) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
+}
+
+}  // namespace
+}  // namespace isowall
