@@ -312,6 +312,7 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     s.done = frame.done;
     s.frame_s = frame.seconds;
     s.figures = master.frame_figures();
+    s.dark = master.dark_screens();
     for (const auto& page : roster_) {
         s.pages.push_back(page->name);
         if (seat_.holder() == page->id) s.steering = page->name;

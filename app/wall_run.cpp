@@ -132,6 +132,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     };
     mo.screen_box = to_engine_options(o.engine).screen_box;
     mo.measure = o.measure;
+    if (o.control || o.http_port >= 0) mo.preview_side = preview_max_side(spec);
     mo.store = in.volume->store;
     mo.store_octree = in.volume->volume.own_octree();
     WallMaster master(mo, comm, spec, in.volume->volume.bounds(), in.iso, in.extractor->value_min(),

@@ -205,6 +205,25 @@ std::string WallMaster::whole_again(const TileState& t) {
     return text;
 }
 
+void WallMaster::preview_lost(int rank) {
+    if (o_.preview_side <= 0) return;
+    const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+    previews_[static_cast<std::size_t>(rank)] =
+        PreviewMsg{make_preview(t.stand_in, generation_, o_.preview_side)};
+    ++previews_taken_;
+}
+
+std::vector<std::string> WallMaster::dark_screens() const {
+    std::vector<std::string> out;
+    for (int rank = 1; rank < comm_.size(); ++rank)
+        if (!living(rank)) {
+            const TileState& t = tiles_[static_cast<std::size_t>(rank)];
+            out.push_back(tile_name(spec_, rank) + " (rank " + std::to_string(rank) + " on " +
+                          t.host + "): " + t.lost_why);
+        }
+    return out;
+}
+
 int WallMaster::lost_count() const {
     return static_cast<int>(
         std::count_if(tiles_.begin(), tiles_.end(), [](const TileState& t) { return t.lost; }));
@@ -261,6 +280,7 @@ void WallMaster::land_for_lost(int from, RegionMsg r) {
     img.depth = std::move(r.depth);
     composite_by_depth(dst, img, r.rect);
     board_->landed(r.job);
+    preview_lost(j.owner);
     trace_.switch_to(left);
     ask_curves();
 }
@@ -344,6 +364,7 @@ void WallMaster::send_views() {
             for (std::size_t i = 0; i < t.stand_in.pixel_count(); ++i)
                 t.stand_in.rgba[4 * i + 3] = 255;
             t.stand_in.depth.assign(t.stand_in.pixel_count(), 1.0f);
+            preview_lost(rank);
             continue;
         }
         send_message(comm_, rank, v);

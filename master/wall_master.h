@@ -72,6 +72,9 @@ struct MasterOptions {
     std::function<std::vector<Box3>(double iso)> work_boxes;
     bool screen_box = true;  // the engine casts no ray outside the volume's screen box
     bool measure = false;    // tiles report emulated correctness curves
+    // The tiles send previews (--control, --http): a lost tile's screen gets one from what the
+    // others drew of it, of this largest side (0: none).
+    int preview_side = 0;
     std::vector<TileResultMsg>* results_out = nullptr;  // also leave the tiles' figures here
     // The volume when it is a store (null otherwise), and its octree file: sent to a tile rank
     // that asks because its host cannot see them (tile/store_client.h).
@@ -138,6 +141,9 @@ class WallMaster {
     const WallSpec& spec() const { return spec_; }
     // Tile ranks lost so far (TileState::lost); finish() then returns kLostRankExit.
     int lost_count() const;
+    // Each lost tile rank as the page names its dark screen: "tile 8 (rank 9 on node3): its
+    // process has ended".
+    std::vector<std::string> dark_screens() const;
 
   private:
     struct TileState {
@@ -166,6 +172,8 @@ class WallMaster {
     bool check_tiles();
     // A helper's result for a lost rank's screen.
     void land_for_lost(int from, RegionMsg r);
+    // The lost rank's preview from its stand-in, with MasterOptions::preview_side.
+    void preview_lost(int rank);
     bool living(int rank) const { return !tiles_[static_cast<std::size_t>(rank)].lost; }
     int living_tiles() const;
     // "a frame was complete 0.41 s after it" (or that none was), for the report's lost line.

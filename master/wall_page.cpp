@@ -111,7 +111,7 @@ std::string state_json(const PageState& s) {
                 {"balance", f.balance},     {"jobs", f.jobs},
                 {"jobs_done", f.jobs_done}, {"migrated", f.migrated},
                 {"c99_s", f.c99_s},         {"steering", s.steering},
-                {"pages", s.pages}}
+                {"pages", s.pages},         {"dark", s.dark}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

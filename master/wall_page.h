@@ -65,6 +65,8 @@ struct PageState {
     FrameFigures figures;
     std::string steering;            // the page that steers, or empty
     std::vector<std::string> pages;  // every page that said hello, in order of arrival
+    // Tile screens whose rank is lost (WallMaster::dark_screens): the others draw them.
+    std::vector<std::string> dark;
 };
 std::string state_json(const PageState& s);
 // A line ran (error empty) or was refused.

@@ -87,7 +87,10 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     s.figures = {40, 40, 12, 0.75, 0.82};
     s.steering = "page 2";
     s.pages = {"page 1", "page 2"};
+    s.dark = {"tile 8 (rank 9 on node3): its process has ended"};
     const auto j = nlohmann::json::parse(state_json(s));
+    ASSERT_EQ(j["dark"].size(), 1u);
+    EXPECT_EQ(j["dark"][0], "tile 8 (rank 9 on node3): its process has ended");
     EXPECT_EQ(j["type"], "state");
     EXPECT_EQ(j["iso"], 52.2);
     EXPECT_EQ(j["frame"], 3);

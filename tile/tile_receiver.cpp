@@ -55,6 +55,7 @@ void Receiver::loop() {
     try {
         Stopwatch alive_sent, master_heard, turn;
         bool master_gone = false;
+        bool quit_seen = false;  // the master asked for this rank's result and image
         while (!ending_) {
             // A turn of this loop takes kReceivePollS; one far longer means this process was
             // stopped (SIGSTOP, a debugger) and has just been let go: the master is not the
@@ -70,6 +71,14 @@ void Receiver::loop() {
                 master_gone = comm_.survives_rank_loss() && comm_.peer_gone(kMasterRank);
             }
             auto e = comm_.receive(-1, master_gone ? 0 : kReceivePollS);
+            if (!e && master_gone && quit_seen) {
+                // The master asked for this rank's outputs, got them and ended: its release may
+                // not have reached this rank before its process went (a wall that lost a rank
+                // ends without MPI_Finalize), so its end is the release.
+                final_cpu_s_ = thread_cpu_seconds();
+                inbox_.push(ReleaseMsg{});
+                return;
+            }
             if (!e && master_gone)
                 throw MasterUnreachable(
                     "the master (rank 0) has ended: the wall cannot go on without it");
@@ -98,6 +107,7 @@ void Receiver::loop() {
                 throw WireError(std::string("a ") + to_string(e->tag) + " message from rank " +
                                 std::to_string(e->from) + ", which does not send them");
             const bool release = std::holds_alternative<ReleaseMsg>(m);
+            quit_seen = quit_seen || std::holds_alternative<QuitMsg>(m);
             // This thread's clock cannot be read once it has ended, which may be before the
             // frame thread takes the release: its last reading is kept first.
             if (release) final_cpu_s_ = thread_cpu_seconds();

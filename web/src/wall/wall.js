@@ -13,7 +13,7 @@ const el = {
   steering: $('steering'), take: $('take'), quit: $('quit'), message: $('message'),
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
   emulated: $('s-emulated'), c99: $('s-c99'), balance: $('s-balance'), jobs: $('s-jobs'), migrated: $('s-migrated'),
-  pages: $('s-pages'), log: $('log'),
+  pages: $('s-pages'), dark: $('s-dark'), log: $('log'),
 };
 const ctx = el.canvas.getContext('2d');
 const kFlushMs = 100;  // a drag or a wheel sends at most this often
@@ -145,6 +145,11 @@ function showState(s) {
   el.jobs.textContent = `${s.jobs_done}/${s.jobs}`;
   el.migrated.textContent = String(s.migrated);
   el.pages.textContent = s.pages.join(', ');
+  // Screens whose tile rank is lost: the other ranks draw them into this mosaic, the wall's own
+  // display stays dark.
+  const dark = s.dark || [];
+  el.dark.parentElement.hidden = dark.length === 0;
+  el.dark.textContent = dark.join('; ');
 }
 
 function logLine(m) {
