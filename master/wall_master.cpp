@@ -269,16 +269,14 @@ void WallMaster::land_for_lost(int from, RegionMsg r) {
         throw WireError(rank_label(spec_, from) + " sent the master a region message for job " +
                         std::to_string(r.job) + ", whose owner is not lost");
     const Stage left = trace_.switch_to(Stage::compose);
-    Image& dst = owner.stand_in;
-    if (r.rect.x < 0 || r.rect.y < 0 || r.rect.x + r.rect.width > dst.width ||
-        r.rect.y + r.rect.height > dst.height)
-        throw WireError(rank_label(spec_, from) + ": region message: rect outside the screen");
+    const PixelRect rect = r.rect;
     Image img;
-    img.width = r.rect.width;
-    img.height = r.rect.height;
-    img.rgba = std::move(r.rgba);
-    img.depth = std::move(r.depth);
-    composite_by_depth(dst, img, r.rect);
+    try {
+        img = region_image(std::move(r), owner.stand_in.width, owner.stand_in.height);
+    } catch (const WireError& e) {
+        throw WireError(rank_label(spec_, from) + ": " + e.what());
+    }
+    composite_by_depth(owner.stand_in, img, rect);
     board_->landed(r.job);
     preview_lost(j.owner);
     trace_.switch_to(left);

@@ -232,19 +232,13 @@ RegionMsg TileJobs::help_result(const JobMsg& job, const RegionKey& key) {
 
 void TileJobs::land(RegionMsg m) {
     const double c0 = thread_cpu_seconds();
-    if (m.rect.x < 0 || m.rect.y < 0 || m.rect.x + m.rect.width > own_.width ||
-        m.rect.y + m.rect.height > own_.height)
-        throw WireError("region message: rect: outside this tile's " + std::to_string(own_.width) +
-                        "x" + std::to_string(own_.height) + " screen");
-    Image img;
-    img.width = m.rect.width;
-    img.height = m.rect.height;
-    img.rgba = std::move(m.rgba);
-    img.depth = std::move(m.depth);
-    composite_by_depth(landed_, img, m.rect);
+    const PixelRect rect = m.rect;
+    const double cpu_end_s = m.cpu_end_s;
+    Image img = region_image(std::move(m), own_.width, own_.height);
+    composite_by_depth(landed_, img, rect);
     landed_any_ = true;
     busy_cpu_s_ += thread_cpu_seconds() - c0;
-    if (measure_) shots_.push_back({m.cpu_end_s, m.rect, std::move(img), false});
+    if (measure_) shots_.push_back({cpu_end_s, rect, std::move(img), false});
 }
 
 Image TileJobs::image() {

@@ -227,6 +227,11 @@ struct RegionMsg {
     std::vector<float> depth;
 };
 
+// A region result's pixels as an image of its rect's size (colour and depth, moved out of `m`),
+// for composite_by_depth into the screen at m.rect; a rect outside a width x height screen is a
+// WireError naming the message.
+Image region_image(RegionMsg&& m, int width, int height);
+
 struct LandedMsg {
     static constexpr Tag kTag = Tag::landed;
     static constexpr std::uint8_t kVersion = 1;

@@ -21,6 +21,19 @@ ReleaseMsg job_wire::decode_release(std::span<const std::byte> bytes) {
     return {};
 }
 
+Image region_image(RegionMsg&& m, int width, int height) {
+    if (m.rect.x < 0 || m.rect.y < 0 || m.rect.x + m.rect.width > width ||
+        m.rect.y + m.rect.height > height)
+        throw WireError("region message: rect: outside this tile's " + std::to_string(width) + "x" +
+                        std::to_string(height) + " screen");
+    Image img;
+    img.width = m.rect.width;
+    img.height = m.rect.height;
+    img.rgba = std::move(m.rgba);
+    img.depth = std::move(m.depth);
+    return img;
+}
+
 std::vector<std::byte> encode(const LostMsg& m) {
     MessageWriter w(LostMsg::kVersion);
     w.put(m.rank);
