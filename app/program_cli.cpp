@@ -93,8 +93,8 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
 void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
     wall_cmd.add_flag("--control", wall.control,
                       "Open the control window on the master's display: a live mosaic of the "
-                      "wall; drag orbits, wheel zooms, Up/Down change the isovalue, s snapshots, "
-                      "Escape quits (after --script FILE, if given)");
+                      "wall; drag orbits, wheel zooms, Up/Down change the isovalue, Left/Right "
+                      "move the head, s snapshots, Escape quits (after --script FILE, if given)");
     wall_cmd.add_option("--control-display", wall.control_display,
                         "X display of the control window (default $DISPLAY)");
     wall_cmd
@@ -187,12 +187,13 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     add_engine_options(*wall_cmd, wall.engine);
     wall_cmd->add_option(
         "--script", wall.script,
-        "Commands (orbit, look-at, zoom, pan, iso, wait, snapshot, quit), one per line; "
+        "Commands (orbit, look-at, zoom, pan, iso, head, wait, snapshot, quit), one per line; "
         "- reads them from the master's console");
     add_control_options(*wall_cmd, wall);
     wall_cmd
         ->add_option("--timeout", wall.timeout_s,
-                     "Seconds a silent tile rank may take before the job ends")
+                     "Seconds a silent tile rank may take before the job ends (under mpirun "
+                     "--enable-recovery: before the others draw its screen)")
         ->transform(number_in(limits::kSeconds))
         ->capture_default_str();
     wall_cmd
