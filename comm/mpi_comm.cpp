@@ -167,11 +167,7 @@ class MpiComm final : public Comm {
     int ranks_on_host() const override { return on_host_; }
     std::string job_id() const override { return job_id_; }
     bool owns_process() const override { return true; }
-    bool survives_rank_loss() const override {
-        const char* v = std::getenv("OMPI_MCA_orte_enable_recovery");
-        const std::string s = v ? v : "";
-        return s == "1" || s == "true" || s == "yes" || s == "on";
-    }
+    bool survives_rank_loss() const override { return survives_rank_loss_; }
     bool peer_gone(int rank) const override {
         const auto it = host_pids_.find(rank);
         if (it == host_pids_.end() || rank == rank_) return false;
@@ -343,6 +339,12 @@ class MpiComm final : public Comm {
     int size_ = 1;
     int on_host_ = 1;  // ranks sharing this host (MPI_COMM_TYPE_SHARED)
     std::string job_id_;
+    // mpirun --enable-recovery (or --mca orte_enable_recovery 1), which it passes to every rank.
+    const bool survives_rank_loss_ = [] {
+        const char* v = std::getenv("OMPI_MCA_orte_enable_recovery");
+        const std::string s = v ? v : "";
+        return s == "1" || s == "true" || s == "yes" || s == "on";
+    }();
     std::map<int, int> host_pids_;  // rank -> process id, for the ranks on this host
     std::set<int> forgotten_;       // ranks gone for good (forget)
     EndWatch end_watch_;

@@ -190,18 +190,22 @@ Camera orbit(const Camera& c, double yaw_deg, double pitch_deg) {
     return out;
 }
 
-Camera pan(const Camera& c, float dx, float dy, float aspect) {
+Camera translate_in_view(const Camera& c, const glm::vec3& offset) {
     const glm::vec3 forward = glm::normalize(c.target - c.eye);
     const glm::vec3 right = glm::normalize(glm::cross(forward, valid_up(forward, c.up)));
     const glm::vec3 up = glm::cross(right, forward);
+    const glm::vec3 move = right * offset.x + up * offset.y - forward * offset.z;
+    Camera out = c;
+    out.eye += move;
+    out.target += move;
+    return out;
+}
+
+Camera pan(const Camera& c, float dx, float dy, float aspect) {
     const float height = c.projection == Projection::perspective
                              ? 2.0f * c.distance() * std::tan(glm::radians(c.fovy_deg) * 0.5f)
                              : c.ortho_height;
-    const glm::vec3 offset = right * (dx * height * aspect) + up * (dy * height);
-    Camera out = c;
-    out.eye += offset;
-    out.target += offset;
-    return out;
+    return translate_in_view(c, {dx * height * aspect, dy * height, 0.0f});
 }
 
 Camera zoom(const Camera& c, float factor) {

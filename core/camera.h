@@ -91,6 +91,9 @@ Camera orbit(const Camera& c, double yaw_deg, double pitch_deg);
 // right, so the scene moves left) and dy screen heights (positive: the view moves up), measured
 // at the target's distance on a screen of the given aspect (width / height).
 Camera pan(const Camera& c, float dx, float dy, float aspect);
+// Moves eye and target together by `offset` in the camera's view space (x right, y up, z back
+// towards the viewer), object units: a pan, a dolly, or a stereo eye beside the camera.
+Camera translate_in_view(const Camera& c, const glm::vec3& offset);
 // factor > 1 moves closer (perspective) or narrows the view (orthographic).
 Camera zoom(const Camera& c, float factor);
 

@@ -43,9 +43,9 @@ JobBoard::JobBoard(const std::vector<std::vector<PixelRect>>& regions,
       depth_(depth),
       in_hand_(regions.size(), 0),
       pools_(pools.empty() ? std::vector<int>(regions.size(), 0) : std::move(pools)),
+      orphans_(regions.size(), false),
       cpu_(2 * regions.size(), 0.0),
       rays_(2 * regions.size(), 0.0) {
-    orphans_.assign(regions.size(), false);
     if (pools_.size() != regions.size())
         throw std::invalid_argument("job board: a pool for every rank, or none");
     for (std::size_t owner = 0; owner < regions.size(); ++owner) {

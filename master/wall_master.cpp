@@ -124,7 +124,7 @@ void WallMaster::wait_until(const std::function<bool()>& done, double timeout_s)
         } else if (silent_.seconds() > timeout_s + (comm_.survives_rank_loss() ? 1.0 : 0.0)) {
             // (A wall that survives a lost rank gives check_tiles, in keep_alive, a second to
             // lose a silent rank first: its alive messages may have come after the last other
-            // message.)
+            // message, and losing it restarts this clock.)
             char msg[96];
             std::snprintf(msg, sizeof(msg), "no tile rank has answered for %g s", timeout_s);
             throw std::runtime_error(std::string(msg) + " (waiting on " + waiting_on() +
@@ -157,8 +157,7 @@ void WallMaster::keep_alive() {
     }
 }
 
-bool WallMaster::check_tiles() {
-    bool lost_one = false;
+void WallMaster::check_tiles() {
     for (int rank = 1; rank < comm_.size(); ++rank) {
         const TileState& t = tiles_[static_cast<std::size_t>(rank)];
         if (!t.hello || t.lost) continue;  // not yet taking views, or given up on
@@ -166,7 +165,6 @@ bool WallMaster::check_tiles() {
         // silence gives it away.
         if (comm_.survives_rank_loss() && comm_.peer_gone(rank)) {
             lose(rank, "its process has ended");
-            lost_one = true;
             continue;
         }
         if (t.heard.seconds() > o_.timeout_s) {
@@ -177,14 +175,12 @@ bool WallMaster::check_tiles() {
                           o_.timeout_s);
             if (comm_.survives_rank_loss() && !gathering_) {
                 lose(rank, why);
-                lost_one = true;
                 continue;
             }
             throw std::runtime_error(rank_label(spec_, rank) + " on " + t.host + " " + why +
                                      "; ending the job");
         }
     }
-    return lost_one;
 }
 
 void WallMaster::idle() {

@@ -168,8 +168,8 @@ class WallMaster {
     // Gives up on `rank` and starts the frame again without it (see TileState::lost).
     void lose(int rank, const std::string& why);
     // Loses every tile rank that is gone or silent past --timeout on a wall that survives a lost
-    // rank (else a silent one ends the job); whether one was lost.
-    bool check_tiles();
+    // rank (else a silent one ends the job).
+    void check_tiles();
     // A helper's result for a lost rank's screen.
     void land_for_lost(int from, RegionMsg r);
     // The lost rank's preview from its stand-in, with MasterOptions::preview_side.

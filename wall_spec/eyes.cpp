@@ -3,7 +3,6 @@
 
 #include <cmath>
 
-#include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
 namespace isowall {
@@ -60,16 +59,7 @@ EyeView eye_view(const Camera& camera, float aspect, const WallSpec& spec, Eye e
         const Camera c = fit_depth_range(camera, bounds);
         return {c, c.frustum(aspect)};
     }
-    // The camera's axes in object space: the look-at basis of Camera::view.
-    const glm::dvec3 forward = glm::normalize(glm::dvec3(camera.target - camera.eye));
-    const glm::dvec3 right =
-        glm::normalize(glm::cross(forward, glm::dvec3(valid_up(glm::vec3(forward), camera.up))));
-    const glm::dvec3 up = glm::cross(right, forward);
-    const glm::dvec3 move = e.x * right + e.y * up - e.z * forward;
-    Camera moved = camera;
-    moved.eye = glm::vec3(glm::dvec3(camera.eye) + move);
-    moved.target = glm::vec3(glm::dvec3(camera.target) + move);
-    moved = fit_depth_range(moved, bounds);
+    const Camera moved = fit_depth_range(translate_in_view(camera, glm::vec3(e)), bounds);
     // The screen's rectangle in the eye's view space, scaled to its near plane.
     const double d = screen_plane_distance(camera, spec);
     const double half_w = 0.5 * screen_plane_width(camera, aspect, spec);
