@@ -19,6 +19,7 @@
 #include "progressive/correctness.h"
 #include "render/renderer_sink.h"
 #include "tests/engine_util.h"
+#include "tests/image_compare.h"
 #include "volume/phantom.h"
 
 namespace isowall {
@@ -161,9 +162,23 @@ TEST(FrontierSeeds, CloseThePictureSoonerAndLeaveTheFinalPictureAsItWas) {
             const FrameRunOutcome off = run_frame(*ex, *renderer, fv, false, threads);
             const FrameRunOutcome on = run_frame(*ex, *renderer, fv, true, threads);
             EXPECT_EQ(on.rays, off.rays) << "every pixel still has its one ray";
+            if (threads > 1) {
+                // Which thread takes which seed first varies, and the engine's promise on
+                // several threads is the full surface's picture within the bar of
+                // Threads.FinalImageMatchesTheFullSurfaceAndRepeats, not one image to the pixel
+                // (one sanitized run on a loaded machine saw C = 0.9981 between these two).
+                const Image full = test::full_surface_image(*ex, *renderer, fv);
+                for (const FrameRunOutcome* run : {&off, &on}) {
+                    const test::ImageComparison vs = test::compare_images(run->final_image, full);
+                    EXPECT_GE(vs.mask_iou, 0.999) << fv;
+                    EXPECT_GE(vs.equal_share, 0.999) << fv;
+                }
+                std::printf("2 threads: %zu pixels differ with and without frontier seeds\n",
+                            test::compare_images(on.final_image, off.final_image).differing_pixels);
+                continue;
+            }
             EXPECT_GE(measure_correctness(on.final_image, off.final_image).c, 0.9999) << fv;
             EXPECT_EQ(coverage_iou(on.final_image, off.final_image), 1.0) << fv;
-            if (threads > 1) continue;  // which thread takes which seed first varies
             // Without the seeds, what the passes stopped short of waits for its own rays.
             ASSERT_GT(on.rays_to_c90, 0u);
             EXPECT_LT(double(on.rays_to_c90), 0.8 * double(off.rays_to_c90))
