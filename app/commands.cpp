@@ -71,10 +71,11 @@ double volume_iso(const std::optional<double>& iso, const OpenedVolume& ov,
                              ex.value_min(), ex.value_max()});
 }
 
-Mesh extract_timed(const SurfaceExtractor& ex, double iso, Timings& t) {
+Mesh extract_timed(const SurfaceExtractor& ex, const FrameView& fv, Timings& t) {
+    const double iso = fv.iso;
     ExtractStats es;
     Stopwatch sw;
-    Mesh mesh = ex.extract_full(iso, &es);
+    Mesh mesh = ex.full_surface(fv, &es);
     t.extract = sw.seconds();
     std::printf(
         "extract: iso %g: %zu triangles, %zu vertices, %zu active cells, %zu octree nodes "
@@ -134,8 +135,8 @@ Camera render_camera(const RenderOptions& o, const Volume& volume, float aspect)
 constexpr double kWarmUpYawDeg = 30;
 FrameView warm_up_view(const FrameView& fv, const Box3& bounds) {
     const Camera cam = fit_depth_range(orbit(fv.camera, kWarmUpYawDeg, 0), bounds);
-    return FrameView{cam, cam.frustum(float(fv.width) / float(fv.height)), fv.width, fv.height,
-                     fv.iso};
+    return FrameView{
+        cam, cam.frustum(float(fv.width) / float(fv.height)), fv.width, fv.height, fv.iso, {}};
 }
 
 ThreadBudget render_threads(const RenderOptions& o) {
@@ -322,12 +323,15 @@ int run_extract(const ExtractOptions& o) {
         throw InputError(
             "--compress", "value",
             "meshopt compresses a .glb, not " + quote(o.out) + "; give --out FILE.glb");
+    FrameView cut;  // extraction needs only the isovalue and the planes
+    cut.clip = checked_clip(o.clip);
     Timings t;
     OpenedVolume ov = open_volume(o.volume);
     t.load = ov.load_s;
     auto ex = prepare(ov, t);
-    const double iso = volume_iso(o.iso, ov, *ex);
-    Mesh mesh = extract_timed(*ex, iso, t);
+    cut.iso = volume_iso(o.iso, ov, *ex);
+    check_clip_keeps(cut.clip, ov.volume.dims(), "--clip", "value");
+    Mesh mesh = extract_timed(*ex, cut, t);
     print_paging(ov);
     Stopwatch sw;
     write_mesh(o.out, mesh, *format, meshopt);
@@ -344,7 +348,8 @@ int run_render(const RenderOptions& o) {
             "--size", "value",
             "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
     check_render_outputs(o);
-    (void)engine_options(o);  // fails early on a bad --order
+    (void)engine_options(o);                    // fails early on a bad --order
+    const ClipSet clip = checked_clip(o.clip);  // and on a bad --clip, before the volume is read
     Timings t;
     // One thread is one core, as on a wall rank with one (app/wall_run.cpp): llvmpipe then
     // rasterises in the drawing thread instead of its own threads on the other cores. The
@@ -362,7 +367,8 @@ int run_render(const RenderOptions& o) {
 
     const float aspect = float(size->x) / float(size->y);
     const Camera cam = render_camera(o, ov.volume, aspect);
-    FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso};
+    FrameView fv{cam, cam.frustum(aspect), size->x, size->y, iso, clip};
+    check_clip_keeps(fv.clip, ov.volume.dims(), "--clip", "value");
 
     // Every output is staged here and appears at the end, all together (no partial output).
     OutputFiles batch;
@@ -378,12 +384,12 @@ int run_render(const RenderOptions& o) {
     }
     if (o.warm_up) {
         Stopwatch warm;
-        const Mesh once = ex->extract_full(iso);
+        const Mesh once = ex->full_surface(fv);
         draw_alone(*renderer, once, fv);
         std::printf("warm-up: the full surface extracted and drawn once, untimed (%.3f s)\n",
                     warm.seconds());
     }
-    Mesh mesh = extract_timed(*ex, iso, t);
+    Mesh mesh = extract_timed(*ex, fv, t);
     Stopwatch sw;
     const Image image = draw_alone(*renderer, mesh, fv);
     t.render = sw.seconds();

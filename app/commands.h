@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/clip_option.h"
 #include "cli/engine_cli.h"
 #include "cli/volume_options.h"
 
@@ -15,6 +16,7 @@ struct InfoOptions {
 struct ExtractOptions {
     VolumeOptions volume;
     std::optional<double> iso;
+    ClipOptions clip;
     std::string out;
     std::string compress = "none";  // a .glb's: none or meshopt
 };
@@ -22,6 +24,7 @@ struct ExtractOptions {
 struct RenderOptions {
     VolumeOptions volume;
     std::optional<double> iso;
+    ClipOptions clip;
     std::string size = "1600x1200";
     std::string out = "isowall.png";
     std::string depth_out;

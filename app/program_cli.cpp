@@ -23,6 +23,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
         "render", "Render one view progressively (or the full surface with --full) to an image");
     add_volume_options(*re_cmd, re.volume);
     add_iso_option(*re_cmd, re.iso);
+    add_clip_options(*re_cmd, re.clip);
     re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     re_cmd->add_option("--out,-o", re.out, "Output image (PNG, or any format OpenImageIO writes)")
         ->capture_default_str();
@@ -177,6 +178,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     add_volume_options(*wall_cmd, wall.volume);
     wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
     add_iso_option(*wall_cmd, wall.iso);
+    add_clip_options(*wall_cmd, wall.clip);
     wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")
         ->capture_default_str();
     wall_cmd->add_option("--tiles-out", wall.tiles_out,
@@ -251,6 +253,7 @@ ProgramCli::ProgramCli() {
         "Extract the full isosurface to a mesh file: PLY, STL, OBJ, VTK PolyData or binary glTF");
     add_volume_options(*ex_cmd, ex.volume);
     add_iso_option(*ex_cmd, ex.iso);
+    add_clip_options(*ex_cmd, ex.clip);
     ex_cmd
         ->add_option("--out,-o", ex.out,
                      "Output mesh, its format by the extension: .ply (binary, with normals), .stl "

@@ -92,7 +92,7 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image) {
     Stopwatch sw;
-    const Mesh mesh = ex.extract_full(fv.iso);
+    const Mesh mesh = ex.full_surface(fv);
     Image full = draw_alone(renderer, mesh, fv);
     const Correctness c = measure_correctness(final_image, full);
     std::printf(
@@ -106,7 +106,7 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
 void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image) {
     Stopwatch sw;
-    const Mesh mesh = ex.extract_full(fv.iso);
+    const Mesh mesh = ex.full_surface(fv);
     const Image truth = draw_truth(renderer, mesh, fv);
     const Fidelity full = measure_fidelity(draw_alone(renderer, mesh, fv), truth);
     const Fidelity own = measure_fidelity(final_image, truth);

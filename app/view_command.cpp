@@ -65,7 +65,7 @@ struct Viewer {
 
     FrameView view() const {
         const Camera c = fit_depth_range(camera, client.ready().bounds);
-        return {c, c.frustum(float(size.x) / float(size.y)), size.x, size.y, iso};
+        return {c, c.frustum(float(size.x) / float(size.y)), size.x, size.y, iso, {}};
     }
     void send() { client.request(view(), setting.lod, setting.cache); }
 

@@ -77,17 +77,20 @@ struct MasterInput {
     std::optional<OpenedVolume> volume;
     std::unique_ptr<SurfaceExtractor> extractor;
     double iso = 0;
+    ClipSet clip;
     std::vector<ScriptLine> script;
 };
 
 MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
+    in.clip = checked_clip(o.clip);
     // The master casts no ray: its volume stays in the shared map.
     in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
     in.iso = checked_iso(o.iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
                                  in.extractor->value_min(), in.extractor->value_max()});
+    check_clip_keeps(in.clip, ov.volume.dims(), "--clip", "value");
     to_engine_options(o.engine);
     // The console and the window or page would both take the operator's commands; one at a
     // time (the window and the page share one loop and take turns).
@@ -122,6 +125,8 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.balance = o.balance;
     if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
     mo.zoom = o.zoom;
+    mo.clip = in.clip;
+    mo.dims = in.volume->volume.dims();
     if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
     mo.regions_from_work = o.region == "auto";
     mo.dispatch = o.dispatch == "emulated" ? Dispatch::emulated : Dispatch::arrival;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/clip_option.h"
 #include "cli/engine_cli.h"
 #include "cli/volume_options.h"
 #include "comm/comm.h"
@@ -19,6 +20,7 @@ struct WallOptions {
     VolumeOptions volume;
     std::string wall;
     std::optional<double> iso;
+    ClipOptions clip;
     std::string out = "mosaic.png";
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";

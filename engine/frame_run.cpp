@@ -37,8 +37,10 @@ bool FrameRun::cast(const FrameView& view, RegionCursor& c, const FrameOutput& o
     cursor_ = &c;
     params_ = opt_.propagation;
     params_.keep_frontier = opt_.frontier_seeds && shown_ != nullptr;
+    params_.cut = in_object_space(view.clip, ex_.volume().spacing());
     if (opt_.region_clip) params_.clip = region_clip(view, c.rect, ex_.volume().spacing());
     refine_params_ = opt_.propagation;
+    refine_params_.cut = params_.cut;
     if (opt_.sampled_triangles)
         params_.samples = refine_params_.samples = sample_grid(view, ex_.volume().spacing());
     if (footprint_) {  // (footprint units come with sampled_triangles only)
@@ -139,9 +141,13 @@ bool FrameRun::cast_level(RayOrder& order, bool second_pass) {
 }
 
 bool FrameRun::cast_ray(glm::ivec2 px, IntersectMode mode, bool second_pass) {
-    const Ray ray = pixel_ray(view_inv_, view_->frustum, view_->width, view_->height, px);
+    // A pixel whose ray the clip planes cut away whole casts none; the others start at the cut.
+    const auto clipped = clip_ray(
+        params_.cut, pixel_ray(view_inv_, view_->frustum, view_->width, view_->height, px));
+    if (!clipped) return true;
+    const Ray& ray = clipped->ray;
     const auto t0 = Clock::now();
-    const RayHit hit = ex_.cast(ray, mode);
+    const RayHit hit = ex_.cast(ray, mode, clipped->t_max);
     now_.t_intersect_s += since(t0);
     ++now_.rays;
     if (second_pass) ++frame_.rays_second_pass;

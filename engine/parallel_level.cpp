@@ -70,10 +70,14 @@ class LevelCast {
             ray = s.ray;
         } else {
             const glm::ivec2 px = job_.pixels[i] + job_.origin;
-            ray = pixel_ray(job_.view_inverse, job_.view.frustum, job_.view.width, job_.view.height,
-                            px);
+            // As FrameRun::cast_ray: no ray where the clip planes cut it away whole.
+            const auto clipped =
+                clip_ray(job_.params.cut, pixel_ray(job_.view_inverse, job_.view.frustum,
+                                                    job_.view.width, job_.view.height, px));
+            if (!clipped) return true;
+            ray = clipped->ray;
             const auto t0 = Clock::now();
-            hit = job_.ex.cast_on(w, ray, job_.mode, std::numeric_limits<float>::max());
+            hit = job_.ex.cast_on(w, ray, job_.mode, clipped->t_max);
             t.intersect_s += since(t0);
             ++t.rays;
             if (!hit.found) return true;

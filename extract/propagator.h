@@ -28,6 +28,7 @@
 #include <glm/vec4.hpp>
 
 #include "core/camera.h"
+#include "core/clip.h"
 #include "core/sample_cull.h"
 #include "extract/adaptive.h"
 #include "extract/footprint.h"
@@ -144,6 +145,10 @@ struct PropagationParams {
     bool keep_frontier = false;
     ScreenClip clip;     // inactive: no limit on screen
     SampleGrid samples;  // inactive: every unit triangulated
+    // The view's clip planes in object space (core/clip.h): a unit wholly cut away is never
+    // entered (it stays unvisited, and no ray reaches it), and the group's triangles are cut at
+    // the planes.
+    ClipSet cut;
 };
 
 // The most frontier units one pass lists: a pass of max_count units has a rim of a few times
@@ -195,6 +200,7 @@ class Propagator {
         g.iso = iso;
         // A border unit finer than a uniform level's is not this level's (adaptive.h).
         if (!resolution_.finer_units() && level < resolution_.max_level()) return g;
+        if (!p.cut.empty() && cut_away(p.cut, unit_box(seed, stride))) return g;
         if (!visited.claim(seed, group_id, level)) return g;
         cache_.clear();
         const glm::vec3 dir = glm::normalize(ray_dir);
@@ -220,6 +226,7 @@ class Propagator {
             if (visited.contains(u, l)) return true;
             const int st = 1 << l;
             if (p.clip.active && !p.clip.may_touch(centre(u, l), st)) return true;
+            if (!p.cut.empty() && cut_away(p.cut, unit_box(u, st))) return true;
             float max_angle = from_angle;
             if (p.mode == PropagationMode::max_count) {
                 if (taken >= p.max_count) {
@@ -305,6 +312,7 @@ class Propagator {
             }
         }
         visited.add_count(taken_cells);
+        clip_mesh(g.mesh, p.cut);
         if (timed_units > 0)
             extract_s_ =
                 timed_s * static_cast<double>(g.cells.size()) / static_cast<double>(timed_units);
@@ -324,6 +332,7 @@ class Propagator {
         g.refinement = true;
         cache_.clear();
         triangulate_cells(base, level, iso, p, g.mesh);
+        clip_mesh(g.mesh, p.cut);
         extract_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return g;
     }
@@ -334,6 +343,11 @@ class Propagator {
     }
 
   private:
+    // The object-space box of the unit of `stride` cells a side at `base`.
+    Box3 unit_box(glm::ivec3 base, int stride) const {
+        return {glm::vec3(base) * v_.spacing, glm::vec3(base + stride) * v_.spacing};
+    }
+
     static constexpr std::size_t kTimedEvery = 16;
 
     // Triangulates the unit of `level` at `c` (a cell at level 0), unless not `emit`, and returns
@@ -377,7 +391,10 @@ class Propagator {
         const glm::ivec3 base = block.base();
         const SampleGrid::WindowBox box =
             p.samples.active ? p.samples.window_box(base, s) : SampleGrid::WindowBox{};
-        if (box.reach != SampleGrid::Reach::inside) {
+        // A unit a clip plane cuts: its pixels' first hits may lie on the cut side, where the
+        // picture shows what lies behind them, so it is drawn whole and cut (clip_mesh).
+        if (box.reach != SampleGrid::Reach::inside ||
+            (!p.cut.empty() && !keeps_whole(p.cut, unit_box(base, s)))) {
             triangulate_cells(base, block.level(), iso, p, mesh);
             return;
         }

@@ -282,4 +282,10 @@ std::unique_ptr<SurfaceExtractor> make_surface_extractor(const Volume& volume,
     });
 }
 
+Mesh SurfaceExtractor::full_surface(const FrameView& view, ExtractStats* stats) const {
+    Mesh mesh = extract_full(view.iso, stats);
+    clip_mesh(mesh, in_object_space(view.clip, volume().spacing()));
+    return mesh;
+}
+
 }  // namespace isowall

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "core/thread_budget.h"
+#include "core/view.h"
 #include "extract/adaptive.h"
 #include "extract/extract.h"
 #include "extract/group.h"
@@ -79,6 +80,8 @@ class SurfaceExtractor {
     virtual double last_extract_s_on(int w) const = 0;
     // Every triangle of the surface at `iso` (the oracle; does not touch visited cells).
     virtual Mesh extract_full(double iso, ExtractStats* stats = nullptr) const = 0;
+    // What a frame of `view` must end up showing: extract_full at view.iso, cut by view.clip.
+    Mesh full_surface(const FrameView& view, ExtractStats* stats = nullptr) const;
 
     // Marks the unit of `level` at `base` (its first cell) as taken by `group_id` in this frame,
     // as a propagation pass would have: a frame that goes on from groups a client already holds

@@ -39,6 +39,7 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     camera_ = orbit(camera_, o.orbit.first, o.orbit.second);
     camera_ = zoom(camera_, o.zoom);
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
+    clip_ = o.clip;
     if (std::string p = camera_problem(camera_); !p.empty())
         throw InputError("--orbit/--zoom/--pan", "value", p);
     if (std::string p = head_problem(camera_, aspect_, spec_, head_); !p.empty())
@@ -348,7 +349,7 @@ void WallMaster::send_views() {
         const PixelRect r = eye_rect(spec_, tile);
         ViewMsg v;
         v.generation = generation_;
-        v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_};
+        v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_, clip_};
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
         t.view = v.view;
@@ -423,6 +424,10 @@ bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where)
         iso_ = checked_isovalue(c->iso, lo_, hi_, where, "iso");
     } else if (const auto* c = std::get_if<HeadCmd>(&cmd)) {
         head_ = c->offset;
+    } else if (const auto* c = std::get_if<ClipCmd>(&cmd)) {
+        if (!keeps_some_voxel(c->clip, o_.dims))
+            throw InputError(where, "clip", "the planes keep nothing of the volume's voxels");
+        clip_ = c->clip;
     } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
         wait(*c);
         return false;

@@ -56,6 +56,8 @@ struct MasterOptions {
     // The first view: the front full view turned, zoomed and panned by these.
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
+    ClipSet clip;        // the first view's clip planes (voxel indices)
+    glm::ivec3 dims{0};  // the volume's voxels: a `clip` that keeps none of them is refused
     // The volume's axes in patient space (volume/volume.h: Orientation), so that the
     // front view is the patient's front whatever the acquisition.
     glm::mat3 front_axes{1.0f};
@@ -128,6 +130,7 @@ class WallMaster {
     bool curves_in() const;
     double iso() const { return iso_; }
     const glm::dvec3& head() const { return head_; }
+    const ClipSet& clip() const { return clip_; }
     double value_min() const { return lo_; }
     double value_max() const { return hi_; }
     // For the control window (--control): the latest preview of each tile rank ([0], the
@@ -222,6 +225,7 @@ class WallMaster {
     float aspect_ = 1;
     Camera camera_;
     glm::dvec3 head_{0};  // the viewer's head from its nominal place (HeadCmd)
+    ClipSet clip_;        // the view's clip planes, voxel indices (ClipCmd)
     std::uint64_t generation_ = 0;
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;

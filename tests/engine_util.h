@@ -23,7 +23,7 @@ inline FrameView make_view(const Volume& v, int w, int h, double iso, float yaw 
 
 // Every triangle of the surface drawn in one go: what the progressive image must end up as.
 inline Image full_surface_image(SurfaceExtractor& ex, Renderer& r, const FrameView& fv) {
-    return draw_alone(r, ex.extract_full(fv.iso), fv);
+    return draw_alone(r, ex.full_surface(fv), fv);
 }
 
 }  // namespace isowall::test

@@ -119,8 +119,8 @@ std::vector<FrameView> two_tiles_seeing(const Box3& box) {
     const Camera cam = front_full_view(box, glm::mat3(1.0f), 4.0f / 3.0f);
     const Frustum f = cam.frustum(4.0f / 3.0f);
     std::vector<FrameView> views(3);
-    views[1] = {cam, f, 640, 480, 0};
-    views[2] = {cam, f, 640, 480, 0};
+    views[1] = {cam, f, 640, 480, 0, {}};
+    views[2] = {cam, f, 640, 480, 0, {}};
     return views;
 }
 const Box3 kUnitBox{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
@@ -208,7 +208,7 @@ TEST(RegionPlan, AFixedGridIsTheOldCut) {
     const Box3 unit{{-0.25f, -0.25f, -0.25f}, {0.25f, 0.25f, 0.25f}};
     const Camera cam = front_full_view(unit, glm::mat3(1.0f), 4.0f / 3.0f);
     std::vector<FrameView> views(2);
-    views[1] = {cam, cam.frustum(4.0f / 3.0f), 640, 480, 0};
+    views[1] = {cam, cam.frustum(4.0f / 3.0f), 640, 480, 0, {}};
     const FramePlan p = grid_plan(views, 128, 96, unit, true);
     EXPECT_EQ(p.regions[1].size(), 25u);
     EXPECT_EQ(p.work[1], estimated_rays(views[1], p.regions[1], unit, true));

@@ -41,7 +41,7 @@ SkinMessages skin_messages(bool exact_only) {
     const Box3 b = v.bounds();
     const Camera cam = fit_depth_range(front_full_view(b, float(w) / h), b);
     s.request.request_id = 4;
-    s.request.view = {cam, cam.frustum(float(w) / h), w, h, kPhantomSkinIso};
+    s.request.view = {cam, cam.frustum(float(w) / h), w, h, kPhantomSkinIso, {}};
     for (const Group& g : sample_groups(v, kPhantomSkinIso, 24, 2000)) {
         std::vector<std::uint8_t> exact;
         const auto bytes =

@@ -66,7 +66,7 @@ TEST(ClientFrames, CoarsePixelsStayDrawnAfterTheDepthClearOfAFinerLevel) {
     Camera cam = fit_depth_range(front_full_view(bounds, float(w) / h), bounds);
     RequestMsg req;
     req.request_id = 1;
-    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
+    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0, {}};
     req.lod = LodSchedule::on;
 
     auto renderer = make_renderer("osmesa");
@@ -104,7 +104,7 @@ TEST(ClientFrames, TheCacheFollowsTheServersGenerationsAndDrawsNamedSlotsCoarseF
     const int w = 64, h = 48;
     Camera cam = fit_depth_range(front_full_view(bounds, float(w) / h), bounds);
     RequestMsg req;
-    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0};
+    req.view = {cam, cam.frustum(float(w) / h), w, h, 7.0, {}};
     req.lod = LodSchedule::on;
     req.cached_groups = true;
     auto renderer = make_renderer("osmesa");
@@ -153,7 +153,7 @@ TEST(ClientFrames, DecodeReportsCountTheTrianglesOfEachEncoding) {
     Camera cam = fit_depth_range(front_full_view(bounds, 4.0f / 3), bounds);
     RequestMsg req;
     req.request_id = 1;
-    req.view = {cam, cam.frustum(4.0f / 3), 32, 24, 7.0};
+    req.view = {cam, cam.frustum(4.0f / 3), 32, 24, 7.0, {}};
     auto renderer = make_renderer("osmesa");
     ClientFrames frames(*renderer);
     EXPECT_FALSE(frames.decode_report(1.0)) << "nothing decoded yet";

@@ -63,7 +63,7 @@ class TestServer {
 inline FrameView front_view(const Box3& bounds, int w, int h, double yaw, double iso) {
     Camera c = front_full_view(bounds, float(w) / float(h));
     c = fit_depth_range(orbit(c, yaw, 0), bounds);
-    return {c, c.frustum(float(w) / float(h)), w, h, iso};
+    return {c, c.frustum(float(w) / float(h)), w, h, iso, {}};
 }
 
 // The front view of the phantom at `w` x `h`, turned by yaw degrees, at `iso`. The phantom is

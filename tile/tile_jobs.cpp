@@ -73,7 +73,7 @@ TileJobs::TileJobs(ProgressiveEngine& engine, Renderer& tile, Renderer& help, bo
 }
 
 void TileJobs::prepare(int width, int height) {
-    tile_sink_.begin(FrameView{Camera{}, Frustum{}, width, height, 0.0});
+    tile_sink_.begin(FrameView{Camera{}, Frustum{}, width, height, 0.0, {}});
     tile_sink_.present();
     landed_.resize(width, height);
 }

@@ -73,6 +73,7 @@ std::vector<std::byte> encode(const ViewMsg& m) {
     MessageWriter w(ViewMsg::kVersion);
     w.put(m.generation);
     put_frame_view(w, m.view);
+    put_clip(w, m.view.clip);
     return w.take();
 }
 
@@ -81,6 +82,7 @@ static ViewMsg decode_view(std::span<const std::byte> bytes) {
     ViewMsg m;
     m.generation = r.get<std::uint64_t>();
     m.view = get_frame_view(r);
+    m.view.clip = get_clip(r);
     r.finish();
     return m;
 }

@@ -59,8 +59,8 @@ struct TileHelloMsg {
 
 struct ViewMsg {
     static constexpr Tag kTag = Tag::view;
-    static constexpr std::uint8_t kVersion = 2;
-    std::uint64_t generation = 0;  // grows with every change of camera or isovalue
+    static constexpr std::uint8_t kVersion = 3;  // 3: the view's clip planes
+    std::uint64_t generation = 0;  // grows with every change of camera, isovalue or clip
     FrameView view;                // the tile's own view; its pixels come as jobs
 };
 
@@ -192,7 +192,7 @@ enum class Band : std::uint8_t { coarse = 0, fine = 1 };
 
 struct JobMsg {
     static constexpr Tag kTag = Tag::job;
-    static constexpr std::uint8_t kVersion = 2;
+    static constexpr std::uint8_t kVersion = 3;  // 3: the view's clip planes
     std::uint64_t generation = 0;
     std::uint32_t job = 0;   // the master's id, unique within a generation
     std::int32_t owner = 0;  // the rank whose tile the region is on

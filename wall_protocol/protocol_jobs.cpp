@@ -77,6 +77,7 @@ std::vector<std::byte> encode(const JobMsg& m) {
     w.put(m.deliver);
     w.put(static_cast<std::uint8_t>(m.band));
     put_frame_view(w, m.view);
+    put_clip(w, m.view.clip);
     put_pixel_rect(w, m.rect);
     return w.take();
 }
@@ -117,6 +118,7 @@ JobMsg job_wire::decode_job(std::span<const std::byte> bytes) {
         r.fail("band: expected 0 (coarse) or 1 (fine), got " + std::to_string(band));
     m.band = static_cast<Band>(band);
     m.view = get_frame_view(r);
+    m.view.clip = get_clip(r);
     m.rect = get_region_rect(r, m.view.width, m.view.height);
     r.finish();
     return m;

@@ -8,13 +8,15 @@
 //   head X Y Z                 the viewer's head moved from its nominal place (x right, y up, z
 //                              towards the viewer; mm on a wall with [physical], else widths of
 //                              the wall): both eyes' off-axis frusta follow
+//   clip PLANE...              cut the volume (voxel indices): x<N, y>N, z<N or A,B,C<D, up to
+//                              eight; `clip box X0 Y0 Z0 X1 Y1 Z1` keeps a box; `clip off`
 //   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
 //   wait time S                a pause of S seconds, whether or not the frame ends first
 //   wait helped N              until tiles have run N jobs of other tiles this frame (or its end)
 //   snapshot NAME              write the mosaic as NAME.png
 //   quit
-// '#' starts a comment; blank lines are skipped. Every change of view or isovalue starts a new
-// frame on every tile (and interrupts the current one).
+// '#' starts a comment; blank lines are skipped. Every change of view, isovalue or clip starts a
+// new frame on every tile (and interrupts the current one).
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -25,6 +27,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/camera.h"
+#include "core/clip.h"
 
 namespace isowall {
 
@@ -53,10 +56,13 @@ struct SnapshotCmd {
 struct HeadCmd {
     glm::dvec3 offset{0};
 };
+struct ClipCmd {
+    ClipSet clip;  // empty: clip off
+};
 struct QuitCmd {};
 
 using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd,
-                                   SnapshotCmd, HeadCmd, QuitCmd>;
+                                   SnapshotCmd, HeadCmd, ClipCmd, QuitCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
 #include "core/image.h"
 
 namespace isowall::message_fields {
@@ -108,6 +110,33 @@ FrameView get_frame_view(MessageReader& r) {
     v.height = get_side(r, "view.height", 1);
     v.iso = get_finite<double>(r, "view.iso");
     return v;
+}
+
+// At most kMaxClipPlanes, each with a unit normal (the planes a parser makes) and a finite offset.
+void put_clip(MessageWriter& w, const ClipSet& c) {
+    w.put(static_cast<std::uint8_t>(c.count));
+    for (const ClipPlane& p : c) {
+        w.put(p.normal);
+        w.put(p.at);
+    }
+}
+
+ClipSet get_clip(MessageReader& r) {
+    const auto n = r.get<std::uint8_t>();
+    if (n > kMaxClipPlanes)
+        r.fail("view.clip: expected at most " + std::to_string(kMaxClipPlanes) + " planes, got " +
+               std::to_string(n));
+    ClipSet c;
+    for (std::uint8_t i = 0; i < n; ++i) {
+        ClipPlane p;
+        p.normal = get_finite_vec3(r, "view.clip.normal");
+        const float len = glm::length(p.normal);
+        if (std::abs(len - 1.0f) > 1e-3f)
+            r.fail("view.clip.normal: expected a unit vector, got length " + std::to_string(len));
+        p.at = get_finite<float>(r, "view.clip.at");
+        c.add(p);
+    }
+    return c;
 }
 
 void put_pixel_rect(MessageWriter& w, const PixelRect& p) {

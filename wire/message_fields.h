@@ -23,8 +23,12 @@ F get_finite(MessageReader& r, const char* field) {
     return v;
 }
 
+// A view's camera, frustum, size and isovalue; its clip planes, which the remote protocol does not
+// carry, go with put_clip.
 void put_frame_view(MessageWriter& w, const FrameView& v);
 FrameView get_frame_view(MessageReader& r);
+void put_clip(MessageWriter& w, const ClipSet& c);
+ClipSet get_clip(MessageReader& r);
 // A side read from the wire, checked against [min_px, max_px] (by default kMaxImageSide) before
 // anything is sized from it.
 std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px);
