@@ -116,6 +116,39 @@ TEST_F(Cli, ExtractWritesThePhantomSurface) {
         << info.out;
 }
 
+// --clip and --clip-box: an extracted mesh has nothing past the planes, a render matches the cut
+// full surface, and bad planes are one line naming the option with nothing written.
+TEST_F(Cli, ClipCutsTheMeshAndThePicture) {
+    auto r =
+        run_isowall(dir_, "extract --iso 160 --clip \"x<90\" --clip \"0,1,1>150\" --out cut.ply");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Mesh m = read_ply(dir_ / "cut.ply");
+    EXPECT_GT(m.triangle_count(), 1000u);
+    for (const glm::vec3& p : m.positions) {  // the phantom's spacing is 1: voxels are object units
+        EXPECT_LE(p.x, 90.0f + 1e-3f);
+        EXPECT_GE(p.y + p.z, 150.0f - 1e-2f);
+    }
+    r = run_isowall(dir_,
+                    "render --size 96x72 --orbit 30 20 --clip-box 30,20,40,150,140,120 "
+                    "--against-full --out box.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("coverage IoU 1.0000"), std::string::npos) << r.out;
+    for (const auto& [args, mentions] :
+         std::vector<std::pair<std::string, std::vector<std::string>>>{
+             {"--clip \"x<<3\"", {"--clip", "x<<3"}},
+             {"--clip \"q>3\"", {"--clip", "x, y, z or three numbers"}},
+             {"--clip-box 0,0,0,10,10", {"--clip-box", "six numbers"}},
+             {"--clip-box 0,0,0,10,0,10", {"--clip-box", "Y0 < Y1"}},
+             {"--clip \"x<-5\"", {"--clip", "keep nothing of the volume"}},
+         }) {
+        r = run_isowall(dir_, "render --size 64x48 --out bad.png " + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        for (const std::string& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
 // --against-full: the final image's C and final pixels against the full surface, printed after
 // the frame; full resolution matches it, a coarse level of detail does not quite.
 TEST_F(Cli, AgainstFullPrintsBothMeasures) {

@@ -137,6 +137,12 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
         {"view.height", [](ViewMsg& m) { m.view.height = kMaxImageSide + 1; }},
         {"view.iso", [](ViewMsg& m) { m.view.iso = std::numeric_limits<double>::quiet_NaN(); }},
         {"view.iso", [](ViewMsg& m) { m.view.iso = -std::numeric_limits<double>::infinity(); }},
+        {"view.clip.normal",
+         [](ViewMsg& m) {
+             m.view.clip.planes[0].normal = {2, 0, 0};
+         }},
+        {"view.clip.normal", [](ViewMsg& m) { m.view.clip.planes[1].normal.x = kNaN; }},
+        {"view.clip.at", [](ViewMsg& m) { m.view.clip.planes[1].at = kInf; }},
     };
     for (const ViewFault& f : faults) {
         ViewMsg m = sample_view();
@@ -144,6 +150,13 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
         SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
         expect_wire_error(Tag::view, encode(m), f.field);
     }
+    // More planes than any view has: the count byte follows the isovalue.
+    ViewMsg none = sample_view();
+    none.view.clip = {};
+    Bytes bytes = encode(none);
+    ASSERT_EQ(bytes.back(), std::byte{0});
+    bytes.back() = std::byte{kMaxClipPlanes + 1};
+    expect_wire_error(Tag::view, bytes, "view.clip: expected at most 8 planes, got 9");
 }
 
 // ---- image --------------------------------------------------------------------------------------

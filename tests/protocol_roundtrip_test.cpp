@@ -45,6 +45,14 @@ TEST(Protocol, ViewAtTheLimitsRoundTrips) {
     m.view.width = kMaxImageSide;
     m.view.height = kMaxImageSide;
     expect_round_trip(m);
+    std::string problem;
+    m.view.clip = clip_box({0, 0, 0}, {1, 1, 1}, problem).value();  // the most planes
+    m.view.clip.add({{1, 0, 0}, 0.5f});
+    m.view.clip.add({{0, 1, 0}, 0.5f});
+    ASSERT_EQ(m.view.clip.count, kMaxClipPlanes);
+    expect_round_trip(m);
+    m.view.clip = {};  // none
+    expect_round_trip(m);
 }
 
 // ---- every message with every field set ------------------------------------------------------
@@ -136,9 +144,10 @@ TEST(Protocol, ProgressBytesAreLittleEndianWithTheVersionFirst) {
 
 TEST(Protocol, ViewHasAFixedSize) {
     // version 1 + generation 8 + camera (3 vec3 36, projection 4, 4 floats 16) 56 + frustum
-    // (6 floats 24, projection 4) 28 + width, height 8 + iso 8: a change here is a change of the
-    // wire format and needs a new ViewMsg::kVersion.
-    EXPECT_EQ(encode(sample_view()).size(), 1u + 8 + 56 + 28 + 8 + 8);
+    // (6 floats 24, projection 4) 28 + width, height 8 + iso 8 + clip (count 1, two planes of a
+    // vec3 and a float, 16 each) 33: a change here is a change of the wire format and needs a new
+    // ViewMsg::kVersion.
+    EXPECT_EQ(encode(sample_view()).size(), 1u + 8 + 56 + 28 + 8 + 8 + 33);
 }
 
 TEST(Protocol, TagNames) {

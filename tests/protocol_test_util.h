@@ -35,7 +35,7 @@ inline bool operator==(const Frustum& a, const Frustum& b) {
 }
 inline bool operator==(const FrameView& a, const FrameView& b) {
     return a.camera == b.camera && a.frustum == b.frustum && a.width == b.width &&
-           a.height == b.height && a.iso == b.iso;
+           a.height == b.height && a.iso == b.iso && a.clip == b.clip;
 }
 inline bool operator==(const PixelRect& a, const PixelRect& b) {
     return a.x == b.x && a.y == b.y && a.width == b.width && a.height == b.height;
@@ -246,6 +246,8 @@ inline ViewMsg sample_view() {
     m.view.width = 1920;
     m.view.height = 1080;
     m.view.iso = 117.25;
+    m.view.clip.add({{0, -1, 0}, -40.5f});  // y < 40.5
+    m.view.clip.add({{0.6f, 0, 0.8f}, 12});
     return m;
 }
 

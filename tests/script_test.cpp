@@ -38,6 +38,25 @@ TEST(Script, ParsesEveryCommand) {
     EXPECT_TRUE(std::holds_alternative<QuitCmd>(lines[9].command));
 }
 
+TEST(Script, ClipTakesPlanesABoxOrOff) {
+    const auto lines = parse_script(
+        "clip x<120 0,1,1>30\n"
+        "clip box 10 20 30 100 110 120\n"
+        "clip off\n",
+        "c.txt");
+    ASSERT_EQ(lines.size(), 3u);
+    const ClipSet& planes = std::get<ClipCmd>(lines[0].command).clip;
+    ASSERT_EQ(planes.count, 2u);
+    EXPECT_TRUE(planes.keeps({100, 20, 20}));
+    EXPECT_FALSE(planes.keeps({130, 20, 20}));
+    EXPECT_FALSE(planes.keeps({100, 10, 10}));
+    const ClipSet& box = std::get<ClipCmd>(lines[1].command).clip;
+    EXPECT_EQ(box.count, 6u);
+    EXPECT_TRUE(box.keeps({50, 50, 50}));
+    EXPECT_FALSE(box.keeps({5, 50, 50}));
+    EXPECT_TRUE(std::get<ClipCmd>(lines[2].command).clip.empty());
+}
+
 TEST(Script, EmptyScriptHasNoCommands) {
     EXPECT_TRUE(parse_script("", "e.txt").empty());
     EXPECT_TRUE(parse_script("# only a comment\n\n   \n", "e.txt").empty());
@@ -66,6 +85,14 @@ TEST(Script, MistakesNameTheFileLineAndCommand) {
         {"pan 0 -1e39", "s.txt:1: pan: expected a number in [-1000, 1000]"},
         {"zoom 1e-50", "s.txt:1: zoom: expected a number in [1e-06, 1e+06], got \"1e-50\""},
         {"snapshot a\x01", "s.txt:1: snapshot: expected a plain name"},
+        {"clip", "s.txt:1: clip: expected \"clip PLANE...\""},
+        {"clip x<<3", "s.txt:1: clip: expected x<N, y>N, z<N or A,B,C<D"},
+        {"clip 0,0,0<1", "s.txt:1: clip: the plane's direction A,B,C is zero"},
+        {"clip x<1e300", "s.txt:1: clip: expected a number in [-1e6, 1e6]"},
+        {"clip x<1 x<2 x<3 x<4 x<5 x<6 x<7 x<8 x<9", "s.txt:1: clip: expected \"clip PLANE...\""},
+        {"clip box 0 0 0 10 10", "s.txt:1: clip: expected \"clip PLANE...\""},
+        {"clip box 0 0 0 10 0 10", "s.txt:1: clip: expected X0 < X1, Y0 < Y1 and Z0 < Z1"},
+        {"clip box 0 0 0 10 10 2e6", "s.txt:1: clip: expected a number in [-1e+06, 1e+06]"},
     };
     for (const Case& c : cases) {
         try {
