@@ -313,6 +313,9 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     s.frame_s = frame.seconds;
     s.figures = master.frame_figures();
     s.dark = master.dark_screens();
+    for (const ClipPlane& p : master.clip())
+        s.clip += (s.clip.empty() ? "" : " ") + clip_plane_text(p);
+    s.dims = master.dims();
     for (const auto& page : roster_) {
         s.pages.push_back(page->name);
         if (seat_.holder() == page->id) s.steering = page->name;

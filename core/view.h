@@ -15,7 +15,7 @@ struct FrameView {
     int width = 0;
     int height = 0;
     double iso = 0;
-    ClipSet clip;  // voxel index coordinates; empty: the whole volume
+    ClipSet clip{};  // voxel index coordinates; empty: the whole volume
 
     PixelRect screen() const { return {0, 0, width, height}; }
 };

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <utility>
 
+#include "wall_spec/script.h"
+
 namespace isowall {
 namespace {
 
@@ -56,6 +58,47 @@ std::string iso_line(double iso, double lo, double hi) {
     return "iso " + number(iso, 17);  // not reached
 }
 
+namespace {
+
+// The axis a plane cuts across (its normal along it), or -1.
+int axis_of(const ClipPlane& p) {
+    for (int a = 0; a < 3; ++a) {
+        glm::vec3 axis{0};
+        axis[a] = 1;
+        if (p.normal == axis || p.normal == -axis) return a;
+    }
+    return -1;
+}
+
+std::string axis_clip_line(int axis, bool below, double at) {
+    return std::string("clip ") + char('x' + axis) + (below ? "<" : ">") + number(at);
+}
+
+}  // namespace
+
+std::string clip_cycle_line(const ClipSet& now, glm::ivec3 dims) {
+    const int axis = now.count == 1 ? axis_of(now.planes[0]) : -1;
+    if (!now.empty() && (axis < 0 || axis == 2)) return "clip off";
+    const int next = now.empty() ? 0 : axis + 1;
+    return axis_clip_line(next, true, std::floor(0.5 * double(dims[next] - 1)));
+}
+
+std::string clip_move_line(const ClipSet& now, glm::ivec3 dims, int steps) {
+    const int axis = now.count == 1 ? axis_of(now.planes[0]) : -1;
+    if (axis < 0 || steps == 0) return "";
+    const ClipPlane& p = now.planes[0];
+    const double side = double(dims[axis] - 1);
+    const double at = double(p.normal[axis]) * double(p.at);  // where the plane crosses the axis
+    const double moved = std::clamp(at + steps * kClipStep * side, 0.0, side);
+    if (moved == at) return "";
+    return axis_clip_line(axis, p.normal[axis] < 0, moved);
+}
+
+void ControlInput::add_clip(const std::string& line, std::vector<std::string>& out) {
+    out.push_back(line);
+    state_.clip = std::get<ClipCmd>(parse_command(line, "control")).clip;
+}
+
 void ControlInput::accumulate(Pending kind, std::vector<std::string>& out) {
     if (pending_ != kind) flush(out);
     pending_ = kind;
@@ -83,11 +126,16 @@ void ControlInput::flush(std::vector<std::string>& out) {
     } else if (kind == Pending::head && head_steps_ != 0) {
         state_.head.x += head_steps_ * state_.head_step;
         out.push_back(head_line(state_.head));
+    } else if (kind == Pending::clip) {
+        if (const std::string line = clip_move_line(state_.clip, state_.dims, clip_steps_);
+            !line.empty())
+            add_clip(line, out);
     }
     drag_x_ = drag_y_ = 0;
     zoom_steps_ = 0;
     iso_steps_ = 0;
     head_steps_ = 0;
+    clip_steps_ = 0;
 }
 
 void ControlInput::drag_to(int x, int y) {
@@ -110,6 +158,12 @@ void ControlInput::key(const std::string& name, std::vector<std::string>& out) {
         flush(out);
         state_.head = glm::dvec3(0);
         out.push_back(head_line(state_.head));
+    } else if ((name == "c" || name == "C") && state_.dims.x > 0) {
+        flush(out);
+        add_clip(clip_cycle_line(state_.clip, state_.dims), out);
+    } else if ((name == "bracketleft" || name == "bracketright") && state_.dims.x > 0) {
+        accumulate(Pending::clip, out);
+        clip_steps_ += name == "bracketright" ? 1 : -1;
     } else if (name == "s" || name == "S") {
         flush(out);
         out.push_back("snapshot " + snapshot_name(next_snapshot_++));

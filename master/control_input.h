@@ -13,6 +13,9 @@
 //   Left/Right     the viewer's head kHeadStepMm (a wall with [physical]) or kHeadStepWidths
 //                  (of the wall's width) left or right: both eyes' frusta follow; Home: back to
 //                  its nominal place
+//   c              clip planes: none -> x < middle -> y < middle -> z < middle -> none (a
+//                  sagittal, coronal or axial cut on most scans)
+//   [ ]            move an axis clip plane by kClipStep of the volume's side, back or on
 //   s              snapshot control-NNN (beside --out)
 //   Escape, close  quit
 #include <string>
@@ -20,6 +23,8 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+
+#include "core/clip.h"
 
 #include "display/x_window.h"
 
@@ -30,6 +35,7 @@ inline constexpr double kZoomStep = 1.25;
 inline constexpr double kIsoStep = 0.01;  // of the volume's value range, per key
 inline constexpr double kHeadStepMm = 50;
 inline constexpr double kHeadStepWidths = 0.01;
+inline constexpr double kClipStep = 0.02;  // of the volume's side along the plane's axis, per key
 
 // What the mapping needs to know of the wall when the events are taken.
 struct ControlState {
@@ -37,6 +43,8 @@ struct ControlState {
     int mosaic_width = 1, mosaic_height = 1;  // the wall in the window (pan is in screen sizes)
     glm::dvec3 head{0};                       // the viewer's head now (head command)
     double head_step = 0;                     // per Left/Right key; 0: the keys do nothing
+    ClipSet clip{};                           // the view's clip planes now
+    glm::ivec3 dims{0};                       // the volume's voxels; 0: the clip keys do nothing
 };
 
 // "control-001" ...: the name of snapshot n.
@@ -50,6 +58,12 @@ int first_free_snapshot(const std::string& out, int from = 1, std::string_view p
 std::string iso_line(double iso, double lo, double hi);
 // "head X Y Z".
 std::string head_line(const glm::dvec3& head);
+// The clip the c key steps to from `now`: "clip x<M" (M the middle of x), then y, then z, then
+// "clip off"; any other set of planes: "clip off".
+std::string clip_cycle_line(const ClipSet& now, glm::ivec3 dims);
+// `now`, one plane across an axis, moved by `steps` of kClipStep of the volume's side along it
+// and kept within the volume; "" when `now` is not one such plane or it would not move.
+std::string clip_move_line(const ClipSet& now, glm::ivec3 dims, int steps);
 
 class ControlInput {
   public:
@@ -64,11 +78,13 @@ class ControlInput {
                                       const ControlState& state);
 
   private:
-    enum class Pending { none, orbit, pan, zoom, iso, head };
+    enum class Pending { none, orbit, pan, zoom, iso, head, clip };
     void accumulate(Pending kind, std::vector<std::string>& out);
     void flush(std::vector<std::string>& out);
     void drag_to(int x, int y);
     void key(const std::string& name, std::vector<std::string>& out);
+    // Adds a clip line to `out` and takes its planes as the state's for the poll's next keys.
+    void add_clip(const std::string& line, std::vector<std::string>& out);
 
     int next_snapshot_;
     bool left_down_ = false, right_down_ = false;  // drags last across polls
@@ -80,6 +96,7 @@ class ControlInput {
     int zoom_steps_ = 0;
     double iso_steps_ = 0;  // in kIsoStep of the range
     int head_steps_ = 0;    // of head_step, right
+    int clip_steps_ = 0;    // of kClipStep, on along the plane's axis
     bool quit_ = false;
 };
 

@@ -30,7 +30,7 @@ std::vector<std::string> status_lines(const ControlStatus& s) {
 
 std::string keys_line() {
     return "drag orbit  right-drag pan  wheel zoom  up/down iso  pgup/pgdn iso x10  left/right "
-           "head  s snapshot  esc quit";
+           "head  c clip  [ ] move it  s snapshot  esc quit";
 }
 
 PixelSize control_window_size(const ControlLayout& layout) {

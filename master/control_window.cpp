@@ -46,8 +46,8 @@ void ControlWindow::present(const WallMaster& master) {
 
 void ControlWindow::begin() {
     std::printf(
-        "control: window on %s (drag: orbit, wheel: zoom, up/down: iso, s: snapshot, "
-        "escape: quit)\n",
+        "control: window on %s (drag: orbit, wheel: zoom, up/down: iso, c and [ ]: clip, "
+        "s: snapshot, escape: quit)\n",
         window_.display_name().c_str());
     std::fflush(stdout);
 }
@@ -59,7 +59,9 @@ std::vector<SteeringLine> ControlWindow::take(const WallMaster& master) {
                              layout_.mosaic.width,
                              layout_.mosaic.height,
                              master.head(),
-                             master.spec().physical ? kHeadStepMm : kHeadStepWidths};
+                             master.spec().physical ? kHeadStepMm : kHeadStepWidths,
+                             master.clip(),
+                             master.dims()};
     std::vector<SteeringLine> lines;
     for (std::string& text : input_.commands(window_.poll(), state))
         lines.push_back({std::move(text), "control"});

@@ -111,7 +111,8 @@ std::string state_json(const PageState& s) {
                 {"balance", f.balance},     {"jobs", f.jobs},
                 {"jobs_done", f.jobs_done}, {"migrated", f.migrated},
                 {"c99_s", f.c99_s},         {"steering", s.steering},
-                {"pages", s.pages},         {"dark", s.dark}}
+                {"pages", s.pages},         {"dark", s.dark},
+                {"clip", s.clip},           {"dims", {s.dims.x, s.dims.y, s.dims.z}}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

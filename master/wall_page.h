@@ -67,6 +67,8 @@ struct PageState {
     std::vector<std::string> pages;  // every page that said hello, in order of arrival
     // Tile screens whose rank is lost (WallMaster::dark_screens): the others draw them.
     std::vector<std::string> dark;
+    std::string clip;    // the view's clip planes as a script writes them ("x<99"), or empty
+    glm::ivec3 dims{0};  // the volume's voxels: the range of the page's clip slider
 };
 std::string state_json(const PageState& s);
 // A line ran (error empty) or was refused.

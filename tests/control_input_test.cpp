@@ -95,6 +95,29 @@ TEST(ControlInput, LeftAndRightMoveTheHeadAndHomeBringsItBack) {
     EXPECT_EQ(std::get<HeadCmd>(c).offset, glm::dvec3(100, -100, 0));
 }
 
+TEST(ControlInput, CStepsThroughTheAxisClipsAndBracketsMoveThem) {
+    ControlState state = kPhantom;
+    ControlInput in;
+    // Without the volume's size (the keys are off) nothing happens.
+    EXPECT_EQ(in.commands({key("c"), key("bracketright")}, state), Lines{});
+    state.dims = {200, 184, 168};
+    EXPECT_EQ(in.commands({key("c"), key("c"), key("c"), key("c")}, state),
+              (Lines{"clip x<99", "clip y<91", "clip z<83", "clip off"}));
+    // A burst of moves is one command, 2% of the side (3.98 voxels of x) a key, in the volume.
+    EXPECT_EQ(in.commands({key("c"), key("bracketright"), key("bracketright"), key("bracketleft")},
+                          state),
+              (Lines{"clip x<99", "clip x<102.98"}));
+    state.clip = std::get<ClipCmd>(parse_command("clip x>190", "t")).clip;
+    EXPECT_EQ(in.commands({key("bracketright"), key("bracketright"), key("bracketright")}, state),
+              Lines{"clip x>199"});
+    state.clip = std::get<ClipCmd>(parse_command("clip x>199", "t")).clip;
+    EXPECT_EQ(in.commands({key("bracketright")}, state), Lines{});  // at the end already
+    // Planes the keys did not make: c turns them off, brackets leave them.
+    state.clip = std::get<ClipCmd>(parse_command("clip 1,1,0<50", "t")).clip;
+    EXPECT_EQ(in.commands({key("bracketleft")}, state), Lines{});
+    EXPECT_EQ(in.commands({key("c")}, state), Lines{"clip off"});
+}
+
 TEST(ControlInput, KindsKeepTheirOrderAndQuitEndsThePoll) {
     ControlInput in(7);
     const Lines lines = in.commands({press(1, 0, 0), motion(10, 0), release(1, 10, 0), press(4),

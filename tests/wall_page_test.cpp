@@ -88,7 +88,11 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     s.steering = "page 2";
     s.pages = {"page 1", "page 2"};
     s.dark = {"tile 8 (rank 9 on node3): its process has ended"};
+    s.clip = "x<99";
+    s.dims = {200, 184, 168};
     const auto j = nlohmann::json::parse(state_json(s));
+    EXPECT_EQ(j["clip"], "x<99");
+    EXPECT_EQ(j["dims"], nlohmann::json({200, 184, 168}));
     ASSERT_EQ(j["dark"].size(), 1u);
     EXPECT_EQ(j["dark"][0], "tile 8 (rank 9 on node3): its process has ended");
     EXPECT_EQ(j["type"], "state");

@@ -112,6 +112,13 @@ try {
   await wall.waitFor(/^page 1: iso 52.2$/m);
   sa = await until(a, (x) => x.log.length >= 4, 'four lines in the log');
   check(sa.log.slice(-3).every((l) => l.who === 'page 1' && !l.error), `page 1's lines ran: ${sa.log.map((l) => l.line).join('; ')}`);
+  // The clip menu: an axis cuts the volume at its middle, and the state the wall sends back
+  // shows it; off takes it away.
+  await a.selectOption('#clip-axis', 'x');
+  await wall.waitFor(/^page 1: clip x<\d+$/m);
+  sa = await until(a, (x) => /^x<\d+$/.test(x.state.clip), 'the clip in the state');
+  await a.selectOption('#clip-axis', '');
+  await wall.waitFor(/^page 1: clip off$/m);
 
   // A second page watches, sees page 1 steer, is refused, takes over and steers.
   const b = await context.newPage();

@@ -34,6 +34,18 @@ export function isoLine(v) {
   return `iso ${num(v)}`;
 }
 
+// The clip line of the page's axis menu and slider: one plane keeping what lies below `at` on
+// `axis` ('x', 'y' or 'z'), or none.
+export function clipLine(axis, at) {
+  return axis ? `clip ${axis}<${num(at)}` : 'clip off';
+}
+
+// The axis and place of a clip the page can show (one axis plane kept below, "x<99"), or null.
+export function axisClip(text) {
+  const m = /^([xyz])<(-?[0-9.]+(?:e[-+]?[0-9]+)?)$/.exec(text ?? '');
+  return m ? { axis: m[1], at: Number(m[2]) } : null;
+}
+
 // A drag's motion in mosaic pixels, cut into lines no more often than the caller flushes.
 export class Drag {
   constructor(kind) {

@@ -3,7 +3,7 @@
 // master runs (master/wall_page.h). One page steers at a time; the others watch and may take over.
 // window.isowallWall is kept up to date for tests.
 import { ready as mosaicReady, isMosaic, decodeMosaic } from './mosaic.js';
-import { Drag, zoomLine, pinchLine, isoLine, num } from './gestures.js';
+import { Drag, zoomLine, pinchLine, isoLine, clipLine, axisClip, num } from './gestures.js';
 import { showMessage as show } from '../ui.js';
 
 const $ = (id) => document.getElementById(id);
@@ -14,6 +14,7 @@ const el = {
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
   emulated: $('s-emulated'), c99: $('s-c99'), balance: $('s-balance'), jobs: $('s-jobs'), migrated: $('s-migrated'),
   pages: $('s-pages'), dark: $('s-dark'), log: $('log'),
+  clipAxis: $('clip-axis'), clipAt: $('clip-at'), clipValue: $('clip-value'),
 };
 const ctx = el.canvas.getContext('2d');
 const kFlushMs = 100;  // a drag or a wheel sends at most this often
@@ -59,7 +60,7 @@ ws.onopen = async () => {
 ws.onclose = (e) => {
   api.connected = false;
   showMessage(`disconnected from the wall${e.reason ? `: ${e.reason}` : ''} (reload to reconnect)`);
-  for (const b of [el.snapshot, el.take, el.quit, el.slider, el.number]) b.disabled = true;
+  for (const b of [el.snapshot, el.take, el.quit, el.slider, el.number, el.clipAxis, el.clipAt]) b.disabled = true;
   el.steering.textContent = 'disconnected';
 };
 
@@ -131,6 +132,7 @@ function showState(s) {
     el.slider.value = s.iso;
     el.number.value = num(s.iso);
   }
+  showClip(s);
   const you = s.steering === api.you;
   el.steering.textContent = you ? 'you steer' : s.steering ? `${s.steering} steers` : 'nobody steers: any input takes the wall';
   el.steering.className = you ? 'you' : '';
@@ -258,6 +260,48 @@ el.slider.addEventListener('change', () => {
 });
 el.number.addEventListener('keydown', (e) => {
   if (e.key === 'Enter') setIso(Number(el.number.value));
+});
+// The clip menu and slider show the wall's clip when it is one axis plane (a script or the control
+// window may have set others: the menu then says "other" until the page sets its own).
+let clipHeld = false;
+function showClip(s) {
+  el.clipAxis.disabled = false;
+  el.clipAt.disabled = false;
+  if (clipHeld) return;
+  const c = axisClip(s.clip);
+  const other = s.clip && !c;
+  let opt = el.clipAxis.querySelector('option[value="other"]');
+  if (other && !opt) {
+    opt = new Option('other', 'other');
+    el.clipAxis.add(opt);
+  }
+  if (opt && !other) opt.remove();
+  el.clipAxis.value = c ? c.axis : other ? 'other' : '';
+  el.clipValue.textContent = s.clip || 'none';
+  if (c) setClipRange(c.axis, c.at);
+}
+function setClipRange(axis, at) {
+  const dims = api.state?.dims ?? [1, 1, 1];
+  el.clipAt.max = Math.max(0, dims['xyz'.indexOf(axis)] - 1);
+  if (at !== undefined) el.clipAt.value = at;
+}
+function sendClip() {
+  const axis = el.clipAxis.value === 'other' ? '' : el.clipAxis.value;
+  run(clipLine(axis, Number(el.clipAt.value)));
+}
+el.clipAxis.addEventListener('change', () => {
+  // A new axis starts at its middle.
+  const axis = el.clipAxis.value;
+  if (axis && axis !== 'other') setClipRange(axis, Math.floor((Number(el.clipAt.max)) / 2));
+  sendClip();
+});
+el.clipAt.addEventListener('input', () => {
+  clipHeld = true;
+  el.clipValue.textContent = `${el.clipAxis.value}<${el.clipAt.value}`;
+});
+el.clipAt.addEventListener('change', () => {
+  clipHeld = false;
+  if (el.clipAxis.value && el.clipAxis.value !== 'other') sendClip();
 });
 el.snapshot.addEventListener('click', () => send({ snapshot: true }));
 el.take.addEventListener('click', () => send({ take: true }));
