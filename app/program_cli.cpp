@@ -92,10 +92,12 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
 }
 
 void add_control_options(CLI::App& wall_cmd, WallOptions& wall) {
-    wall_cmd.add_flag("--control", wall.control,
-                      "Open the control window on the master's display: a live mosaic of the "
-                      "wall; drag orbits, wheel zooms, Up/Down change the isovalue, Left/Right "
-                      "move the head, s snapshots, Escape quits (after --script FILE, if given)");
+    wall_cmd.add_flag(
+        "--control", wall.control,
+        "Open the control window on the master's display: a live mosaic of the "
+        "wall; drag orbits, wheel zooms, Up/Down change the isovalue, Left/Right "
+        "move the head, c and [ ] clip, s snapshots, Escape quits (after --script FILE, "
+        "if given)");
     wall_cmd.add_option("--control-display", wall.control_display,
                         "X display of the control window (default $DISPLAY)");
     wall_cmd
@@ -187,10 +189,10 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         ->check(CLI::IsMember({"osmesa", "egl"}))
         ->capture_default_str();
     add_engine_options(*wall_cmd, wall.engine);
-    wall_cmd->add_option(
-        "--script", wall.script,
-        "Commands (orbit, look-at, zoom, pan, iso, head, wait, snapshot, quit), one per line; "
-        "- reads them from the master's console");
+    wall_cmd->add_option("--script", wall.script,
+                         "Commands (orbit, look-at, zoom, pan, iso, head, clip, wait, snapshot, "
+                         "quit), one per line; "
+                         "- reads them from the master's console");
     add_control_options(*wall_cmd, wall);
     wall_cmd
         ->add_option("--timeout", wall.timeout_s,
