@@ -1,5 +1,6 @@
 #include "app/commands.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include "extract/surface_extractor.h"
 #include "files/image_io.h"
 #include "files/mesh_formats.h"
+#include "master/legend.h"
 #include "readers/voxel_ops.h"
 #include "render/renderer.h"
 #include "volume/phantom.h"
@@ -206,10 +208,37 @@ void replay_and_report(const RenderOptions& o, FrameResult& fr, const FrameView&
                 fr.timeline.size(), sw.seconds());
 }
 
+// A coloured surface's legend (master/legend.h) and the engine's hook that colours it.
+struct Colouring {
+    std::function<void(Mesh&)> hook;
+    std::optional<ColourScale> scale;
+    std::string label;
+
+    // `img` as written out: with the legend when the surface is coloured.
+    Image written(const Image& img) const {
+        if (!scale) return img;
+        Image out = img;
+        draw_legend(out, *scale, label);
+        return out;
+    }
+};
+
+Colouring colouring(const std::optional<OpenedColourField>& field, const ColourOptions& o,
+                    const Volume& surface) {
+    if (!field) return {};
+    std::string label = std::filesystem::path(o.by).filename().string();
+    for (char& c : label) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return {colour_hook(field->field, surface.spacing()), field->field.scale,
+            label + " (" + std::string(field->field.scale.map.name) + ")"};
+}
+
 std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
-                               const FrameView& fv, Timings& t, OutputFiles& batch) {
+                               const FrameView& fv, Timings& t, OutputFiles& batch,
+                               const Colouring& colour) {
     warm_up(renderer);
-    ProgressiveEngine engine(ex, engine_options(o));
+    EngineOptions options = engine_options(o);
+    options.colour = colour.hook;
+    ProgressiveEngine engine(ex, options);
     auto progress = [&](const TimelineSample& s) {
         if (o.quiet) return;
         std::printf("  %7.2f s  level %2d  rays %9zu (%6.2f%%)  groups %6zu  triangles %9zu\n",
@@ -263,8 +292,8 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
                     fr.mask_nodes, fr.mask_level, fr.screen_pixels);
 
     Image full;
-    if (o.against_full) full = print_against_full(ex, renderer, fv, fr.final_image);
-    if (o.against_truth) print_against_truth(ex, renderer, fv, fr.final_image);
+    if (o.against_full) full = print_against_full(ex, renderer, fv, fr.final_image, colour.hook);
+    if (o.against_truth) print_against_truth(ex, renderer, fv, fr.final_image, colour.hook);
 
     const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
                               !o.snapshots.empty() || !o.snapshot_rays.empty();
@@ -272,7 +301,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
     // After the replay, by when OpenImageIO has loaded beside it (preload_image_io above).
     Stopwatch sw;
-    write_image(batch, o.out, fr.final_image);
+    write_image(batch, o.out, colour.written(fr.final_image));
     if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
     t.write = sw.seconds();
     return last.triangles;
@@ -350,6 +379,7 @@ int run_render(const RenderOptions& o) {
     check_render_outputs(o);
     (void)engine_options(o);                    // fails early on a bad --order
     const ClipSet clip = checked_clip(o.clip);  // and on a bad --clip, before the volume is read
+    (void)checked_colour_map(o.colour);         // and on a bad --colormap
     Timings t;
     // One thread is one core, as on a wall rank with one (app/wall_run.cpp): llvmpipe then
     // rasterises in the drawing thread instead of its own threads on the other cores. The
@@ -364,6 +394,8 @@ int run_render(const RenderOptions& o) {
     auto ex = prepare(ov, t, render_threads(o));
     if (!o.full) prepare_error_rule(engine_options(o), *ex, ov.volume);
     const double iso = volume_iso(o.iso, ov, *ex);
+    const std::optional<OpenedColourField> field = open_colour_field(o.colour, o.volume, ov.volume);
+    const Colouring colour = colouring(field, o.colour, ov.volume);
 
     const float aspect = float(size->x) / float(size->y);
     const Camera cam = render_camera(o, ov.volume, aspect);
@@ -373,7 +405,7 @@ int run_render(const RenderOptions& o) {
     // Every output is staged here and appears at the end, all together (no partial output).
     OutputFiles batch;
     if (!o.full) {
-        const std::size_t triangles = render_progressive(o, *ex, *renderer, fv, t, batch);
+        const std::size_t triangles = render_progressive(o, *ex, *renderer, fv, t, batch, colour);
         const std::size_t files = batch.size();
         batch.commit();
         std::printf("wrote %s%s%s (%zu file(s) in all)\n", o.out.c_str(),
@@ -384,12 +416,14 @@ int run_render(const RenderOptions& o) {
     }
     if (o.warm_up) {
         Stopwatch warm;
-        const Mesh once = ex->full_surface(fv);
+        Mesh once = ex->full_surface(fv);
+        if (colour.hook) colour.hook(once);
         draw_alone(*renderer, once, fv);
         std::printf("warm-up: the full surface extracted and drawn once, untimed (%.3f s)\n",
                     warm.seconds());
     }
     Mesh mesh = extract_timed(*ex, fv, t);
+    if (colour.hook) colour.hook(mesh);
     Stopwatch sw;
     const Image image = draw_alone(*renderer, mesh, fv);
     t.render = sw.seconds();
@@ -398,7 +432,7 @@ int run_render(const RenderOptions& o) {
                 std::string(renderer->name()).c_str(), size->x, size->y,
                 100.0 * double(covered) / double(image.pixel_count()), covered, t.render);
     sw.restart();
-    write_image(batch, o.out, image);
+    write_image(batch, o.out, colour.written(image));
     if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);
     batch.commit();
     t.write = sw.seconds();

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "cli/clip_option.h"
+#include "cli/colour_option.h"
 #include "cli/engine_cli.h"
 #include "cli/volume_options.h"
 
@@ -25,6 +26,7 @@ struct RenderOptions {
     VolumeOptions volume;
     std::optional<double> iso;
     ClipOptions clip;
+    ColourOptions colour;
     std::string size = "1600x1200";
     std::string out = "isowall.png";
     std::string depth_out;

@@ -24,6 +24,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     add_volume_options(*re_cmd, re.volume);
     add_iso_option(*re_cmd, re.iso);
     add_clip_options(*re_cmd, re.clip);
+    add_colour_options(*re_cmd, re.colour);
     re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     re_cmd->add_option("--out,-o", re.out, "Output image (PNG, or any format OpenImageIO writes)")
         ->capture_default_str();

@@ -90,9 +90,10 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 // the timings): 1 and 100% at full resolution, up to the renderers' ties; below that, what
 // adaptive resolution's meta-cells change on screen.
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                         const Image& final_image) {
+                         const Image& final_image, const std::function<void(Mesh&)>& colour) {
     Stopwatch sw;
-    const Mesh mesh = ex.full_surface(fv);
+    Mesh mesh = ex.full_surface(fv);
+    if (colour) colour(mesh);
     Image full = draw_alone(renderer, mesh, fv);
     const Correctness c = measure_correctness(final_image, full);
     std::printf(
@@ -104,9 +105,10 @@ Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const F
 }
 
 void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                         const Image& final_image) {
+                         const Image& final_image, const std::function<void(Mesh&)>& colour) {
     Stopwatch sw;
-    const Mesh mesh = ex.full_surface(fv);
+    Mesh mesh = ex.full_surface(fv);
+    if (colour) colour(mesh);
     const Image truth = draw_truth(renderer, mesh, fv);
     const Fidelity full = measure_fidelity(draw_alone(renderer, mesh, fv), truth);
     const Fidelity own = measure_fidelity(final_image, truth);

@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 // What `isowall render` prints about a frame besides its timings: the correctness thresholds
 // reached, the draw-only floor, the final image against the full surface, and covered pixels.
 #include <cstddef>
@@ -39,13 +40,15 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 
 // The final image against the full surface drawn in the same view (outside the timings); returns
 // that image, the truth the timeline is also measured against.
+// `colour`: the engine's colour hook (EngineOptions::colour), so the full surface is coloured as
+// the frame's groups were.
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                         const Image& final_image);
+                         const Image& final_image, const std::function<void(Mesh&)>& colour = {});
 
 // The final image against the truth (app/whole_frame.h draw_truth), beside the full surface at one
 // sample per pixel, and the fidelity gate; outside the timings.
 void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
-                         const Image& final_image);
+                         const Image& final_image, const std::function<void(Mesh&)>& colour = {});
 
 // When the frame's first group showed, counted from the command's start (the frame began
 // `frame_at` seconds after it; `load_s` and `octree_s` of that went to the volume and its octree):

@@ -97,7 +97,7 @@ std::optional<ClippedRay> clip_ray(const ClipSet& clip, const Ray& ray) {
 namespace {
 
 struct Corner {
-    glm::vec3 position, normal;
+    glm::vec3 position, normal, colour;
 };
 
 // Sutherland-Hodgman: the part of convex polygon `in` on the kept side of `plane`.
@@ -112,8 +112,8 @@ void clip_polygon(const std::vector<Corner>& in, const ClipPlane& plane, std::ve
             const float t = da / (da - db);
             const glm::vec3 n = a.normal + t * (b.normal - a.normal);
             const float len = glm::length(n);
-            out.push_back(
-                {a.position + t * (b.position - a.position), len > 0 ? n / len : a.normal});
+            out.push_back({a.position + t * (b.position - a.position), len > 0 ? n / len : a.normal,
+                           a.colour + t * (b.colour - a.colour)});
         }
     }
 }
@@ -126,6 +126,7 @@ void clip_mesh(Mesh& mesh, const ClipSet& clip) {
     std::vector<std::uint8_t> kept(n);
     for (std::size_t v = 0; v < n; ++v) kept[v] = clip.keeps(mesh.positions[v]) ? 1 : 0;
     const bool normals = mesh.normals.size() == n;
+    const bool colours = mesh.colours.size() == n;
     Mesh out;
     std::vector<std::uint32_t> index(n, UINT32_MAX);  // old vertex -> new
     auto keep_vertex = [&](std::uint32_t v) {
@@ -133,6 +134,7 @@ void clip_mesh(Mesh& mesh, const ClipSet& clip) {
             index[v] = static_cast<std::uint32_t>(out.positions.size());
             out.positions.push_back(mesh.positions[v]);
             if (normals) out.normals.push_back(mesh.normals[v]);
+            if (colours) out.colours.push_back(mesh.colours[v]);
         }
         out.indices.push_back(index[v]);
     };
@@ -146,7 +148,8 @@ void clip_mesh(Mesh& mesh, const ClipSet& clip) {
         }
         poly.clear();
         for (int k = 0; k < 3; ++k)
-            poly.push_back({mesh.positions[tri[k]], normals ? mesh.normals[tri[k]] : glm::vec3(0)});
+            poly.push_back({mesh.positions[tri[k]], normals ? mesh.normals[tri[k]] : glm::vec3(0),
+                            colours ? glm::vec3(mesh.colours[tri[k]]) : glm::vec3(0)});
         for (const ClipPlane& p : clip) {
             clip_polygon(poly, p, next);
             poly.swap(next);
@@ -158,6 +161,7 @@ void clip_mesh(Mesh& mesh, const ClipSet& clip) {
         for (const Corner& c : poly) {
             out.positions.push_back(c.position);
             if (normals) out.normals.push_back(c.normal);
+            if (colours) out.colours.push_back(glm::u8vec3(glm::round(c.colour)));
         }
         for (std::uint32_t k = 1; k + 1 < poly.size(); ++k)
             out.indices.insert(out.indices.end(), {first, first + k, first + k + 1});

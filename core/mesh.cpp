@@ -12,6 +12,14 @@ void Mesh::append(const Mesh& other) {
     const auto base = static_cast<std::uint32_t>(positions.size());
     positions.insert(positions.end(), other.positions.begin(), other.positions.end());
     normals.insert(normals.end(), other.normals.begin(), other.normals.end());
+    // Colours stay one per position, or none: a mesh without them takes a neutral grey.
+    if (!other.colours.empty() || !colours.empty()) {
+        colours.resize(base, glm::u8vec3(160));
+        if (other.colours.empty())
+            colours.resize(positions.size(), glm::u8vec3(160));
+        else
+            colours.insert(colours.end(), other.colours.begin(), other.colours.end());
+    }
     // resize, not reserve: reserve allocates exactly what is asked, so a mesh built by many
     // appends would copy all its indices at every one (quadratic); resize grows geometrically.
     const std::size_t from = indices.size();

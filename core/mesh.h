@@ -13,6 +13,9 @@ struct Mesh {
     std::vector<glm::vec3> positions;    // object space (voxel index * spacing)
     std::vector<glm::vec3> normals;      // unit, one per position
     std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
+    // Empty (the surface's one colour), or one sRGB colour per position: a surface coloured by a
+    // second field (volume/colour_field.h).
+    std::vector<glm::u8vec3> colours;
 
     std::size_t triangle_count() const { return indices.size() / 3; }
     std::size_t vertex_count() const { return positions.size(); }

@@ -65,8 +65,10 @@ std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int 
                                    Mesh& out, SampleCullScratch& scratch) {
     out.positions.clear();
     out.normals.clear();
+    out.colours.clear();
     out.indices.clear();
     const std::size_t n = mesh.positions.size();
+    const bool colours = mesh.colours.size() == n;
     scratch.window.resize(n);
     scratch.kept_always.assign(n, 0);
     for (std::size_t v = 0; v < n; ++v) {
@@ -88,6 +90,7 @@ std::size_t keep_sampled_triangles(const Mesh& mesh, const glm::mat4& clip, int 
                 scratch.remap[v] = static_cast<std::uint32_t>(out.positions.size());
                 out.positions.push_back(mesh.positions[v]);
                 out.normals.push_back(mesh.normals[v]);
+                if (colours) out.colours.push_back(mesh.colours[v]);
             }
             out.indices.push_back(scratch.remap[v]);
         }

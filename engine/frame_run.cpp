@@ -239,6 +239,7 @@ bool FrameRun::add_found(FoundGroup& f) {
     stage(Stage::render);
     const auto t1 = Clock::now();
     if (cursor_->sizing) add_drawn(*cursor_, g.mesh, view_m_, *view_);
+    if (opt_.colour) opt_.colour(g.mesh);
     sink_->add(g);
     now_.t_render_s += since(t1);
     dirty_ = true;

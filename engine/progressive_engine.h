@@ -30,6 +30,10 @@
 namespace isowall {
 
 struct EngineOptions {
+    // Called on every group's mesh before it reaches the sink (the frame's thread): what colours
+    // a surface by a second field (volume/colour_field.h), so that whatever the sink draws,
+    // records or sends is coloured alike. Empty: the surface's one colour.
+    std::function<void(Mesh&)> colour;
     RayOrderKind order = RayOrderKind::dynamic_grid;
     IntersectMode intersect = IntersectMode::exact;
     PropagationParams propagation;

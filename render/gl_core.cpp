@@ -85,6 +85,7 @@ GlCore::GlCore(std::string_view backend, GlLoader loader)
     projection_location_ = gl_->GetUniformLocation(program_, "projection");
     normal_matrix_location_ = gl_->GetUniformLocation(program_, "normal_matrix");
     orthographic_location_ = gl_->GetUniformLocation(program_, "orthographic");
+    coloured_location_ = gl_->GetUniformLocation(program_, "coloured");
 
     // One set of buffers, refilled by every draw(): meshes arrive once per frame and change
     // between frames, so caching per mesh would buy nothing yet.
@@ -92,6 +93,7 @@ GlCore::GlCore(std::string_view backend, GlLoader loader)
     gl_->BindVertexArray(vertex_array_);
     gl_->GenBuffers(1, &position_buffer_);
     gl_->GenBuffers(1, &normal_buffer_);
+    gl_->GenBuffers(1, &colour_buffer_attr_);
     gl_->GenBuffers(1, &index_buffer_);
     gl_->BindBuffer(GL_ARRAY_BUFFER, position_buffer_);
     gl_->VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
@@ -99,6 +101,9 @@ GlCore::GlCore(std::string_view backend, GlLoader loader)
     gl_->BindBuffer(GL_ARRAY_BUFFER, normal_buffer_);
     gl_->VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
     gl_->EnableVertexAttribArray(1);
+    // Colours, when a mesh has them (draw enables the array then): bytes, normalised to [0, 1].
+    gl_->BindBuffer(GL_ARRAY_BUFFER, colour_buffer_attr_);
+    gl_->VertexAttribPointer(2, 3, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(glm::u8vec3), nullptr);
     // The element buffer binding is part of the vertex array's state.
     gl_->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer_);
     gl_->BindVertexArray(0);
@@ -116,6 +121,7 @@ GlCore::~GlCore() {
     gl_->DeleteRenderbuffers(1, &depth_buffer_);
     gl_->DeleteBuffers(1, &position_buffer_);
     gl_->DeleteBuffers(1, &normal_buffer_);
+    gl_->DeleteBuffers(1, &colour_buffer_attr_);
     gl_->DeleteBuffers(1, &index_buffer_);
     gl_->DeleteVertexArrays(1, &vertex_array_);
     gl_->DeleteProgram(program_);
@@ -235,6 +241,10 @@ void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& proj
         fail("draw", "mesh has " + std::to_string(mesh.normals.size()) + " normals for " +
                          std::to_string(mesh.positions.size()) + " positions");
     }
+    if (!mesh.colours.empty() && mesh.colours.size() != mesh.positions.size()) {
+        fail("draw", "mesh has " + std::to_string(mesh.colours.size()) + " colours for " +
+                         std::to_string(mesh.positions.size()) + " positions");
+    }
     if (mesh.empty()) return;
     bind_frame();
     gl_->Enable(GL_DEPTH_TEST);
@@ -250,6 +260,8 @@ void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& proj
     gl_->UniformMatrix3fv(normal_matrix_location_, 1, GL_FALSE, glm::value_ptr(normal_matrix));
     // A perspective matrix copies -z into w; an orthographic one leaves w at 1.
     gl_->Uniform1i(orthographic_location_, projection[2][3] == 0.0f ? 1 : 0);
+    const bool coloured = !mesh.colours.empty();
+    gl_->Uniform1i(coloured_location_, coloured ? 1 : 0);
 
     const auto bytes = [](const auto& v) {
         return static_cast<GLsizeiptr>(v.size() * sizeof(v[0]));
@@ -259,6 +271,13 @@ void GlCore::draw(const Mesh& mesh, const glm::mat4& view, const glm::mat4& proj
     gl_->BufferData(GL_ARRAY_BUFFER, bytes(mesh.positions), mesh.positions.data(), GL_STREAM_DRAW);
     gl_->BindBuffer(GL_ARRAY_BUFFER, normal_buffer_);
     gl_->BufferData(GL_ARRAY_BUFFER, bytes(mesh.normals), mesh.normals.data(), GL_STREAM_DRAW);
+    if (coloured) {
+        gl_->BindBuffer(GL_ARRAY_BUFFER, colour_buffer_attr_);
+        gl_->BufferData(GL_ARRAY_BUFFER, bytes(mesh.colours), mesh.colours.data(), GL_STREAM_DRAW);
+        gl_->EnableVertexAttribArray(2);
+    } else {
+        gl_->DisableVertexAttribArray(2);
+    }
     gl_->BufferData(GL_ELEMENT_ARRAY_BUFFER, bytes(mesh.indices), mesh.indices.data(),
                     GL_STREAM_DRAW);
     check("glBufferData");

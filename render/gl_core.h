@@ -72,11 +72,13 @@ class GlCore {
     unsigned vertex_array_ = 0;
     unsigned position_buffer_ = 0;
     unsigned normal_buffer_ = 0;
+    unsigned colour_buffer_attr_ = 0;  // vertex colours (colour_buffer_ is the frame's)
     unsigned index_buffer_ = 0;
     int model_view_location_ = -1;
     int projection_location_ = -1;
     int normal_matrix_location_ = -1;
     int orthographic_location_ = -1;
+    int coloured_location_ = -1;
     std::vector<std::uint32_t> depth_scratch_;  // read_coverage's rows, as GL gives them
     void* fence_ = nullptr;                     // flush()'s GLsync, until it has passed
 };

@@ -66,6 +66,7 @@ namespace isowall {
     X(PFNGLBUFFERDATAPROC, BufferData)                           \
     X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)         \
     X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray) \
+    X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray) \
     X(PFNGLDRAWELEMENTSPROC, DrawElements)                       \
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                         \
     X(PFNGLREADPIXELSPROC, ReadPixels)
