@@ -226,10 +226,8 @@ struct Colouring {
 Colouring colouring(const std::optional<OpenedColourField>& field, const ColourOptions& o,
                     const Volume& surface) {
     if (!field) return {};
-    std::string label = std::filesystem::path(o.by).filename().string();
-    for (char& c : label) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return {colour_hook(field->field, surface.spacing()), field->field.scale,
-            label + " (" + std::string(field->field.scale.map.name) + ")"};
+            colour_label(o, field->field.scale)};
 }
 
 std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,

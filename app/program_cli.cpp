@@ -182,6 +182,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
     wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
     add_iso_option(*wall_cmd, wall.iso);
     add_clip_options(*wall_cmd, wall.clip);
+    add_colour_options(*wall_cmd, wall.colour);
     wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")
         ->capture_default_str();
     wall_cmd->add_option("--tiles-out", wall.tiles_out,

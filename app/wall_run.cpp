@@ -78,12 +78,14 @@ struct MasterInput {
     std::unique_ptr<SurfaceExtractor> extractor;
     double iso = 0;
     ClipSet clip;
+    std::optional<OpenedColourField> colour;  // --color-by: checked here, its range for the legend
     std::vector<ScriptLine> script;
 };
 
 MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
     in.clip = checked_clip(o.clip);
+    (void)checked_colour_map(o.colour);
     // The master casts no ray: its volume stays in the shared map.
     in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
@@ -91,6 +93,7 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     in.iso = checked_iso(o.iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
                                  in.extractor->value_min(), in.extractor->value_max()});
     check_clip_keeps(in.clip, ov.volume.dims(), "--clip", "value");
+    in.colour = open_colour_field(o.colour, o.volume, ov.volume);
     to_engine_options(o.engine);
     // The console and the window or page would both take the operator's commands; one at a
     // time (the window and the page share one loop and take turns).
@@ -126,6 +129,10 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
     mo.zoom = o.zoom;
     mo.clip = in.clip;
+    if (in.colour) {
+        mo.legend = in.colour->field.scale;
+        mo.legend_label = colour_label(o.colour, in.colour->field.scale);
+    }
     mo.dims = in.volume->volume.dims();
     if (o.pan.size() == 2) mo.pan = {o.pan[0], o.pan[1]};
     mo.regions_from_work = o.region == "auto";
@@ -209,6 +216,10 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     auto help_renderer = make_renderer(o.gl);
     TileSetup setup{*extractor, *renderer, *help_renderer, to_engine_options(o.engine),
                     {},         o.measure};
+    // The master has checked --color-by against the volume; every rank reads the field itself.
+    const std::optional<OpenedColourField> colour =
+        open_colour_field(o.colour, o.volume, ov.volume);
+    if (colour) setup.engine.colour = colour_hook(colour->field, ov.volume.spacing());
     setup.engine.region_clip = o.region_clip;
     setup.engine.threads = budget.usable();
     if (o.fault.on(comm.rank())) setup.fault = o.fault;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli/clip_option.h"
+#include "cli/colour_option.h"
 #include "cli/engine_cli.h"
 #include "cli/volume_options.h"
 #include "comm/comm.h"
@@ -21,6 +22,7 @@ struct WallOptions {
     std::string wall;
     std::optional<double> iso;
     ClipOptions clip;
+    ColourOptions colour;
     std::string out = "mosaic.png";
     std::string tiles_out;  // folder for per-tile images (optional)
     std::string gl = "osmesa";

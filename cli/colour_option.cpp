@@ -1,5 +1,8 @@
 #include "cli/colour_option.h"
 
+#include <cctype>
+#include <filesystem>
+
 #include "cli/cli_checks.h"
 #include "core/error.h"
 #include "core/number.h"
@@ -50,6 +53,12 @@ std::optional<OpenedColourField> open_colour_field(const ColourOptions& colour,
                                                    : finite_range(values);
     out.field = {&values, {map, lo, hi}};
     return out;
+}
+
+std::string colour_label(const ColourOptions& colour, const ColourScale& scale) {
+    std::string label = std::filesystem::path(colour.by).filename().string();
+    for (char& c : label) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return label + " (" + std::string(scale.map.name) + ")";
 }
 
 std::function<void(Mesh&)> colour_hook(const ColourField& field, glm::vec3 spacing) {

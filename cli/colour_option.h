@@ -38,6 +38,9 @@ std::optional<OpenedColourField> open_colour_field(const ColourOptions& colour,
                                                    const VolumeOptions& surface_options,
                                                    const Volume& surface);
 
+// The legend's title: the field's file name, lower case, and the map ("dose.nrrd (viridis)").
+std::string colour_label(const ColourOptions& colour, const ColourScale& scale);
+
 // The engine's colour hook for `field` over `surface`'s spacing (EngineOptions::colour).
 std::function<void(Mesh&)> colour_hook(const ColourField& field, glm::vec3 spacing);
 

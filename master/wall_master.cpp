@@ -1,5 +1,7 @@
 #include "master/wall_master.h"
 
+#include "master/legend.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -507,6 +509,7 @@ void WallMaster::write_mosaics(const std::filesystem::path& path, std::vector<Mo
                                OutputFiles* batch) const {
     const PixelSize vs = virtual_screen_size(spec_);
     for (auto& [file, image] : mosaic_files(path, std::move(mosaics), vs.width, vs.height)) {
+        if (o_.legend) draw_legend(image, *o_.legend, o_.legend_label);
         if (batch)
             write_image(*batch, file, image);
         else

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "comm/comm.h"
+#include "core/colour_map.h"
 #include "core/test_fault.h"
 #include "core/util.h"
 #include "core/view.h"
@@ -56,7 +57,10 @@ struct MasterOptions {
     // The first view: the front full view turned, zoomed and panned by these.
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
-    ClipSet clip;        // the first view's clip planes (voxel indices)
+    ClipSet clip;  // the first view's clip planes (voxel indices)
+    // A surface coloured by a second field (--color-by): the legend the mosaics carry.
+    std::optional<ColourScale> legend;
+    std::string legend_label;
     glm::ivec3 dims{0};  // the volume's voxels: a `clip` that keeps none of them is refused
     // The volume's axes in patient space (volume/volume.h: Orientation), so that the
     // front view is the patient's front whatever the acquisition.

@@ -149,6 +149,55 @@ TEST_F(Cli, ClipCutsTheMeshAndThePicture) {
     EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 
+// --color-by: the picture coloured by a second field equals the full surface coloured alike, with
+// the legend in the written image; a bad map, range or field is one line and no image.
+TEST_F(Cli, ColorByColoursThePictureAndBadFieldsAreOneLine) {
+    // A field on the phantom's grid (200x184x168) growing along x, and one a voxel short.
+    auto write_field = [&](const char* name, int nx) {
+        std::string data(std::size_t(nx) * 184 * 168, '\0');
+        for (std::size_t i = 0; i < data.size(); ++i)
+            data[i] = char(std::uint8_t(int(i % std::size_t(nx)) * 255 / (nx - 1)));
+        std::ofstream(dir_ / name, std::ios::binary)
+            << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << nx << " 184 168\nencoding: raw\n\n"
+            << data;
+    };
+    write_field("ramp.nrrd", 200);
+    write_field("short.nrrd", 199);
+    auto r = run_isowall(dir_,
+                         "render --size 160x120 --color-by ramp.nrrd --colormap magma "
+                         "--against-full --out coloured.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("coverage IoU 1.0000"), std::string::npos) << r.out;
+    const Image img = read_image(dir_ / "coloured.png");
+    // magma's low end is near black, its high end a pale yellow: the right of the ball is far
+    // brighter in red than the left.
+    auto red = [&](int x0, int x1) {
+        double sum = 0, n = 0;
+        for (int y = 0; y < 80; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const std::uint8_t* p = &img.rgba[4 * (std::size_t(y) * img.width + x)];
+                if (p[0] + p[1] + p[2] == 0) continue;
+                sum += p[0];
+                n += 1;
+            }
+        return n > 0 ? sum / n : 0.0;
+    };
+    EXPECT_GT(red(100, 160), red(0, 60) + 40) << red(0, 60) << " " << red(100, 160);
+    for (const auto& [args, mentions] :
+         std::vector<std::pair<std::string, std::vector<std::string>>>{
+             {"--color-by ramp.nrrd --colormap rainbow", {"--colormap", "rainbow", "viridis"}},
+             {"--color-by ramp.nrrd --color-range 5 2", {"--color-range", "LO below HI"}},
+             {"--color-by short.nrrd", {"short.nrrd", "--color-by", "199x184x168", "same grid"}},
+             {"--color-by missing.nrrd", {"missing.nrrd"}},
+         }) {
+        r = run_isowall(dir_, "render --size 64x48 --out bad.png " + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        for (const std::string& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
 // --against-full: the final image's C and final pixels against the full surface, printed after
 // the frame; full resolution matches it, a coarse level of detail does not quite.
 TEST_F(Cli, AgainstFullPrintsBothMeasures) {
