@@ -316,6 +316,10 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     for (const ClipPlane& p : master.clip())
         s.clip += (s.clip.empty() ? "" : " ") + clip_plane_text(p);
     s.dims = master.dims();
+    if (master.options().legend) {
+        s.legend = *master.options().legend;
+        s.legend_label = master.options().legend_label;
+    }
     for (const auto& page : roster_) {
         s.pages.push_back(page->name);
         if (seat_.holder() == page->id) s.steering = page->name;

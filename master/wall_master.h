@@ -136,6 +136,7 @@ class WallMaster {
     const glm::dvec3& head() const { return head_; }
     const ClipSet& clip() const { return clip_; }
     glm::ivec3 dims() const { return o_.dims; }
+    const MasterOptions& options() const { return o_; }
     double value_min() const { return lo_; }
     double value_max() const { return hi_; }
     // For the control window (--control): the latest preview of each tile rank ([0], the

@@ -102,6 +102,24 @@ std::string welcome_json(const std::string& you, const ControlLayout& layout,
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
+namespace {
+
+// The page's legend: its title, the ends of the range and nine colours from the low end to the
+// high one (a CSS gradient through them shows the map); null when the surface has one colour.
+json legend_json(const PageState& s) {
+    if (!s.legend.map.table) return nullptr;
+    json stops = json::array();
+    for (int i = 0; i <= 8; ++i) {
+        const glm::u8vec3 c = s.legend.map.at(i / 8.0);
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "#%02x%02x%02x", c.x, c.y, c.z);
+        stops.push_back(hex);
+    }
+    return {{"label", s.legend_label}, {"lo", s.legend.lo}, {"hi", s.legend.hi}, {"stops", stops}};
+}
+
+}  // namespace
+
 std::string state_json(const PageState& s) {
     const FrameFigures& f = s.figures;
     return json{{"type", "state"},          {"iso", s.iso},
@@ -112,7 +130,8 @@ std::string state_json(const PageState& s) {
                 {"jobs_done", f.jobs_done}, {"migrated", f.migrated},
                 {"c99_s", f.c99_s},         {"steering", s.steering},
                 {"pages", s.pages},         {"dark", s.dark},
-                {"clip", s.clip},           {"dims", {s.dims.x, s.dims.y, s.dims.z}}}
+                {"clip", s.clip},           {"dims", {s.dims.x, s.dims.y, s.dims.z}},
+                {"legend", legend_json(s)}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/colour_map.h"
 #include "core/image.h"
 #include "master/wall_master.h"
 #include "wall_spec/control_layout.h"
@@ -69,6 +70,9 @@ struct PageState {
     std::vector<std::string> dark;
     std::string clip;    // the view's clip planes as a script writes them ("x<99"), or empty
     glm::ivec3 dims{0};  // the volume's voxels: the range of the page's clip slider
+    // A surface coloured by a second field: the legend's title and scale (no map: none).
+    std::string legend_label;
+    ColourScale legend{};
 };
 std::string state_json(const PageState& s);
 // A line ran (error empty) or was refused.

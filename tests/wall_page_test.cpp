@@ -92,6 +92,15 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     s.dims = {200, 184, 168};
     const auto j = nlohmann::json::parse(state_json(s));
     EXPECT_EQ(j["clip"], "x<99");
+    EXPECT_TRUE(j["legend"].is_null());
+    s.legend = {*colour_map_named("viridis"), 2, 8};
+    s.legend_label = "dose.nrrd (viridis)";
+    const auto k = nlohmann::json::parse(state_json(s));
+    EXPECT_EQ(k["legend"]["label"], "dose.nrrd (viridis)");
+    EXPECT_EQ(k["legend"]["hi"], 8);
+    ASSERT_EQ(k["legend"]["stops"].size(), 9u);
+    EXPECT_EQ(k["legend"]["stops"][0], "#440154");
+    EXPECT_EQ(k["legend"]["stops"][8], "#fde725");
     EXPECT_EQ(j["dims"], nlohmann::json({200, 184, 168}));
     ASSERT_EQ(j["dark"].size(), 1u);
     EXPECT_EQ(j["dark"][0], "tile 8 (rank 9 on node3): its process has ended");

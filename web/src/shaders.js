@@ -2,12 +2,15 @@
 export const kVertexShader = `#version 300 es
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 colour_in;
 uniform mat4 model_view;
 uniform mat4 projection;
 uniform mat3 normal_matrix;
 out vec3 view_position;
 out vec3 view_normal;
+out vec3 vertex_colour;
 void main() {
+    vertex_colour = colour_in;
     vec4 p = model_view * vec4(position, 1.0);
     view_position = p.xyz;
     view_normal = normal_matrix * normal;
@@ -19,7 +22,9 @@ export const kFragmentShader = `#version 300 es
 precision highp float;
 in vec3 view_position;
 in vec3 view_normal;
+in vec3 vertex_colour;
 uniform bool orthographic;
+uniform bool coloured;
 out vec4 colour;
 const vec3 kFrontColour = vec3(0.9, 0.85, 0.75);
 const vec3 kBackColour = vec3(0.6, 0.68, 0.85);
@@ -29,10 +34,10 @@ const float kSpecular = 0.25;
 const float kShininess = 40.0;
 void main() {
     vec3 n = normalize(view_normal);
-    vec3 base = kFrontColour;
+    vec3 base = coloured ? vertex_colour : kFrontColour;
     if (!gl_FrontFacing) {
         n = -n;
-        base = kBackColour;
+        base = coloured ? 0.6 * vertex_colour : kBackColour;
     }
     vec3 to_light = orthographic ? vec3(0.0, 0.0, 1.0) : normalize(-view_position);
     float lambert = max(dot(n, to_light), 0.0);

@@ -14,6 +14,7 @@ const el = {
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
   emulated: $('s-emulated'), c99: $('s-c99'), balance: $('s-balance'), jobs: $('s-jobs'), migrated: $('s-migrated'),
   pages: $('s-pages'), dark: $('s-dark'), log: $('log'),
+  legendLabel: $('s-legend-label'), legendLo: $('s-legend-lo'), legendHi: $('s-legend-hi'), legendBar: $('s-legend-bar'),
   clipAxis: $('clip-axis'), clipAt: $('clip-at'), clipValue: $('clip-value'),
 };
 const ctx = el.canvas.getContext('2d');
@@ -149,6 +150,14 @@ function showState(s) {
   el.pages.textContent = s.pages.join(', ');
   // Screens whose tile rank is lost: the other ranks draw them into this mosaic, the wall's own
   // display stays dark.
+  const legend = s.legend;
+  el.legendLabel.parentElement.hidden = !legend;
+  if (legend) {
+    el.legendLabel.textContent = legend.label;
+    el.legendLo.textContent = num(legend.lo);
+    el.legendHi.textContent = num(legend.hi);
+    el.legendBar.style.background = `linear-gradient(to right, ${legend.stops.join(', ')})`;
+  }
   const dark = s.dark || [];
   el.dark.parentElement.hidden = dark.length === 0;
   el.dark.textContent = dark.join('; ');
