@@ -41,26 +41,29 @@ ClipSet in_object_space(const ClipSet& voxel, glm::vec3 spacing) {
     return out;
 }
 
+namespace {
+
+// The corner of `box` farthest along `n` (`far`), or least far.
+glm::vec3 corner_along(const Box3& box, glm::vec3 n, bool far) {
+    glm::vec3 c;
+    for (int a = 0; a < 3; ++a) c[a] = (n[a] >= 0) == far ? box.max[a] : box.min[a];
+    return c;
+}
+
+}  // namespace
+
 bool cut_away(const ClipSet& clip, const Box3& box) {
-    for (const ClipPlane& p : clip) {
-        // The corner farthest along the normal is the one most likely kept.
-        const glm::vec3 far{p.normal.x >= 0 ? box.max.x : box.min.x,
-                            p.normal.y >= 0 ? box.max.y : box.min.y,
-                            p.normal.z >= 0 ? box.max.z : box.min.z};
-        if (p.side(far) < 0) return true;
-    }
-    return false;
+    // A plane cuts the whole box away when even the corner farthest along its normal is cut.
+    return std::any_of(clip.begin(), clip.end(), [&box](const ClipPlane& p) {
+        return p.side(corner_along(box, p.normal, true)) < 0;
+    });
 }
 
 bool keeps_whole(const ClipSet& clip, const Box3& box) {
-    for (const ClipPlane& p : clip) {
-        // The corner least far along the normal is the one most likely cut.
-        const glm::vec3 near{p.normal.x >= 0 ? box.min.x : box.max.x,
-                             p.normal.y >= 0 ? box.min.y : box.max.y,
-                             p.normal.z >= 0 ? box.min.z : box.max.z};
-        if (p.side(near) < 0) return false;
-    }
-    return true;
+    // Every plane keeps the whole box when it keeps even the corner least far along its normal.
+    return std::all_of(clip.begin(), clip.end(), [&box](const ClipPlane& p) {
+        return p.side(corner_along(box, p.normal, false)) >= 0;
+    });
 }
 
 bool keeps_some_voxel(const ClipSet& clip, glm::ivec3 dims) {

@@ -36,6 +36,37 @@ void expect_args(const std::vector<std::string>& w, std::size_t n, const std::st
             "expected \"" + usage + "\", got " + std::to_string(w.size() - 1) + " argument(s)");
 }
 
+// `clip PLANE...`, `clip box X0 Y0 Z0 X1 Y1 Z1` or `clip off` (words `w`, w[0] = "clip").
+ClipCmd parse_clip(const std::vector<std::string>& w, const std::string& where) {
+    const std::string& c = w[0];
+    auto num = [&](std::size_t i, const NumberRange& range) {
+        return checked_number(w[i], range, where, c);
+    };
+    const char* usage =
+        "expected \"clip PLANE...\" (x<N, y>N, z<N or A,B,C<D, at most 8), \"clip box X0 Y0 "
+        "Z0 X1 Y1 Z1\" or \"clip off\"";
+    if (w.size() == 2 && w[1] == "off") return ClipCmd{};
+    std::string problem;
+    if (w.size() >= 2 && w[1] == "box") {
+        if (w.size() != 8) throw InputError(where, c, usage);
+        const glm::vec3 lo(num(2, limits::kCoordinate), num(3, limits::kCoordinate),
+                           num(4, limits::kCoordinate));
+        const glm::vec3 hi(num(5, limits::kCoordinate), num(6, limits::kCoordinate),
+                           num(7, limits::kCoordinate));
+        const auto box = clip_box(lo, hi, problem);
+        if (!box) throw InputError(where, c, problem);
+        return ClipCmd{*box};
+    }
+    if (w.size() < 2 || w.size() - 1 > kMaxClipPlanes) throw InputError(where, c, usage);
+    ClipCmd cmd;
+    for (std::size_t i = 1; i < w.size(); ++i) {
+        const auto plane = parse_clip_plane(w[i], problem);
+        if (!plane) throw InputError(where, c, problem);
+        cmd.clip.add(*plane);
+    }
+    return cmd;
+}
+
 }  // namespace
 
 ScriptCommand parse_command(std::string_view text, const std::string& where) {
@@ -95,31 +126,7 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
         expect_args(w, 3, where, "head X Y Z");
         return HeadCmd{{num(1, limits::kHead), num(2, limits::kHead), num(3, limits::kHead)}};
     }
-    if (c == "clip") {
-        const char* usage =
-            "expected \"clip PLANE...\" (x<N, y>N, z<N or A,B,C<D, at most 8), \"clip box X0 Y0 "
-            "Z0 X1 Y1 Z1\" or \"clip off\"";
-        if (w.size() == 2 && w[1] == "off") return ClipCmd{};
-        std::string problem;
-        if (w.size() >= 2 && w[1] == "box") {
-            if (w.size() != 8) throw InputError(where, c, usage);
-            const glm::vec3 lo(num(2, limits::kCoordinate), num(3, limits::kCoordinate),
-                               num(4, limits::kCoordinate));
-            const glm::vec3 hi(num(5, limits::kCoordinate), num(6, limits::kCoordinate),
-                               num(7, limits::kCoordinate));
-            const auto box = clip_box(lo, hi, problem);
-            if (!box) throw InputError(where, c, problem);
-            return ClipCmd{*box};
-        }
-        if (w.size() < 2 || w.size() - 1 > kMaxClipPlanes) throw InputError(where, c, usage);
-        ClipCmd cmd;
-        for (std::size_t i = 1; i < w.size(); ++i) {
-            const auto plane = parse_clip_plane(w[i], problem);
-            if (!plane) throw InputError(where, c, problem);
-            cmd.clip.add(*plane);
-        }
-        return cmd;
-    }
+    if (c == "clip") return parse_clip(w, where);
     if (c == "quit") {
         expect_args(w, 0, where, "quit");
         return QuitCmd{};
