@@ -1,5 +1,7 @@
 #include "core/clip.h"
 
+#include <glm/matrix.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -67,7 +69,34 @@ bool keeps_whole(const ClipSet& clip, const Box3& box) {
 }
 
 bool keeps_some_voxel(const ClipSet& clip, glm::ivec3 dims) {
-    return !cut_away(clip, {glm::vec3(0), glm::vec3(glm::max(dims - 1, glm::ivec3(0)))});
+    const glm::dvec3 hi(glm::max(dims - 1, glm::ivec3(0)));
+    struct Half {
+        glm::dvec3 n;
+        double at;
+    };
+    std::vector<Half> all;  // the box's six faces, then the planes: keeps dot(n, p) >= at
+    for (int a = 0; a < 3; ++a) {
+        glm::dvec3 n(0);
+        n[a] = 1;
+        all.push_back({n, 0});
+        all.push_back({-n, -hi[a]});
+    }
+    for (const ClipPlane& p : clip) all.push_back({glm::dvec3(p.normal), double(p.at)});
+    const double eps = 1e-6 * (1 + std::max({hi.x, hi.y, hi.z}));
+    auto inside = [&](const glm::dvec3& q) {
+        return std::all_of(all.begin(), all.end(),
+                           [&](const Half& h) { return glm::dot(h.n, q) - h.at >= -eps; });
+    };
+    for (std::size_t i = 0; i < all.size(); ++i)
+        for (std::size_t j = i + 1; j < all.size(); ++j)
+            for (std::size_t k = j + 1; k < all.size(); ++k) {
+                // The rows of the system are the three normals (glm's matrices are by columns).
+                const glm::dmat3 m = glm::transpose(glm::dmat3(all[i].n, all[j].n, all[k].n));
+                if (std::abs(glm::determinant(m)) < 1e-12) continue;
+                if (inside(glm::inverse(m) * glm::dvec3(all[i].at, all[j].at, all[k].at)))
+                    return true;
+            }
+    return false;
 }
 
 std::optional<RaySpan> kept_span(const ClipSet& clip, const Ray& ray) {

@@ -63,7 +63,9 @@ bool cut_away(const ClipSet& clip, const Box3& box);
 bool keeps_whole(const ClipSet& clip, const Box3& box);
 
 // False when `clip` (voxel indices) keeps no part of a volume of `dims` voxels: its picture would
-// be empty (cut_away of the box the voxels span).
+// be empty. Exact, for the planes together: the box the voxels span and the kept half-spaces meet
+// when some point where three of their planes cross lies in all of them (a bounded convex set
+// that is not empty has such a corner).
 bool keeps_some_voxel(const ClipSet& clip, glm::ivec3 dims);
 
 // The part of `ray` (t >= 0) in the kept space: [t0, t1], t1 possibly infinite; nullopt when the

@@ -141,6 +141,8 @@ TEST_F(Cli, ClipCutsTheMeshAndThePicture) {
     expect_one_line_error(bad("--clip-box 0,0,0,10,10"), {"--clip-box", "six numbers"});
     expect_one_line_error(bad("--clip-box 0,0,0,10,0,10"), {"--clip-box", "Y0 < Y1"});
     expect_one_line_error(bad("--clip \"x<-5\""), {"--clip", "keep nothing of the volume"});
+    expect_one_line_error(bad("--clip \"x<10\" --clip \"x>20\""),
+                          {"--clip", "keep nothing of the volume"});
     EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 

@@ -100,10 +100,16 @@ TEST(ClipPlanes, BoxesWhollyCutAndWhollyKept) {
     ClipSet past;
     past.add(parsed("x>25"));
     EXPECT_FALSE(keeps_some_voxel(past, {20, 20, 20}));
-    // Judged plane by plane (cut_away): two planes that each keep part of the box but keep
-    // nothing together pass as keeping some.
+    // Planes that each keep part of the box but keep nothing of it together.
     c.add(parsed("x>15"));
-    EXPECT_TRUE(keeps_some_voxel(c, {20, 20, 20}));
+    EXPECT_FALSE(keeps_some_voxel(c, {20, 20, 20}));
+    // A wedge: x + y > 30 and x < 12 meet inside the 20^3 box only where y > 18.
+    ClipSet wedge;
+    wedge.add(parsed("1,1,0>30"));
+    wedge.add(parsed("x<12"));
+    EXPECT_TRUE(keeps_some_voxel(wedge, {20, 20, 20}));
+    EXPECT_FALSE(keeps_some_voxel(wedge, {20, 18, 20}));  // y at most 17
+    EXPECT_TRUE(keeps_some_voxel(ClipSet{}, {20, 20, 20}));
 }
 
 TEST(ClipPlanes, VoxelPlanesInObjectSpaceFollowTheSpacing) {
