@@ -26,9 +26,11 @@ struct ControlStatus {
     std::uint64_t frame = 0;  // the master's generation
     bool done = false;        // every tile has finished the frame
     std::string last;         // the last command the window gave, e.g. "orbit -30 0"
+    std::string clip{};       // the view's clip planes as a script writes them, or empty
 };
 
-// The two lines of the status bar: the isovalue, its range, the frame and the last command;
+// The two lines of the status bar: the isovalue, its range, the frame, the clip planes and the
+// last command;
 // then the keys (keys_line).
 std::vector<std::string> status_lines(const ControlStatus& s);
 std::string keys_line();
