@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace isowall {
 namespace {
@@ -41,17 +42,27 @@ void colour_mesh(Mesh& mesh, const ColourField& field, glm::vec3 spacing) {
 
 std::pair<double, double> finite_range(const Volume& v) {
     return dispatch_voxel_type(v.type(), [&](auto tag) {
-        const auto view = v.view<decltype(tag)>();
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int z = 0; z < view.dims.z; ++z)
-            for (int y = 0; y < view.dims.y; ++y)
-                for (int x = 0; x < view.dims.x; ++x) {
-                    const double d = static_cast<double>(view.at(x, y, z));
-                    if (!std::isfinite(d)) continue;
-                    lo = std::min(lo, d);
-                    hi = std::max(hi, d);
-                }
-        return lo <= hi ? std::pair{lo, hi} : std::pair{0.0, 0.0};
+        using T = decltype(tag);
+        const auto view = v.view<T>();
+        T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
+        bool any = false;
+        auto take = [&](T d) {
+            if constexpr (std::is_floating_point_v<T>)
+                if (!std::isfinite(d)) return;
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+            any = true;
+        };
+        // Every rank of a wall coloured without --color-range runs this at start-up: an x-fastest
+        // array in one pass; a bricked one voxel by voxel, as its partial bricks hold padding.
+        if (!view.bricked()) {
+            for (std::size_t i = 0, n = view.voxel_count(); i < n; ++i) take(view.data[i]);
+        } else {
+            for (int z = 0; z < view.dims.z; ++z)
+                for (int y = 0; y < view.dims.y; ++y)
+                    for (int x = 0; x < view.dims.x; ++x) take(view.at(x, y, z));
+        }
+        return any ? std::pair{double(lo), double(hi)} : std::pair{0.0, 0.0};
     });
 }
 
