@@ -313,8 +313,7 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     s.frame_s = frame.seconds;
     s.figures = master.frame_figures();
     s.dark = master.dark_screens();
-    for (const ClipPlane& p : master.clip())
-        s.clip += (s.clip.empty() ? "" : " ") + clip_plane_text(p);
+    s.clip = clip_text(master.clip());
     s.dims = master.dims();
     if (master.options().legend) {
         s.legend = *master.options().legend;

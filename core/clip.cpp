@@ -27,9 +27,16 @@ bool operator==(const ClipSet& a, const ClipSet& b) {
 }
 
 std::ostream& operator<<(std::ostream& os, const ClipSet& c) {
-    os << "clip{";
-    for (const ClipPlane& p : c) os << (&p == c.begin() ? "" : " ") << clip_plane_text(p);
-    return os << "}";
+    return os << "clip{" << clip_text(c) << "}";
+}
+
+std::string clip_text(const ClipSet& clip) {
+    std::string out;
+    for (const ClipPlane& p : clip) {
+        if (!out.empty()) out += ' ';
+        out += clip_plane_text(p);
+    }
+    return out;
 }
 
 ClipSet in_object_space(const ClipSet& voxel, glm::vec3 spacing) {

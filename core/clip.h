@@ -99,5 +99,8 @@ std::optional<ClipSet> clip_box(glm::vec3 lo, glm::vec3 hi, std::string& problem
 
 // The operator's form of `plane` (what parse_clip_plane reads back to the same plane).
 std::string clip_plane_text(const ClipPlane& plane);
+// Every plane of `clip` so, space-separated ("x<99 z>40"): a script's `clip` line without the word;
+// empty for none.
+std::string clip_text(const ClipSet& clip);
 
 }  // namespace isowall

@@ -41,10 +41,7 @@ ControlWindow::ControlWindow(const WallSpec& spec, const std::string& display,
 void ControlWindow::present(const WallMaster& master) {
     ControlStatus status{master.iso(),        master.value_min(),  master.value_max(),
                          master.generation(), master.frame_done(), last_};
-    for (const ClipPlane& p : master.clip()) {
-        if (!status.clip.empty()) status.clip += ' ';
-        status.clip += clip_plane_text(p);
-    }
+    status.clip = clip_text(master.clip());
     window_.present(compose_control(layout_, tile_previews(master), status_lines(status)));
 }
 

@@ -31,6 +31,11 @@ TEST(ClipPlanes, AxisAndGeneralPlanesKeepTheSideTheyName) {
     EXPECT_NEAR(glm::length(diagonal.normal), 1.0f, 1e-6f);
     EXPECT_GE(diagonal.side({6, 5, 0}), 0);
     EXPECT_LT(diagonal.side({4, 5, 0}), 0);
+    ClipSet two;
+    two.add(below);
+    two.add(above);
+    EXPECT_EQ(clip_text(two), "x<60 z>-4.5");
+    EXPECT_EQ(clip_text(ClipSet{}), "");
     // The operator's form reads back to the same plane.
     for (const ClipPlane& p : {below, above, diagonal}) {
         const ClipPlane again = parsed(clip_plane_text(p).c_str());
