@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "app/render_report.h"
+#include "app/surfaces_frame.h"
 #include "app/whole_frame.h"
 #include "cli/cli_checks.h"
 #include "cli/iso_option.h"
@@ -71,6 +72,13 @@ double volume_iso(const std::optional<double>& iso, const OpenedVolume& ov,
                   const SurfaceExtractor& ex) {
     return checked_iso(iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
                              ex.value_min(), ex.value_max()});
+}
+
+// --iso's surfaces for the volume `ov` that `ex` extracts from.
+std::vector<SurfaceStyle> volume_surfaces(const std::vector<std::string>& given,
+                                          const OpenedVolume& ov, const SurfaceExtractor& ex) {
+    return checked_surfaces(given, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
+                                    ex.value_min(), ex.value_max()});
 }
 
 Mesh extract_timed(const SurfaceExtractor& ex, const FrameView& fv, Timings& t) {
@@ -177,8 +185,13 @@ void stage_snapshots(const RenderOptions& o, const TimelineSample& s, const Imag
 // draw-only floor and the timeline. With --against-full (`full` drawn), every replayed image is
 // also measured against the full surface: the time to C = 99% of the true picture, not only of
 // the engine's own final one.
+// `measure` replays the frame, handing each image to its argument when that is set
+// (app/whole_frame.h measure_frame, app/surfaces_frame.h measure_surfaces); `renderer`, when
+// given, draws the draw-only floor.
+using ImageCallback = std::function<void(const TimelineSample&, const Image&)>;
 void replay_and_report(const RenderOptions& o, FrameResult& fr, const FrameView& fv,
-                       Renderer& renderer, const Image& full, OutputFiles& batch) {
+                       const std::function<void(const ImageCallback&)>& measure, Renderer* renderer,
+                       const Image& full, OutputFiles& batch) {
     Stopwatch sw;
     std::vector<bool> c_done(o.snapshots.size()), r_done(o.snapshot_rays.size());
     std::vector<TimelineSample> vs_full;
@@ -191,14 +204,12 @@ void replay_and_report(const RenderOptions& o, FrameResult& fr, const FrameView&
         vs_full.push_back(s);
         vs_full.back().correctness = measure_correctness(img, full);
     };
-    measure_frame(
-        fr, fv, renderer,
-        images ? std::function<void(const TimelineSample&, const Image&)>(on_image) : nullptr);
+    measure(images ? ImageCallback(on_image) : nullptr);
     print_thresholds(fr, fr.timeline);
     if (o.against_full) print_thresholds(fr, vs_full, "the full surface at full resolution");
     // The draw-only floor draws the triangles again in one go (about as long as the replay on a
     // volume finer than the screen): a figure for studies, with their options.
-    if (o.against_full || !o.timeline.empty()) print_draw_only(fr, fv, renderer);
+    if (renderer && (o.against_full || !o.timeline.empty())) print_draw_only(fr, fv, *renderer);
     if (!o.timeline.empty()) {
         write_timeline_csv(batch, o.timeline, fr.timeline, fr.rays_screen);
         std::printf("timeline: %s (%zu samples; plot with scripts/plot_timeline.py)\n",
@@ -295,7 +306,11 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
 
     const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
                               !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (want_measure) replay_and_report(o, fr, fv, renderer, full, batch);
+    if (want_measure)
+        replay_and_report(
+            o, fr, fv,
+            [&](const ImageCallback& on_image) { measure_frame(fr, fv, renderer, on_image); },
+            &renderer, full, batch);
 
     // After the replay, by when OpenImageIO has loaded beside it (preload_image_io above).
     Stopwatch sw;
@@ -303,6 +318,183 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
     t.write = sw.seconds();
     return last.triangles;
+}
+
+// The engine's colour hook for one of several surfaces: the second field's where one colours
+// them all, else the surface's own colour where it has one.
+std::function<void(Mesh&)> surface_hook(const Colouring& colour, const SurfaceStyle& style) {
+    if (colour.hook || !style.coloured) return colour.hook;
+    return solid_colour_hook(style.colour);
+}
+
+// The layers of several surfaces: the first draws with `ex` and `renderer`, every other with an
+// extractor sharing its octree and a renderer of its own (all kept in `keep`).
+struct SurfaceParts {
+    std::vector<std::unique_ptr<SurfaceExtractor>> extractors;
+    std::vector<std::unique_ptr<Renderer>> renderers;
+    std::vector<std::unique_ptr<ProgressiveEngine>> engines;
+    std::vector<SurfaceLayer> layers;
+};
+
+SurfaceParts surface_parts(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                           const std::vector<SurfaceStyle>& styles, const Colouring& colour) {
+    SurfaceParts p;
+    for (std::size_t k = 0; k < styles.size(); ++k) {
+        SurfaceExtractor* e = &ex;
+        Renderer* r = &renderer;
+        if (k > 0) {
+            p.extractors.push_back(ex.share());
+            e = p.extractors.back().get();
+            p.renderers.push_back(make_renderer(o.gl));
+            r = p.renderers.back().get();
+        }
+        warm_up(*r);
+        EngineOptions options = engine_options(o);
+        options.colour = surface_hook(colour, styles[k]);
+        p.engines.push_back(std::make_unique<ProgressiveEngine>(*e, options));
+        p.layers.push_back({p.engines.back().get(), r, styles[k]});
+    }
+    return p;
+}
+
+// Each layer's full surface, coloured as its engine colours groups; `triangles` counts them. With
+// `t`, each extraction is timed and printed (extract_timed) and their sum kept in t->extract.
+std::vector<Mesh> full_meshes(const SurfaceExtractor& ex, const std::vector<SurfaceLayer>& layers,
+                              const FrameView& fv, std::size_t& triangles, Timings* t = nullptr) {
+    std::vector<Mesh> meshes;
+    for (const SurfaceLayer& l : layers) {
+        FrameView v = fv;
+        v.iso = l.style.iso;
+        Timings one;
+        meshes.push_back(t ? extract_timed(ex, v, one) : ex.full_surface(v));
+        if (t) t->extract += one.extract;
+        if (l.engine->options().colour) l.engine->options().colour(meshes.back());
+        triangles += meshes.back().triangle_count();
+    }
+    return meshes;
+}
+
+void print_surfaces_frame(const SurfacesFrame& sf, const SurfaceParts& parts) {
+    const FrameResult& fr = sf.frame;
+    const TimelineSample& last = fr.timeline.back();
+    std::printf(
+        "progressive: %zu surfaces, one ray-order level of each in turn: %zu rays in %.3f s: %zu "
+        "groups, %zu triangles, %zu cells visited\n",
+        sf.layers.size(), fr.rays_cast, fr.elapsed_s, fr.group_count, last.triangles,
+        last.cells_visited);
+    for (std::size_t k = 0; k < sf.layers.size(); ++k) {
+        const FrameResult& l = sf.layers[k];
+        std::printf("  surface %s: %zu rays, %zu groups, %zu triangles (%zu drawn)\n",
+                    surface_style_text(parts.layers[k].style).c_str(), l.rays_cast, l.group_count,
+                    l.timeline.back().triangles, l.triangles_drawn);
+    }
+    std::printf(
+        "stages (summed over threads and surfaces): intersection %.3f s | propagation %.3f s | "
+        "extraction %.3f s | rendering %.3f s\n",
+        last.t_intersect_s, last.t_propagate_s, last.t_extract_s, last.t_render_s);
+    std::printf("covered: the final image covers %zu px\n", covered_pixels(fr.final_image));
+}
+
+// Several surfaces, or one translucent (core/surface_style.h): app/surfaces_frame.h's frame,
+// reported as render_progressive reports one surface's.
+std::size_t render_surfaces(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                            const std::vector<SurfaceStyle>& styles, const FrameView& fv,
+                            Timings& t, OutputFiles& batch, const Colouring& colour) {
+    SurfaceParts parts = surface_parts(o, ex, renderer, styles, colour);
+    if (o.warm_up) {
+        const SurfacesFrame w = draw_surfaces(parts.layers, warm_up_view(fv, ex.volume().bounds()));
+        std::printf(
+            "warm-up: an untimed frame of the view turned %g degrees: %zu triangles in "
+            "%.3f s\n",
+            kWarmUpYawDeg, w.frame.timeline.back().triangles, w.frame.elapsed_s);
+    }
+    const double frame_at = t.command.seconds();
+    SurfacesFrame sf = draw_surfaces(parts.layers, fv);
+    preload_image_io();
+    t.frame = sf.frame.elapsed_s;
+    FrameResult& fr = sf.frame;
+    print_surfaces_frame(sf, parts);
+    print_first_picture(fr, frame_at, t.load, t.octree);
+
+    Image full;
+    if (o.against_full || o.against_truth) {
+        Stopwatch sw;
+        std::size_t triangles = 0;
+        const std::vector<Mesh> meshes = full_meshes(ex, parts.layers, fv, triangles);
+        full = draw_surfaces_alone(parts.layers, meshes, fv);
+        if (o.against_full) print_full_comparison(full, triangles, fr.final_image, sw.seconds());
+        if (o.against_truth)
+            print_truth_comparison(draw_surfaces_alone(parts.layers, meshes, fv, kTruthSamples),
+                                   full, triangles, fr.final_image, sw.seconds());
+    }
+    const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
+                              !o.snapshots.empty() || !o.snapshot_rays.empty();
+    if (want_measure)
+        replay_and_report(
+            o, fr, fv,
+            [&](const ImageCallback& on_image) {
+                measure_surfaces(sf, parts.layers, fv, on_image);
+            },
+            nullptr, full, batch);
+    Stopwatch sw;
+    write_image(batch, o.out, colour.written(fr.final_image));
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, fr.final_image);
+    t.write = sw.seconds();
+    return fr.timeline.back().triangles;
+}
+
+// `render --full`'s picture written (with the legend of a coloured surface) and committed.
+void write_full_picture(const RenderOptions& o, const Image& image, const Colouring& colour,
+                        Timings& t, OutputFiles& batch) {
+    Stopwatch sw;
+    write_image(batch, o.out, colour.written(image));
+    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);
+    batch.commit();
+    t.write = sw.seconds();
+    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
+                o.depth_out.c_str());
+}
+
+// `render --full`: the surface extracted whole and drawn in one go; its triangles.
+std::size_t render_full_surface(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                                const FrameView& fv, Timings& t, OutputFiles& batch,
+                                const Colouring& colour) {
+    if (o.warm_up) {
+        Stopwatch warm;
+        Mesh once = ex.full_surface(fv);
+        if (colour.hook) colour.hook(once);
+        draw_alone(renderer, once, fv);
+        std::printf("warm-up: the full surface extracted and drawn once, untimed (%.3f s)\n",
+                    warm.seconds());
+    }
+    Mesh mesh = extract_timed(ex, fv, t);
+    if (colour.hook) colour.hook(mesh);
+    Stopwatch sw;
+    const Image image = draw_alone(renderer, mesh, fv);
+    t.render = sw.seconds();
+    const std::size_t covered = covered_pixels(image);
+    std::printf("render: %s %dx%d, %.1f%% of pixels covered, %zu px (%.3f s)\n",
+                std::string(renderer.name()).c_str(), fv.width, fv.height,
+                100.0 * double(covered) / double(image.pixel_count()), covered, t.render);
+    write_full_picture(o, image, colour, t, batch);
+    return mesh.triangle_count();
+}
+
+// `render --full` of several surfaces: each extracted whole, drawn alone into its layer, and the
+// layers composited; their triangles.
+std::size_t render_full_surfaces(const RenderOptions& o, SurfaceExtractor& ex, Renderer& renderer,
+                                 const std::vector<SurfaceStyle>& styles, const FrameView& fv,
+                                 Timings& t, OutputFiles& batch, const Colouring& colour) {
+    SurfaceParts parts = surface_parts(o, ex, renderer, styles, colour);
+    std::size_t triangles = 0;
+    const std::vector<Mesh> meshes = full_meshes(ex, parts.layers, fv, triangles, &t);
+    Stopwatch sw;
+    const Image image = draw_surfaces_alone(parts.layers, meshes, fv);
+    t.render = sw.seconds();
+    std::printf("render: %zu surfaces composited, %dx%d, %zu px covered (%.3f s)\n", meshes.size(),
+                fv.width, fv.height, covered_pixels(image), t.render);
+    write_full_picture(o, image, colour, t, batch);
+    return triangles;
 }
 
 // What the file carried that a user checks (format, modality, series, scaling), and where the
@@ -375,7 +567,8 @@ int run_render(const RenderOptions& o) {
             "--size", "value",
             "expected WIDTHxHEIGHT, each an integer in [1, 32768], got " + quote(o.size));
     check_render_outputs(o);
-    (void)engine_options(o);                    // fails early on a bad --order
+    check_surface_texts(o.iso);                 // fails early on a bad --iso
+    (void)engine_options(o);                    // and on a bad --order
     const ClipSet clip = checked_clip(o.clip);  // and on a bad --clip, before the volume is read
     (void)checked_colour_map(o.colour);         // and on a bad --colormap
     Timings t;
@@ -391,9 +584,12 @@ int run_render(const RenderOptions& o) {
     t.load = ov.load_s;
     auto ex = prepare(ov, t, render_threads(o));
     if (!o.full) prepare_error_rule(engine_options(o), *ex, ov.volume);
-    const double iso = volume_iso(o.iso, ov, *ex);
+    const std::vector<SurfaceStyle> surfaces = volume_surfaces(o.iso, ov, *ex);
+    const double iso = surfaces[0].iso;
+    const bool layered = !one_opaque_surface(surfaces);
     const std::optional<OpenedColourField> field = open_colour_field(o.colour, o.volume, ov.volume);
-    const Colouring colour = colouring(field, o.colour, ov.volume);
+    Colouring colour = colouring(field, o.colour, ov.volume);
+    if (!layered) colour.hook = surface_hook(colour, surfaces[0]);
 
     const float aspect = float(size->x) / float(size->y);
     const Camera cam = render_camera(o, ov.volume, aspect);
@@ -403,7 +599,9 @@ int run_render(const RenderOptions& o) {
     // Every output is staged here and appears at the end, all together (no partial output).
     OutputFiles batch;
     if (!o.full) {
-        const std::size_t triangles = render_progressive(o, *ex, *renderer, fv, t, batch, colour);
+        const std::size_t triangles =
+            layered ? render_surfaces(o, *ex, *renderer, surfaces, fv, t, batch, colour)
+                    : render_progressive(o, *ex, *renderer, fv, t, batch, colour);
         const std::size_t files = batch.size();
         batch.commit();
         std::printf("wrote %s%s%s (%zu file(s) in all)\n", o.out.c_str(),
@@ -412,32 +610,11 @@ int run_render(const RenderOptions& o) {
         t.print(triangles);
         return 0;
     }
-    if (o.warm_up) {
-        Stopwatch warm;
-        Mesh once = ex->full_surface(fv);
-        if (colour.hook) colour.hook(once);
-        draw_alone(*renderer, once, fv);
-        std::printf("warm-up: the full surface extracted and drawn once, untimed (%.3f s)\n",
-                    warm.seconds());
-    }
-    Mesh mesh = extract_timed(*ex, fv, t);
-    if (colour.hook) colour.hook(mesh);
-    Stopwatch sw;
-    const Image image = draw_alone(*renderer, mesh, fv);
-    t.render = sw.seconds();
-    const std::size_t covered = covered_pixels(image);
-    std::printf("render: %s %dx%d, %.1f%% of pixels covered, %zu px (%.3f s)\n",
-                std::string(renderer->name()).c_str(), size->x, size->y,
-                100.0 * double(covered) / double(image.pixel_count()), covered, t.render);
-    sw.restart();
-    write_image(batch, o.out, colour.written(image));
-    if (!o.depth_out.empty()) write_depth(batch, o.depth_out, image);
-    batch.commit();
-    t.write = sw.seconds();
-    std::printf("wrote %s%s%s\n", o.out.c_str(), o.depth_out.empty() ? "" : " and ",
-                o.depth_out.c_str());
+    const std::size_t triangles =
+        layered ? render_full_surfaces(o, *ex, *renderer, surfaces, fv, t, batch, colour)
+                : render_full_surface(o, *ex, *renderer, fv, t, batch, colour);
     print_paging(ov);
-    t.print(mesh.triangle_count());
+    t.print(triangles);
     return 0;
 }
 

@@ -24,7 +24,7 @@ struct ExtractOptions {
 
 struct RenderOptions {
     VolumeOptions volume;
-    std::optional<double> iso;
+    std::vector<std::string> iso;  // one isovalue, or surfaces VALUE[:COLOUR[:OPACITY]]
     ClipOptions clip;
     ColourOptions colour;
     std::string size = "1600x1200";

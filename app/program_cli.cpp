@@ -22,7 +22,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& re) {
     auto* re_cmd = app.add_subcommand(
         "render", "Render one view progressively (or the full surface with --full) to an image");
     add_volume_options(*re_cmd, re.volume);
-    add_iso_option(*re_cmd, re.iso);
+    add_surfaces_option(*re_cmd, re.iso);
     add_clip_options(*re_cmd, re.clip);
     add_colour_options(*re_cmd, re.colour);
     re_cmd->add_option("--size", re.size, "Image size WIDTHxHEIGHT")->capture_default_str();

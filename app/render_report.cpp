@@ -89,18 +89,44 @@ void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& rende
 // The progressive frame's final image against the full surface drawn in the same view (outside
 // the timings): 1 and 100% at full resolution, up to the renderers' ties; below that, what
 // adaptive resolution's meta-cells change on screen.
+void print_full_comparison(const Image& full, std::size_t triangles, const Image& final_image,
+                           double seconds) {
+    const Correctness c = measure_correctness(final_image, full);
+    std::printf(
+        "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%%, coverage "
+        "IoU %.5f (%.3f s, not part of the timings)\n",
+        triangles, c.significant, c.c, 100.0 * c.final_pixels, coverage_iou(final_image, full),
+        seconds);
+}
+
+void print_truth_comparison(const Image& truth, const Image& full, std::size_t triangles,
+                            const Image& final_image, double seconds) {
+    const Fidelity at_one = measure_fidelity(full, truth);
+    const Fidelity own = measure_fidelity(final_image, truth);
+    const bool holds = passes_fidelity_gate(own, at_one);
+    std::printf(
+        "against the truth (the full surface, %zu triangles, at %dx%d samples a pixel, "
+        "box-filtered: %zu px covered; %.3f s, not part of the timings):\n",
+        triangles, kTruthSamples, kTruthSamples, covered_pixels(truth), seconds);
+    auto row = [](const char* what, const Fidelity& f) {
+        std::printf("  %-34s C_T = %.5f, coverage IoU %.5f, %.2f%% of px off by > 8/255\n", what,
+                    f.c, f.iou, 100.0 * f.off_share);
+    };
+    row("final image:", own);
+    row("full surface at 1 sample a pixel:", at_one);
+    const double c_bar = at_one.c - kFidelityC, iou_bar = at_one.iou - kFidelityIoU;
+    std::printf("  fidelity gate: %s (C_T %.5f %s %.5f, IoU %.5f %s %.5f)\n",
+                holds ? "holds" : "FAILS", own.c, own.c >= c_bar ? ">=" : "<", c_bar, own.iou,
+                own.iou >= iou_bar ? ">=" : "<", iou_bar);
+}
+
 Image print_against_full(const SurfaceExtractor& ex, Renderer& renderer, const FrameView& fv,
                          const Image& final_image, const std::function<void(Mesh&)>& colour) {
     Stopwatch sw;
     Mesh mesh = ex.full_surface(fv);
     if (colour) colour(mesh);
     Image full = draw_alone(renderer, mesh, fv);
-    const Correctness c = measure_correctness(final_image, full);
-    std::printf(
-        "against the full surface (%zu triangles, %zu px): C = %.5f, final px %.3f%%, coverage "
-        "IoU %.5f (%.3f s, not part of the timings)\n",
-        mesh.triangle_count(), c.significant, c.c, 100.0 * c.final_pixels,
-        coverage_iou(final_image, full), sw.seconds());
+    print_full_comparison(full, mesh.triangle_count(), final_image, sw.seconds());
     return full;
 }
 
@@ -110,23 +136,8 @@ void print_against_truth(const SurfaceExtractor& ex, Renderer& renderer, const F
     Mesh mesh = ex.full_surface(fv);
     if (colour) colour(mesh);
     const Image truth = draw_truth(renderer, mesh, fv);
-    const Fidelity full = measure_fidelity(draw_alone(renderer, mesh, fv), truth);
-    const Fidelity own = measure_fidelity(final_image, truth);
-    const bool holds = passes_fidelity_gate(own, full);
-    std::printf(
-        "against the truth (the full surface, %zu triangles, at %dx%d samples a pixel, "
-        "box-filtered: %zu px covered; %.3f s, not part of the timings):\n",
-        mesh.triangle_count(), kTruthSamples, kTruthSamples, covered_pixels(truth), sw.seconds());
-    auto row = [](const char* what, const Fidelity& f) {
-        std::printf("  %-34s C_T = %.5f, coverage IoU %.5f, %.2f%% of px off by > 8/255\n", what,
-                    f.c, f.iou, 100.0 * f.off_share);
-    };
-    row("final image:", own);
-    row("full surface at 1 sample a pixel:", full);
-    const double c_bar = full.c - kFidelityC, iou_bar = full.iou - kFidelityIoU;
-    std::printf("  fidelity gate: %s (C_T %.5f %s %.5f, IoU %.5f %s %.5f)\n",
-                holds ? "holds" : "FAILS", own.c, own.c >= c_bar ? ">=" : "<", c_bar, own.iou,
-                own.iou >= iou_bar ? ">=" : "<", iou_bar);
+    print_truth_comparison(truth, draw_alone(renderer, mesh, fv), mesh.triangle_count(),
+                           final_image, sw.seconds());
 }
 
 void print_first_picture(const FrameResult& fr, double frame_at, double load_s, double octree_s) {

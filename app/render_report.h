@@ -38,6 +38,14 @@ void print_thresholds(const FrameResult& fr, const std::vector<TimelineSample>& 
 // The floor for "C = 99% in time T": drawing the same triangles in one go.
 void print_draw_only(const FrameResult& fr, const FrameView& fv, Renderer& renderer);
 
+// The final image against `full` (the full surface, `triangles` of it, drawn in the same view):
+// C, final pixels and coverage IoU, and the `seconds` that took, outside the timings.
+void print_full_comparison(const Image& full, std::size_t triangles, const Image& final_image,
+                           double seconds);
+// The final image and `full` (at one sample a pixel) against `truth`, and the fidelity gate.
+void print_truth_comparison(const Image& truth, const Image& full, std::size_t triangles,
+                            const Image& final_image, double seconds);
+
 // The final image against the full surface drawn in the same view (outside the timings); returns
 // that image, the truth the timeline is also measured against.
 // `colour`: the engine's colour hook (EngineOptions::colour), so the full surface is coloured as

@@ -4,8 +4,11 @@
 // skin.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "core/surface_style.h"
 
 namespace isowall {
 
@@ -23,5 +26,17 @@ struct IsoSource {
 // phantom. Throws an InputError naming the source and --iso when a file has none, or when the
 // isovalue lies outside [lo, hi] (no surface there: a blank picture).
 double checked_iso(const std::optional<double>& iso, const IsoSource& source);
+
+// --iso as `render` takes it: an isovalue, or several surfaces, each VALUE[:COLOUR[:OPACITY]]
+// (core/surface_style.h), the option repeated or its values listed.
+void add_surfaces_option(CLI::App& cmd, std::vector<std::string>& surfaces);
+
+// The surfaces --iso gives for `source`, in canonical order (core/surface_style.h): without --iso
+// the phantom's skin, as checked_iso. Throws an InputError naming the source and --iso for a text
+// that is no surface, an isovalue outside [lo, hi], one isovalue given twice or too many.
+std::vector<SurfaceStyle> checked_surfaces(const std::vector<std::string>& given,
+                                           const IsoSource& source);
+// The same texts checked before any volume is read (no range yet): a typo fails at once.
+void check_surface_texts(const std::vector<std::string>& given);
 
 }  // namespace isowall

@@ -1,8 +1,10 @@
 #include "core/image_ops.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <utility>
 
 namespace isowall {
 
@@ -14,6 +16,49 @@ void composite_by_depth(Image& dst, const Image& src, const PixelRect& where) {
         dst.depth[d] = src.depth[s];
         for (int k = 0; k < 4; ++k) dst.rgba[4 * d + k] = src.rgba[4 * s + k];
     });
+}
+
+Image composite_layers(const std::vector<const Image*>& layers, const std::vector<float>& opacity) {
+    if (layers.empty() || layers.size() != opacity.size())
+        throw std::invalid_argument("composite_layers: one opacity a layer, and a layer at least");
+    const Image& first = *layers[0];
+    for (const Image* l : layers)
+        if (l->width != first.width || l->height != first.height ||
+            l->depth.size() != l->pixel_count() || l->rgba.size() != 4 * l->pixel_count())
+            throw std::invalid_argument("composite_layers: layers of one size, with depth");
+    Image out;
+    out.resize(first.width, first.height);
+    std::vector<std::size_t> order(layers.size());
+    for (std::size_t p = 0; p < out.pixel_count(); ++p) {
+        std::size_t n = 0;
+        for (std::size_t k = 0; k < layers.size(); ++k)
+            if (layers[k]->depth[p] < 1.0f) order[n++] = k;
+        if (n == 0) {  // the background, as the first layer's frame has it
+            for (int ch = 0; ch < 4; ++ch) out.rgba[4 * p + ch] = first.rgba[4 * p + ch];
+            continue;
+        }
+        // Back to front: farther first; at equal depth the later layer first, so the earlier ends
+        // in front. n is at most a handful: an insertion sort.
+        auto behind = [&](std::size_t a, std::size_t b) {
+            const float da = layers[a]->depth[p], db = layers[b]->depth[p];
+            return da != db ? da > db : a > b;
+        };
+        for (std::size_t i = 1; i < n; ++i)
+            for (std::size_t j = i; j > 0 && behind(order[j], order[j - 1]); --j)
+                std::swap(order[j], order[j - 1]);
+        float c[3] = {0, 0, 0};
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t k = order[i];
+            const float a = std::clamp(opacity[k], 0.0f, 1.0f);
+            for (int ch = 0; ch < 3; ++ch)
+                c[ch] = a * float(layers[k]->rgba[4 * p + ch]) + (1 - a) * c[ch];
+        }
+        for (int ch = 0; ch < 3; ++ch)
+            out.rgba[4 * p + ch] = static_cast<std::uint8_t>(std::lround(std::min(c[ch], 255.0f)));
+        out.rgba[4 * p + 3] = 255;
+        out.depth[p] = layers[order[n - 1]]->depth[p];
+    }
+    return out;
 }
 
 void place(Image& dst, const Image& src, const PixelRect& where) {

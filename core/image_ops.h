@@ -3,6 +3,7 @@
 // on another, depth compositing. Pure functions over Image.
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 #include "core/camera.h"
 #include "core/image.h"
@@ -30,6 +31,14 @@ void for_each_placed_pixel(const Image& dst, const Image& src, const PixelRect& 
 // a helper that rendered part of it): where `src` is nearer than `dst`, dst takes its colour and
 // depth. `src` covers `where` of dst; both must carry depth (std::invalid_argument otherwise).
 void composite_by_depth(Image& dst, const Image& src, const PixelRect& where);
+
+// Layers of one screen (each a surface drawn alone: core/surface_style.h) blended at every pixel
+// back to front by depth over a black background, layer k with opacity[k] in [0, 1]; at equal
+// depth the earlier layer lies in front. The result's alpha is 255 and its depth the nearest
+// layer's where any layer covers the pixel; elsewhere it is the first layer's background. Every
+// layer must have the first's size and depth, and `opacity` one entry a layer
+// (std::invalid_argument otherwise).
+Image composite_layers(const std::vector<const Image*>& layers, const std::vector<float>& opacity);
 
 // The smallest rect holding every pixel `img` covers (depth below 1); empty when it covers none
 // or has no depth.

@@ -11,6 +11,7 @@
 #include "files/image_io.h"
 #include "files/ply.h"
 #include "tests/cli_util.h"
+#include "tests/image_compare.h"
 #include "tests/test_util.h"
 
 namespace isowall {
@@ -189,6 +190,43 @@ TEST_F(Cli, ColorByColoursThePictureAndBadFieldsAreOneLine) {
     expect_one_line_error(bad("short.nrrd"),
                           {"short.nrrd", "--color-by", "199x184x168", "same grid"});
     expect_one_line_error(bad("missing.nrrd"), {"missing.nrrd"});
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
+// Several surfaces: the skin at 0.3 over the bone is the same picture with the surfaces given in
+// either order, and on two threads as on one; it equals the full surfaces composited (--full)
+// with their coverage; bad styles are one line and no image.
+TEST_F(Cli, SurfacesInEitherOrderAndOnEitherThreadsAreOnePicture) {
+    const std::string common = "render --size 160x120 --orbit 30 20 -q --no-measure ";
+    auto r = run_isowall(dir_, common + "--threads 1 --iso 80:skin:0.3 --iso 160:bone --out a.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("2 surfaces"), std::string::npos) << r.out;
+    r = run_isowall(dir_, common + "--threads 1 --iso 160:bone --iso 80:skin:0.3 --out b.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_isowall(dir_, common + "--threads 2 --iso 160:bone --iso 80:skin:0.3 --out c.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_isowall(dir_, common + "--full --iso 160:bone --iso 80:skin:0.3 --out full.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("2 surfaces composited"), std::string::npos) << r.out;
+    const Image a = read_image(dir_ / "a.png"), b = read_image(dir_ / "b.png");
+    EXPECT_TRUE(a.rgba == b.rgba) << "the order the surfaces were given in changed the picture";
+    const test::ImageComparison threads = test::compare_images(read_image(dir_ / "c.png"), a);
+    EXPECT_GE(threads.equal_share, 0.999) << threads;
+    const test::ImageComparison full = test::compare_images(a, read_image(dir_ / "full.png"));
+    EXPECT_GE(full.equal_share, 0.999) << full;
+    // The skin is seen through: behind it the bone's colour shows, so the picture is not the
+    // skin's alone.
+    r = run_isowall(dir_, common + "--threads 1 --iso 80:skin:0.3 --out skin.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_LT(test::compare_images(read_image(dir_ / "skin.png"), a).equal_share, 0.9);
+
+    auto bad = [&](const std::string& args) {
+        return run_isowall(dir_, "render --size 64x48 --out bad.png " + args);
+    };
+    expect_one_line_error(bad("--iso 80:mauve"), {"--iso", "unknown colour 'mauve'"});
+    expect_one_line_error(bad("--iso 80:skin:1.5"), {"--iso", "opacity in [0, 1]"});
+    expect_one_line_error(bad("--iso 80 --iso 80:red"), {"--iso", "isovalue 80 given twice"});
+    expect_one_line_error(bad("--iso 80:skin:0.3 --iso 300"), {"phantom", "--iso", "300"});
     EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 
