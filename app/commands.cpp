@@ -320,13 +320,6 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     return last.triangles;
 }
 
-// The engine's colour hook for one of several surfaces: the second field's where one colours
-// them all, else the surface's own colour where it has one.
-std::function<void(Mesh&)> surface_hook(const Colouring& colour, const SurfaceStyle& style) {
-    if (colour.hook || !style.coloured) return colour.hook;
-    return solid_colour_hook(style.colour);
-}
-
 // The layers of several surfaces: the first draws with `ex` and `renderer`, every other with an
 // extractor sharing its octree and a renderer of its own (all kept in `keep`).
 struct SurfaceParts {
@@ -350,7 +343,7 @@ SurfaceParts surface_parts(const RenderOptions& o, SurfaceExtractor& ex, Rendere
         }
         warm_up(*r);
         EngineOptions options = engine_options(o);
-        options.colour = surface_hook(colour, styles[k]);
+        options.colour = surface_colour_hook(styles[k], colour.hook);
         p.engines.push_back(std::make_unique<ProgressiveEngine>(*e, options));
         p.layers.push_back({p.engines.back().get(), r, styles[k]});
     }
@@ -589,7 +582,7 @@ int run_render(const RenderOptions& o) {
     const bool layered = !one_opaque_surface(surfaces);
     const std::optional<OpenedColourField> field = open_colour_field(o.colour, o.volume, ov.volume);
     Colouring colour = colouring(field, o.colour, ov.volume);
-    if (!layered) colour.hook = surface_hook(colour, surfaces[0]);
+    if (!layered) colour.hook = surface_colour_hook(surfaces[0], colour.hook);
 
     const float aspect = float(size->x) / float(size->y);
     const Camera cam = render_camera(o, ov.volume, aspect);

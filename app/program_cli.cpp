@@ -180,7 +180,7 @@ CLI::App* add_wall_command(CLI::App& app, WallOptions& wall) {
         "Display-wall run under mpirun: rank 0 is the master, ranks 1..T drive one tile each");
     add_volume_options(*wall_cmd, wall.volume);
     wall_cmd->add_option("--wall", wall.wall, "Wall file (TOML; see walls/)")->required();
-    add_iso_option(*wall_cmd, wall.iso);
+    add_surfaces_option(*wall_cmd, wall.iso);
     add_clip_options(*wall_cmd, wall.clip);
     add_colour_options(*wall_cmd, wall.colour);
     wall_cmd->add_option("--out,-o", wall.out, "Mosaic of the whole wall (PNG)")

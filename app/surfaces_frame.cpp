@@ -26,19 +26,6 @@ struct LiveLayer {
     bool ok = true;       // false once stopped
 };
 
-// `to` += what `s` adds: the whole picture's figures at a moment sum every surface's.
-void add_sample(TimelineSample& to, const TimelineSample& s) {
-    to.rays += s.rays;
-    to.cells_visited += s.cells_visited;
-    to.triangles += s.triangles;
-    to.groups += s.groups;
-    to.t_intersect_s += s.t_intersect_s;
-    to.t_propagate_s += s.t_propagate_s;
-    to.t_extract_s += s.t_extract_s;
-    to.t_render_s += s.t_render_s;
-    to.level = std::max(to.level, s.level);
-}
-
 // One timeline on the picture's clock: at each surface's sample, what every surface had by then.
 void merge_timelines(SurfacesFrame& out, const std::vector<double>& offsets) {
     struct Event {

@@ -119,6 +119,8 @@ struct Viewer {
         if (apply_camera_command(cmd, camera, float(size.x) / float(size.y))) {
         } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
             const ReadyMsg& r = client.ready();
+            if (!c->surfaces.empty())  // several, or one with a colour or opacity
+                throw InputError(where, "iso", "the remote viewer shows one plain surface: iso V");
             iso = checked_isovalue(c->iso, r.value_min, r.value_max, where, "iso");
         } else if (const auto* c = std::get_if<WaitCmd>(&cmd)) {
             if (c->until == WaitCmd::Until::time)

@@ -78,6 +78,7 @@ struct MasterInput {
     std::unique_ptr<SurfaceExtractor> extractor;
     double iso = 0;
     ClipSet clip;
+    std::vector<SurfaceStyle> surfaces;       // --iso's, canonical order
     std::optional<OpenedColourField> colour;  // --color-by: checked here, its range for the legend
     std::vector<ScriptLine> script;
 };
@@ -90,8 +91,13 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
-    in.iso = checked_iso(o.iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
+    in.surfaces =
+        checked_surfaces(o.iso, {ov.file ? ov.file->string() : std::string("phantom"), !ov.file,
                                  in.extractor->value_min(), in.extractor->value_max()});
+    in.iso = in.surfaces[0].iso;
+    if (o.measure && !one_opaque_surface(in.surfaces))
+        throw InputError("--measure", "--iso",
+                         "studies one opaque surface; drop --measure or give one --iso");
     check_clip_keeps(in.clip, ov.volume.dims(), "--clip", "value");
     in.colour = open_colour_field(o.colour, o.volume, ov.volume);
     to_engine_options(o.engine);
@@ -129,6 +135,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     if (o.orbit.size() == 2) mo.orbit = {o.orbit[0], o.orbit[1]};
     mo.zoom = o.zoom;
     mo.clip = in.clip;
+    mo.surfaces = in.surfaces;
     if (in.colour) {
         mo.legend = in.colour->field.scale;
         mo.legend_label = colour_label(o.colour, in.colour->field.scale);
@@ -223,6 +230,7 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.engine.region_clip = o.region_clip;
     setup.engine.threads = budget.usable();
     if (o.fault.on(comm.rank())) setup.fault = o.fault;
+    setup.make_renderer = [gl = o.gl] { return make_renderer(gl); };
     const PixelRect tile = eye_rect(spec, tile_of_rank(spec, comm.rank()));
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;

@@ -20,7 +20,7 @@ namespace isowall {
 struct WallOptions {
     VolumeOptions volume;
     std::string wall;
-    std::optional<double> iso;
+    std::vector<std::string> iso;  // one isovalue, or surfaces VALUE[:COLOUR[:OPACITY]]
     ClipOptions clip;
     ColourOptions colour;
     std::string out = "mosaic.png";

@@ -65,8 +65,4 @@ std::function<void(Mesh&)> colour_hook(const ColourField& field, glm::vec3 spaci
     return [field, spacing](Mesh& mesh) { colour_mesh(mesh, field, spacing); };
 }
 
-std::function<void(Mesh&)> solid_colour_hook(glm::u8vec3 rgb) {
-    return [rgb](Mesh& mesh) { mesh.colours.assign(mesh.vertex_count(), rgb); };
-}
-
 }  // namespace isowall

@@ -44,7 +44,4 @@ std::string colour_label(const ColourOptions& colour, const ColourScale& scale);
 // The engine's colour hook for `field` over `surface`'s spacing (EngineOptions::colour).
 std::function<void(Mesh&)> colour_hook(const ColourField& field, glm::vec3 spacing);
 
-// The engine's colour hook for a surface of one colour (`--iso 105:bone`): every vertex `rgb`.
-std::function<void(Mesh&)> solid_colour_hook(glm::u8vec3 rgb);
-
 }  // namespace isowall

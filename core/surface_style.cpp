@@ -153,4 +153,10 @@ std::string surfaces_problem(const std::vector<SurfaceStyle>& surfaces) {
     return {};
 }
 
+std::function<void(Mesh&)> surface_colour_hook(const SurfaceStyle& style,
+                                               const std::function<void(Mesh&)>& field) {
+    if (field || !style.coloured) return field;
+    return [rgb = style.colour](Mesh& mesh) { mesh.colours.assign(mesh.vertex_count(), rgb); };
+}
+
 }  // namespace isowall

@@ -6,12 +6,15 @@
 // depth at every pixel (core/image_ops.h composite_layers): it does not depend on the order the
 // surfaces were given in, or on which thread or rank drew a layer.
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
+
+#include "core/mesh.h"
 
 namespace isowall {
 
@@ -51,6 +54,12 @@ std::vector<SurfaceStyle> canonical_order(std::vector<SurfaceStyle> surfaces);
 // Why `surfaces` cannot be shown together, or empty: none, more than kMaxSurfaces, or one
 // isovalue given twice.
 std::string surfaces_problem(const std::vector<SurfaceStyle>& surfaces);
+
+// What colours a surface's meshes (EngineOptions::colour): `field` where a second field colours
+// every surface, else the style's own colour where it has one (every vertex), else nothing (the
+// plain headlight colours).
+std::function<void(Mesh&)> surface_colour_hook(const SurfaceStyle& style,
+                                               const std::function<void(Mesh&)>& field = {});
 
 // Whether the set is drawn as one plain opaque surface (the engine's single-surface picture).
 inline bool one_opaque_surface(const std::vector<SurfaceStyle>& s) {

@@ -37,32 +37,34 @@ std::vector<Message> samples() {
     result.spans = {{2, 100.0, 0.5, 0.25}, {6, 101.0, 0.1, 0.1}};
     JobMsg job{9, 4, 2, 2, Band::fine, view, {1, 0, 2, 3}};
     JobDoneMsg done{9, 4, 500, 3, 40, 0.1, 0.9, 100.5, 100.6, 96};
-    RegionMsg region{9, 4, {1, 1, 2, 1}, 0.9, {1, 2, 3, 4, 5, 6, 7, 8}, {0.25f, 0.75f}};
+    RegionMsg region{9, 4, 1, {1, 1, 2, 1}, 0.9, {1, 2, 3, 4, 5, 6, 7, 8}, {0.25f, 0.75f}};
     PreviewMsg preview{9, 2, 1, {10, 20, 30, 40, 50, 60}};
-    return {TileHelloMsg{"tile-1", 1, false},
-            TileHelloMsg{"tile-1", 16, true},
-            ViewMsg{5, view},
-            ProgressMsg{5, 12345, 0.5},
-            SnapshotMsg{},
-            image,
-            no_depth,
-            QuitMsg{},
-            result,
-            ReleaseMsg{},
-            StartMsg{},
-            AliveMsg{},
-            job,
-            done,
-            region,
-            LandedMsg{9, 4},
-            preview,
-            StoreAskMsg{StorePart::chunk, 42},
-            StoreMetaMsg{true, R"({"zarr_format": 2})", R"({"isowall": {}})", 4096, 100},
-            StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}},
-            CurveAskMsg{9},
-            CurveMsg{{9, 100, {{0.5, 40, 1.25}, {0.75, 100, 0}}}},
-            FailedMsg{false, "0/1/1/0: cannot decompress"},
-            LostMsg{3}};  // new last
+    return {
+        TileHelloMsg{"tile-1", 1, false},
+        TileHelloMsg{"tile-1", 16, true},
+        ViewMsg{5, view},
+        ViewMsg{6, view, {{40, {177, 122, 101}, 0.3f, true}, {105.5, {241, 214, 145}, 1, true}}},
+        ProgressMsg{5, 12345, 0.5},
+        SnapshotMsg{},
+        image,
+        no_depth,
+        QuitMsg{},
+        result,
+        ReleaseMsg{},
+        StartMsg{},
+        AliveMsg{},
+        job,
+        done,
+        region,
+        LandedMsg{9, 4},
+        preview,
+        StoreAskMsg{StorePart::chunk, 42},
+        StoreMetaMsg{true, R"({"zarr_format": 2})", R"({"isowall": {}})", 4096, 100},
+        StorePartMsg{StorePart::chunk, 42, {std::byte{0x28}, std::byte{0xb5}}},
+        CurveAskMsg{9},
+        CurveMsg{{9, 100, {{0.5, 40, 1.25}, {0.75, 100, 0}}}},
+        FailedMsg{false, "0/1/1/0: cannot decompress"},
+        LostMsg{3}};  // new last
 }
 
 }  // namespace

@@ -42,6 +42,7 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     camera_ = zoom(camera_, o.zoom);
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
     clip_ = o.clip;
+    surfaces_ = o.surfaces.empty() ? std::vector<SurfaceStyle>{SurfaceStyle{iso}} : o.surfaces;
     if (std::string p = camera_problem(camera_); !p.empty())
         throw InputError("--orbit/--zoom/--pan", "value", p);
     if (std::string p = head_problem(camera_, aspect_, spec_, head_); !p.empty())
@@ -352,6 +353,7 @@ void WallMaster::send_views() {
         ViewMsg v;
         v.generation = generation_;
         v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_, clip_};
+        v.surfaces = surfaces_;
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
         t.view = v.view;
@@ -423,7 +425,14 @@ bool WallMaster::execute(const ScriptCommand& cmd, const std::string& where) {
 bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where) {
     if (apply_camera_command(cmd, camera_, aspect_)) {
     } else if (const auto* c = std::get_if<IsoCmd>(&cmd)) {
-        iso_ = checked_isovalue(c->iso, lo_, hi_, where, "iso");
+        std::vector<SurfaceStyle> s =
+            c->surfaces.empty() ? std::vector<SurfaceStyle>{SurfaceStyle{c->iso}} : c->surfaces;
+        for (SurfaceStyle& one : s) one.iso = checked_isovalue(one.iso, lo_, hi_, where, "iso");
+        if (o_.measure && !one_opaque_surface(s))
+            throw InputError(where, "iso",
+                             "--measure studies one opaque surface; this wall measures its frames");
+        surfaces_ = std::move(s);
+        iso_ = surfaces_[0].iso;
     } else if (const auto* c = std::get_if<HeadCmd>(&cmd)) {
         head_ = c->offset;
     } else if (const auto* c = std::get_if<ClipCmd>(&cmd)) {

@@ -58,6 +58,9 @@ struct MasterOptions {
     std::pair<float, float> orbit{0, 0}, pan{0, 0};
     float zoom = 1;
     ClipSet clip;  // the first view's clip planes (voxel indices)
+    // The first view's surfaces (core/surface_style.h, canonical order); empty: one plain surface
+    // at the isovalue the master is made with.
+    std::vector<SurfaceStyle> surfaces;
     // A surface coloured by a second field (--color-by): the legend the mosaics carry.
     std::optional<ColourScale> legend;
     std::string legend_label;
@@ -133,6 +136,8 @@ class WallMaster {
     // With --measure, every tile's curve of the finished frame has come in (ask_curves).
     bool curves_in() const;
     double iso() const { return iso_; }
+    // The surfaces the tiles draw (one plain one at iso() unless several were asked for).
+    const std::vector<SurfaceStyle>& surfaces() const { return surfaces_; }
     const glm::dvec3& head() const { return head_; }
     const ClipSet& clip() const { return clip_; }
     glm::ivec3 dims() const { return o_.dims; }
@@ -230,8 +235,9 @@ class WallMaster {
     double iso_, lo_, hi_;
     float aspect_ = 1;
     Camera camera_;
-    glm::dvec3 head_{0};  // the viewer's head from its nominal place (HeadCmd)
-    ClipSet clip_;        // the view's clip planes, voxel indices (ClipCmd)
+    glm::dvec3 head_{0};                  // the viewer's head from its nominal place (HeadCmd)
+    ClipSet clip_;                        // the view's clip planes, voxel indices (ClipCmd)
+    std::vector<SurfaceStyle> surfaces_;  // the view's surfaces; surfaces_[0].iso is iso_
     std::uint64_t generation_ = 0;
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;

@@ -1,10 +1,23 @@
 #include "progressive/timeline.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
 
 namespace isowall {
+
+void add_sample(TimelineSample& to, const TimelineSample& s) {
+    to.rays += s.rays;
+    to.cells_visited += s.cells_visited;
+    to.triangles += s.triangles;
+    to.groups += s.groups;
+    to.t_intersect_s += s.t_intersect_s;
+    to.t_propagate_s += s.t_propagate_s;
+    to.t_extract_s += s.t_extract_s;
+    to.t_render_s += s.t_render_s;
+    to.level = std::max(to.level, s.level);
+}
 
 namespace {
 

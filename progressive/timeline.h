@@ -24,6 +24,10 @@ struct TimelineSample {
     Correctness correctness;  // against the final image; filled by a replay
 };
 
+// `to` plus what `s` adds: the figures of several frames cast together (the surfaces of one
+// picture) at one moment: counts and stage seconds summed, the deepest level.
+void add_sample(TimelineSample& to, const TimelineSample& s);
+
 // Columns: time_s, rays, rays_share (of `rays_screen`), cells_visited, triangles, groups,
 // final_pixels, c, t_intersect_s, t_propagate_s, t_extract_s, t_render_s, level.
 void write_timeline_csv(const std::filesystem::path& path,

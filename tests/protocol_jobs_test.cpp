@@ -82,6 +82,7 @@ struct RegionFault {
 
 TEST(ProtocolJobs, RegionFaultsThrowNamingTheField) {
     const RegionFault faults[] = {
+        {"layer", [](RegionMsg& m) { m.layer = kMaxSurfaces; }},
         {"rect", [](RegionMsg& m) { m.rect.width = 0; }},
         {"rect", [](RegionMsg& m) { m.rect.x = -1; }},
         {"rect",

@@ -143,6 +143,9 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
          }},
         {"view.clip.normal", [](ViewMsg& m) { m.view.clip.planes[1].normal.x = kNaN; }},
         {"view.clip.at", [](ViewMsg& m) { m.view.clip.planes[1].at = kInf; }},
+        {"view.surfaces.iso", [](ViewMsg& m) { m.surfaces[1].iso = kNaN; }},
+        {"view.surfaces.opacity", [](ViewMsg& m) { m.surfaces[0].opacity = 1.5f; }},
+        {"view.surfaces.opacity", [](ViewMsg& m) { m.surfaces[0].opacity = -kInf; }},
     };
     for (const ViewFault& f : faults) {
         ViewMsg m = sample_view();
@@ -150,13 +153,26 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
         SCOPED_TRACE(testing::Message() << f.field << " in " << testing::PrintToString(m));
         expect_wire_error(Tag::view, encode(m), f.field);
     }
-    // More planes than any view has: the count byte follows the isovalue.
+    // More planes, or surfaces, than any view has: the planes' count byte follows the isovalue,
+    // the surfaces' count the planes.
     ViewMsg none = sample_view();
     none.view.clip = {};
+    none.surfaces = {};
     Bytes bytes = encode(none);
+    ASSERT_EQ(bytes[bytes.size() - 2], std::byte{0});
     ASSERT_EQ(bytes.back(), std::byte{0});
-    bytes.back() = std::byte{kMaxClipPlanes + 1};
+    bytes.back() = std::byte{kMaxSurfaces + 1};
+    expect_wire_error(Tag::view, bytes, "view.surfaces: expected at most 8 surfaces, got 9");
+    bytes.back() = std::byte{0};
+    bytes[bytes.size() - 2] = std::byte{kMaxClipPlanes + 1};
     expect_wire_error(Tag::view, bytes, "view.clip: expected at most 8 planes, got 9");
+    // A coloured flag is a bool byte: 0 or 1.
+    ViewMsg one = sample_view();
+    one.view.clip = {};
+    one.surfaces.resize(1);
+    bytes = encode(one);
+    bytes.back() = std::byte{2};
+    expect_wire_error(Tag::view, bytes, "bool byte 2");
 }
 
 // ---- image --------------------------------------------------------------------------------------

@@ -55,7 +55,7 @@ inline bool operator==(const TileHelloMsg& a, const TileHelloMsg& b) {
     return a.host == b.host && a.threads == b.threads && a.loaded == b.loaded;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
-    return a.generation == b.generation && a.view == b.view;
+    return a.generation == b.generation && a.view == b.view && a.surfaces == b.surfaces;
 }
 inline bool operator==(const ProgressMsg& a, const ProgressMsg& b) {
     return a.generation == b.generation && a.rays == b.rays && a.cpu_s == b.cpu_s;
@@ -103,8 +103,8 @@ inline bool operator==(const JobDoneMsg& a, const JobDoneMsg& b) {
            a.bytes == b.bytes;
 }
 inline bool operator==(const RegionMsg& a, const RegionMsg& b) {
-    return a.generation == b.generation && a.job == b.job && a.rect == b.rect &&
-           a.cpu_end_s == b.cpu_end_s && a.rgba == b.rgba && a.depth == b.depth;
+    return a.generation == b.generation && a.job == b.job && a.layer == b.layer &&
+           a.rect == b.rect && a.cpu_end_s == b.cpu_end_s && a.rgba == b.rgba && a.depth == b.depth;
 }
 inline bool operator==(const LandedMsg& a, const LandedMsg& b) {
     return a.generation == b.generation && a.job == b.job;
@@ -248,6 +248,7 @@ inline ViewMsg sample_view() {
     m.view.iso = 117.25;
     m.view.clip.add({{0, -1, 0}, -40.5f});  // y < 40.5
     m.view.clip.add({{0.6f, 0, 0.8f}, 12});
+    m.surfaces = {{117.25, {177, 122, 101}, 0.3f, true}, {160.5, kDefaultSurfaceColour, 1, false}};
     return m;
 }
 
@@ -275,6 +276,7 @@ inline RegionMsg sample_region() {
     RegionMsg m;
     m.generation = 11;
     m.job = 5;
+    m.layer = 3;
     m.rect = {100, 50, 3, 2};
     m.cpu_end_s = 0.75;
     for (int i = 0; i < 3 * 2 * 4; ++i) m.rgba.push_back(static_cast<std::uint8_t>(7 * i + 1));

@@ -57,6 +57,21 @@ TEST(Script, ClipTakesPlanesABoxOrOff) {
     EXPECT_TRUE(std::get<ClipCmd>(lines[2].command).clip.empty());
 }
 
+// `iso` with several surfaces: each VALUE[:COLOUR[:OPACITY]], kept in the one order every
+// picture of them uses; one plain value stays a plain isovalue.
+TEST(Script, IsoTakesSeveralSurfaces) {
+    const auto lines = parse_script("iso 105:bone 40:skin:0.3\niso 60\niso 60::0.5\n", "i.txt");
+    ASSERT_EQ(lines.size(), 3u);
+    const IsoCmd& two = std::get<IsoCmd>(lines[0].command);
+    ASSERT_EQ(two.surfaces.size(), 2u);
+    EXPECT_EQ(two.iso, 40);
+    EXPECT_EQ(two.surfaces[0].iso, 40);
+    EXPECT_FLOAT_EQ(two.surfaces[0].opacity, 0.3f);
+    EXPECT_EQ(two.surfaces[1].colour, glm::u8vec3(241, 214, 145));
+    EXPECT_TRUE(std::get<IsoCmd>(lines[1].command).surfaces.empty());
+    EXPECT_EQ(std::get<IsoCmd>(lines[2].command).surfaces.size(), 1u);
+}
+
 TEST(Script, EmptyScriptHasNoCommands) {
     EXPECT_TRUE(parse_script("", "e.txt").empty());
     EXPECT_TRUE(parse_script("# only a comment\n\n   \n", "e.txt").empty());
@@ -93,6 +108,11 @@ TEST(Script, MistakesNameTheFileLineAndCommand) {
         {"clip box 0 0 0 10 10", "s.txt:1: clip: expected \"clip PLANE...\""},
         {"clip box 0 0 0 10 0 10", "s.txt:1: clip: expected X0 < X1, Y0 < Y1 and Z0 < Z1"},
         {"clip box 0 0 0 10 10 2e6", "s.txt:1: clip: expected a number in [-1e+06, 1e+06]"},
+        {"iso", "s.txt:1: iso: expected \"iso V\", got 0 argument(s)"},
+        {"iso 40:mauve", "s.txt:1: iso: unknown colour 'mauve'"},
+        {"iso 40:skin:2", "s.txt:1: iso: expected an opacity in [0, 1]"},
+        {"iso 40 40:red", "s.txt:1: iso: isovalue 40 given twice"},
+        {"iso 40 abc", "s.txt:1: iso: expected an isovalue before ':', got 'abc'"},
     };
     for (const Case& c : cases) {
         try {

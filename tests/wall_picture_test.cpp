@@ -3,12 +3,15 @@
 // mosaic, with regions migrated, equals the static one), and a script's clip command changes the
 // picture as --clip from the start does. A surface coloured by a second field: every rank colours
 // its groups alike (balanced equals static), the colours follow the field, and the mosaic carries
-// the legend.
+// the legend. Several surfaces: every rank draws each surface's layer and composites them, a
+// helper's result lands in its surface's layer, and the mosaic is `render`'s picture of the same
+// surfaces.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <fstream>
 
+#include "app/commands.h"
 #include "app/wall_run.h"
 #include "comm/inproc_comm.h"
 #include "files/image_io.h"
@@ -148,6 +151,53 @@ TEST(WallColour, EveryRankColoursItsGroupsByTheFieldAndTheMosaicHasTheLegend) {
     EXPECT_GE(bar_row, 0) << "no legend bar";
     std::printf("colour: left %.0f %.0f %.0f, right %.0f %.0f %.0f; %s\n", left.x, left.y, left.z,
                 right.x, right.y, right.z, testing::PrintToString(same).c_str());
+}
+
+// The skin at 0.3 over the bone, cut by a plane: the balanced mosaic, with regions migrated,
+// equals the static one and `render`'s single picture of the same view.
+TEST(WallSurfaces, TheBalancedMosaicIsRendersPictureOfTheSameSurfaces) {
+    WallOptions fixed = clip_wall("surfaces_static", false);
+    WallOptions balanced = clip_wall("surfaces_balanced", true);
+    for (WallOptions* o : {&fixed, &balanced}) {
+        o->iso = {"160:bone", "80:skin:0.3"};
+        o->clip.planes = {"x<130"};
+    }
+    run(fixed);
+    const std::vector<TileResultMsg> results = run(balanced);
+    std::uint64_t helped = 0;
+    for (const TileResultMsg& t : results) helped += t.jobs_helped;
+    EXPECT_GT(helped, 0u) << "nothing migrated";
+    const test::ImageComparison same = compare(balanced.out, fixed.out);
+    EXPECT_GE(same.mask_iou, 0.999) << same;
+    EXPECT_GE(same.equal_share, 0.999) << same;
+    EXPECT_GT(same.covered_both, 1000u) << same;
+
+    RenderOptions r;
+    r.size = "320x240";
+    r.orbit = {30, 20};
+    r.iso = {"80:skin:0.3", "160:bone"};
+    r.clip.planes = {"x<130"};
+    r.volume.no_cache = true;
+    r.no_measure = true;
+    r.quiet = true;
+    r.out = (std::filesystem::path(fixed.out).parent_path() / "render.png").string();
+    testing::internal::CaptureStdout();
+    const int code = run_render(r);
+    testing::internal::GetCapturedStdout();
+    ASSERT_EQ(code, 0);
+    const test::ImageComparison render = compare(fixed.out, r.out);
+    EXPECT_GE(render.mask_iou, 0.999) << render;
+    EXPECT_GE(render.equal_share, 0.999) << render;
+    // The skin is seen through: the bone's colour shows behind it (bone is yellower: more red
+    // and green than blue, beyond what the skin alone gives).
+    WallOptions skin = clip_wall("surfaces_skin", false);
+    skin.iso = {"80:skin:0.3"};
+    skin.clip.planes = {"x<130"};
+    run(skin);
+    EXPECT_LT(compare(skin.out, fixed.out).equal_share, 0.9);
+    std::printf("%llu jobs migrated; balanced against static: %s; static against render: %s\n",
+                (unsigned long long)helped, testing::PrintToString(same).c_str(),
+                testing::PrintToString(render).c_str());
 }
 
 }  // namespace

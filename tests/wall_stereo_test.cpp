@@ -75,7 +75,7 @@ TEST(StereoWall, SideBySideEyesShowEachBallWithTheDisparityOfItsDepth) {
     o.tiles_out = (dir / "tiles").string();
     o.volume.path = write_balls(dir).string();
     o.volume.no_cache = true;
-    o.iso = 128;
+    o.iso = {"128"};
     const std::vector<int> codes = run(o, 9);
     for (int code : codes) EXPECT_EQ(code, 0);
     const Image left = read_image(dir / "m-left.png"), right = read_image(dir / "m-right.png");

@@ -13,9 +13,9 @@
 #include "core/pacer.h"
 #include "core/util.h"
 #include "progressive/trace.h"
+#include "tile/layered_jobs.h"
 #include "tile/store_client.h"
 #include "tile/tile_inbox.h"
-#include "tile/tile_jobs.h"
 #include "tile/tile_receiver.h"
 
 namespace isowall {
@@ -29,8 +29,8 @@ class TileRank {
     TileRank(Comm& comm, TileSetup& setup)
         : comm_(comm),
           setup_(setup),
-          engine_(setup.extractor, options()),
-          jobs_(engine_, setup.renderer, setup.help_renderer, setup.measure) {
+          jobs_(LayeredJobsSetup{setup.extractor, setup.renderer, setup.help_renderer, options(),
+                                 setup.make_renderer, setup.measure}) {
         for (FrameShow* f : setup.shows) shows_.push_back({f, PresentPacer(f->interval_s())});
     }
 
@@ -144,7 +144,7 @@ class TileRank {
             last_progress_s_ = s.time_s;
             const Stage left = trace_.switch_to(Stage::comm);
             send_message(comm_, kMasterRank,
-                         ProgressMsg{jobs_.generation(), s.rays,
+                         ProgressMsg{jobs_.generation(), jobs_.now().rays,
                                      thread_cpu_seconds() - cpu0_ + jobs_.workers_beyond_s()});
             answer_snapshots();
             trace_.switch_to(left);
@@ -202,7 +202,7 @@ class TileRank {
         if (j.owner != comm_.rank()) raise_test_signal(setup_.fault, FaultMoment::migration);
         // A job starts by setting up its region (the help image and the groups that may show in
         // it: render work) before the engine's stages take over.
-        TileJobs::Outcome out;
+        LayeredJobs::Outcome out;
         {
             // With compute slots (--emulate-cores), the job runs while it holds one; a view that
             // comes while the rank waits for it ends the wait, as it would end the job.
@@ -215,12 +215,15 @@ class TileRank {
             interrupted_ = true;
             return;
         }
-        if (out.result) {
+        if (!out.results.empty()) {
             trace_.switch_to(Stage::send);
             const double c0 = thread_cpu_seconds();
-            auto bytes = encode(*out.result);
-            out.done.bytes = bytes.size();
-            result_.bytes_sent += bytes.size();
+            std::vector<std::vector<std::byte>> encoded;
+            for (const RegionMsg& r : out.results) {
+                encoded.push_back(encode(r));
+                out.done.bytes += encoded.back().size();
+            }
+            result_.bytes_sent += out.done.bytes;
             ++result_.jobs_helped;
             if (setup_.fault.action == FaultAction::late && j.generation == first_view_) {
                 // The `late` test fault: the master learns the job is done, and its result
@@ -228,11 +231,11 @@ class TileRank {
                 // view's job just after the change (a late result the owner must drop).
                 send_message(comm_, kMasterRank, out.done);
                 inbox_.wait_interrupt();
-                comm_.send(j.deliver, Tag::region, std::move(bytes));
+                for (auto& bytes : encoded) comm_.send(j.deliver, Tag::region, std::move(bytes));
                 trace_.switch_to(Stage::comm);
                 return;
             }
-            comm_.send(j.deliver, Tag::region, std::move(bytes));
+            for (auto& bytes : encoded) comm_.send(j.deliver, Tag::region, std::move(bytes));
             jobs_.add_busy(thread_cpu_seconds() - c0);  // sending is part of the job
             trace_.switch_to(Stage::comm);
         } else {
@@ -255,9 +258,9 @@ class TileRank {
         }
         const LandedMsg landed{r.generation, r.job};
         trace_.switch_to(Stage::compose);
-        jobs_.land(std::move(r));
+        const bool whole = jobs_.land(std::move(r));  // every surface's result of the job
         trace_.switch_to(Stage::comm);
-        send_message(comm_, kMasterRank, landed);
+        if (whole) send_message(comm_, kMasterRank, landed);
         changed(/*in_job=*/false);
     }
 
@@ -339,8 +342,7 @@ class TileRank {
     Comm& comm_;
     TileSetup& setup_;
     TraceRecorder trace_;
-    ProgressiveEngine engine_;
-    TileJobs jobs_;
+    LayeredJobs jobs_;
     TileInbox inbox_;
     TileResultMsg result_;
     std::optional<FrameCurve> answered_;  // the curve sent for a complete frame (--measure)

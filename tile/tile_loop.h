@@ -7,6 +7,7 @@
 // and at quit sends its figures, trace and final image, then stays until the master releases it
 // (a helper's result may still be on its way to it).
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ struct TileSetup {
     StoreClient* store_client = nullptr;
     // The host's compute slots (--emulate-cores): a job runs while holding one; none: no limit.
     HostSlots* slots = nullptr;
+    // Renderers for a picture's other surfaces (tile/layered_jobs.h), two a surface; empty: the
+    // rank draws one surface.
+    std::function<std::unique_ptr<Renderer>()> make_renderer = {};
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

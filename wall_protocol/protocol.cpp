@@ -74,6 +74,7 @@ std::vector<std::byte> encode(const ViewMsg& m) {
     w.put(m.generation);
     put_frame_view(w, m.view);
     put_clip(w, m.view.clip);
+    put_surfaces(w, m.surfaces);
     return w.take();
 }
 
@@ -83,6 +84,7 @@ static ViewMsg decode_view(std::span<const std::byte> bytes) {
     m.generation = r.get<std::uint64_t>();
     m.view = get_frame_view(r);
     m.view.clip = get_clip(r);
+    m.surfaces = get_surfaces(r);
     r.finish();
     return m;
 }

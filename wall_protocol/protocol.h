@@ -12,6 +12,7 @@
 
 #include "comm/comm.h"
 #include "core/preview.h"
+#include "core/surface_style.h"
 #include "core/view.h"
 #include "progressive/trace.h"
 #include "wall_spec/wall.h"  // kMasterRank: the rank the messages go to and come from
@@ -59,9 +60,12 @@ struct TileHelloMsg {
 
 struct ViewMsg {
     static constexpr Tag kTag = Tag::view;
-    static constexpr std::uint8_t kVersion = 3;  // 3: the view's clip planes
+    static constexpr std::uint8_t kVersion = 4;  // 3: the view's clip planes; 4: surfaces
     std::uint64_t generation = 0;  // grows with every change of camera, isovalue or clip
     FrameView view;                // the tile's own view; its pixels come as jobs
+    // The surfaces drawn together (core/surface_style.h, canonical order); view.iso is the first's.
+    // Empty: one plain surface at view.iso.
+    std::vector<SurfaceStyle> surfaces{};
 };
 
 struct ProgressMsg {
@@ -218,11 +222,12 @@ struct JobDoneMsg {
 
 struct RegionMsg {
     static constexpr Tag kTag = Tag::region;
-    static constexpr std::uint8_t kVersion = 1;
+    static constexpr std::uint8_t kVersion = 2;  // 2: the layer
     std::uint64_t generation = 0;
     std::uint32_t job = 0;
-    PixelRect rect;        // in the owner's screen; rgba and depth are its pixels
-    double cpu_end_s = 0;  // the helper's emulated time at the end of the job
+    std::uint8_t layer = 0;  // which of the view's surfaces (ViewMsg::surfaces) it shows
+    PixelRect rect;          // in the owner's screen; rgba and depth are its pixels
+    double cpu_end_s = 0;    // the helper's emulated time at the end of the job
     std::vector<std::uint8_t> rgba;
     std::vector<float> depth;
 };

@@ -161,6 +161,7 @@ std::vector<std::byte> encode(const RegionMsg& m) {
     w.reserve(64 + m.rgba.size() + 4 * m.depth.size());  // one allocation for the pixels
     w.put(m.generation);
     w.put(m.job);
+    w.put(m.layer);
     put_pixel_rect(w, m.rect);
     w.put(m.cpu_end_s);
     put_pixels(w, m.rgba, m.depth);
@@ -172,6 +173,10 @@ RegionMsg job_wire::decode_region(std::span<const std::byte> bytes) {
     RegionMsg m;
     m.generation = r.get<std::uint64_t>();
     m.job = r.get<std::uint32_t>();
+    m.layer = r.get<std::uint8_t>();
+    if (m.layer >= kMaxSurfaces)
+        r.fail("layer: expected below " + std::to_string(kMaxSurfaces) + ", got " +
+               std::to_string(m.layer));
     // The owner checks the rect against its own screen; here it must be a possible image.
     m.rect = get_region_rect(r, kMaxImageSide, kMaxImageSide);
     m.cpu_end_s = get_seconds(r, "cpu_end_s");

@@ -67,6 +67,25 @@ ClipCmd parse_clip(const std::vector<std::string>& w, const std::string& where) 
     return cmd;
 }
 
+// `iso V`, or `iso V[:COLOUR[:OPACITY]]...`: several surfaces (core/surface_style.h).
+IsoCmd parse_iso(const std::vector<std::string>& w, const std::string& where) {
+    if (w.size() == 2 && w[1].find(':') == std::string::npos)
+        return IsoCmd{checked_number(w[1], limits::kAnyFinite, where, "iso")};
+    if (w.size() < 2) expect_args(w, 1, where, "iso V");
+    IsoCmd cmd;
+    for (std::size_t i = 1; i < w.size(); ++i) {
+        std::string problem;
+        const auto style = parse_surface_style(w[i], problem);
+        if (!style) throw InputError(where, "iso", problem);
+        cmd.surfaces.push_back(*style);
+    }
+    if (std::string problem = surfaces_problem(cmd.surfaces); !problem.empty())
+        throw InputError(where, "iso", problem);
+    cmd.surfaces = canonical_order(cmd.surfaces);
+    cmd.iso = cmd.surfaces[0].iso;
+    return cmd;
+}
+
 }  // namespace
 
 ScriptCommand parse_command(std::string_view text, const std::string& where) {
@@ -99,10 +118,7 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
         expect_args(w, 2, where, "pan DX DY");
         return PanCmd{float(num(1, limits::kPan)), float(num(2, limits::kPan))};
     }
-    if (c == "iso") {
-        expect_args(w, 1, where, "iso V");
-        return IsoCmd{num(1, limits::kAnyFinite)};
-    }
+    if (c == "iso") return parse_iso(w, where);
     if (c == "wait") {
         if (w.size() == 2 && w[1] == "done") return WaitCmd{WaitCmd::Until::done, 0};
         if (w.size() == 3 && (w[1] == "rays" || w[1] == "helped"))

@@ -5,6 +5,7 @@
 //   zoom F                     F > 1 moves closer
 //   pan DX DY                  move the view by DX screen widths right and DY heights up
 //   iso V                      new isovalue
+//   iso V[:COLOUR[:OPACITY]]... several surfaces at once (`iso 40:skin:0.3 105:bone`)
 //   head X Y Z                 the viewer's head moved from its nominal place (x right, y up, z
 //                              towards the viewer; mm on a wall with [physical], else widths of
 //                              the wall): both eyes' off-axis frusta follow
@@ -28,6 +29,7 @@
 
 #include "core/camera.h"
 #include "core/clip.h"
+#include "core/surface_style.h"
 
 namespace isowall {
 
@@ -44,7 +46,10 @@ struct PanCmd {
     float dx = 0, dy = 0;
 };
 struct IsoCmd {
-    double iso = 0;
+    double iso = 0;  // the first surface's
+    // Several surfaces, or one with a colour or opacity (core/surface_style.h, canonical order);
+    // empty: one plain surface at `iso`.
+    std::vector<SurfaceStyle> surfaces = {};
 };
 struct WaitCmd {
     enum class Until { rays, time, helped, done } until = Until::done;

@@ -139,6 +139,34 @@ ClipSet get_clip(MessageReader& r) {
     return c;
 }
 
+void put_surfaces(MessageWriter& w, const std::vector<SurfaceStyle>& s) {
+    w.put(static_cast<std::uint8_t>(s.size()));
+    for (const SurfaceStyle& one : s) {
+        w.put(one.iso);
+        for (int c = 0; c < 3; ++c) w.put(one.colour[c]);
+        w.put(one.opacity);
+        w.put(static_cast<std::uint8_t>(one.coloured ? 1 : 0));  // get_bool's byte
+    }
+}
+
+std::vector<SurfaceStyle> get_surfaces(MessageReader& r) {
+    const auto n = r.get<std::uint8_t>();
+    if (n > kMaxSurfaces)
+        r.fail("view.surfaces: expected at most " + std::to_string(kMaxSurfaces) +
+               " surfaces, got " + std::to_string(n));
+    std::vector<SurfaceStyle> out(n);
+    for (SurfaceStyle& one : out) {
+        one.iso = get_finite<double>(r, "view.surfaces.iso");
+        for (int c = 0; c < 3; ++c) one.colour[c] = r.get<std::uint8_t>();
+        one.opacity = get_finite<float>(r, "view.surfaces.opacity");
+        if (one.opacity < 0 || one.opacity > 1)
+            r.fail("view.surfaces.opacity: expected a number in [0, 1], got " +
+                   std::to_string(one.opacity));
+        one.coloured = r.get_bool();
+    }
+    return out;
+}
+
 void put_pixel_rect(MessageWriter& w, const PixelRect& p) {
     w.put(static_cast<std::int32_t>(p.x));
     w.put(static_cast<std::int32_t>(p.y));

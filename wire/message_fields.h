@@ -5,9 +5,11 @@
 // way.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "core/surface_style.h"
 #include "core/view.h"
 #include "wire/wire.h"
 
@@ -29,6 +31,10 @@ void put_frame_view(MessageWriter& w, const FrameView& v);
 FrameView get_frame_view(MessageReader& r);
 void put_clip(MessageWriter& w, const ClipSet& c);
 ClipSet get_clip(MessageReader& r);
+// The surfaces of a picture (core/surface_style.h): at most kMaxSurfaces, each a finite isovalue,
+// its colour and an opacity in [0, 1]; the field named on failure (`view.surfaces.opacity`).
+void put_surfaces(MessageWriter& w, const std::vector<SurfaceStyle>& s);
+std::vector<SurfaceStyle> get_surfaces(MessageReader& r);
 // A side read from the wire, checked against [min_px, max_px] (by default kMaxImageSide) before
 // anything is sized from it.
 std::int32_t get_side(MessageReader& r, const char* field, std::int32_t min_px);
