@@ -315,6 +315,7 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     s.dark = master.dark_screens();
     s.clip = clip_text(master.clip());
     s.dims = master.dims();
+    for (const SurfaceStyle& one : master.surfaces()) s.surfaces.push_back(surface_style_text(one));
     if (master.options().legend) {
         s.legend = *master.options().legend;
         s.legend_label = master.options().legend_label;

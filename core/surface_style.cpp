@@ -79,7 +79,10 @@ std::optional<glm::u8vec3> surface_colour_named(std::string_view name) {
 
 std::string colour_names() {
     std::string out;
-    for (const NamedColour& c : kNamed) out += (out.empty() ? "" : ", ") + std::string(c.name);
+    for (const NamedColour& c : kNamed) {
+        if (!out.empty()) out += ", ";
+        out += c.name;
+    }
     return out;
 }
 

@@ -66,4 +66,10 @@ inline bool one_opaque_surface(const std::vector<SurfaceStyle>& s) {
     return s.size() == 1 && s[0].opacity >= 1;
 }
 
+// Whether the set is one plain surface: opaque, in the headlight's colours (what a bare isovalue
+// gives, and what the printed forms leave as the isovalue alone).
+inline bool one_plain_surface(const std::vector<SurfaceStyle>& s) {
+    return one_opaque_surface(s) && !s[0].coloured;
+}
+
 }  // namespace isowall

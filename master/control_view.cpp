@@ -24,6 +24,7 @@ std::vector<std::string> status_lines(const ControlStatus& s) {
                   s.value_max, static_cast<unsigned long long>(s.frame),
                   s.done ? "done" : "running");
     std::string line = first;
+    if (!s.surfaces.empty()) line = "iso " + s.surfaces + line.substr(line.find("  ["));
     if (!s.clip.empty()) line += "   clip " + s.clip;
     if (!s.last.empty()) line += "   last: " + s.last;
     return {line, keys_line()};

@@ -27,10 +27,12 @@ struct ControlStatus {
     bool done = false;        // every tile has finished the frame
     std::string last;         // the last command the window gave, e.g. "orbit -30 0"
     std::string clip{};       // the view's clip planes as a script writes them, or empty
+    // Several surfaces (or one coloured or translucent), as `iso` takes them; empty: one plain.
+    std::string surfaces{};
 };
 
-// The two lines of the status bar: the isovalue, its range, the frame, the clip planes and the
-// last command;
+// The two lines of the status bar: the isovalue (or the surfaces), its range, the frame, the clip
+// planes and the last command;
 // then the keys (keys_line).
 std::vector<std::string> status_lines(const ControlStatus& s);
 std::string keys_line();

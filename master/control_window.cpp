@@ -42,6 +42,11 @@ void ControlWindow::present(const WallMaster& master) {
     ControlStatus status{master.iso(),        master.value_min(),  master.value_max(),
                          master.generation(), master.frame_done(), last_};
     status.clip = clip_text(master.clip());
+    if (const auto& s = master.surfaces(); !one_plain_surface(s))
+        for (const SurfaceStyle& one : s) {
+            if (!status.surfaces.empty()) status.surfaces += ' ';
+            status.surfaces += surface_style_text(one);
+        }
     window_.present(compose_control(layout_, tile_previews(master), status_lines(status)));
 }
 

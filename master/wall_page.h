@@ -68,7 +68,10 @@ struct PageState {
     std::vector<std::string> pages;  // every page that said hello, in order of arrival
     // Tile screens whose rank is lost (WallMaster::dark_screens): the others draw them.
     std::vector<std::string> dark;
-    std::string clip;    // the view's clip planes as a script writes them ("x<99"), or empty
+    std::string clip;  // the view's clip planes as a script writes them ("x<99"), or empty
+    // The surfaces drawn together, each as `iso` takes it ("40:#b17a65:0.3"); one plain one: its
+    // isovalue alone.
+    std::vector<std::string> surfaces;
     glm::ivec3 dims{0};  // the volume's voxels: the range of the page's clip slider
     // A surface coloured by a second field: the legend's title and scale (no map: none).
     std::string legend_label;

@@ -133,6 +133,9 @@ TEST(ControlView, TheStatusBarShowsTheIsovalue) {
     s.clip = "x<99 z>40";
     EXPECT_EQ(status_lines(s)[0], "iso 52.2  [0, 220]   frame 3 running   clip x<99 z>40");
     s.clip.clear();
+    s.surfaces = "52.2:#b17a65:0.3 160";
+    EXPECT_EQ(status_lines(s)[0], "iso 52.2:#b17a65:0.3 160  [0, 220]   frame 3 running");
+    s.surfaces.clear();
     // Drawn: text pixels appear in the bar, and a long line is cut at the window's edge.
     const ControlLayout l = control_layout(grid(1, 1, 60, 20));
     const Image img = compose_control(l, {}, lines);

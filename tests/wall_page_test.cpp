@@ -90,8 +90,10 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     s.dark = {"tile 8 (rank 9 on node3): its process has ended"};
     s.clip = "x<99";
     s.dims = {200, 184, 168};
+    s.surfaces = {"40:#b17a65:0.3", "105"};
     const auto j = nlohmann::json::parse(state_json(s));
     EXPECT_EQ(j["clip"], "x<99");
+    EXPECT_EQ(j["surfaces"], nlohmann::json({"40:#b17a65:0.3", "105"}));
     EXPECT_TRUE(j["legend"].is_null());
     s.legend = {*colour_map_named("viridis"), 2, 8};
     s.legend_label = "dose.nrrd (viridis)";

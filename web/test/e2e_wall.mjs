@@ -119,6 +119,13 @@ try {
   sa = await until(a, (x) => /^x<\d+$/.test(x.state.clip), 'the clip in the state');
   await a.selectOption('#clip-axis', '');
   await wall.waitFor(/^page 1: clip off$/m);
+  // Several surfaces typed in: the wall draws both and the state lists them; one value again
+  // goes back to one plain surface.
+  await a.fill('#surfaces', '80:skin:0.3 160:bone');
+  await a.press('#surfaces', 'Enter');
+  await wall.waitFor(/^page 1: iso 80:skin:0.3 160:bone$/m);
+  sa = await until(a, (x) => x.state.surfaces.length === 2, 'two surfaces in the state');
+  check(sa.state.surfaces[0] === '80:#b17a65:0.3', `the first surface reads ${sa.state.surfaces[0]}`);
 
   // A second page watches, sees page 1 steer, is refused, takes over and steers.
   const b = await context.newPage();

@@ -34,6 +34,13 @@ export function isoLine(v) {
   return `iso ${num(v)}`;
 }
 
+// The script line for several surfaces typed as `iso` takes them ("40:skin:0.3 105:bone"), or
+// null when nothing is typed; the wall checks each.
+export function surfacesLine(text) {
+  const words = String(text).trim().split(/\s+/).filter((w) => w.length > 0);
+  return words.length > 0 ? `iso ${words.join(' ')}` : null;
+}
+
 // The clip line of the page's axis menu and slider: one plane keeping what lies below `at` on
 // `axis` ('x', 'y' or 'z'), or none.
 export function clipLine(axis, at) {

@@ -3,12 +3,12 @@
 // master runs (master/wall_page.h). One page steers at a time; the others watch and may take over.
 // window.isowallWall is kept up to date for tests.
 import { ready as mosaicReady, isMosaic, decodeMosaic } from './mosaic.js';
-import { Drag, zoomLine, pinchLine, isoLine, clipLine, axisClip, num } from './gestures.js';
+import { Drag, zoomLine, pinchLine, isoLine, surfacesLine, clipLine, axisClip, num } from './gestures.js';
 import { showMessage as show } from '../ui.js';
 
 const $ = (id) => document.getElementById(id);
 const el = {
-  wallName: $('wall-name'), slider: $('iso-slider'), number: $('iso-number'),
+  wallName: $('wall-name'), slider: $('iso-slider'), number: $('iso-number'), surfaces: $('surfaces'),
   rangeMin: $('range-min'), rangeMax: $('range-max'), snapshot: $('snapshot'),
   steering: $('steering'), take: $('take'), quit: $('quit'), message: $('message'),
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
@@ -134,6 +134,8 @@ function showState(s) {
     el.number.value = num(s.iso);
   }
   showClip(s);
+  el.surfaces.disabled = false;
+  if (document.activeElement !== el.surfaces) el.surfaces.value = (s.surfaces ?? []).join(' ');
   const you = s.steering === api.you;
   el.steering.textContent = you ? 'you steer' : s.steering ? `${s.steering} steers` : 'nobody steers: any input takes the wall';
   el.steering.className = you ? 'you' : '';
@@ -269,6 +271,12 @@ el.slider.addEventListener('change', () => {
 });
 el.number.addEventListener('keydown', (e) => {
   if (e.key === 'Enter') setIso(Number(el.number.value));
+});
+el.surfaces.addEventListener('keydown', (e) => {
+  if (e.key !== 'Enter') return;
+  const line = surfacesLine(el.surfaces.value);
+  if (line) run(line);
+  el.surfaces.blur();
 });
 // The clip menu and slider show the wall's clip when it is one axis plane (a script or the control
 // window may have set others: the menu then says "other" until the page sets its own).
