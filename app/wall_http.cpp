@@ -316,6 +316,9 @@ std::string WallHttp::state_of(const WallMaster& master, const FrameNote& frame)
     s.clip = clip_text(master.clip());
     s.dims = master.dims();
     for (const SurfaceStyle& one : master.surfaces()) s.surfaces.push_back(surface_style_text(one));
+    s.steps = master.options().steps;
+    s.step = master.step();
+    s.playing = master.playing();
     if (master.options().legend) {
         s.legend = *master.options().legend;
         s.legend_label = master.options().legend_label;

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "app/remote_commands.h"
+#include "app/step_volumes.h"
 #include "app/wall_http.h"
 #include "app/wall_outputs.h"
 #include "cli/iso_option.h"
@@ -25,6 +26,7 @@
 #include "master/wall_master.h"
 #include "render/renderer.h"
 #include "store/open_store.h"
+#include "volume/time_steps.h"
 #include "tile/preview_show.h"
 #include "tile/store_client.h"
 #include "tile/tile_loop.h"
@@ -64,6 +66,12 @@ std::unique_ptr<SurfaceExtractor> open_extractor(const OpenedVolume& ov, ThreadB
     return make_surface_extractor(ov.volume, src, nullptr, budget);
 }
 
+// --volume's time series, when it is a numbered pattern (volume/time_steps.h).
+std::optional<TimeSeries> time_series(const VolumeOptions& v) {
+    if (!is_series_pattern(v.path)) return std::nullopt;
+    return find_series(v.path, "--volume");
+}
+
 // The rank's thread budget: --threads, or its share of the node's cores (core/
 // thread_budget.h), so that ranks emulating a wall on one machine do not oversubscribe it.
 ThreadBudget rank_budget(const WallOptions& o, const Comm& comm) {
@@ -79,6 +87,7 @@ struct MasterInput {
     double iso = 0;
     ClipSet clip;
     std::vector<SurfaceStyle> surfaces;       // --iso's, canonical order
+    std::optional<TimeSeries> series;         // --volume's steps, when it is a numbered pattern
     std::optional<OpenedColourField> colour;  // --color-by: checked here, its range for the legend
     std::vector<ScriptLine> script;
 };
@@ -87,8 +96,13 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
     in.clip = checked_clip(o.clip);
     (void)checked_colour_map(o.colour);
+    // A time series: the master reads step 0 (its range, bounds and work estimate stand for
+    // every step); the tiles open the others.
+    in.series = time_series(o.volume);
+    VolumeOptions first = o.volume;
+    if (in.series) first.path = in.series->steps[0].string();
     // The master casts no ray: its volume stays in the shared map.
-    in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
+    in.volume.emplace(open_volume(first, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
     in.surfaces =
@@ -136,6 +150,12 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.zoom = o.zoom;
     mo.clip = in.clip;
     mo.surfaces = in.surfaces;
+    if (in.series) {
+        mo.steps = in.series->steps.size();
+        std::printf("time series: %zu steps, %s to %s\n", mo.steps,
+                    in.series->steps.front().filename().c_str(),
+                    in.series->steps.back().filename().c_str());
+    }
     if (in.colour) {
         mo.legend = in.colour->field.scale;
         mo.legend_label = colour_label(o.colour, in.colour->field.scale);
@@ -207,10 +227,19 @@ OpenedVolume open_tile_volume(const WallOptions& o, Comm& comm,
     return open_volume(o.volume, std::move(reader), remote->octree_file(), use);
 }
 
-int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
+int run_tile_rank(const WallOptions& given, Comm& comm, const WallSpec& spec,
+                  ThreadBudget budget) {
+    // A time series: step 0 opened here, the others when a view first shows them.
+    const std::optional<TimeSeries> series = time_series(given.volume);
+    WallOptions o = given;
+    if (series) o.volume.path = series->steps[0].string();
     std::optional<StoreClient> remote;
     const OpenedVolume ov = open_tile_volume(o, comm, remote);
     auto extractor = open_extractor(ov, budget);
+    std::optional<StepVolumes> steps;
+    if (series)
+        steps.emplace(*series, o.volume, VolumeUse{.copies_on_host = comm.ranks_on_host()}, budget,
+                      ov, *extractor);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
     // thread, unless the user says otherwise: the work then stays on its core and in the frame
     // thread's CPU clock, which the trace and the emulated time read. With more, llvmpipe keeps
@@ -231,6 +260,10 @@ int run_tile_rank(const WallOptions& o, Comm& comm, const WallSpec& spec, Thread
     setup.engine.threads = budget.usable();
     if (o.fault.on(comm.rank())) setup.fault = o.fault;
     setup.make_renderer = [gl = o.gl] { return make_renderer(gl); };
+    if (steps)
+        setup.step_extractor = [&steps](std::uint32_t k) -> SurfaceExtractor& {
+            return steps->extractor(k);
+        };
     const PixelRect tile = eye_rect(spec, tile_of_rank(spec, comm.rank()));
     setup.timeout_s = o.timeout_s;
     setup.tile_width = tile.width;

@@ -138,6 +138,15 @@ void ControlInput::flush(std::vector<std::string>& out) {
     clip_steps_ = 0;
 }
 
+std::string time_key_line(const std::string& key, const ControlState& state) {
+    if (state.steps == 0) return {};
+    if (key == "p" || key == "P") return state.playing ? "pause" : "play loop";
+    if (key == "comma" && state.step > 0) return "time " + std::to_string(state.step - 1);
+    if (key == "period" && state.step + 1 < state.steps)
+        return "time " + std::to_string(state.step + 1);
+    return {};
+}
+
 void ControlInput::drag_to(int x, int y) {
     if (left_down_ || right_down_) {
         drag_x_ += x - last_x_;
@@ -164,6 +173,12 @@ void ControlInput::key(const std::string& name, std::vector<std::string>& out) {
     } else if ((name == "bracketleft" || name == "bracketright") && state_.dims.x > 0) {
         accumulate(Pending::clip, out);
         clip_steps_ += name == "bracketright" ? 1 : -1;
+    } else if (std::string line = time_key_line(name, state_); !line.empty()) {
+        flush(out);
+        out.push_back(line);
+        // The poll's next keys see what this one asked for.
+        if (line.starts_with("time ")) state_.step = std::uint32_t(std::stoul(line.substr(5)));
+        state_.playing = line.starts_with("play");
     } else if (name == "s" || name == "S") {
         flush(out);
         out.push_back("snapshot " + snapshot_name(next_snapshot_++));

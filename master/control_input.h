@@ -45,6 +45,10 @@ struct ControlState {
     double head_step = 0;                     // per Left/Right key; 0: the keys do nothing
     ClipSet clip{};                           // the view's clip planes now
     glm::ivec3 dims{0};                       // the volume's voxels; 0: the clip keys do nothing
+    // A time series: its steps (0: none, the time keys do nothing), the step shown, and whether
+    // it plays.
+    std::uint32_t steps = 0, step = 0;
+    bool playing = false;
 };
 
 // "control-001" ...: the name of snapshot n.
@@ -64,6 +68,10 @@ std::string clip_cycle_line(const ClipSet& now, glm::ivec3 dims);
 // `now`, one plane across an axis, moved by `steps` of kClipStep of the volume's side along it
 // and kept within the volume; "" when `now` is not one such plane or it would not move.
 std::string clip_move_line(const ClipSet& now, glm::ivec3 dims, int steps);
+
+// The line a time key gives (comma: the step before, period: the step after, p: play round and
+// round or pause), or "" when it changes nothing (the first or last step, or no series).
+std::string time_key_line(const std::string& key, const ControlState& state);
 
 class ControlInput {
   public:

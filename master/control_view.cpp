@@ -25,6 +25,7 @@ std::vector<std::string> status_lines(const ControlStatus& s) {
                   s.done ? "done" : "running");
     std::string line = first;
     if (!s.surfaces.empty()) line = "iso " + s.surfaces + line.substr(line.find("  ["));
+    if (!s.time.empty()) line += "   " + s.time;
     if (!s.clip.empty()) line += "   clip " + s.clip;
     if (!s.last.empty()) line += "   last: " + s.last;
     return {line, keys_line()};
@@ -32,7 +33,7 @@ std::vector<std::string> status_lines(const ControlStatus& s) {
 
 std::string keys_line() {
     return "drag orbit  right-drag pan  wheel zoom  up/down iso  pgup/pgdn iso x10  left/right "
-           "head  c clip  [ ] move it  s snapshot  esc quit";
+           "head  c clip  [ ] move it  , . time  p play  s snapshot  esc quit";
 }
 
 PixelSize control_window_size(const ControlLayout& layout) {

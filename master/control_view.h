@@ -29,6 +29,7 @@ struct ControlStatus {
     std::string clip{};       // the view's clip planes as a script writes them, or empty
     // Several surfaces (or one coloured or translucent), as `iso` takes them; empty: one plain.
     std::string surfaces{};
+    std::string time{};  // a time series: "time 3/8", "time 3/8 playing"; empty otherwise
 };
 
 // The two lines of the status bar: the isovalue (or the surfaces), its range, the frame, the clip

@@ -42,6 +42,9 @@ void ControlWindow::present(const WallMaster& master) {
     ControlStatus status{master.iso(),        master.value_min(),  master.value_max(),
                          master.generation(), master.frame_done(), last_};
     status.clip = clip_text(master.clip());
+    if (const std::size_t n = master.options().steps; n > 0)
+        status.time = "time " + std::to_string(master.step()) + "/" + std::to_string(n) +
+                      (master.playing() ? " playing" : "");
     if (const auto& s = master.surfaces(); !one_plain_surface(s))
         for (const SurfaceStyle& one : s) {
             if (!status.surfaces.empty()) status.surfaces += ' ';
@@ -53,7 +56,7 @@ void ControlWindow::present(const WallMaster& master) {
 void ControlWindow::begin() {
     std::printf(
         "control: window on %s (drag: orbit, wheel: zoom, up/down: iso, c and [ ]: clip, "
-        "s: snapshot, escape: quit)\n",
+        "comma/period: time step, p: play, s: snapshot, escape: quit)\n",
         window_.display_name().c_str());
     std::fflush(stdout);
 }
@@ -67,7 +70,10 @@ std::vector<SteeringLine> ControlWindow::take(const WallMaster& master) {
                              master.head(),
                              master.spec().physical ? kHeadStepMm : kHeadStepWidths,
                              master.clip(),
-                             master.dims()};
+                             master.dims(),
+                             std::uint32_t(master.options().steps),
+                             master.step(),
+                             master.playing()};
     std::vector<SteeringLine> lines;
     for (std::string& text : input_.commands(window_.poll(), state))
         lines.push_back({std::move(text), "control"});

@@ -190,6 +190,27 @@ void WallMaster::check_tiles() {
 void WallMaster::idle() {
     keep_alive();
     while (auto e = comm_.receive(-1, 0)) handle(*e);
+    play_on();
+}
+
+void WallMaster::play_on() {
+    if (!playing_ || !frame_done() || (o_.measure && !curves_in())) return;
+    const FrameFigures f = frame_figures();
+    std::printf("time %u: frame %llu done in %.3f s, emulated %.3f s", step_,
+                static_cast<unsigned long long>(generation_), frame_start_.seconds(),
+                f.emulated_s);
+    if (f.c99_s >= 0) std::printf(", C = 99%% at %.3f s", f.c99_s);
+    std::printf("\n");
+    std::fflush(stdout);
+    if (step_ + 1 < o_.steps) {
+        ++step_;
+    } else if (loop_) {
+        step_ = 0;
+    } else {
+        playing_ = false;
+        return;
+    }
+    send_views();
 }
 
 bool WallMaster::all_tiles(const std::function<bool(const TileState&)>& pred) const {
@@ -354,6 +375,7 @@ void WallMaster::send_views() {
         v.generation = generation_;
         v.view = {eye.camera, tile_frustum(eye.wall, spec_, tile), r.width, r.height, iso_, clip_};
         v.surfaces = surfaces_;
+        v.step = step_;
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
         t.view = v.view;
@@ -435,6 +457,23 @@ bool WallMaster::change_view(const ScriptCommand& cmd, const std::string& where)
         iso_ = surfaces_[0].iso;
     } else if (const auto* c = std::get_if<HeadCmd>(&cmd)) {
         head_ = c->offset;
+    } else if (const auto* c = std::get_if<TimeCmd>(&cmd)) {
+        if (o_.steps == 0) throw InputError(where, "time", "the volume is not a time series");
+        if (c->step >= o_.steps)
+            throw InputError(where, "time",
+                             "step " + std::to_string(c->step) + ": the series has " +
+                                 std::to_string(o_.steps) + " steps (0 to " +
+                                 std::to_string(o_.steps - 1) + ")");
+        step_ = c->step;
+    } else if (const auto* c = std::get_if<PlayCmd>(&cmd)) {
+        if (o_.steps == 0) throw InputError(where, "play", "the volume is not a time series");
+        playing_ = true;
+        loop_ = c->loop;
+        play_on();
+        return false;
+    } else if (std::holds_alternative<PauseCmd>(cmd)) {
+        playing_ = false;
+        return false;
     } else if (const auto* c = std::get_if<ClipCmd>(&cmd)) {
         if (!keeps_some_voxel(c->clip, o_.dims))
             throw InputError(where, "clip", "the planes keep nothing of the volume's voxels");
@@ -469,7 +508,12 @@ void WallMaster::wait(const WaitCmd& w) {
         // frame is done once its curves are in: the tiles measure it when it completes, and a
         // next view sent meanwhile would find some tiles still measuring (late on 2 cores) and
         // hand their regions to others: the measurement would change the next frame's figures.
-        if (frame_done() && (!o_.measure || curves_in())) return true;
+        if (frame_done() && (!o_.measure || curves_in())) {
+            // Playing (to the last step, not round and round): the next step's frame.
+            if (!playing_ || loop_) return true;
+            play_on();
+            return !playing_;
+        }
         if (w.until == WaitCmd::Until::helped) return double(migrations_.size()) >= w.amount;
         return w.until == WaitCmd::Until::rays && double(total_rays()) >= w.amount;
     };

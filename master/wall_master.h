@@ -61,6 +61,8 @@ struct MasterOptions {
     // The first view's surfaces (core/surface_style.h, canonical order); empty: one plain surface
     // at the isovalue the master is made with.
     std::vector<SurfaceStyle> surfaces;
+    // The steps of a time series (volume/time_steps.h); 0: the volume does not change.
+    std::size_t steps = 0;
     // A surface coloured by a second field (--color-by): the legend the mosaics carry.
     std::optional<ColourScale> legend;
     std::string legend_label;
@@ -138,6 +140,8 @@ class WallMaster {
     double iso() const { return iso_; }
     // The surfaces the tiles draw (one plain one at iso() unless several were asked for).
     const std::vector<SurfaceStyle>& surfaces() const { return surfaces_; }
+    std::uint32_t step() const { return step_; }
+    bool playing() const { return playing_; }
     const glm::dvec3& head() const { return head_; }
     const ClipSet& clip() const { return clip_; }
     glm::ivec3 dims() const { return o_.dims; }
@@ -238,6 +242,11 @@ class WallMaster {
     glm::dvec3 head_{0};                  // the viewer's head from its nominal place (HeadCmd)
     ClipSet clip_;                        // the view's clip planes, voxel indices (ClipCmd)
     std::vector<SurfaceStyle> surfaces_;  // the view's surfaces; surfaces_[0].iso is iso_
+    std::uint32_t step_ = 0;              // the time step shown
+    bool playing_ = false, loop_ = false;  // PlayCmd
+    // Playing: once the frame is done (and measured, with --measure), its step's line, then the
+    // next step's frame; at the last step playing stops, or starts again at 0 with `play loop`.
+    void play_on();
     std::uint64_t generation_ = 0;
     std::vector<TileState> tiles_;  // by rank; [0] is the master
     Stopwatch frame_start_;

@@ -131,7 +131,8 @@ std::string state_json(const PageState& s) {
                 {"c99_s", f.c99_s},         {"steering", s.steering},
                 {"pages", s.pages},         {"dark", s.dark},
                 {"clip", s.clip},           {"dims", {s.dims.x, s.dims.y, s.dims.z}},
-                {"surfaces", s.surfaces},   {"legend", legend_json(s)}}
+                {"surfaces", s.surfaces},   {"steps", s.steps},
+                {"step", s.step},           {"playing", s.playing},   {"legend", legend_json(s)}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

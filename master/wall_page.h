@@ -72,6 +72,9 @@ struct PageState {
     // The surfaces drawn together, each as `iso` takes it ("40:#b17a65:0.3"); one plain one: its
     // isovalue alone.
     std::vector<std::string> surfaces;
+    // A time series: its steps (0: none), the step shown, whether it plays.
+    std::uint64_t steps = 0, step = 0;
+    bool playing = false;
     glm::ivec3 dims{0};  // the volume's voxels: the range of the page's clip slider
     // A surface coloured by a second field: the legend's title and scale (no map: none).
     std::string legend_label;

@@ -118,6 +118,24 @@ TEST(ControlInput, CStepsThroughTheAxisClipsAndBracketsMoveThem) {
     EXPECT_EQ(in.commands({key("c")}, state), Lines{"clip off"});
 }
 
+TEST(ControlInput, CommaAndPeriodStepThroughTimeAndPPlaysOrPauses) {
+    ControlState state = kPhantom;
+    ControlInput in;
+    // Not a series: the keys do nothing.
+    EXPECT_EQ(in.commands({key("period"), key("p")}, state), Lines{});
+    state.steps = 8;
+    state.step = 6;
+    EXPECT_EQ(in.commands({key("period"), key("period"), key("comma")}, state),
+              (Lines{"time 7", "time 6"}));  // no step past the last
+    state.step = 0;
+    EXPECT_EQ(in.commands({key("comma")}, state), Lines{});
+    EXPECT_EQ(in.commands({key("p"), key("p")}, state), (Lines{"play loop", "pause"}));
+    state.playing = true;
+    EXPECT_EQ(in.commands({key("p")}, state), Lines{"pause"});
+    for (const std::string& line : Lines{"time 7", "play loop", "pause"})
+        EXPECT_NO_THROW(parse_command(line, "control")) << line;
+}
+
 TEST(ControlInput, KindsKeepTheirOrderAndQuitEndsThePoll) {
     ControlInput in(7);
     const Lines lines = in.commands({press(1, 0, 0), motion(10, 0), release(1, 10, 0), press(4),

@@ -133,6 +133,9 @@ TEST(ControlView, TheStatusBarShowsTheIsovalue) {
     s.clip = "x<99 z>40";
     EXPECT_EQ(status_lines(s)[0], "iso 52.2  [0, 220]   frame 3 running   clip x<99 z>40");
     s.clip.clear();
+    s.time = "time 3/8 playing";
+    EXPECT_EQ(status_lines(s)[0], "iso 52.2  [0, 220]   frame 3 running   time 3/8 playing");
+    s.time.clear();
     s.surfaces = "52.2:#b17a65:0.3 160";
     EXPECT_EQ(status_lines(s)[0], "iso 52.2:#b17a65:0.3 160  [0, 220]   frame 3 running");
     s.surfaces.clear();

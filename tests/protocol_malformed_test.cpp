@@ -12,6 +12,7 @@
 
 #include "tests/largest_allocation.h"
 #include "tests/protocol_test_util.h"
+#include "volume/time_steps.h"
 
 namespace isowall {
 namespace {
@@ -155,24 +156,31 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
     }
     // More planes, or surfaces, than any view has: the planes' count byte follows the isovalue,
     // the surfaces' count the planes.
+    // (The step's 4 bytes come last.)
     ViewMsg none = sample_view();
     none.view.clip = {};
     none.surfaces = {};
+    none.step = 0;
     Bytes bytes = encode(none);
-    ASSERT_EQ(bytes[bytes.size() - 2], std::byte{0});
-    ASSERT_EQ(bytes.back(), std::byte{0});
-    bytes.back() = std::byte{kMaxSurfaces + 1};
+    const std::size_t at = bytes.size() - 4;  // the surfaces' count
+    ASSERT_EQ(bytes[at - 1], std::byte{0});
+    ASSERT_EQ(bytes[at], std::byte{0});
+    bytes[at] = std::byte{kMaxSurfaces + 1};
     expect_wire_error(Tag::view, bytes, "view.surfaces: expected at most 8 surfaces, got 9");
-    bytes.back() = std::byte{0};
-    bytes[bytes.size() - 2] = std::byte{kMaxClipPlanes + 1};
+    bytes[at] = std::byte{0};
+    bytes[at - 1] = std::byte{kMaxClipPlanes + 1};
     expect_wire_error(Tag::view, bytes, "view.clip: expected at most 8 planes, got 9");
     // A coloured flag is a bool byte: 0 or 1.
     ViewMsg one = sample_view();
     one.view.clip = {};
     one.surfaces.resize(1);
+    one.step = 0;
     bytes = encode(one);
-    bytes.back() = std::byte{2};
+    bytes[bytes.size() - 5] = std::byte{2};
     expect_wire_error(Tag::view, bytes, "bool byte 2");
+    // A step past any series.
+    one.step = kMaxTimeSteps;
+    expect_wire_error(Tag::view, encode(one), "step: expected below 100000");
 }
 
 // ---- image --------------------------------------------------------------------------------------

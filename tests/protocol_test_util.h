@@ -55,7 +55,8 @@ inline bool operator==(const TileHelloMsg& a, const TileHelloMsg& b) {
     return a.host == b.host && a.threads == b.threads && a.loaded == b.loaded;
 }
 inline bool operator==(const ViewMsg& a, const ViewMsg& b) {
-    return a.generation == b.generation && a.view == b.view && a.surfaces == b.surfaces;
+    return a.generation == b.generation && a.view == b.view && a.surfaces == b.surfaces &&
+           a.step == b.step;
 }
 inline bool operator==(const ProgressMsg& a, const ProgressMsg& b) {
     return a.generation == b.generation && a.rays == b.rays && a.cpu_s == b.cpu_s;
@@ -249,6 +250,7 @@ inline ViewMsg sample_view() {
     m.view.clip.add({{0, -1, 0}, -40.5f});  // y < 40.5
     m.view.clip.add({{0.6f, 0, 0.8f}, 12});
     m.surfaces = {{117.25, {177, 122, 101}, 0.3f, true}, {160.5, kDefaultSurfaceColour, 1, false}};
+    m.step = 0x01020304;
     return m;
 }
 

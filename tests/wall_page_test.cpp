@@ -94,6 +94,14 @@ TEST(WallPage, StateAndWelcomeAreTheFieldsThePageReads) {
     const auto j = nlohmann::json::parse(state_json(s));
     EXPECT_EQ(j["clip"], "x<99");
     EXPECT_EQ(j["surfaces"], nlohmann::json({"40:#b17a65:0.3", "105"}));
+    EXPECT_EQ(j["steps"], 0);
+    s.steps = 8;
+    s.step = 3;
+    s.playing = true;
+    const auto t = nlohmann::json::parse(state_json(s));
+    EXPECT_EQ(t["steps"], 8);
+    EXPECT_EQ(t["step"], 3);
+    EXPECT_EQ(t["playing"], true);
     EXPECT_TRUE(j["legend"].is_null());
     s.legend = {*colour_map_named("viridis"), 2, 8};
     s.legend_label = "dose.nrrd (viridis)";

@@ -26,8 +26,8 @@ LayeredJobs::~LayeredJobs() = default;
 LayeredJobs::Layer& LayeredJobs::layer(std::size_t k, const SurfaceStyle& style) {
     if (k >= layers_.size()) layers_.resize(k + 1);
     std::unique_ptr<Layer>& l = layers_[k];
-    const bool same_colour =
-        l && l->style.coloured == style.coloured && l->style.colour == style.colour;
+    const bool same_colour = l && l->jobs && l->style.coloured == style.coloured &&
+                             l->style.colour == style.colour;
     if (same_colour) {
         l->style = style;
         return *l;
@@ -37,7 +37,7 @@ LayeredJobs::Layer& LayeredJobs::layer(std::size_t k, const SurfaceStyle& style)
         if (k > 0) {
             if (!setup_.make_renderer)
                 throw std::logic_error("a tile without a renderer factory draws one surface");
-            l->extractor = setup_.extractor.share();
+            l->extractor = setup_.extractor->share();
             l->tile = setup_.make_renderer();
             l->help = setup_.make_renderer();
         }
@@ -46,15 +46,26 @@ LayeredJobs::Layer& LayeredJobs::layer(std::size_t k, const SurfaceStyle& style)
     l->jobs.reset();  // before the engine it refers to
     EngineOptions options = setup_.engine;
     options.colour = surface_colour_hook(style, setup_.engine.colour);
-    l->engine = std::make_unique<ProgressiveEngine>(l->extractor ? *l->extractor : setup_.extractor,
-                                                    options);
+    l->engine = std::make_unique<ProgressiveEngine>(
+        l->extractor ? *l->extractor : *setup_.extractor, options);
     l->jobs = std::make_unique<TileJobs>(*l->engine, l->tile ? *l->tile : setup_.tile,
                                          l->help ? *l->help : setup_.help, setup_.measure);
     return *l;
 }
 
+void LayeredJobs::use_extractor(SurfaceExtractor& extractor) {
+    setup_.extractor = &extractor;
+    for (std::size_t k = 0; k < layers_.size(); ++k) {
+        Layer& l = *layers_[k];
+        l.jobs.reset();  // made again by layer(), before the engine it refers to goes
+        l.engine.reset();
+        if (k > 0) l.extractor = extractor.share();
+    }
+}
+
 void LayeredJobs::prepare(int width, int height) {
-    for (auto& l : layers_) l->jobs->prepare(width, height);
+    for (auto& l : layers_)
+        if (l->jobs) l->jobs->prepare(width, height);
 }
 
 void LayeredJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
@@ -75,11 +86,11 @@ void LayeredJobs::begin(const ViewMsg& v, const std::atomic<bool>& stop,
 }
 
 bool LayeredJobs::started() const {
-    return layers_[0]->jobs->started();
+    return layers_[0]->jobs && layers_[0]->jobs->started();
 }
 
 std::uint64_t LayeredJobs::generation() const {
-    return layers_[0]->jobs->generation();
+    return layers_[0]->jobs ? layers_[0]->jobs->generation() : 0;
 }
 
 LayeredJobs::Outcome LayeredJobs::run(const JobMsg& job, int rank) {

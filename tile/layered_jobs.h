@@ -23,7 +23,7 @@
 namespace isowall {
 
 struct LayeredJobsSetup {
-    SurfaceExtractor& extractor;  // the first surface's; the others share its octree
+    SurfaceExtractor* extractor;  // the first surface's; the others share its octree
     Renderer& tile;               // the first surface's tile and help renderers
     Renderer& help;
     EngineOptions engine;  // every surface's, but for the colour (a second field's colours all)
@@ -38,6 +38,9 @@ class LayeredJobs {
     ~LayeredJobs();
 
     void prepare(int width, int height);
+    // Another volume from the next frame on (a time step, volume/time_steps.h): every surface's
+    // engine is made again over `extractor`, which must outlive its use here.
+    void use_extractor(SurfaceExtractor& extractor);
     // A new frame: the surfaces of `v` (one plain one at v.view.iso when it lists none).
     void begin(const ViewMsg& v, const std::atomic<bool>& stop,
                const ProgressiveEngine::Progress& progress);

@@ -29,7 +29,7 @@ class TileRank {
     TileRank(Comm& comm, TileSetup& setup)
         : comm_(comm),
           setup_(setup),
-          jobs_(LayeredJobsSetup{setup.extractor, setup.renderer, setup.help_renderer, options(),
+          jobs_(LayeredJobsSetup{&setup.extractor, setup.renderer, setup.help_renderer, options(),
                                  setup.make_renderer, setup.measure}) {
         for (FrameShow* f : setup.shows) shows_.push_back({f, PresentPacer(f->interval_s())});
     }
@@ -121,6 +121,7 @@ class TileRank {
         if (first_view_ == 0) first_view_ = v.generation;
         keep_curve();
         close_frame();
+        use_step(v.step);
         // Setting up the frame (its engine frame, the tile's image cleared) is part of the frame's
         // busy CPU (TileJobs::begin), so it is render here, not comm; with compute slots it holds
         // one, as a job does (the engine frame starts its first stages), or goes on without one
@@ -154,6 +155,16 @@ class TileRank {
         cpu0_ = thread_cpu_seconds();
         ++result_.frames;
         land_early();
+    }
+
+    // The volume of time step `step` for the frames from now on.
+    void use_step(std::uint32_t step) {
+        if (step == step_) return;
+        if (!setup_.step_extractor)
+            throw WireError("view message: step " + std::to_string(step) +
+                            ": the volume has one time step");
+        jobs_.use_extractor(setup_.step_extractor(step));
+        step_ = step;
     }
 
     // With --measure, the curve of the frame a new view ends against what the tile shows now (final
@@ -355,6 +366,7 @@ class TileRank {
     Stopwatch shown_clock_;
     double cpu0_ = 0, last_progress_s_ = -1;
     std::uint64_t first_view_ = 0;  // the generation of the first view (the `late` test fault)
+    std::uint32_t step_ = 0;        // the time step whose volume the frames draw
     double io_charged_s_ = 0, comm_charged_s_ = 0;
     bool interrupted_ = false;
 };

@@ -6,6 +6,7 @@
 // progress point, lands helpers' results, answers snapshot requests from the frame being built,
 // and at quit sends its figures, trace and final image, then stays until the master releases it
 // (a helper's result may still be on its way to it).
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -45,6 +46,9 @@ struct TileSetup {
     // Renderers for a picture's other surfaces (tile/layered_jobs.h), two a surface; empty: the
     // rank draws one surface.
     std::function<std::unique_ptr<Renderer>()> make_renderer = {};
+    // The extractor of a time step of a series (volume/time_steps.h), opened on first use and
+    // kept while it is in use; `extractor` is step 0's. Empty: the volume has one step.
+    std::function<SurfaceExtractor&(std::uint32_t step)> step_extractor = {};
 };
 
 // How much longer than a limit a tile rank waits before it names a silent master: ranks after the

@@ -4,6 +4,8 @@
 // caller repeats the checks and none forgets them.
 #include "wall_protocol/protocol.h"
 
+#include "volume/time_steps.h"
+
 #include "wall_protocol/protocol_jobs.h"
 #include "wall_protocol/protocol_store.h"
 #include "wire/message_fields.h"
@@ -75,6 +77,7 @@ std::vector<std::byte> encode(const ViewMsg& m) {
     put_frame_view(w, m.view);
     put_clip(w, m.view.clip);
     put_surfaces(w, m.surfaces);
+    w.put(m.step);
     return w.take();
 }
 
@@ -85,6 +88,10 @@ static ViewMsg decode_view(std::span<const std::byte> bytes) {
     m.view = get_frame_view(r);
     m.view.clip = get_clip(r);
     m.surfaces = get_surfaces(r);
+    m.step = r.get<std::uint32_t>();
+    if (m.step >= kMaxTimeSteps)
+        r.fail("step: expected below " + std::to_string(kMaxTimeSteps) + ", got " +
+               std::to_string(m.step));
     r.finish();
     return m;
 }

@@ -60,12 +60,13 @@ struct TileHelloMsg {
 
 struct ViewMsg {
     static constexpr Tag kTag = Tag::view;
-    static constexpr std::uint8_t kVersion = 4;  // 3: the view's clip planes; 4: surfaces
+    static constexpr std::uint8_t kVersion = 5;  // 3: clip planes; 4: surfaces; 5: time step
     std::uint64_t generation = 0;  // grows with every change of camera, isovalue or clip
     FrameView view;                // the tile's own view; its pixels come as jobs
     // The surfaces drawn together (core/surface_style.h, canonical order); view.iso is the first's.
     // Empty: one plain surface at view.iso.
     std::vector<SurfaceStyle> surfaces{};
+    std::uint32_t step = 0;  // the time step of a series (volume/time_steps.h); 0 otherwise
 };
 
 struct ProgressMsg {

@@ -143,6 +143,20 @@ ScriptCommand parse_command(std::string_view text, const std::string& where) {
         return HeadCmd{{num(1, limits::kHead), num(2, limits::kHead), num(3, limits::kHead)}};
     }
     if (c == "clip") return parse_clip(w, where);
+    if (c == "time") {
+        expect_args(w, 1, where, "time N");
+        // Below volume/time_steps.h's kMaxTimeSteps: the master checks it against the series.
+        return TimeCmd{static_cast<std::uint32_t>(num(1, {0, 99999, false, true}))};
+    }
+    if (c == "play") {
+        if (w.size() == 1) return PlayCmd{};
+        if (w.size() == 2 && w[1] == "loop") return PlayCmd{true};
+        throw InputError(where, c, "expected \"play\" or \"play loop\"");
+    }
+    if (c == "pause") {
+        expect_args(w, 0, where, "pause");
+        return PauseCmd{};
+    }
     if (c == "quit") {
         expect_args(w, 0, where, "quit");
         return QuitCmd{};

@@ -14,11 +14,16 @@
 //   wait rays N | wait done    until N rays in all (or the frame's end) | the frame's end
 //   wait time S                a pause of S seconds, whether or not the frame ends first
 //   wait helped N              until tiles have run N jobs of other tiles this frame (or its end)
+//   time N                     show step N (from 0) of a time series (--volume 'run/t_%03d.nrrd')
+//   play | play loop           the next step each time a frame is done, to the last (or round
+//                              and round); `wait done` while playing waits for the last step
+//   pause                      stop playing
 //   snapshot NAME              write the mosaic as NAME.png
 //   quit
 // '#' starts a comment; blank lines are skipped. Every change of view, isovalue or clip starts a
 // new frame on every tile (and interrupts the current one).
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -65,9 +70,20 @@ struct ClipCmd {
     ClipSet clip;  // empty: clip off
 };
 struct QuitCmd {};
+// A time series (volume/time_steps.h): show step `step` (from 0).
+struct TimeCmd {
+    std::uint32_t step = 0;
+};
+// Play the series from the step shown: the next step each time a frame is done, to the last
+// (`play loop`: round and round until `pause`).
+struct PlayCmd {
+    bool loop = false;
+};
+struct PauseCmd {};
 
 using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd,
-                                   SnapshotCmd, HeadCmd, ClipCmd, QuitCmd>;
+                                   SnapshotCmd, HeadCmd, ClipCmd, QuitCmd, TimeCmd, PlayCmd,
+                                   PauseCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages

@@ -126,6 +126,8 @@ try {
   await wall.waitFor(/^page 1: iso 80:skin:0.3 160:bone$/m);
   sa = await until(a, (x) => x.state.surfaces.length === 2, 'two surfaces in the state');
   check(sa.state.surfaces[0] === '80:#b17a65:0.3', `the first surface reads ${sa.state.surfaces[0]}`);
+  // The phantom is one volume: no time controls.
+  check(sa.state.steps === 0 && await a.isHidden('label.time'), 'no time controls without a series');
 
   // A second page watches, sees page 1 steer, is refused, takes over and steers.
   const b = await context.newPage();

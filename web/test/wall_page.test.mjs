@@ -2,7 +2,7 @@
 // (master/control_input.h), and the mosaic message (master/wall_page.h: encode_mosaic).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { Drag, num, orbitLine, panLine, zoomLine, pinchLine, isoLine, surfacesLine, clipLine, axisClip } from '../src/wall/gestures.js';
+import { Drag, num, orbitLine, panLine, zoomLine, pinchLine, isoLine, surfacesLine, timeLine, clipLine, axisClip } from '../src/wall/gestures.js';
 import { ready, isMosaic, mosaicHeader, decodeMosaic } from '../src/wall/mosaic.js';
 import { readFileSync } from 'node:fs';
 import { join, dirname } from 'node:path';
@@ -19,6 +19,7 @@ test('gestures become the control window\'s lines', () => {
   assert.equal(isoLine(52.2), 'iso 52.2');
   assert.equal(surfacesLine('  40:skin:0.3   105:bone '), 'iso 40:skin:0.3 105:bone');
   assert.equal(surfacesLine('   '), null);
+  assert.equal(timeLine(3), 'time 3');
   assert.equal(clipLine('x', 99), 'clip x<99');
   assert.equal(clipLine('', 5), 'clip off');
   assert.deepEqual(axisClip('z<83.5'), { axis: 'z', at: 83.5 });

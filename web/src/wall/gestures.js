@@ -34,6 +34,11 @@ export function isoLine(v) {
   return `iso ${num(v)}`;
 }
 
+// The script line that shows time step n of a series.
+export function timeLine(n) {
+  return `time ${Math.round(n)}`;
+}
+
 // The script line for several surfaces typed as `iso` takes them ("40:skin:0.3 105:bone"), or
 // null when nothing is typed; the wall checks each.
 export function surfacesLine(text) {

@@ -3,12 +3,12 @@
 // master runs (master/wall_page.h). One page steers at a time; the others watch and may take over.
 // window.isowallWall is kept up to date for tests.
 import { ready as mosaicReady, isMosaic, decodeMosaic } from './mosaic.js';
-import { Drag, zoomLine, pinchLine, isoLine, surfacesLine, clipLine, axisClip, num } from './gestures.js';
+import { Drag, zoomLine, pinchLine, isoLine, surfacesLine, timeLine, clipLine, axisClip, num } from './gestures.js';
 import { showMessage as show } from '../ui.js';
 
 const $ = (id) => document.getElementById(id);
 const el = {
-  wallName: $('wall-name'), slider: $('iso-slider'), number: $('iso-number'), surfaces: $('surfaces'),
+  wallName: $('wall-name'), slider: $('iso-slider'), number: $('iso-number'), surfaces: $('surfaces'), timeBox: document.querySelector('label.time'), timeStep: $('time-step'), timeValue: $('time-value'), play: $('play'),
   rangeMin: $('range-min'), rangeMax: $('range-max'), snapshot: $('snapshot'),
   steering: $('steering'), take: $('take'), quit: $('quit'), message: $('message'),
   canvas: $('mosaic'), frameState: $('frame-state'), frame: $('s-frame'), wall: $('s-wall'),
@@ -135,6 +135,7 @@ function showState(s) {
   }
   showClip(s);
   el.surfaces.disabled = false;
+  showTime(s);
   if (document.activeElement !== el.surfaces) el.surfaces.value = (s.surfaces ?? []).join(' ');
   const you = s.steering === api.you;
   el.steering.textContent = you ? 'you steer' : s.steering ? `${s.steering} steers` : 'nobody steers: any input takes the wall';
@@ -272,6 +273,23 @@ el.slider.addEventListener('change', () => {
 el.number.addEventListener('keydown', (e) => {
   if (e.key === 'Enter') setIso(Number(el.number.value));
 });
+// A time series: the slider shows the step (unless held), the button plays round and round or
+// pauses.
+let timeHeld = false;
+function showTime(s) {
+  el.timeBox.hidden = !(s.steps > 0);
+  if (!(s.steps > 0)) return;
+  el.timeStep.max = s.steps - 1;
+  if (!timeHeld) el.timeStep.value = s.step;
+  el.timeValue.textContent = `${s.step}/${s.steps}`;
+  el.play.textContent = s.playing ? 'Pause' : 'Play';
+}
+el.timeStep.addEventListener('input', () => { timeHeld = true; });
+el.timeStep.addEventListener('change', () => {
+  timeHeld = false;
+  run(timeLine(Number(el.timeStep.value)));
+});
+el.play.addEventListener('click', () => run(api.state?.playing ? 'pause' : 'play loop'));
 el.surfaces.addEventListener('keydown', (e) => {
   if (e.key !== 'Enter') return;
   const line = surfacesLine(el.surfaces.value);
