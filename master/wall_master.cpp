@@ -77,6 +77,12 @@ void WallMaster::handle(const Envelope& e) {
     } else if (auto* p = std::get_if<ProgressMsg>(&m)) {
         if (p->generation == generation_ && board_) {  // older: frames that were interrupted
             t.rays = std::max(t.rays, p->rays);
+            t.on_view = true;
+            if (switch_s_ < 0 && generation_ > 1 &&
+                all_tiles([](const TileState& s) { return s.on_view; })) {
+                switch_s_ = frame_start_.seconds();
+                switches_s_.push_back(switch_s_);
+            }
             order_.clock(e.from, p->cpu_s);
             dispatch();
         }
@@ -193,13 +199,23 @@ void WallMaster::idle() {
     play_on();
 }
 
+void WallMaster::print_switches() const {
+    if (switches_s_.empty()) return;
+    std::vector<double> s = switches_s_;
+    std::sort(s.begin(), s.end());
+    std::printf(
+        "view changes: %zu; every tile had cast a ray of the new view %.1f ms after the change "
+        "(median), %.1f ms at most\n",
+        s.size(), 1e3 * s[(s.size() - 1) / 2], 1e3 * s.back());
+}
+
 void WallMaster::play_on() {
     if (!playing_ || !frame_done() || (o_.measure && !curves_in())) return;
     const FrameFigures f = frame_figures();
     std::printf("time %u: frame %llu done in %.3f s, emulated %.3f s", step_,
-                static_cast<unsigned long long>(generation_), frame_start_.seconds(),
-                f.emulated_s);
+                static_cast<unsigned long long>(generation_), frame_start_.seconds(), f.emulated_s);
     if (f.c99_s >= 0) std::printf(", C = 99%% at %.3f s", f.c99_s);
+    if (switch_s_ >= 0) std::printf("; every tile on it %.1f ms after the change", 1e3 * switch_s_);
     std::printf("\n");
     std::fflush(stdout);
     if (step_ + 1 < o_.steps) {
@@ -378,6 +394,7 @@ void WallMaster::send_views() {
         v.step = step_;
         TileState& t = tiles_[static_cast<std::size_t>(rank)];
         t.rays = 0;
+        t.on_view = false;
         t.view = v.view;
         if (t.lost) {
             // Its screen, drawn by the others: the background, then their results by depth.
@@ -422,6 +439,7 @@ void WallMaster::send_views() {
     dispatch();
     ask_curves();  // a frame with no job (nothing of the volume on the wall) is complete at once
     frame_start_ = Stopwatch();
+    switch_s_ = -1;
     trace_.switch_to(left);
 }
 
@@ -632,6 +650,7 @@ void WallMaster::report(OutputFiles& batch) {
         }
     print_scheduler(stdout, o_.balance, frame_done(), *board_, order_, migrations_, results);
     print_earlier_frames(stdout, results, completed_);
+    print_switches();
     if (o_.results_out) *o_.results_out = results;
     trace_.close();
     print_stage_table(stdout, trace_.spans(), results);

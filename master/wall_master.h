@@ -171,6 +171,7 @@ class WallMaster {
         bool hello = false;         // said hello after loading: takes views, sends alive messages
         Stopwatch heard;            // since its last message of any kind
         std::uint64_t rays = 0;     // of the current generation
+        bool on_view = false;       // it has cast a ray of the current generation
         FrameView view;             // of the current generation
         std::optional<ImageMsg> image;  // the answer to the pending image request
         std::optional<TileResultMsg> result;
@@ -243,6 +244,12 @@ class WallMaster {
     ClipSet clip_;                        // the view's clip planes, voxel indices (ClipCmd)
     std::vector<SurfaceStyle> surfaces_;  // the view's surfaces; surfaces_[0].iso is iso_
     std::uint32_t step_ = 0;              // the time step shown
+    // How long after each change of view (the first aside) every tile had cast its first ray of
+    // the new one: the time a change takes to interrupt the wall; -1 until then.
+    double switch_s_ = -1;
+    std::vector<double> switches_s_;
+    // The report's line of the changes' switches (none when the view never changed).
+    void print_switches() const;
     bool playing_ = false, loop_ = false;  // PlayCmd
     // Playing: once the frame is done (and measured, with --measure), its step's line, then the
     // next step's frame; at the last step playing stops, or starts again at 0 with `play loop`.
