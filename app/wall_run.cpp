@@ -26,12 +26,12 @@
 #include "master/wall_master.h"
 #include "render/renderer.h"
 #include "store/open_store.h"
-#include "volume/time_steps.h"
 #include "tile/preview_show.h"
 #include "tile/store_client.h"
 #include "tile/tile_loop.h"
 #include "tile/tile_window.h"
 #include "volume/phantom.h"
+#include "volume/time_steps.h"
 #include "wall_spec/control_layout.h"
 #include "wall_spec/script.h"
 #include "wall_spec/wall.h"
@@ -96,13 +96,11 @@ MasterInput check_master_input(const WallOptions& o, ThreadBudget budget) {
     MasterInput in;
     in.clip = checked_clip(o.clip);
     (void)checked_colour_map(o.colour);
-    // A time series: the master reads step 0 (its range, bounds and work estimate stand for
-    // every step); the tiles open the others.
+    // A time series: the master reads the first step shown (--time: its range, bounds and work
+    // estimate stand for every step); the tiles open each step a view shows.
     in.series = time_series(o.volume);
-    VolumeOptions first = o.volume;
-    if (in.series) first.path = in.series->steps[0].string();
     // The master casts no ray: its volume stays in the shared map.
-    in.volume.emplace(open_volume(first, /*quiet=*/false, VolumeUse{.casts = false}));
+    in.volume.emplace(open_volume(o.volume, /*quiet=*/false, VolumeUse{.casts = false}));
     const OpenedVolume& ov = *in.volume;
     in.extractor = open_extractor(ov, budget);
     in.surfaces =
@@ -152,6 +150,7 @@ int run_master(const WallOptions& o, Comm& comm, const WallSpec& spec, MasterInp
     mo.surfaces = in.surfaces;
     if (in.series) {
         mo.steps = in.series->steps.size();
+        mo.first_step = o.volume.time;
         std::printf("time series: %zu steps, %s to %s\n", mo.steps,
                     in.series->steps.front().filename().c_str(),
                     in.series->steps.back().filename().c_str());
@@ -227,12 +226,14 @@ OpenedVolume open_tile_volume(const WallOptions& o, Comm& comm,
     return open_volume(o.volume, std::move(reader), remote->octree_file(), use);
 }
 
-int run_tile_rank(const WallOptions& given, Comm& comm, const WallSpec& spec,
-                  ThreadBudget budget) {
+int run_tile_rank(const WallOptions& given, Comm& comm, const WallSpec& spec, ThreadBudget budget) {
     // A time series: step 0 opened here, the others when a view first shows them.
     const std::optional<TimeSeries> series = time_series(given.volume);
     WallOptions o = given;
-    if (series) o.volume.path = series->steps[0].string();
+    if (series) {
+        o.volume.path = series->steps[0].string();
+        o.volume.time = 0;
+    }
     std::optional<StoreClient> remote;
     const OpenedVolume ov = open_tile_volume(o, comm, remote);
     auto extractor = open_extractor(ov, budget);

@@ -1,5 +1,7 @@
 #include "cli/volume_options.h"
 
+#include "volume/time_steps.h"
+
 #include <cstdio>
 
 #include "cli/cli_checks.h"
@@ -28,6 +30,11 @@ void add_volume_options(CLI::App& app, VolumeOptions& o) {
                    "FOLDER:level=N a multiscale level), the same over "
                    "http:// or https://, or a store made by `isowall import` (its folder; read on "
                    "first touch under --memory-limit). Default: the built-in phantom");
+    app.add_option("--time", o.time,
+                   "With a numbered --volume pattern (a time series, e.g. 'run/t_%03d.nrrd': "
+                   "the folder's files with a number there, without a gap), the step to open, "
+                   "from 0; the wall starts there")
+        ->transform(number_in({0, 99999, false, true}));
     app.add_option("--dims", o.dims, "Raw volume size in voxels: X Y Z (x varies fastest)")
         ->expected(3)
         ->transform(number_in({1, 2147483647.0, false, true}));
@@ -196,6 +203,24 @@ OpenedVolume open_volume(const VolumeOptions& o, std::shared_ptr<const store::St
 }
 
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
+    if (is_series_pattern(o.path)) {
+        const TimeSeries series = find_series(o.path, "--volume");
+        if (o.time >= series.steps.size())
+            throw InputError("--time", "value",
+                             "step " + std::to_string(o.time) + ": the series has " +
+                                 std::to_string(series.steps.size()) + " steps (0 to " +
+                                 std::to_string(series.steps.size() - 1) + ")");
+        VolumeOptions step = o;
+        step.path = series.steps[o.time].string();
+        if (!quiet)
+            std::printf("time: step %u of %zu steps, %s\n", o.time, series.steps.size(),
+                        step.path.c_str());
+        step.time = 0;
+        return open_volume(step, quiet, use);
+    }
+    if (o.time != 0)
+        throw InputError("--time", "value",
+                         "applies to a time series: a numbered --volume pattern (run/t_%03d.nrrd)");
     OpenedVolume out;
     Stopwatch sw;
     std::string store_note;

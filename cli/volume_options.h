@@ -1,5 +1,6 @@
 #pragma once
 // The volume options every subcommand shares, and opening the volume they describe.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -27,6 +28,8 @@ struct VolumeOptions {
     std::string memory_limit;         // a store's cap ("512M", "8G"); empty: the default share
     double http_timeout = 30;         // a volume over HTTP: seconds without a byte before a retry
     int http_connections = 8;         // a volume over HTTP: objects fetched at once
+    // A time series (a numbered pattern, volume/time_steps.h): the step opened (the wall's first).
+    std::uint32_t time = 0;
 };
 
 void add_volume_options(CLI::App& app, VolumeOptions& opts);
@@ -60,7 +63,7 @@ std::uint64_t memory_limit(const VolumeOptions& opts, VolumeUse use);
 std::filesystem::path cache_dir(const VolumeOptions& opts);
 
 // Loads the file (or generates the phantom), moves it into huge pages when --huge-pages says so,
-// and prints one line about it.
+// and prints one line about it. A numbered pattern (a time series) opens its step --time.
 OpenedVolume open_volume(const VolumeOptions& opts, bool quiet = false, VolumeUse use = {});
 // The store named by `opts` read through `reader` where this host cannot see it (a wall rank's
 // bricks from the master, tile/store_client.h), its octree copied to the file `octree`: the

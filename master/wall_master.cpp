@@ -42,6 +42,7 @@ WallMaster::WallMaster(const MasterOptions& o, Comm& comm, const WallSpec& spec,
     camera_ = zoom(camera_, o.zoom);
     camera_ = pan(camera_, o.pan.first, o.pan.second, aspect_);
     clip_ = o.clip;
+    step_ = o.first_step;
     surfaces_ = o.surfaces.empty() ? std::vector<SurfaceStyle>{SurfaceStyle{iso}} : o.surfaces;
     if (std::string p = camera_problem(camera_); !p.empty())
         throw InputError("--orbit/--zoom/--pan", "value", p);

@@ -63,6 +63,7 @@ struct MasterOptions {
     std::vector<SurfaceStyle> surfaces;
     // The steps of a time series (volume/time_steps.h); 0: the volume does not change.
     std::size_t steps = 0;
+    std::uint32_t first_step = 0;  // the step the first view shows (--time)
     // A surface coloured by a second field (--color-by): the legend the mosaics carry.
     std::optional<ColourScale> legend;
     std::string legend_label;

@@ -230,6 +230,39 @@ TEST_F(Cli, SurfacesInEitherOrderAndOnEitherThreadsAreOnePicture) {
     EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 
+// A time series given as a numbered pattern: render --time N draws step N's file as that file
+// alone draws; a step past the series, --time on one volume, and a gap are one line and no image.
+TEST_F(Cli, RenderDrawsAStepOfATimeSeries) {
+    for (int t = 0; t < 3; ++t) {
+        std::string data(16 * 16 * 16, '\0');
+        for (int i = 0; i < 16 * 16 * 16; ++i) {
+            const int x = i % 16, y = i / 16 % 16, z = i / 256;
+            const int d2 =
+                (x - 5 - 3 * t) * (x - 5 - 3 * t) + (y - 8) * (y - 8) + (z - 8) * (z - 8);
+            data[std::size_t(i)] = char(std::uint8_t(d2 < 16 ? 200 : 0));
+        }
+        std::ofstream(dir_ / ("s_" + std::to_string(t) + ".nrrd"), std::ios::binary)
+            << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 16 16 16\nencoding: raw\n\n"
+            << data;
+    }
+    const std::string common = "render --size 64x48 --iso 100 --threads 1 -q --no-measure ";
+    auto r = run_isowall(dir_, common + "-v s_%d.nrrd --time 2 --out step.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("time: step 2 of 3 steps"), std::string::npos) << r.out;
+    r = run_isowall(dir_, common + "-v s_2.nrrd --out file.png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(read_image(dir_ / "step.png").rgba == read_image(dir_ / "file.png").rgba);
+    auto bad = [&](const std::string& args) { return run_isowall(dir_, common + args); };
+    expect_one_line_error(bad("-v s_%d.nrrd --time 3 --out bad.png"),
+                          {"--time", "step 3: the series has 3 steps (0 to 2)"});
+    expect_one_line_error(bad("-v s_0.nrrd --time 1 --out bad.png"),
+                          {"--time", "applies to a time series"});
+    std::filesystem::rename(dir_ / "s_1.nrrd", dir_ / "s_x.nrrd");
+    expect_one_line_error(bad("-v s_%d.nrrd --out bad.png"),
+                          {"s_1.nrrd", "time step 1 is missing"});
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
 // --against-full: the final image's C and final pixels against the full surface, printed after
 // the frame; full resolution matches it, a coarse level of detail does not quite.
 TEST_F(Cli, AgainstFullPrintsBothMeasures) {
