@@ -43,8 +43,8 @@ SurfaceExtractor& StepVolumes::extractor(std::uint32_t step) {
     const glm::ivec3 d = s->volume.volume.dims();
     if (d != dims_)
         throw InputError(o.path, "--volume",
-                         "time step " + std::to_string(step) + " has " + std::to_string(d.x) +
-                             "x" + std::to_string(d.y) + "x" + std::to_string(d.z) +
+                         "time step " + std::to_string(step) + " has " + std::to_string(d.x) + "x" +
+                             std::to_string(d.y) + "x" + std::to_string(d.z) +
                              " voxels, step 0 has " + std::to_string(dims_.x) + "x" +
                              std::to_string(dims_.y) + "x" + std::to_string(dims_.z));
     OctreeSource src;

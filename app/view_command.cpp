@@ -139,8 +139,9 @@ struct Viewer {
             return false;
         } else if (std::holds_alternative<TimeCmd>(cmd) || std::holds_alternative<PlayCmd>(cmd) ||
                    std::holds_alternative<PauseCmd>(cmd)) {
-            throw InputError(where, "time", "the remote viewer shows one volume; a series plays "
-                                            "on the wall (isowall wall --volume PATTERN)");
+            throw InputError(where, "time",
+                             "the remote viewer shows one volume; a series plays "
+                             "on the wall (isowall wall --volume PATTERN)");
         }
         if (std::string p = camera_problem(camera); !p.empty())
             throw InputError(where, "camera", p);

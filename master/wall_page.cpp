@@ -132,7 +132,8 @@ std::string state_json(const PageState& s) {
                 {"pages", s.pages},         {"dark", s.dark},
                 {"clip", s.clip},           {"dims", {s.dims.x, s.dims.y, s.dims.z}},
                 {"surfaces", s.surfaces},   {"steps", s.steps},
-                {"step", s.step},           {"playing", s.playing},   {"legend", legend_json(s)}}
+                {"step", s.step},           {"playing", s.playing},
+                {"legend", legend_json(s)}}
         .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 

@@ -66,8 +66,7 @@ TEST(TimeSteps, AGapOrNothingIsOneLineNamingTheFile) {
     const std::string gap = error_of((dir / "s_%d.nrrd").string());
     EXPECT_NE(gap.find("s_3.nrrd"), std::string::npos) << gap;
     EXPECT_NE(gap.find("time step 3 is missing (files 0 to 4 found)"), std::string::npos) << gap;
-    EXPECT_NE(error_of((dir / "none_%d.nrrd").string()).find("no file matches"),
-              std::string::npos);
+    EXPECT_NE(error_of((dir / "none_%d.nrrd").string()).find("no file matches"), std::string::npos);
     EXPECT_NE(error_of((dir / "s_%d_%d.nrrd").string()).find("found more"), std::string::npos);
     EXPECT_NE(error_of((dir / "missing_folder/s_%d.nrrd").string()).find("cannot list"),
               std::string::npos);

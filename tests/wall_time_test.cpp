@@ -30,10 +30,9 @@ void write_ball_step(const std::filesystem::path& path, int t, int side = kBallS
                 data[(std::size_t(z) * side + y) * side + x] =
                     char(std::uint8_t(std::clamp(255.0 - 25.0 * d, 0.0, 255.0)));
             }
-    std::ofstream(path, std::ios::binary)
-        << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << side << " " << side << " " << side
-        << "\nencoding: raw\n\n"
-        << data;
+    std::ofstream(path, std::ios::binary) << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: " << side
+                                          << " " << side << " " << side << "\nencoding: raw\n\n"
+                                          << data;
 }
 
 std::filesystem::path write_ball_series(const std::string& name) {
@@ -148,7 +147,8 @@ TEST(WallTime, BadStepsAreOneLine) {
     // A step of another size: the tile that opens it names the file.
     write_ball_step(series / "ball_05.nrrd", 5, kBallSide + 1);
     o.script = script_file(series, "time 5\nwait done\n");
-    one_line(run_series(o), "ball_05.nrrd: --volume: time step 5 has 33x33x33 voxels, step 0 has 32x32x32");
+    one_line(run_series(o),
+             "ball_05.nrrd: --volume: time step 5 has 33x33x33 voxels, step 0 has 32x32x32");
     // A step missing from the numbers.
     std::filesystem::remove(series / "ball_05.nrrd");
     o.script.clear();

@@ -26,8 +26,8 @@ LayeredJobs::~LayeredJobs() = default;
 LayeredJobs::Layer& LayeredJobs::layer(std::size_t k, const SurfaceStyle& style) {
     if (k >= layers_.size()) layers_.resize(k + 1);
     std::unique_ptr<Layer>& l = layers_[k];
-    const bool same_colour = l && l->jobs && l->style.coloured == style.coloured &&
-                             l->style.colour == style.colour;
+    const bool same_colour =
+        l && l->jobs && l->style.coloured == style.coloured && l->style.colour == style.colour;
     if (same_colour) {
         l->style = style;
         return *l;

@@ -81,9 +81,9 @@ struct PlayCmd {
 };
 struct PauseCmd {};
 
-using ScriptCommand = std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd,
-                                   SnapshotCmd, HeadCmd, ClipCmd, QuitCmd, TimeCmd, PlayCmd,
-                                   PauseCmd>;
+using ScriptCommand =
+    std::variant<OrbitCmd, LookAtCmd, ZoomCmd, PanCmd, IsoCmd, WaitCmd, SnapshotCmd, HeadCmd,
+                 ClipCmd, QuitCmd, TimeCmd, PlayCmd, PauseCmd>;
 
 struct ScriptLine {
     int line = 0;  // 1-based, for messages
