@@ -202,22 +202,25 @@ OpenedVolume open_volume(const VolumeOptions& o, std::shared_ptr<const store::St
     return out;
 }
 
+// A numbered pattern's step --time, opened as any volume.
+static OpenedVolume open_step(const VolumeOptions& o, bool quiet, VolumeUse use) {
+    const TimeSeries series = find_series(o.path, "--volume");
+    if (o.time >= series.steps.size())
+        throw InputError("--time", "value",
+                         "step " + std::to_string(o.time) + ": the series has " +
+                             std::to_string(series.steps.size()) + " steps (0 to " +
+                             std::to_string(series.steps.size() - 1) + ")");
+    VolumeOptions step = o;
+    step.path = series.steps[o.time].string();
+    if (!quiet)
+        std::printf("time: step %u of %zu steps, %s\n", o.time, series.steps.size(),
+                    step.path.c_str());
+    step.time = 0;
+    return open_volume(step, quiet, use);
+}
+
 OpenedVolume open_volume(const VolumeOptions& o, bool quiet, VolumeUse use) {
-    if (is_series_pattern(o.path)) {
-        const TimeSeries series = find_series(o.path, "--volume");
-        if (o.time >= series.steps.size())
-            throw InputError("--time", "value",
-                             "step " + std::to_string(o.time) + ": the series has " +
-                                 std::to_string(series.steps.size()) + " steps (0 to " +
-                                 std::to_string(series.steps.size() - 1) + ")");
-        VolumeOptions step = o;
-        step.path = series.steps[o.time].string();
-        if (!quiet)
-            std::printf("time: step %u of %zu steps, %s\n", o.time, series.steps.size(),
-                        step.path.c_str());
-        step.time = 0;
-        return open_volume(step, quiet, use);
-    }
+    if (is_series_pattern(o.path)) return open_step(o, quiet, use);
     if (o.time != 0)
         throw InputError("--time", "value",
                          "applies to a time series: a numbered --volume pattern (run/t_%03d.nrrd)");
