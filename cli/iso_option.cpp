@@ -30,7 +30,15 @@ void add_surfaces_option(CLI::App& cmd, std::vector<std::string>& surfaces) {
                   "[:OPACITY]] each, e.g. --iso 40:skin:0.3 --iso 105:bone (COLOUR: #rrggbb or "
                   "a name: skin, bone, white, red, ...; OPACITY in [0, 1], default 1)",
                   kPhantomSkinIso);
-    cmd.add_option("--iso", surfaces, help)->type_name("VALUE[:COLOUR[:OPACITY]]");
+    // Each value is checked as it is parsed (a typo or a non-finite number is refused naming the
+    // option and the value); the volume's range is checked once it is read.
+    const CLI::Validator style(
+        [](std::string& text) {
+            std::string problem;
+            return parse_surface_style(text, problem) ? std::string() : problem;
+        },
+        "VALUE[:COLOUR[:OPACITY]]");
+    cmd.add_option("--iso", surfaces, help)->type_name("VALUE[:COLOUR[:OPACITY]]")->check(style);
 }
 
 namespace {

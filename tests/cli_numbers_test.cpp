@@ -36,6 +36,8 @@ const std::vector<CliSlot> kCliSlots = {
     {"render --header-bytes {}", "--header-bytes", {"-5", "2.5", "1e300"}},
     {"render --http-timeout {}", "--http-timeout", {"0", "-5", "0.05", "3601", "1e300"}},
     {"render --http-connections {}", "--http-connections", {"0", "-1", "65", "2.5", "1e300"}},
+    {"render --time {}", "--time", {"-1", "2.5", "100000", "1e300"}},
+    {"render --iso 40:skin:{}", "--iso", {"1.5", "-0.1", "1e300"}},
     {"extract --iso {} --out s.ply", "--iso", {}},
     {"wall --wall w.toml --iso {}", "--iso", {}},
     {"wall --wall w.toml --orbit 0 {}", "--orbit", {"1e300"}},

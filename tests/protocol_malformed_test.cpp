@@ -162,7 +162,7 @@ TEST(ProtocolMalformed, ViewFaultsThrowNamingTheField) {
     none.surfaces = {};
     none.step = 0;
     Bytes bytes = encode(none);
-    const std::size_t at = bytes.size() - 4;  // the surfaces' count
+    const std::size_t at = bytes.size() - 5;  // the surfaces' count (the step's 4 bytes after it)
     ASSERT_EQ(bytes[at - 1], std::byte{0});
     ASSERT_EQ(bytes[at], std::byte{0});
     bytes[at] = std::byte{kMaxSurfaces + 1};
