@@ -50,6 +50,21 @@ test::ImageComparison compare(const std::string& a, const std::string& b) {
     return test::compare_images(read_image(a), read_image(b), within_one);
 }
 
+// Runs `balanced` (regions migrated) and compares its mosaic with `fixed`'s (run already): the
+// same picture. Returns the jobs migrated; `same` gets the comparison.
+std::uint64_t expect_balanced_is_static(const WallOptions& balanced, const WallOptions& fixed,
+                                        test::ImageComparison& same) {
+    const std::vector<TileResultMsg> results = run(balanced);
+    std::uint64_t helped = 0;
+    for (const TileResultMsg& t : results) helped += t.jobs_helped;
+    EXPECT_GT(helped, 0u) << "nothing migrated";
+    same = compare(balanced.out, fixed.out);
+    EXPECT_GE(same.mask_iou, 0.999) << same;
+    EXPECT_GE(same.equal_share, 0.999) << same;
+    EXPECT_GT(same.covered_both, 1000u) << same;
+    return helped;
+}
+
 TEST(WallClip, BalancedAndStaticClippedMosaicsAreEqualAndCut) {
     WallOptions whole = clip_wall("whole", false);
     WallOptions cut = clip_wall("static", false);
@@ -57,14 +72,8 @@ TEST(WallClip, BalancedAndStaticClippedMosaicsAreEqualAndCut) {
     for (WallOptions* o : {&cut, &balanced}) o->clip.planes = {"x<100", "0,1,1>170"};
     run(whole);
     run(cut);
-    const std::vector<TileResultMsg> results = run(balanced);
-    std::uint64_t helped = 0;
-    for (const TileResultMsg& t : results) helped += t.jobs_helped;
-    EXPECT_GT(helped, 0u) << "nothing migrated";
-    const test::ImageComparison same = compare(balanced.out, cut.out);
-    EXPECT_GE(same.mask_iou, 0.999) << same;
-    EXPECT_GE(same.equal_share, 0.999) << same;
-    EXPECT_GT(same.covered_both, 1000u) << same;
+    test::ImageComparison same;
+    const std::uint64_t helped = expect_balanced_is_static(balanced, cut, same);
     const test::ImageComparison against_whole = compare(cut.out, whole.out);
     EXPECT_LT(against_whole.equal_share, 0.9) << "the planes cut nothing: " << against_whole;
     std::printf("%llu jobs migrated; balanced against static: %s; cut against whole: %s\n",
@@ -126,13 +135,8 @@ TEST(WallColour, EveryRankColoursItsGroupsByTheFieldAndTheMosaicHasTheLegend) {
         o->colour.by = ramp.string();
     }
     run(fixed);
-    const std::vector<TileResultMsg> results = run(balanced);
-    std::uint64_t helped = 0;
-    for (const TileResultMsg& t : results) helped += t.jobs_helped;
-    EXPECT_GT(helped, 0u) << "nothing migrated";
-    const test::ImageComparison same = compare(balanced.out, fixed.out);
-    EXPECT_GE(same.mask_iou, 0.999) << same;
-    EXPECT_GE(same.equal_share, 0.999) << same;
+    test::ImageComparison same;
+    expect_balanced_is_static(balanced, fixed, same);
     // The front view looks along +y, x to the right: viridis runs from purple (blue above red and
     // green) on the left through green to yellow (red and green above blue) on the right.
     const Image m = read_image(fixed.out);
@@ -163,14 +167,8 @@ TEST(WallSurfaces, TheBalancedMosaicIsRendersPictureOfTheSameSurfaces) {
         o->clip.planes = {"x<130"};
     }
     run(fixed);
-    const std::vector<TileResultMsg> results = run(balanced);
-    std::uint64_t helped = 0;
-    for (const TileResultMsg& t : results) helped += t.jobs_helped;
-    EXPECT_GT(helped, 0u) << "nothing migrated";
-    const test::ImageComparison same = compare(balanced.out, fixed.out);
-    EXPECT_GE(same.mask_iou, 0.999) << same;
-    EXPECT_GE(same.equal_share, 0.999) << same;
-    EXPECT_GT(same.covered_both, 1000u) << same;
+    test::ImageComparison same;
+    const std::uint64_t helped = expect_balanced_is_static(balanced, fixed, same);
 
     RenderOptions r;
     r.size = "320x240";
