@@ -308,14 +308,31 @@ void WallMaster::land_for_lost(int from, RegionMsg r) {
                         std::to_string(r.job) + ", whose owner is not lost");
     const Stage left = trace_.switch_to(Stage::compose);
     const PixelRect rect = r.rect;
+    const std::uint8_t layer = r.layer;
     Image img;
     try {
         img = region_image(std::move(r), owner.stand_in.width, owner.stand_in.height);
     } catch (const WireError& e) {
         throw WireError(rank_label(spec_, from) + ": " + e.what());
     }
-    composite_by_depth(owner.stand_in, img, rect);
-    board_->landed(r.job);
+    // Each surface's result into its layer, the layers blended (core/surface_style.h); the job
+    // has landed once every surface's result is in.
+    if (layer >= owner.stand_in_layers.size())
+        throw WireError(rank_label(spec_, from) + ": region message: layer " +
+                        std::to_string(layer) + ": the view has " +
+                        std::to_string(owner.stand_in_layers.size()) + " surface(s)");
+    composite_by_depth(owner.stand_in_layers[layer], img, rect);
+    std::vector<const Image*> layers;
+    std::vector<float> opacity;
+    for (std::size_t k = 0; k < owner.stand_in_layers.size(); ++k) {
+        layers.push_back(&owner.stand_in_layers[k]);
+        opacity.push_back(surfaces_[k].opacity);
+    }
+    owner.stand_in =
+        layers.size() == 1 ? owner.stand_in_layers[0] : composite_layers(layers, opacity);
+    std::uint32_t& in = owner.layers_in[r.job];
+    in |= 1u << layer;
+    if (in == (1u << layers.size()) - 1) board_->landed(r.job);
     preview_lost(j.owner);
     trace_.switch_to(left);
     ask_curves();
@@ -403,6 +420,8 @@ void WallMaster::send_views() {
             for (std::size_t i = 0; i < t.stand_in.pixel_count(); ++i)
                 t.stand_in.rgba[4 * i + 3] = 255;
             t.stand_in.depth.assign(t.stand_in.pixel_count(), 1.0f);
+            t.stand_in_layers.assign(surfaces_.size(), t.stand_in);
+            t.layers_in.clear();
             preview_lost(rank);
             continue;
         }

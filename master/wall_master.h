@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "comm/comm.h"
@@ -184,6 +185,10 @@ class WallMaster {
         double lost_at_s = 0;       // seconds into the run
         double whole_after_s = -1;  // from then until a frame was complete again
         Image stand_in;
+        // With several surfaces, each surface's layer of `stand_in` (which blends them), and
+        // the layers landed of each job, a bit a layer: the job has landed once all are in.
+        std::vector<Image> stand_in_layers;
+        std::unordered_map<std::uint32_t, std::uint32_t> layers_in;
     };
     // Gives up on `rank` and starts the frame again without it (see TileState::lost).
     void lose(int rank, const std::string& why);

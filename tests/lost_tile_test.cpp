@@ -34,6 +34,7 @@ struct Lost {
     const char* fault;  // ISOWALL_TEST_FAULT
     const char* name;
     const char* rank = "rank 9 (tile 8)";  // as the warning and the report name it
+    const char* extra = "";                // more wall options (wall_cmd)
 };
 
 // The run's folder: the wall file, the script of four views with a snapshot after each.
@@ -49,10 +50,11 @@ std::filesystem::path prepare(const std::string& name) {
 // --timeout 8: a stopped rank is given up on after 8 s of silence. With 4 s, two tiles once took
 // the master for silent under the suite's load (25 ranks beside another test on 2 cores) and
 // ended themselves.
-std::string wall_cmd(const std::filesystem::path& dir) {
+// `extra`: more wall options, the same in a run and its reference.
+std::string wall_cmd(const std::filesystem::path& dir, const std::string& extra = "") {
     return mpirun(25, "--enable-recovery ") + "wall --wall '" + (dir / "6x4.toml").string() +
            "' --out '" + (dir / "m.png").string() + "' --script '" + (dir / "views.txt").string() +
-           "' --timeout 8 --zoom 1.6";
+           "' --timeout 8 --zoom 1.6" + extra;
 }
 
 bool any_process_of(const std::filesystem::path& dir) {
@@ -72,8 +74,9 @@ void expect_the_others_draw_its_screen(const Lost& l, const std::filesystem::pat
     SCOPED_TRACE(l.fault);
     const auto dir = prepare(l.name);
     Stopwatch took;
-    const int rc = run(std::string("env ISOWALL_TEST_FAULT=") + l.fault + " " + wall_cmd(dir),
-                       dir / "run.log", kGuardS);
+    const int rc =
+        run(std::string("env ISOWALL_TEST_FAULT=") + l.fault + " " + wall_cmd(dir, l.extra),
+            dir / "run.log", kGuardS);
     const std::string log = slurp(dir / "run.log");
     std::printf("%s: exit %d after %.1f s\n", l.fault, rc, took.seconds());
     EXPECT_NE(rc, 124) << "still running after " << kGuardS << " s: " << log;
@@ -114,6 +117,16 @@ TEST(LostTile, TheOthersDrawItsScreenAndTheShowGoesOn) {
           Lost{"stop@migration:1", "stop_while_helping", "rank 1 (tile 0)"},
           Lost{"stop@next:9", "stop_between_frames"}})
         expect_the_others_draw_its_screen(l, ref);
+}
+
+// Two surfaces, the skin translucent over the bone: the others draw the lost tile's screen as
+// each surface's layer (the master blends the layers of its results) and the show goes on.
+TEST(LostTile, TwoSurfacesAreDrawnForALostTileLayerByLayer) {
+    const char* surfaces = " --iso 80:skin:0.3 --iso 160:bone";
+    const auto ref = prepare("two_surfaces_reference");
+    ASSERT_EQ(run(wall_cmd(ref, surfaces), ref / "run.log", kGuardS), 0) << slurp(ref / "run.log");
+    expect_the_others_draw_its_screen(
+        Lost{"kill@frame:9", "kill_two_surfaces", "rank 9 (tile 8)", surfaces}, ref);
 }
 
 // Without --enable-recovery Open MPI ends every rank once one dies: the wall stops, named, as
