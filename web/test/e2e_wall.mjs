@@ -10,6 +10,8 @@
 //   4. Over https with a token and --measure: the page and its WebSocket (wss), the emulated time
 //      to the wall's C = 99% on the page, a wrong token refused; an address off loopback without
 //      TLS refused with one line.
+//   5. A time series of 8 steps: the page's Time slider shows a step, its Play button plays round
+//      and round and pauses, each as the script line the wall prints.
 //   ISOWALL_BIN=build/bin/isowall ISOWALL_PAGE_MOSAIC=build/tests/isowall_test_page_mosaic \
 //     ISOWALL_OUT=out node test/e2e_wall.mjs
 import { chromium } from 'playwright-core';
@@ -209,6 +211,43 @@ try {
   await p.click('#quit');
   check((await wall.exit(120)) === 0, 'the TLS wall ended from the page');
   await tls.close();
+  wall = null;
+
+  // 5: a time series (8 numbered volumes of a ball moving along x, written here).
+  const series = join(out, 'series');
+  mkdirSync(series, { recursive: true });
+  for (let t = 0; t < 8; ++t) {
+    const n = 32, voxels = Buffer.alloc(n * n * n);
+    for (let z = 0; z < n; ++z) for (let y = 0; y < n; ++y) for (let x = 0; x < n; ++x) {
+      const d = Math.hypot(x - 8 - 2 * t, y - 16, z - 16);
+      voxels[(z * n + y) * n + x] = Math.max(0, Math.min(255, Math.round(255 - 25 * d)));
+    }
+    const name = join(series, `ball_${String(t).padStart(2, '0')}.nrrd`);
+    writeFileSync(name, Buffer.concat([Buffer.from(`NRRD0004\ntype: uint8\ndimension: 3\nsizes: ${n} ${n} ${n}\nencoding: raw\n\n`), voxels]));
+  }
+  wall = new WallRun(bin, 5, [...wallArgs, '-v', join(series, 'ball_%02d.nrrd'), '--iso', '128', '--http', '0',
+    '--out', join(out, 'series_wall.png')]);
+  const seriesUrl = (await wall.waitFor(/http: page at (http:\/\/\S+)/))[1];
+  const seriesContext = await browser.newContext({ viewport: { width: 1300, height: 800 } });
+  const t = await seriesContext.newPage();
+  await t.goto(`${seriesUrl}?confirm=0`);
+  let st = await until(t, (x) => x.state && x.state.steps === 8 && x.state.done, 'the series\' first frame');
+  check(!(await t.isHidden('label.time')) && st.state.step === 0, 'the time controls show step 0 of 8');
+  await t.locator('#time-step').fill('5');
+  await wall.waitFor(/^page \d+: time 5$/m);
+  st = await until(t, (x) => x.state.step === 5 && x.state.done, 'step 5 shown');
+  check((await t.textContent('#time-value')) === '5/8', `the slider's step: ${await t.textContent('#time-value')}`);
+  await t.click('#play');
+  await wall.waitFor(/^page \d+: play loop$/m);
+  st = await until(t, (x) => x.state.playing && x.state.step !== 5, 'the series playing');
+  check((await t.textContent('#play')) === 'Pause', `playing, at step ${st.state.step}`);
+  await t.click('#play');
+  await wall.waitFor(/^page \d+: pause$/m);
+  st = await until(t, (x) => !x.state.playing, 'the series paused');
+  check((await t.textContent('#play')) === 'Play', `paused at step ${st.state.step}`);
+  await t.click('#quit');
+  check((await wall.exit(120)) === 0, 'the series wall ended from the page');
+  await seriesContext.close();
   wall = null;
 
   const open = spawnSync('timeout', ['120', 'mpirun', '--oversubscribe', '-np', '5', bin, 'wall', ...wallArgs,
