@@ -219,6 +219,13 @@ void replay_and_report(const RenderOptions& o, FrameResult& fr, const FrameView&
                 fr.timeline.size(), sw.seconds());
 }
 
+// Whether the frame is replayed after it (replay_and_report): for the correctness tables, unless
+// --no-measure, and for every output that needs the replayed images.
+bool wants_replay(const RenderOptions& o) {
+    return !o.no_measure || o.against_full || !o.timeline.empty() || !o.snapshots.empty() ||
+           !o.snapshot_rays.empty();
+}
+
 // A coloured surface's legend (master/legend.h) and the engine's hook that colours it.
 struct Colouring {
     std::function<void(Mesh&)> hook;
@@ -304,9 +311,7 @@ std::size_t render_progressive(const RenderOptions& o, SurfaceExtractor& ex, Ren
     if (o.against_full) full = print_against_full(ex, renderer, fv, fr.final_image, colour.hook);
     if (o.against_truth) print_against_truth(ex, renderer, fv, fr.final_image, colour.hook);
 
-    const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
-                              !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (want_measure)
+    if (wants_replay(o))
         replay_and_report(
             o, fr, fv,
             [&](const ImageCallback& on_image) { measure_frame(fr, fv, renderer, on_image); },
@@ -420,9 +425,7 @@ std::size_t render_surfaces(const RenderOptions& o, SurfaceExtractor& ex, Render
             print_truth_comparison(draw_surfaces_alone(parts.layers, meshes, fv, kTruthSamples),
                                    full, triangles, fr.final_image, sw.seconds());
     }
-    const bool want_measure = !o.no_measure || o.against_full || !o.timeline.empty() ||
-                              !o.snapshots.empty() || !o.snapshot_rays.empty();
-    if (want_measure)
+    if (wants_replay(o))
         replay_and_report(
             o, fr, fv,
             [&](const ImageCallback& on_image) {

@@ -13,12 +13,12 @@ struct StepVolumes::Step {
 };
 
 StepVolumes::StepVolumes(TimeSeries series, VolumeOptions options, VolumeUse use,
-                         ThreadBudget budget, const OpenedVolume& first,
+                         OpenExtractor open_extractor, const OpenedVolume& first,
                          SurfaceExtractor& first_extractor)
     : series_(std::move(series)),
       options_(std::move(options)),
       use_(use),
-      budget_(budget),
+      open_extractor_(std::move(open_extractor)),
       dims_(first.volume.dims()),
       first_(first_extractor) {}
 
@@ -47,10 +47,7 @@ SurfaceExtractor& StepVolumes::extractor(std::uint32_t step) {
                              std::to_string(d.y) + "x" + std::to_string(d.z) +
                              " voxels, step 0 has " + std::to_string(dims_.x) + "x" +
                              std::to_string(dims_.y) + "x" + std::to_string(dims_.z));
-    OctreeSource src;
-    if (s->volume.file) src.volume_path = *s->volume.file;
-    src.cache_dir = s->volume.cache_dir;
-    s->extractor = make_surface_extractor(s->volume.volume, src, nullptr, budget_);
+    s->extractor = open_extractor_(s->volume);
     ++opened_;
     kept_.push_front(std::move(s));
     // The one in use is the front: the oldest beyond kKept others go.

@@ -5,11 +5,11 @@
 // have step 0's voxels.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <memory>
 
 #include "cli/volume_options.h"
-#include "core/thread_budget.h"
 #include "extract/surface_extractor.h"
 #include "volume/time_steps.h"
 
@@ -20,10 +20,14 @@ class StepVolumes {
     // Steps kept open beside the one in use.
     static constexpr std::size_t kKept = 3;
 
+    // How the rank makes an opened volume's extractor (its octree mapped or built).
+    using OpenExtractor = std::function<std::unique_ptr<SurfaceExtractor>(const OpenedVolume&)>;
+
     // `first` is step 0's volume and extractor, opened by the caller (kept for the rank's life);
     // `options` the --volume options every step is opened with (its path replaced).
-    StepVolumes(TimeSeries series, VolumeOptions options, VolumeUse use, ThreadBudget budget,
-                const OpenedVolume& first, SurfaceExtractor& first_extractor);
+    StepVolumes(TimeSeries series, VolumeOptions options, VolumeUse use,
+                OpenExtractor open_extractor, const OpenedVolume& first,
+                SurfaceExtractor& first_extractor);
     ~StepVolumes();
 
     // Step `step`'s extractor, valid until the next call that opens a step kKept + 1 calls later.
@@ -37,7 +41,7 @@ class StepVolumes {
     TimeSeries series_;
     VolumeOptions options_;
     VolumeUse use_;
-    ThreadBudget budget_;
+    OpenExtractor open_extractor_;
     glm::ivec3 dims_;
     SurfaceExtractor& first_;
     std::list<std::unique_ptr<Step>> kept_;  // the most recently used first

@@ -239,8 +239,9 @@ int run_tile_rank(const WallOptions& given, Comm& comm, const WallSpec& spec, Th
     auto extractor = open_extractor(ov, budget);
     std::optional<StepVolumes> steps;
     if (series)
-        steps.emplace(*series, o.volume, VolumeUse{.copies_on_host = comm.ranks_on_host()}, budget,
-                      ov, *extractor);
+        steps.emplace(
+            *series, o.volume, VolumeUse{.copies_on_host = comm.ranks_on_host()},
+            [budget](const OpenedVolume& v) { return open_extractor(v, budget); }, ov, *extractor);
     // A rank with one core (a wall emulated on one machine) has llvmpipe rasterise in its drawing
     // thread, unless the user says otherwise: the work then stays on its core and in the frame
     // thread's CPU clock, which the trace and the emulated time read. With more, llvmpipe keeps

@@ -114,4 +114,11 @@ std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
     return static_cast<std::uint64_t>(bytes);
 }
 
+int hex_digit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
 }  // namespace isowall

@@ -62,6 +62,9 @@ double checked_number(std::string_view text, const NumberRange& range, const std
 double checked_isovalue(double iso, double lo, double hi, const std::string& where,
                         const std::string& field);
 
+// The value of a hexadecimal digit (0-9, a-f, A-F), or -1 for any other character.
+int hex_digit(char c);
+
 // A size in bytes as an option gives it (--memory-limit): "512M", "8G", "1.5GiB", "1048576";
 // nullopt for anything else (or zero).
 std::optional<std::uint64_t> parse_byte_size(std::string_view text);

@@ -37,13 +37,6 @@ constexpr std::array<NamedColour, 18> kNamed{{
     {"tan", {210, 180, 140}},
 }};
 
-int hex_digit(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
-
 std::optional<glm::u8vec3> parse_colour(std::string_view t) {
     if (t.size() == 7 && t[0] == '#') {
         glm::u8vec3 c{0};

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "core/number.h"
 #include "remote/view_server.h"
 
 namespace isowall::remote {
@@ -14,13 +15,6 @@ constexpr std::string_view kJson = "application/json";
 
 web::HttpResponse text(int status, std::string body) {
     return {status, std::string(kText), std::move(body) + "\n"};
-}
-
-int hex_digit(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
 }
 
 std::optional<std::string> percent_decode(std::string_view s) {
